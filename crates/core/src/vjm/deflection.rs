@@ -1,0 +1,181 @@
+//! Rigid and deflected forward kinematics, deflection (Eq. 2-9) and the linearized
+//! Cartesian compliance. Every function here is allocation-free, bounded by the chain length
+//! and panic-free.
+
+use nalgebra::{Isometry3, Matrix6, Translation3, UnitQuaternion, Vector3};
+
+use super::{Data, Element, Model, Vector6};
+use crate::error::{TickError, check_finite};
+
+/// Validates a joint vector against the model.
+pub(crate) fn check_q(model: &Model, q: &[f64]) -> Result<(), TickError> {
+    if q.len() != model.dof {
+        return Err(TickError::WrongLength {
+            what: "q",
+            expected: model.dof,
+            got: q.len(),
+        });
+    }
+    check_finite("q", q)
+}
+
+/// The motion of an actuated joint; identity for fixed elements and springs.
+#[inline]
+fn joint_motion(e: &Element, q: &[f64]) -> Option<Isometry3<f64>> {
+    match *e {
+        Element::Fixed(t) => Some(t),
+        Element::Revolute { axis, index } => {
+            let angle = q.get(index).copied().unwrap_or(0.0);
+            Some(Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_axis_angle(&axis, angle),
+            ))
+        }
+        Element::Prismatic { axis, index } => {
+            let travel = q.get(index).copied().unwrap_or(0.0);
+            Some(Isometry3::from_parts(
+                Translation3::from(axis.into_inner() * travel),
+                UnitQuaternion::identity(),
+            ))
+        }
+        Element::Spring { .. } => None,
+    }
+}
+
+/// Rigid forward kinematics without checks (callers have validated `q`).
+fn rigid_tcp(model: &Model, q: &[f64]) -> Isometry3<f64> {
+    model
+        .elements
+        .iter()
+        .filter_map(|e| joint_motion(e, q))
+        .fold(Isometry3::identity(), |t, m| t * m)
+}
+
+/// Rigid TCP pose in the base frame (Eq. 2 with i = 0). `q` [rad or m], length
+/// [`Model::dof`]. Also stored in `data.tcp`.
+pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f64>, TickError> {
+    check_q(model, q)?;
+    data.tcp = rigid_tcp(model, q);
+    Ok(data.tcp)
+}
+
+/// TCP deflection `[dx, dy, dz, rx, ry, rz]` [m, rad] in the base frame under the TCP wrench
+/// `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m] (base frame, moment about the TCP): the paper's exact
+/// model. Torques on each spring are taken in the undeformed pose (Eq. 5-6, plus the applied
+/// moment), turned into angles `M / k` (Eq. 7) and inserted as z-y'-x'' rotations (Eq. 3-4);
+/// the result is the deflected FK (Eq. 8) minus the rigid one (Eq. 9): the translation, then
+/// the rotation vector of `R_deflected * R_rigid^T`.
+///
+/// Fills `data.tcp`, `data.tcp_deflected` and `data.spring_angles`.
+pub fn deflection(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    wrench: &Vector6,
+) -> Result<Vector6, TickError> {
+    check_q(model, q)?;
+    check_finite("wrench", wrench.as_slice())?;
+    let tcp = rigid_tcp(model, q);
+    let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
+    let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
+
+    let mut rigid = Isometry3::identity();
+    let mut deflected = Isometry3::identity();
+    for e in model.elements.iter() {
+        match (joint_motion(e, q), e) {
+            (Some(m), _) => {
+                rigid *= m;
+                deflected *= m;
+            }
+            (None, Element::Spring { compliance, index }) => {
+                // Eq. 5-6: load moved to the spring origin, expressed in the spring frame.
+                let r = tcp.translation.vector - rigid.translation.vector;
+                let m_local = rigid.rotation.inverse() * (moment + r.cross(&force));
+                // Eq. 7: alpha = M_C / k_C, beta = M_B / k_B, gamma = M_A / k_A.
+                let angles = compliance.component_mul(&m_local);
+                if let Some(slot) = data.spring_angles.get_mut(*index) {
+                    *slot = angles;
+                }
+                // Eq. 4: R* = Rz(gamma) Ry(beta) Rx(alpha), nalgebra's roll-pitch-yaw.
+                let r_star = UnitQuaternion::from_euler_angles(angles.x, angles.y, angles.z);
+                deflected *= r_star;
+            }
+            (None, _) => {}
+        }
+    }
+    data.tcp = tcp;
+    data.tcp_deflected = deflected;
+    let dp = deflected.translation.vector - tcp.translation.vector;
+    let dr = (deflected.rotation * tcp.rotation.inverse()).scaled_axis();
+    Ok(Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z))
+}
+
+/// The 6x6 Cartesian compliance of the linearized model, `C = sum_s J_s K_s^-1 J_s^T`
+/// [m/N, m/(N m), rad/N, rad/(N m)] in the base frame, ordered as the wrench
+/// `[F; M]` and the deflection `[dp; dr]`: `deflection(q, w) = C w + O(|w|^2)`.
+/// `J_s` maps the three spring angles to the TCP's translation and rotation.
+/// Also stored in `data.compliance`.
+pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f64>, TickError> {
+    check_q(model, q)?;
+    let tcp = rigid_tcp(model, q);
+    let mut c = Matrix6::zeros();
+    let mut frame = Isometry3::identity();
+    for e in model.elements.iter() {
+        match (joint_motion(e, q), e) {
+            (Some(m), _) => frame *= m,
+            (None, Element::Spring { compliance, .. }) => {
+                let r = tcp.translation.vector - frame.translation.vector;
+                let rot = frame.rotation.to_rotation_matrix();
+                for (a, &ca) in compliance.iter().enumerate() {
+                    if ca == 0.0 {
+                        continue;
+                    }
+                    let u: Vector3<f64> = rot.matrix().column(a).into_owned();
+                    let lin = u.cross(&r);
+                    let col = Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z);
+                    c += (col * col.transpose()) * ca;
+                }
+            }
+            (None, _) => {}
+        }
+    }
+    data.tcp = tcp;
+    data.compliance = c;
+    Ok(c)
+}
+
+/// Fills `data.jacobian` with the actuated-joint Jacobian of the rigid TCP, rows
+/// `[v; w]` in the base frame, and `data.tcp` with the rigid pose. Columns past the model's
+/// dof are zero.
+pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), TickError> {
+    check_q(model, q)?;
+    let tcp = rigid_tcp(model, q);
+    data.jacobian.fill(0.0);
+    let mut frame = Isometry3::identity();
+    for e in model.elements.iter() {
+        // The joint's axis is expressed in the frame *before* its own motion (the same axis
+        // after it, since a joint moves along/about its own axis).
+        let column = match *e {
+            Element::Revolute { axis, index } => {
+                let u = frame.rotation * axis.into_inner();
+                let lin = u.cross(&(tcp.translation.vector - frame.translation.vector));
+                Some((index, Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z)))
+            }
+            Element::Prismatic { axis, index } => {
+                let u = frame.rotation * axis.into_inner();
+                Some((index, Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0)))
+            }
+            _ => None,
+        };
+        if let Some((index, col)) = column {
+            if index < data.jacobian.ncols() {
+                data.jacobian.set_column(index, &col);
+            }
+        }
+        if let Some(m) = joint_motion(e, q) {
+            frame *= m;
+        }
+    }
+    data.tcp = tcp;
+    Ok(())
+}

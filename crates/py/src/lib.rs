@@ -1,0 +1,37 @@
+//! Python bindings of deflect: thin wrappers that convert numpy arrays, call deflect-core
+//! and map its errors onto one exception tree rooted in `ValueError`.
+//!
+//! ```text
+//! ValueError
+//! └── deflect.DeflectError
+//!     ├── deflect.LoadError        malformed or inconsistent files (URDF, TOML, CSV, JSON)
+//!     ├── deflect.InputError       wrong shapes, NaN/inf, out-of-range inputs
+//!     ├── deflect.SingularError    singular pose: no unique correction
+//!     └── deflect.ConvergenceError an iterative solve missed its tolerance
+//! ```
+
+use pyo3::create_exception;
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+
+mod convert;
+mod vjm;
+
+create_exception!(deflect, DeflectError, PyValueError, "Root of deflect's exceptions.");
+create_exception!(deflect, LoadError, DeflectError, "A file could not be loaded or validated.");
+create_exception!(deflect, InputError, DeflectError, "An input has the wrong shape or is not finite.");
+create_exception!(deflect, SingularError, DeflectError, "The pose is singular.");
+create_exception!(deflect, ConvergenceError, DeflectError, "An iterative solve did not converge.");
+
+#[pymodule]
+fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("DeflectError", py.get_type::<DeflectError>())?;
+    m.add("LoadError", py.get_type::<LoadError>())?;
+    m.add("InputError", py.get_type::<InputError>())?;
+    m.add("SingularError", py.get_type::<SingularError>())?;
+    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    vjm::register(m)?;
+    Ok(())
+}
