@@ -156,7 +156,8 @@ impl SerialRobot {
 
     /// Axis-specific correction `dq` (dof,) so that the robot commanded to `q + dq` under
     /// `wrench` puts its deflected TCP on the rigid TCP of `q`. `max_iterations=1` gives the
-    /// first-order `-J^+ delta`.
+    /// first-order `-J^+ delta`. Raises `ConvergenceError` when the pose error left exceeds
+    /// `tolerance` (an arm with fewer than 6 joints rarely cancels it all: pass a looser one).
     #[pyo3(signature = (q, wrench, max_iterations=10, tolerance=1e-12))]
     fn joint_correction<'py>(
         &self,
@@ -171,6 +172,12 @@ impl SerialRobot {
         let w = vector6(&wrench, "wrench")?;
         let c = vjm::joint_correction(model, &mut Data::new(model), &q, &w, max_iterations, tolerance)
             .map_err(tick_err)?;
+        if !c.converged {
+            return Err(crate::ConvergenceError::new_err(format!(
+                "joint correction: residual {:e} > tolerance {tolerance:e} after {} iterations",
+                c.residual, c.iterations
+            )));
+        }
         Ok(c.dq.get(..model.dof()).unwrap_or(&[]).to_pyarray(py))
     }
 

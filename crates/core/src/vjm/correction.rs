@@ -38,8 +38,12 @@ pub struct JointCorrection {
     pub iterations: usize,
     /// Remaining pose error `|[dp; dr]|` [m, rad] of the deflected TCP at `q + dq`.
     pub residual: f64,
-    /// Smallest singular value of the actuated-joint Jacobian at the last step.
+    /// Smallest singular value of the actuated-joint Jacobian at the last step (NaN if no
+    /// step was needed).
     pub sigma_min: f64,
+    /// `residual <= tolerance`. An under-actuated robot (fewer than 6 joints) generally
+    /// cannot cancel the whole pose error: it gets the least-squares fixed point instead.
+    pub converged: bool,
 }
 
 /// Axis-specific correction: the `dq` such that the robot commanded to `q + dq` and loaded by
@@ -48,9 +52,9 @@ pub struct JointCorrection {
 /// Each step solves `J dq = -e` in the least-squares, minimum-norm sense through an SVD of
 /// the actuated-joint Jacobian (robots with fewer or more than 6 axes work too); with
 /// `max_iterations = 1` this is the paper's first-order `dq = -J^+ Delta`. The wrench is held
-/// constant in the base frame while the pose changes. Returns [`TickError::Singular`] near a
-/// singular pose and [`TickError::NotConverged`] when `residual > tolerance` after
-/// `max_iterations` steps (use `tolerance = f64::INFINITY` to accept any).
+/// constant in the base frame while the pose changes. Steps stop once the residual is at most
+/// `tolerance` or after `max_iterations`; [`JointCorrection::converged`] says which. Returns
+/// [`TickError::Singular`] near a singular pose.
 pub fn joint_correction(
     model: &Model,
     data: &mut Data,
@@ -74,6 +78,7 @@ pub fn joint_correction(
         iterations: 0,
         residual: f64::INFINITY,
         sigma_min: f64::NAN,
+        converged: false,
     };
     for it in 0..=max_iterations {
         let qcur = qk;
@@ -117,11 +122,6 @@ pub fn joint_correction(
     for ((dst, &qi), &q0) in out.dq.iter_mut().zip(qk.iter()).zip(q) {
         *dst = qi - q0;
     }
-    if out.residual > tolerance {
-        return Err(TickError::NotConverged {
-            iterations: out.iterations,
-            residual: out.residual,
-        });
-    }
+    out.converged = out.residual <= tolerance;
     Ok(out)
 }

@@ -1,0 +1,449 @@
+//! Hand-derived cases of the virtual-joint model (VJM paper, Eq. 1-9).
+
+use approx::assert_relative_eq;
+use deflect_core::vjm::{self, Data, Element, Vector6};
+use deflect_core::{BuildError, ModelBuilder, TickError};
+use nalgebra::{Isometry3, Matrix3, Rotation3, UnitQuaternion, Vector3};
+use proptest::prelude::*;
+
+const INF: f64 = f64::INFINITY;
+
+fn w(f: [f64; 6]) -> Vector6 {
+    Vector6::from_row_slice(&f)
+}
+
+/// One spring at the base, soft about z, a rigid 1.2 m bar along x to the TCP.
+#[test]
+fn one_spring_bending_is_exact_rotation() {
+    let (l, kz, fy) = (1.2, 2.0e4, 500.0);
+    let model = ModelBuilder::new()
+        .spring([INF, INF, kz])
+        .unwrap()
+        .fixed(Isometry3::translation(l, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, fy, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    // Eq. 6: M_A = r x F = L * Fy about z; Eq. 7: gamma = M_A / k_A = 0.03 rad.
+    let gamma = l * fy / kz;
+    assert_relative_eq!(gamma, 0.03, epsilon = 1e-15);
+    // The bar turns rigidly by gamma about the base z axis.
+    assert_relative_eq!(d[0], l * gamma.cos() - l, epsilon = 1e-15);
+    assert_relative_eq!(d[1], l * gamma.sin(), epsilon = 1e-15);
+    assert_relative_eq!(d[2], 0.0, epsilon = 1e-15);
+    assert_relative_eq!(d[5], gamma, epsilon = 1e-15);
+    assert_relative_eq!(data.spring_angles[0].z, gamma, epsilon = 1e-15);
+    // The force along the bar loads nothing.
+    let d = vjm::deflection(&model, &mut data, &[], &w([1e4, 0.0, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    assert_eq!(d, Vector6::zeros());
+}
+
+/// Two springs in series, torques taken in the undeformed pose (Eq. 5-6).
+#[test]
+fn two_springs_in_series() {
+    let (l1, l2, k1, k2, fy) = (0.8, 0.5, 5.0e4, 1.0e4, 300.0);
+    let model = ModelBuilder::new()
+        .spring([INF, INF, k1])
+        .unwrap()
+        .fixed(Isometry3::translation(l1, 0.0, 0.0))
+        .unwrap()
+        .spring([INF, INF, k2])
+        .unwrap()
+        .fixed(Isometry3::translation(l2, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, fy, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    let g1 = (l1 + l2) * fy / k1; // 7.8e-3 rad
+    let g2 = l2 * fy / k2; // 15e-3 rad
+    let x = l1 * g1.cos() + l2 * (g1 + g2).cos();
+    let y = l1 * g1.sin() + l2 * (g1 + g2).sin();
+    assert_relative_eq!(d[0], x - (l1 + l2), epsilon = 1e-15);
+    assert_relative_eq!(d[1], y, epsilon = 1e-15);
+    assert_relative_eq!(d[5], g1 + g2, epsilon = 1e-15);
+    // y = 0.8 sin(0.0078) + 0.5 sin(0.0228) = 6.2399e-3 + 11.3990e-3 m
+    assert_relative_eq!(d[1], 0.017_638_9, epsilon = 1e-7);
+}
+
+/// A pure moment reaches every spring unchanged; the three angles compose as
+/// z-y'-x'' (Eq. 4), written out here element by element.
+#[test]
+fn moment_load_and_eq4_rotation() {
+    let k = [2.0e3, 4.0e3, 8.0e3];
+    let m = [30.0, -50.0, 70.0];
+    let model = ModelBuilder::new()
+        .spring(k)
+        .unwrap()
+        .fixed(Isometry3::translation(0.0, 0.0, 0.3))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    // Moment about the TCP: the spring sits 0.3 m below it, but a pure moment is free.
+    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, 0.0, 0.0, m[0], m[1], m[2]])).unwrap();
+    let (a, b, g) = (m[0] / k[0], m[1] / k[1], m[2] / k[2]);
+    let (ca, sa, cb, sb, cg, sg) = (a.cos(), a.sin(), b.cos(), b.sin(), g.cos(), g.sin());
+    #[rustfmt::skip]
+    let r_star = Matrix3::new(
+        cb * cg, sa * sb * cg - ca * sg, ca * sb * cg + sa * sg,
+        cb * sg, sa * sb * sg + ca * cg, ca * sb * sg - sa * cg,
+        -sb,     sa * cb,                ca * cb,
+    );
+    let rv = Rotation3::from_matrix_unchecked(r_star).scaled_axis();
+    for i in 0..3 {
+        assert_relative_eq!(d[3 + i], rv[i], epsilon = 1e-14);
+    }
+    // The TCP 0.3 m up the z axis swings with R*: dp = R* (0,0,0.3) - (0,0,0.3).
+    let dp = r_star * Vector3::new(0.0, 0.0, 0.3) - Vector3::new(0.0, 0.0, 0.3);
+    for i in 0..3 {
+        assert_relative_eq!(d[i], dp[i], epsilon = 1e-15);
+    }
+}
+
+/// A planar 2R arm with torsion springs: the linearized compliance is
+/// `sum c_i J_i J_i^T` written out by hand.
+fn planar_2r() -> deflect_core::Model {
+    ModelBuilder::new()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([INF, INF, 1.0e4])
+        .unwrap()
+        .fixed(Isometry3::translation(0.7, 0.0, 0.0))
+        .unwrap()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([INF, INF, 2.5e3])
+        .unwrap()
+        .fixed(Isometry3::translation(0.4, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn planar_2r_compliance_by_hand() {
+    let model = planar_2r();
+    let mut data = Data::new(&model);
+    let q = [0.4, -1.1];
+    let c = vjm::compliance(&model, &mut data, &q).unwrap();
+    // Spring 1 at the origin, spring 2 at the elbow; TCP at p.
+    let elbow = Vector3::new(0.7 * 0.4f64.cos(), 0.7 * 0.4f64.sin(), 0.0);
+    let p = elbow + Vector3::new(0.4 * (-0.7f64).cos(), 0.4 * (-0.7f64).sin(), 0.0);
+    let mut expect = nalgebra::Matrix6::<f64>::zeros();
+    for (origin, k) in [(Vector3::zeros(), 1.0e4), (elbow, 2.5e3)] {
+        let r: Vector3<f64> = p - origin;
+        // z x r = (-ry, rx, 0); angular part (0, 0, 1).
+        let j: Vector6 = Vector6::new(-r.y, r.x, 0.0, 0.0, 0.0, 1.0);
+        expect += j * j.transpose() / k;
+    }
+    assert_relative_eq!(c, expect, epsilon = 1e-18);
+    // Same model through the joint Jacobian: spring axes coincide with the joints, so
+    // C = J diag(1/k) J^T.
+    vjm::joint_jacobian(&model, &mut data, &q).unwrap();
+    let j = data.jacobian.fixed_columns::<2>(0).into_owned();
+    let kinv = nalgebra::Matrix2::new(1.0e-4, 0.0, 0.0, 4.0e-4);
+    assert_relative_eq!(c, j * kinv * j.transpose(), epsilon = 1e-18);
+}
+
+/// Exact and linearized agree to second order as the load goes to zero.
+#[test]
+fn exact_minus_linear_is_second_order() {
+    let model = planar_2r();
+    let mut data = Data::new(&model);
+    let q = [0.4, -1.1];
+    let c = vjm::compliance(&model, &mut data, &q).unwrap();
+    let w0 = w([120.0, -80.0, 0.0, 0.0, 0.0, 15.0]);
+    let err = |s: f64| {
+        let d = vjm::deflection(&model, &mut Data::new(&model), &q, &(w0 * s)).unwrap();
+        (d - c * (w0 * s)).norm()
+    };
+    let (e1, e2) = (err(1.0), err(0.1));
+    assert!(e1 > 1e-9, "the exact model is non-linear at this load: {e1}");
+    // Halving the load by 10 divides a second-order error by 100 (within 2 %).
+    assert_relative_eq!(e1 / e2, 100.0, max_relative = 0.02);
+}
+
+#[test]
+fn zero_load_gives_zero_deflection() {
+    let model = planar_2r();
+    let d = vjm::deflection(&model, &mut Data::new(&model), &[0.3, 0.2], &Vector6::zeros()).unwrap();
+    assert_eq!(d, Vector6::zeros());
+}
+
+/// A prismatic joint carries the frame; springs after it see the shifted lever arm.
+#[test]
+fn prismatic_joint_moves_the_lever() {
+    let model = ModelBuilder::new()
+        .spring([INF, 1.0e4, INF])
+        .unwrap()
+        .prismatic(Vector3::x() * 3.0)
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    let t = vjm::forward(&model, &mut data, &[0.25]).unwrap();
+    assert_relative_eq!(t.translation.vector, Vector3::new(0.25, 0.0, 0.0));
+    let c = vjm::compliance(&model, &mut data, &[0.25]).unwrap();
+    // Fz at 0.25 m: moment -0.25 Fz about y, dz = 0.25^2 / k per N.
+    assert_relative_eq!(c[(2, 2)], 0.0625 / 1.0e4, epsilon = 1e-20);
+}
+
+#[test]
+fn joint_correction_lands_the_deflected_tcp_on_target() {
+    // Torsion springs coaxial with the joints: the deflected arm is the rigid arm with angles
+    // q + dq + gamma, so dq = -gamma(q + dq) cancels position and orientation exactly.
+    let model = planar_2r();
+    let mut data = Data::new(&model);
+    let q = [0.4, -1.1];
+    let target = vjm::forward(&model, &mut data, &q).unwrap();
+    let wr = w([200.0, -150.0, 0.0, 0.0, 0.0, 0.0]);
+    let corr = vjm::joint_correction(&model, &mut data, &q, &wr, 30, 1e-14).unwrap();
+    assert!(corr.converged, "{corr:?}");
+    let qc = [q[0] + corr.dq[0], q[1] + corr.dq[1]];
+    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    let gamma = [data.spring_angles[0].z, data.spring_angles[1].z];
+    assert_relative_eq!(corr.dq[0], -gamma[0], epsilon = 1e-13);
+    assert_relative_eq!(corr.dq[1], -gamma[1], epsilon = 1e-13);
+    assert!((data.tcp_deflected.translation.vector - target.translation.vector).norm() < 1e-14);
+    assert_eq!(corr.dq[2..], [0.0; 6]);
+    // One step is the paper's first-order -J^+ delta: already within 5 % of the deflection.
+    let d0 = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let one = vjm::joint_correction(&model, &mut data, &q, &wr, 1, 0.0).unwrap();
+    assert!(!one.converged && one.iterations == 1);
+    assert!(one.residual < 0.05 * d0.norm(), "{one:?}");
+}
+
+#[test]
+fn under_actuated_correction_is_least_squares() {
+    // The same arm but soft out of plane: a vertical load bends it out of the plane, which
+    // no z joint can undo. The correction keeps the in-plane fixed point and flags it.
+    let model = ModelBuilder::new()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([2.0e4, 2.0e4, 1.0e4])
+        .unwrap()
+        .fixed(Isometry3::translation(0.7, 0.0, 0.0))
+        .unwrap()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([2.0e4, 2.0e4, 2.5e3])
+        .unwrap()
+        .fixed(Isometry3::translation(0.4, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    let q = [0.4, -1.1];
+    let target = vjm::forward(&model, &mut data, &q).unwrap();
+    let wr = w([200.0, -150.0, -400.0, 0.0, 0.0, 0.0]);
+    let before = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let corr = vjm::joint_correction(&model, &mut data, &q, &wr, 20, 1e-12).unwrap();
+    assert!(!corr.converged && corr.iterations == 20, "{corr:?}");
+    let qc = [q[0] + corr.dq[0], q[1] + corr.dq[1]];
+    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    let e = data.tcp_deflected.translation.vector - target.translation.vector;
+    // The out-of-plane sag stays; the in-plane error is far smaller than before.
+    assert_relative_eq!(e.z, before[2], max_relative = 0.05);
+    let inplane_before = (before[0].powi(2) + before[1].powi(2)).sqrt();
+    assert!(inplane_before > 1e-2);
+    assert!((e.x.powi(2) + e.y.powi(2)).sqrt() < 0.1 * inplane_before, "{e:?}");
+}
+
+#[test]
+fn joint_correction_six_dof_converges_exactly() {
+    // A spatial 6R arm with springs about every axis: 6 joints can cancel the full pose error.
+    let mut b = ModelBuilder::new();
+    let axes = [
+        Vector3::z(),
+        Vector3::y(),
+        Vector3::y(),
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::x(),
+    ];
+    let offsets = [
+        Vector3::new(0.0, 0.0, 0.4),
+        Vector3::new(0.6, 0.0, 0.0),
+        Vector3::new(0.5, 0.0, 0.05),
+        Vector3::new(0.2, 0.0, 0.0),
+        Vector3::new(0.1, 0.0, 0.0),
+        Vector3::new(0.15, 0.0, 0.0),
+    ];
+    for (a, o) in axes.iter().zip(offsets) {
+        b = b
+            .revolute(*a)
+            .unwrap()
+            .spring([2.0e5, 2.0e5, 1.0e5])
+            .unwrap()
+            .fixed(Isometry3::translation(o.x, o.y, o.z))
+            .unwrap();
+    }
+    let model = b.build().unwrap();
+    let mut data = Data::new(&model);
+    let q = [0.1, -0.4, 0.9, 0.2, 0.6, -0.3];
+    let target = vjm::forward(&model, &mut data, &q).unwrap();
+    let wr = w([300.0, -200.0, -500.0, 10.0, 0.0, -5.0]);
+    let corr = vjm::joint_correction(&model, &mut data, &q, &wr, 10, 1e-13).unwrap();
+    assert!(corr.converged && corr.iterations >= 2, "{corr:?}");
+    let mut qc = q;
+    for (qi, dq) in qc.iter_mut().zip(corr.dq) {
+        *qi += dq;
+    }
+    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    let t = data.tcp_deflected;
+    assert!((t.translation.vector - target.translation.vector).norm() < 1e-13);
+    assert!((t.rotation * target.rotation.inverse()).angle() < 1e-13);
+    // The commanded Cartesian pose moves the TCP against the deflection.
+    let d = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let cmd = vjm::commanded_pose(&target, &d);
+    let dp = cmd.translation.vector - target.translation.vector;
+    assert_relative_eq!(dp, -d.fixed_rows::<3>(0).into_owned(), epsilon = 1e-15);
+    let back = UnitQuaternion::from_scaled_axis(d.fixed_rows::<3>(3).into_owned()) * cmd.rotation;
+    assert!((back.inverse() * target.rotation).angle() < 1e-14);
+}
+
+#[test]
+fn singular_pose_is_reported() {
+    // Two prismatic joints along the same axis: rank 1 where 2 is needed.
+    let twin = ModelBuilder::new()
+        .prismatic(Vector3::x())
+        .unwrap()
+        .prismatic(Vector3::x())
+        .unwrap()
+        .spring([1.0e3, 1.0e3, 1.0e3])
+        .unwrap()
+        .fixed(Isometry3::translation(0.0, 0.0, 0.5))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&twin);
+    let r = vjm::joint_correction(
+        &twin,
+        &mut data,
+        &[0.0, 0.0],
+        &w([10.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        3,
+        1e-12,
+    );
+    assert!(matches!(r, Err(TickError::Singular { sigma_min }) if sigma_min < 1e-12));
+}
+
+#[test]
+fn bad_inputs_are_typed_errors() {
+    let model = planar_2r();
+    let mut data = Data::new(&model);
+    assert_eq!(
+        vjm::forward(&model, &mut data, &[0.0]),
+        Err(TickError::WrongLength {
+            what: "q",
+            expected: 2,
+            got: 1
+        })
+    );
+    assert_eq!(
+        vjm::deflection(&model, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
+        Err(TickError::NonFinite { what: "q", index: 1 })
+    );
+    assert_eq!(
+        vjm::deflection(
+            &model,
+            &mut data,
+            &[0.0, 0.0],
+            &w([0.0, 0.0, f64::INFINITY, 0.0, 0.0, 0.0])
+        ),
+        Err(TickError::NonFinite {
+            what: "wrench",
+            index: 2
+        })
+    );
+    assert_eq!(
+        vjm::compliance(&model, &mut data, &[0.0, 0.0, 0.0]).unwrap_err(),
+        TickError::WrongLength {
+            what: "q",
+            expected: 2,
+            got: 3
+        }
+    );
+}
+
+#[test]
+fn builder_rejects_bad_elements() {
+    assert_eq!(
+        ModelBuilder::new().revolute(Vector3::zeros()).unwrap_err(),
+        BuildError::ZeroAxis { element: 0 }
+    );
+    assert_eq!(
+        ModelBuilder::new()
+            .fixed(Isometry3::translation(f64::NAN, 0.0, 0.0))
+            .unwrap_err(),
+        BuildError::NonFiniteTransform { element: 0 }
+    );
+    let e = ModelBuilder::new()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([1.0, -2.0, 3.0])
+        .unwrap_err();
+    assert_eq!(
+        e,
+        BuildError::NonPositiveStiffness {
+            element: 1,
+            axis: 1,
+            value: -2.0
+        }
+    );
+    assert!(e.to_string().contains("about axis y is -2"));
+    assert!(matches!(
+        ModelBuilder::new().spring([1.0, f64::NAN, 1.0]),
+        Err(BuildError::NonPositiveStiffness { axis: 1, .. })
+    ));
+    let mut b = ModelBuilder::new();
+    for _ in 0..deflect_core::vjm::MAX_DOF {
+        b = b.revolute(Vector3::z()).unwrap();
+    }
+    assert_eq!(
+        b.revolute(Vector3::z()).unwrap_err(),
+        BuildError::CapacityExceeded {
+            what: "joints",
+            capacity: deflect_core::vjm::MAX_DOF
+        }
+    );
+}
+
+#[test]
+fn spring_inside_a_link_is_undone_after_the_spring() {
+    let frame = Isometry3::new(Vector3::new(0.1, 0.2, 0.3), Vector3::new(0.3, -0.2, 0.5));
+    let model = ModelBuilder::new()
+        .fixed(Isometry3::translation(1.0, 0.0, 0.0))
+        .unwrap()
+        .spring_at(frame, [1.0e4, 1.0e4, 1.0e4])
+        .unwrap()
+        .build()
+        .unwrap();
+    // Rigid FK is unchanged by the spring placement.
+    let t = vjm::forward(&model, &mut Data::new(&model), &[]).unwrap();
+    assert_relative_eq!(t.translation.vector, Vector3::new(1.0, 0.0, 0.0), epsilon = 1e-15);
+    assert!(
+        model
+            .elements()
+            .iter()
+            .any(|e| matches!(e, Element::Spring { index: 0, .. }))
+    );
+}
+
+proptest! {
+    /// For small loads the exact model matches `C w` to second order in every pose.
+    #[test]
+    fn small_loads_are_linear(q0 in -3.0..3.0f64, q1 in -3.0..3.0f64,
+                              fx in -1.0..1.0f64, fy in -1.0..1.0f64, mz in -1.0..1.0f64) {
+        let model = planar_2r();
+        let mut data = Data::new(&model);
+        let c = vjm::compliance(&model, &mut data, &[q0, q1]).unwrap();
+        let wr = w([fx, fy, 0.0, 0.0, 0.0, mz]);
+        let d = vjm::deflection(&model, &mut data, &[q0, q1], &wr).unwrap();
+        let lin = c * wr;
+        // |w| <= 1.7 N gives angles below 4e-4 rad: second-order terms below 1e-6 of |lin|.
+        prop_assert!((d - lin).norm() <= 1e-3 * lin.norm() + 1e-15);
+    }
+}
