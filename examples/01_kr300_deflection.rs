@@ -20,7 +20,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let robot = SerialRobot::from_files(&urdf, &toml, &tip)?;
     let q: Vec<f64> = if args.len() > 3 {
-        args[3..].iter().map(|s| s.parse()).collect::<Result<_, _>>()?
+        args[3..]
+            .iter()
+            .map(|s| s.parse())
+            .collect::<Result<_, _>>()?
     } else {
         deflect_tests::KR300_MILLING_POSE.to_vec()
     };

@@ -128,7 +128,10 @@ impl core::fmt::Display for LoadError {
                 referenced_by,
             } => write!(f, "unknown link '{link}' (referenced by {referenced_by})"),
             Self::TipNotReachable { tip, base } => {
-                write!(f, "tip link '{tip}' is not reachable from base link '{base}'")
+                write!(
+                    f,
+                    "tip link '{tip}' is not reachable from base link '{base}'"
+                )
             }
             Self::NotATree { link } => write!(
                 f,
@@ -142,7 +145,10 @@ impl core::fmt::Display for LoadError {
                 joint,
                 lower,
                 upper,
-            } => write!(f, "joint '{joint}': invalid limits lower={lower} upper={upper}"),
+            } => write!(
+                f,
+                "joint '{joint}': invalid limits lower={lower} upper={upper}"
+            ),
             Self::UnsupportedJoint { joint, kind } => {
                 write!(f, "joint '{joint}': {kind} joints are not supported")
             }
@@ -380,7 +386,9 @@ impl SerialRobot {
         let mut names = Vec::new();
         let mut limits = Vec::new();
         let mut spring_names = Vec::new();
-        let mut add_springs = |mut b: ModelBuilder, link: &str| -> Result<ModelBuilder, LoadError> {
+        let mut add_springs = |mut b: ModelBuilder,
+                               link: &str|
+         -> Result<ModelBuilder, LoadError> {
             let mut n_on_link = 0usize;
             for (entry, s) in springs.iter().enumerate() {
                 if s.link != link {
@@ -414,7 +422,11 @@ impl SerialRobot {
                     kind: "mimic".to_string(),
                 });
             }
-            b = b.fixed(pose(&j.origin.xyz.0, &j.origin.rpy.0, &format!("joint '{}'", j.name))?)?;
+            b = b.fixed(pose(
+                &j.origin.xyz.0,
+                &j.origin.rpy.0,
+                &format!("joint '{}'", j.name),
+            )?)?;
             let axis = Vector3::from(j.axis.xyz.0);
             let moving = matches!(
                 j.joint_type,

@@ -82,7 +82,13 @@ fn moment_load_and_eq4_rotation() {
         .unwrap();
     let mut data = Data::new(&model);
     // Moment about the TCP: the spring sits 0.3 m below it, but a pure moment is free.
-    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, 0.0, 0.0, m[0], m[1], m[2]])).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[],
+        &w([0.0, 0.0, 0.0, m[0], m[1], m[2]]),
+    )
+    .unwrap();
     let (a, b, g) = (m[0] / k[0], m[1] / k[1], m[2] / k[2]);
     let (ca, sa, cb, sb, cg, sg) = (a.cos(), a.sin(), b.cos(), b.sin(), g.cos(), g.sin());
     #[rustfmt::skip]
@@ -160,7 +166,10 @@ fn exact_minus_linear_is_second_order() {
         (d - c * (w0 * s)).norm()
     };
     let (e1, e2) = (err(1.0), err(0.1));
-    assert!(e1 > 1e-9, "the exact model is non-linear at this load: {e1}");
+    assert!(
+        e1 > 1e-9,
+        "the exact model is non-linear at this load: {e1}"
+    );
     // Halving the load by 10 divides a second-order error by 100 (within 2 %).
     assert_relative_eq!(e1 / e2, 100.0, max_relative = 0.02);
 }
@@ -168,7 +177,13 @@ fn exact_minus_linear_is_second_order() {
 #[test]
 fn zero_load_gives_zero_deflection() {
     let model = planar_2r();
-    let d = vjm::deflection(&model, &mut Data::new(&model), &[0.3, 0.2], &Vector6::zeros()).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut Data::new(&model),
+        &[0.3, 0.2],
+        &Vector6::zeros(),
+    )
+    .unwrap();
     assert_eq!(d, Vector6::zeros());
 }
 
@@ -248,7 +263,10 @@ fn under_actuated_correction_is_least_squares() {
     assert_relative_eq!(e.z, before[2], max_relative = 0.05);
     let inplane_before = (before[0].powi(2) + before[1].powi(2)).sqrt();
     assert!(inplane_before > 1e-2);
-    assert!((e.x.powi(2) + e.y.powi(2)).sqrt() < 0.1 * inplane_before, "{e:?}");
+    assert!(
+        (e.x.powi(2) + e.y.powi(2)).sqrt() < 0.1 * inplane_before,
+        "{e:?}"
+    );
 }
 
 #[test]
@@ -344,7 +362,10 @@ fn bad_inputs_are_typed_errors() {
     );
     assert_eq!(
         vjm::deflection(&model, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
-        Err(TickError::NonFinite { what: "q", index: 1 })
+        Err(TickError::NonFinite {
+            what: "q",
+            index: 1
+        })
     );
     assert_eq!(
         vjm::deflection(
@@ -423,7 +444,11 @@ fn spring_inside_a_link_is_undone_after_the_spring() {
         .unwrap();
     // Rigid FK is unchanged by the spring placement.
     let t = vjm::forward(&model, &mut Data::new(&model), &[]).unwrap();
-    assert_relative_eq!(t.translation.vector, Vector3::new(1.0, 0.0, 0.0), epsilon = 1e-15);
+    assert_relative_eq!(
+        t.translation.vector,
+        Vector3::new(1.0, 0.0, 0.0),
+        epsilon = 1e-15
+    );
     assert!(
         model
             .elements()

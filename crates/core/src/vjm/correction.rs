@@ -94,11 +94,12 @@ pub fn joint_correction(
             break;
         }
         joint_jacobian(model, data, qs)?;
-        let svd = SVD::try_new(data.jacobian, true, true, f64::EPSILON, SVD_MAX_ITERATIONS)
-            .ok_or(TickError::NotConverged {
+        let svd = SVD::try_new(data.jacobian, true, true, f64::EPSILON, SVD_MAX_ITERATIONS).ok_or(
+            TickError::NotConverged {
                 iterations: SVD_MAX_ITERATIONS,
                 residual: f64::NAN,
-            })?;
+            },
+        )?;
         // The `min(dof, 6)` largest singular values span the reachable directions.
         let mut sv = [0.0f64; 6];
         for (dst, &s) in sv.iter_mut().zip(svd.singular_values.iter()) {

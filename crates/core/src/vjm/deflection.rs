@@ -4,7 +4,7 @@
 
 use nalgebra::{Isometry3, Matrix6, Translation3, UnitQuaternion, Vector3};
 
-use super::{Data, Element, Model, Vector6};
+use super::{Data, Element, MAX_DOF, Model, Vector6};
 use crate::error::{TickError, check_finite};
 
 /// Validates a joint vector against the model.
@@ -19,35 +19,55 @@ pub(crate) fn check_q(model: &Model, q: &[f64]) -> Result<(), TickError> {
     check_finite("q", q)
 }
 
-/// The motion of an actuated joint; identity for fixed elements and springs.
+/// The motions of the actuated joints at `q`, computed once per call (each costs a sin/cos).
+fn joint_motions(model: &Model, q: &[f64]) -> [Isometry3<f64>; MAX_DOF] {
+    let mut out = [Isometry3::identity(); MAX_DOF];
+    for e in model.elements.iter() {
+        let (m, index) = match *e {
+            Element::Revolute { axis, index } => (
+                Isometry3::from_parts(
+                    Translation3::identity(),
+                    UnitQuaternion::from_axis_angle(&axis, q.get(index).copied().unwrap_or(0.0)),
+                ),
+                index,
+            ),
+            Element::Prismatic { axis, index } => (
+                Isometry3::from_parts(
+                    Translation3::from(axis.into_inner() * q.get(index).copied().unwrap_or(0.0)),
+                    UnitQuaternion::identity(),
+                ),
+                index,
+            ),
+            _ => continue,
+        };
+        if let Some(slot) = out.get_mut(index) {
+            *slot = m;
+        }
+    }
+    out
+}
+
+/// The transform an element applies (`None` for a spring), given the joint motions.
 #[inline]
-fn joint_motion(e: &Element, q: &[f64]) -> Option<Isometry3<f64>> {
+fn motion(e: &Element, motions: &[Isometry3<f64>; MAX_DOF]) -> Option<Isometry3<f64>> {
     match *e {
         Element::Fixed(t) => Some(t),
-        Element::Revolute { axis, index } => {
-            let angle = q.get(index).copied().unwrap_or(0.0);
-            Some(Isometry3::from_parts(
-                Translation3::identity(),
-                UnitQuaternion::from_axis_angle(&axis, angle),
-            ))
-        }
-        Element::Prismatic { axis, index } => {
-            let travel = q.get(index).copied().unwrap_or(0.0);
-            Some(Isometry3::from_parts(
-                Translation3::from(axis.into_inner() * travel),
-                UnitQuaternion::identity(),
-            ))
-        }
+        Element::Revolute { index, .. } | Element::Prismatic { index, .. } => Some(
+            motions
+                .get(index)
+                .copied()
+                .unwrap_or_else(Isometry3::identity),
+        ),
         Element::Spring { .. } => None,
     }
 }
 
 /// Rigid forward kinematics without checks (callers have validated `q`).
-fn rigid_tcp(model: &Model, q: &[f64]) -> Isometry3<f64> {
+fn rigid_tcp(model: &Model, motions: &[Isometry3<f64>; MAX_DOF]) -> Isometry3<f64> {
     model
         .elements
         .iter()
-        .filter_map(|e| joint_motion(e, q))
+        .filter_map(|e| motion(e, motions))
         .fold(Isometry3::identity(), |t, m| t * m)
 }
 
@@ -55,7 +75,7 @@ fn rigid_tcp(model: &Model, q: &[f64]) -> Isometry3<f64> {
 /// [`Model::dof`]. Also stored in `data.tcp`.
 pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f64>, TickError> {
     check_q(model, q)?;
-    data.tcp = rigid_tcp(model, q);
+    data.tcp = rigid_tcp(model, &joint_motions(model, q));
     Ok(data.tcp)
 }
 
@@ -75,14 +95,15 @@ pub fn deflection(
 ) -> Result<Vector6, TickError> {
     check_q(model, q)?;
     check_finite("wrench", wrench.as_slice())?;
-    let tcp = rigid_tcp(model, q);
+    let motions = joint_motions(model, q);
+    let tcp = rigid_tcp(model, &motions);
     let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
     let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
 
     let mut rigid = Isometry3::identity();
     let mut deflected = Isometry3::identity();
     for e in model.elements.iter() {
-        match (joint_motion(e, q), e) {
+        match (motion(e, &motions), e) {
             (Some(m), _) => {
                 rigid *= m;
                 deflected *= m;
@@ -117,11 +138,12 @@ pub fn deflection(
 /// Also stored in `data.compliance`.
 pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f64>, TickError> {
     check_q(model, q)?;
-    let tcp = rigid_tcp(model, q);
+    let motions = joint_motions(model, q);
+    let tcp = rigid_tcp(model, &motions);
     let mut c = Matrix6::zeros();
     let mut frame = Isometry3::identity();
     for e in model.elements.iter() {
-        match (joint_motion(e, q), e) {
+        match (motion(e, &motions), e) {
             (Some(m), _) => frame *= m,
             (None, Element::Spring { compliance, .. }) => {
                 let r = tcp.translation.vector - frame.translation.vector;
@@ -149,7 +171,8 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
 /// dof are zero.
 pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), TickError> {
     check_q(model, q)?;
-    let tcp = rigid_tcp(model, q);
+    let motions = joint_motions(model, q);
+    let tcp = rigid_tcp(model, &motions);
     data.jacobian.fill(0.0);
     let mut frame = Isometry3::identity();
     for e in model.elements.iter() {
@@ -172,7 +195,7 @@ pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), T
                 data.jacobian.set_column(index, &col);
             }
         }
-        if let Some(m) = joint_motion(e, q) {
+        if let Some(m) = motion(e, &motions) {
             frame *= m;
         }
     }

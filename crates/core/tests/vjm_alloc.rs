@@ -1,0 +1,80 @@
+//! The per-call VJM paths allocate nothing: a counting global allocator watches 1e4 calls.
+//! One test function only, so no other test thread allocates meanwhile.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use deflect_core::vjm::{self, Data, Vector6};
+use deflect_core::{ModelBuilder, TickError};
+use nalgebra::{Isometry3, Vector3};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn vjm_calls_do_not_allocate() {
+    let mut b = ModelBuilder::new();
+    for (i, axis) in [
+        Vector3::z(),
+        Vector3::y(),
+        Vector3::y(),
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::x(),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        b = b
+            .revolute(axis)
+            .unwrap()
+            .spring([3.0e6, 3.0e6, 1.0e6])
+            .unwrap()
+            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
+            .unwrap();
+    }
+    let model = b.build().unwrap();
+    let mut data = Data::new(&model);
+    let wrench = Vector6::new(300.0, -200.0, -500.0, 10.0, 0.0, -5.0);
+    let mut q = [0.1, -0.4, 0.9, 0.2, 0.6, -0.3];
+    let mut sink = 0.0;
+
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for i in 0..10_000 {
+        q[0] = 1e-4 * i as f64;
+        sink += vjm::forward(&model, &mut data, &q).unwrap().translation.x;
+        sink += vjm::deflection(&model, &mut data, &q, &wrench).unwrap()[0];
+        sink += vjm::compliance(&model, &mut data, &q).unwrap()[(0, 0)];
+        vjm::joint_jacobian(&model, &mut data, &q).unwrap();
+        if i % 100 == 0 {
+            sink += vjm::joint_correction(&model, &mut data, &q, &wrench, 3, 1e-12)
+                .unwrap()
+                .dq[0];
+        }
+        // Error paths allocate nothing either.
+        let bad = vjm::deflection(&model, &mut data, &q[..5], &wrench);
+        assert!(matches!(bad, Err(TickError::WrongLength { .. })));
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(sink.is_finite());
+    assert_eq!(after - before, 0, "allocations on the per-call path");
+}
