@@ -5,8 +5,13 @@
 use std::hint::black_box;
 use std::time::Instant;
 
+use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
+use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::mechanism::ParallelRobot2;
+use deflect_core::motion::{Trajectory, paper_limits};
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300};
+use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
+use nalgebra::Vector2;
 
 /// Runs `tick(i)` `n` times and prints median / p99.9 / max in ns.
 pub fn report(name: &str, n: usize, budget_ns: f64, mut tick: impl FnMut(usize)) {
@@ -54,4 +59,47 @@ fn main() {
         q[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::joint_correction(model, &mut data, black_box(&q), &w, 1, 0.0).ok());
     });
+
+    // The 2 kHz D'Alembert loop of the parallel robot: plan (sample the jerk-limited profile)
+    // -> F_D = -m* a -> compliance map -> corrected point -> closed-form IK.
+    let text = std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv"))
+        .expect("shipped table");
+    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)
+        .expect("valid table")
+        .with_options(QueryOptions {
+            out_of_grid: OutOfGrid::Clamp,
+            ..QueryOptions::default()
+        });
+    let view = map.view();
+    let robot2 = ParallelRobot2::paper();
+    let traj = Trajectory::line(
+        Vector2::new(0.222132, -0.075),
+        Vector2::new(0.222132, 0.075),
+        &paper_limits(5).expect("paper limits"),
+    )
+    .expect("valid line");
+    let period = traj.duration();
+    for (name, corr) in [
+        (
+            "dalembert tick (one-shot)",
+            DalembertCorrector::new(5.0).expect("mass"),
+        ),
+        (
+            "dalembert tick (3 fixed-pt)",
+            DalembertCorrector::new(5.0)
+                .expect("mass")
+                .with_fixed_point(3, 0.0),
+        ),
+    ] {
+        let mut q2 = Vector2::zeros();
+        report(name, n, budget, |i| {
+            // Tick-by-tick sampling at 2 kHz, wrapping around the 375 ms motion.
+            let t = (i as f64 / 2000.0) % period;
+            let s = traj.sample(black_box(t)).expect("in range");
+            if let Ok(tick) = corr.step(&robot2, &view, &s.position, &s.acceleration, &q2) {
+                q2 = tick.joints;
+            }
+            black_box(q2);
+        });
+    }
 }

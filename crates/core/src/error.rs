@@ -42,7 +42,10 @@ impl fmt::Display for BuildError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::CapacityExceeded { what, capacity } => {
-                write!(f, "too many {what}: the real-time model holds at most {capacity}")
+                write!(
+                    f,
+                    "too many {what}: the real-time model holds at most {capacity}"
+                )
             }
             Self::NonFiniteTransform { element } => {
                 write!(f, "element {element}: transform is not finite")

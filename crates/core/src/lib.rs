@@ -29,12 +29,22 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod compliance_map;
+pub mod dalembert;
 pub mod error;
+pub mod mechanism;
+pub mod motion;
 pub mod vjm;
 
 #[cfg(feature = "urdf")]
 pub mod robot;
 
+#[cfg(feature = "alloc")]
+pub use compliance_map::ComplianceMap;
+pub use compliance_map::{
+    ComplianceMapError, ComplianceMapView, Interpolation, OutOfGrid, QueryError, QueryOptions,
+    QueryStatus,
+};
 pub use error::{BuildError, TickError};
 pub use vjm::{Data, Model, ModelBuilder};
 

@@ -386,34 +386,37 @@ impl SerialRobot {
         let mut names = Vec::new();
         let mut limits = Vec::new();
         let mut spring_names = Vec::new();
-        let mut add_springs = |mut b: ModelBuilder,
-                               link: &str|
-         -> Result<ModelBuilder, LoadError> {
-            let mut n_on_link = 0usize;
-            for (entry, s) in springs.iter().enumerate() {
-                if s.link != link {
-                    continue;
-                }
-                let label = format!("virtual_joint #{entry} on link '{link}'");
-                let frame = pose(&s.xyz, &s.rpy, &label)?;
-                if let Some((axis, &value)) = s.k.iter().enumerate().find(|(_, v)| !(**v > 0.0)) {
-                    return Err(LoadError::NonPositiveStiffness {
-                        link: link.to_string(),
-                        entry,
-                        axis,
-                        value,
+        let mut add_springs =
+            |mut b: ModelBuilder, link: &str| -> Result<ModelBuilder, LoadError> {
+                let mut n_on_link = 0usize;
+                for (entry, s) in springs.iter().enumerate() {
+                    if s.link != link {
+                        continue;
+                    }
+                    let label = format!("virtual_joint #{entry} on link '{link}'");
+                    let frame = pose(&s.xyz, &s.rpy, &label)?;
+                    if let Some((axis, &value)) =
+                        s.k.iter()
+                            .enumerate()
+                            .find(|(_, v)| v.is_nan() || **v <= 0.0)
+                    {
+                        return Err(LoadError::NonPositiveStiffness {
+                            link: link.to_string(),
+                            entry,
+                            axis,
+                            value,
+                        });
+                    }
+                    b = b.spring_at(frame, s.k)?;
+                    spring_names.push(if n_on_link == 0 {
+                        link.to_string()
+                    } else {
+                        format!("{link}#{n_on_link}")
                     });
+                    n_on_link += 1;
                 }
-                b = b.spring_at(frame, s.k)?;
-                spring_names.push(if n_on_link == 0 {
-                    link.to_string()
-                } else {
-                    format!("{link}#{n_on_link}")
-                });
-                n_on_link += 1;
-            }
-            Ok(b)
-        };
+                Ok(b)
+            };
         b = add_springs(b, &base)?;
         for j in &path {
             if j.mimic.is_some() {

@@ -9,19 +9,49 @@
 //!     ├── deflect.SingularError    singular pose: no unique correction
 //!     └── deflect.ConvergenceError an iterative solve missed its tolerance
 //! ```
+// Bindings must not crash the interpreter: errors become Python exceptions.
+#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod compliance_map;
 mod convert;
+mod dalembert;
+mod motion;
 mod vjm;
 
-create_exception!(deflect, DeflectError, PyValueError, "Root of deflect's exceptions.");
-create_exception!(deflect, LoadError, DeflectError, "A file could not be loaded or validated.");
-create_exception!(deflect, InputError, DeflectError, "An input has the wrong shape or is not finite.");
-create_exception!(deflect, SingularError, DeflectError, "The pose is singular.");
-create_exception!(deflect, ConvergenceError, DeflectError, "An iterative solve did not converge.");
+create_exception!(
+    deflect,
+    DeflectError,
+    PyValueError,
+    "Root of deflect's exceptions."
+);
+create_exception!(
+    deflect,
+    LoadError,
+    DeflectError,
+    "A file could not be loaded or validated."
+);
+create_exception!(
+    deflect,
+    InputError,
+    DeflectError,
+    "An input has the wrong shape or is not finite."
+);
+create_exception!(
+    deflect,
+    SingularError,
+    DeflectError,
+    "The pose is singular."
+);
+create_exception!(
+    deflect,
+    ConvergenceError,
+    DeflectError,
+    "An iterative solve did not converge."
+);
 
 #[pymodule]
 fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -33,5 +63,8 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     vjm::register(m)?;
+    compliance_map::register(m)?;
+    motion::register(m)?;
+    dalembert::register(m)?;
     Ok(())
 }

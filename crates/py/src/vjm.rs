@@ -170,8 +170,15 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vec_of(&q, "q", model.dof())?;
         let w = vector6(&wrench, "wrench")?;
-        let c = vjm::joint_correction(model, &mut Data::new(model), &q, &w, max_iterations, tolerance)
-            .map_err(tick_err)?;
+        let c = vjm::joint_correction(
+            model,
+            &mut Data::new(model),
+            &q,
+            &w,
+            max_iterations,
+            tolerance,
+        )
+        .map_err(tick_err)?;
         if !c.converged {
             return Err(crate::ConvergenceError::new_err(format!(
                 "joint correction: residual {:e} > tolerance {tolerance:e} after {} iterations",

@@ -161,8 +161,7 @@ impl ModelBuilder {
         self.calls += 1;
         let mut compliance = Vector3::zeros();
         for (axis, (&ki, ci)) in k.iter().zip(compliance.iter_mut()).enumerate() {
-            // `!(ki > 0.0)` also catches NaN.
-            if !(ki > 0.0) {
+            if ki.is_nan() || ki <= 0.0 {
                 return Err(BuildError::NonPositiveStiffness {
                     element,
                     axis,

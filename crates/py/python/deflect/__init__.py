@@ -5,23 +5,39 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 """
 
 from ._deflect import (
+    ComplianceMap,
     ConvergenceError,
+    CorrectedPath,
+    DalembertCorrector,
     DeflectError,
     InputError,
     LoadError,
+    ParallelRobot2,
     SerialRobot,
     SingularError,
+    Trajectory,
     __version__,
     commanded_pose,
+    paper_limits,
+    plan_line,
+    plan_polyline,
 )
 
 __all__ = [
+    "ComplianceMap",
     "ConvergenceError",
+    "CorrectedPath",
+    "DalembertCorrector",
     "DeflectError",
     "InputError",
     "LoadError",
+    "ParallelRobot2",
     "SerialRobot",
     "SingularError",
+    "Trajectory",
     "__version__",
     "commanded_pose",
+    "paper_limits",
+    "plan_line",
+    "plan_polyline",
 ]

@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension ``deflect._deflect``."""
 
 from os import PathLike
-from typing import List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -60,3 +60,169 @@ class SerialRobot:
 
 def commanded_pose(target: FloatArray, deflection: FloatArray) -> FloatArray:
     """(4, 4) pose to command so that the deflected TCP lands on ``target``."""
+
+class ComplianceMap:
+    """Compliance map from static tests (Paksoy et al. 2025, Eq. 9-14): per-node lines
+    ``disp_d = sum_f (slope[d, f] * F_f + offset[d, f])`` blended bilinearly (Eq. 14) or with a
+    C1 cubic Hermite interpolation. SI: positions m, forces N, displacements m.
+
+    ``interpolation``: ``"bilinear"`` | ``"bicubic"``; ``out_of_grid``: ``"error"`` |
+    ``"clamp"`` | ``"extrapolate"``. Bad input raises ``InputError``, bad files ``LoadError``.
+    """
+
+    @staticmethod
+    def from_csv(
+        path: StrPath,
+        force_unit: str = "N",
+        length_unit: str = "mm",
+        interpolation: str = "bilinear",
+        out_of_grid: str = "error",
+    ) -> "ComplianceMap":
+        """Paper-format table (columns x_mm, y_mm, m, n, o, p, s, u, v, w)."""
+    @staticmethod
+    def from_csv_text(
+        text: str,
+        force_unit: str = "N",
+        length_unit: str = "mm",
+        interpolation: str = "bilinear",
+        out_of_grid: str = "error",
+    ) -> "ComplianceMap": ...
+    @staticmethod
+    def fit(
+        positions: FloatArray,
+        force_axis: npt.NDArray[np.int64],
+        force: FloatArray,
+        displacement: Optional[FloatArray] = None,
+        *,
+        upper: Optional[FloatArray] = None,
+        lower: Optional[FloatArray] = None,
+        spacing: Optional[float] = None,
+        extension: float = 0.0,
+        n_force: Optional[int] = None,
+        position_tolerance: float = 1e-6,
+        interpolation: str = "bilinear",
+        out_of_grid: str = "error",
+    ) -> "ComplianceMap":
+        """Least-squares lines per node (Eq. 10-13) from (N, 2) positions [m], (N,) force axes,
+        (N,) forces [N] and (N, n_disp) displacements [m] (or upper/lower two-point form)."""
+    @staticmethod
+    def fit_csv(
+        path: StrPath,
+        force_unit: str = "N",
+        length_unit: str = "mm",
+        n_force: Optional[int] = None,
+        position_tolerance: float = 1e-6,
+        interpolation: str = "bilinear",
+        out_of_grid: str = "error",
+    ) -> "ComplianceMap":
+        """Static-test CSV: x, y, force_axis, force, dx, dy[, dz, rx, ry, rz]."""
+    def to_json(self) -> str:
+        """Versioned JSON (format_version 1, SI units recorded)."""
+    @staticmethod
+    def from_json(text: str) -> "ComplianceMap": ...
+    def with_options(
+        self, interpolation: Optional[str] = None, out_of_grid: Optional[str] = None
+    ) -> "ComplianceMap": ...
+    def displacement(
+        self,
+        position: FloatArray,
+        force: FloatArray,
+        *,
+        interpolation: Optional[str] = None,
+        out_of_grid: Optional[str] = None,
+    ) -> FloatArray:
+        """(n_displacement,) [m] at position (2,) or (3,) [m] (z ignored) under force [N]."""
+    def displacement_batch(
+        self,
+        P: FloatArray,
+        F: FloatArray,
+        *,
+        interpolation: Optional[str] = None,
+        out_of_grid: Optional[str] = None,
+    ) -> FloatArray:
+        """(N, 2|3), (N, n_force) -> (N, n_displacement); releases the GIL."""
+    def cross_validate(self, forces: FloatArray, axis: str = "y") -> Dict[str, Any]:
+        """Leave-one-node-out RMS [m] of bilinear vs bicubic."""
+    @property
+    def residuals(self) -> Optional[List[Dict[str, Any]]]:
+        """Per-node fit statistics, or None if the map was not fitted."""
+    @property
+    def x(self) -> FloatArray: ...
+    @property
+    def y(self) -> FloatArray: ...
+    @property
+    def n_force(self) -> int: ...
+    @property
+    def n_displacement(self) -> int: ...
+    @property
+    def interpolation(self) -> str: ...
+    @property
+    def out_of_grid(self) -> str: ...
+    @property
+    def slopes(self) -> FloatArray:
+        """(nx, ny, n_displacement, n_force) [m/N]."""
+    @property
+    def offsets(self) -> FloatArray:
+        """(nx, ny, n_displacement, n_force) [m]."""
+
+class Trajectory:
+    """A planned motion sampled at a fixed rate; one row per tick, SI units."""
+    @property
+    def t(self) -> FloatArray: ...
+    @property
+    def position(self) -> FloatArray: ...
+    @property
+    def velocity(self) -> FloatArray: ...
+    @property
+    def acceleration(self) -> FloatArray: ...
+    @property
+    def jerk(self) -> FloatArray: ...
+    @property
+    def duration(self) -> float: ...
+    @property
+    def rate_hz(self) -> float: ...
+    def __len__(self) -> int: ...
+
+def plan_line(
+    start: ArrayLike, end: ArrayLike, v_max: float, a_max: float, j_max: float, rate_hz: float = 2000.0
+) -> Trajectory: ...
+def plan_polyline(
+    points: ArrayLike, v_max: float, a_max: float, j_max: float, rate_hz: float = 2000.0
+) -> Trajectory: ...
+def paper_limits(g_level: int) -> Tuple[float, float, float]:
+    """(v_max, a_max, j_max) reproducing the paper's motion durations at 1..5 g."""
+
+class ParallelRobot2:
+    """The paper's 2-DoF planar parallel robot; p = C - O [m], q = (theta_A, theta_B) [rad]."""
+    def __init__(self, link: float = 0.150, half_width: float = 0.090, min_sigma: float = 0.020) -> None: ...
+    def ik(self, p: ArrayLike) -> FloatArray: ...
+    def fk(self, q: ArrayLike) -> FloatArray: ...
+    def jacobian(self, q: ArrayLike) -> FloatArray: ...
+    def singularity_distance(self, q: ArrayLike) -> float: ...
+    @property
+    def reach(self) -> float: ...
+
+class CorrectedPath:
+    """Output of DalembertCorrector.correct: one row per tick."""
+    t: FloatArray
+    desired: FloatArray
+    position: FloatArray
+    joints: FloatArray
+    force: FloatArray
+    displacement: FloatArray
+    flagged_ticks: List[int]
+
+class DalembertCorrector:
+    """D'Alembert trajectory correction: F_D = -mass * a, map displacement, command, IK."""
+    def __init__(
+        self,
+        compliance_map: ComplianceMap,
+        mechanism: ParallelRobot2,
+        mass: float = 5.0,
+        iterations: int = 0,
+        tolerance: float = 0.0,
+    ) -> None: ...
+    @property
+    def mass(self) -> float: ...
+    def step(self, position: ArrayLike, acceleration: ArrayLike) -> Dict[str, Any]: ...
+    def correct(self, trajectory: Trajectory) -> CorrectedPath: ...

@@ -1,0 +1,447 @@
+//! Fitting a [`ComplianceMap`] from static tests (Eq. 10-13), with per-node statistics, and
+//! the paper's two-point input form (displacements of P_u and P_l extrapolated along the
+//! tool axis).
+
+use alloc::vec;
+use alloc::vec::Vec;
+
+use super::{ComplianceMap, ComplianceMapError, MAX_AXES, check_counts, sqrt};
+
+/// Column names used in errors for the displacement entries of a [`Measurement`].
+pub(crate) const DISPLACEMENT_COLUMNS: [&str; MAX_AXES] = ["d0", "d1", "d2", "d3", "d4", "d5"];
+
+/// One static-test reading: at node position `(x, y)` [m] a force `force` [N] (or moment
+/// [N m]) is applied along force axis `force_axis` only, and the displacement of the working
+/// point is measured (`displacement[..n_displacement]`, [m] or [rad]; later entries unused).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Measurement {
+    /// Node x [m].
+    pub x: f64,
+    /// Node y [m].
+    pub y: f64,
+    /// Loaded force axis, `0..n_force`.
+    pub force_axis: usize,
+    /// Force level [N] (moment [N m]).
+    pub force: f64,
+    /// Measured displacement [m] / [rad]; the first `n_displacement` entries are used.
+    pub displacement: [f64; MAX_AXES],
+}
+
+impl Measurement {
+    /// A reading with the displacement copied from `displacement` (at most [`MAX_AXES`]
+    /// entries are kept; missing ones are 0).
+    pub fn new(x: f64, y: f64, force_axis: usize, force: f64, displacement: &[f64]) -> Self {
+        let mut d = [0.0; MAX_AXES];
+        d.iter_mut().zip(displacement).for_each(|(a, b)| *a = *b);
+        Self {
+            x,
+            y,
+            force_axis,
+            force,
+            displacement: d,
+        }
+    }
+
+    /// A reading in the paper's two-point form: displacements of the upper point `upper`
+    /// (P_u) and lower point `lower` (P_l) of the end effector, extrapolated to the working
+    /// point with [`two_point_displacement`].
+    #[allow(clippy::too_many_arguments)] // reason: one reading's fields, in table order
+    pub fn from_two_point(
+        x: f64,
+        y: f64,
+        force_axis: usize,
+        force: f64,
+        upper: &[f64],
+        lower: &[f64],
+        spacing: f64,
+        extension: f64,
+    ) -> Result<Self, ComplianceMapError> {
+        let n = upper.len().min(lower.len()).min(MAX_AXES);
+        let mut d = [0.0; MAX_AXES];
+        two_point_displacement(
+            upper.get(..n).unwrap_or(&[]),
+            lower.get(..n).unwrap_or(&[]),
+            spacing,
+            extension,
+            d.get_mut(..n).unwrap_or(&mut []),
+        )?;
+        Ok(Self {
+            x,
+            y,
+            force_axis,
+            force,
+            displacement: d,
+        })
+    }
+}
+
+/// Displacement of the working point W from those of two points on the tool axis (the
+/// paper's static tests measure P_u and P_l on the end effector and extrapolate 2.5 mm below
+/// its bottom, Appendix A and section 4.2.1).
+///
+/// With the end effector rigid and its rotation small, the displacement of a point on the
+/// line P_u P_l is affine in its position along the line, so
+///
+/// ```text
+/// delta_W = delta_l + (e / L) * (delta_l - delta_u)
+/// ```
+///
+/// where `L = |P_u P_l| > 0` is the spacing of the two points [m] and `e` the signed distance
+/// from P_l to W along the axis pointing from P_u to P_l [m] (`e > 0` beyond P_l, the paper's
+/// `e = 2.5 mm`; `e = 0` gives P_l, `e = -L` gives P_u). `(delta_l - delta_u) / L` is the
+/// small tilt of the tool axis [rad] for the transverse components. Component-wise on equal
+/// length slices; `out` gets `min(len)` entries.
+pub fn two_point_displacement(
+    upper: &[f64],
+    lower: &[f64],
+    spacing: f64,
+    extension: f64,
+    out: &mut [f64],
+) -> Result<(), ComplianceMapError> {
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(ComplianceMapError::BadTwoPoint { spacing });
+    }
+    let k = extension / spacing;
+    for ((o, u), l) in out.iter_mut().zip(upper).zip(lower) {
+        *o = l + k * (l - u);
+    }
+    Ok(())
+}
+
+/// Options of [`fit()`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FitOptions {
+    /// Number of force axes (1..=6).
+    pub n_force: usize,
+    /// Number of displacement axes (1..=6).
+    pub n_displacement: usize,
+    /// Coordinates closer than this are the same grid line [m]. Default 1e-6 m.
+    pub position_tolerance: f64,
+}
+
+impl Default for FitOptions {
+    /// The paper's case: 2 forces, 2 displacements, 1 um position tolerance.
+    fn default() -> Self {
+        Self {
+            n_force: 2,
+            n_displacement: 2,
+            position_tolerance: 1e-6,
+        }
+    }
+}
+
+/// Statistics of one line fit `disp_d = slope * F_f + offset` at one node (Eq. 12-13).
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "std", derive(serde::Serialize, serde::Deserialize))]
+pub struct LineStats {
+    /// Fitted slope [m/N].
+    pub slope: f64,
+    /// Fitted offset [m].
+    pub offset: f64,
+    /// Root mean square of the residuals, `sqrt(sum r^2 / k)` over the `k` readings [m].
+    pub rms: f64,
+    /// Coefficient of determination `1 - SS_res / SS_tot` (1 when the displacement does not
+    /// vary at all).
+    pub r_squared: f64,
+}
+
+/// Fit statistics of one node.
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "std", derive(serde::Serialize, serde::Deserialize))]
+pub struct NodeFit {
+    /// Node index along x.
+    pub i: usize,
+    /// Node index along y.
+    pub j: usize,
+    /// Node x [m] (mean of its readings' x).
+    pub x: f64,
+    /// Node y [m].
+    pub y: f64,
+    /// Line statistics, index `d * n_force + f`.
+    pub lines: Vec<LineStats>,
+    /// 2-norm condition number of the design matrix `A = [F_k 1]` (Eq. 12) per force axis;
+    /// it depends on the force levels and on the force unit (here N).
+    pub condition: Vec<f64>,
+    /// Readings per force axis.
+    pub samples: Vec<usize>,
+}
+
+/// Groups coordinates into grid lines: returns the line centres (means, computed relative to
+/// the lowest value so that equal coordinates give exactly that value) and each value's line.
+fn cluster(
+    values: &[f64],
+    axis: &'static str,
+    tolerance: f64,
+) -> Result<(Vec<f64>, Vec<usize>), ComplianceMapError> {
+    let mut order: Vec<usize> = (0..values.len()).collect();
+    let val = |k: usize| values.get(k).copied().unwrap_or(0.0);
+    order.sort_by(|a, b| val(*a).total_cmp(&val(*b)));
+    let mut centres = Vec::new();
+    let mut line_of = vec![0usize; values.len()];
+    let (mut start, mut prev, mut sum, mut count) = (f64::NAN, f64::NAN, 0.0, 0usize);
+    for &k in &order {
+        let v = val(k);
+        if count > 0 && v - prev > tolerance {
+            centres.push(start + sum / count as f64);
+            (sum, count) = (0.0, 0);
+        }
+        if count == 0 {
+            start = v;
+        } else if v - start > tolerance {
+            return Err(ComplianceMapError::AmbiguousCoordinate {
+                axis,
+                low: start,
+                high: v,
+                tolerance,
+            });
+        }
+        if let Some(slot) = line_of.get_mut(k) {
+            *slot = centres.len();
+        }
+        sum += v - start;
+        count += 1;
+        prev = v;
+    }
+    if count > 0 {
+        centres.push(start + sum / count as f64);
+    }
+    Ok((centres, line_of))
+}
+
+/// Grid lines along x and y [m] and each reading's node index.
+pub(crate) type Grid = (Vec<f64>, Vec<f64>, Vec<usize>);
+
+/// Grid lines of the readings' positions and each reading's node `i * ny + j`; checks that
+/// the nodes form a full rectilinear grid of at least 2 x 2.
+pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, ComplianceMapError> {
+    let xs: Vec<f64> = measurements.iter().map(|m| m.x).collect();
+    let ys: Vec<f64> = measurements.iter().map(|m| m.y).collect();
+    let (cx, line_x) = cluster(&xs, "x", tol)?;
+    let (cy, line_y) = cluster(&ys, "y", tol)?;
+    let (nx, ny) = (cx.len(), cy.len());
+    if nx < 2 {
+        return Err(ComplianceMapError::TooFewNodes {
+            axis: "x",
+            count: nx,
+        });
+    }
+    if ny < 2 {
+        return Err(ComplianceMapError::TooFewNodes {
+            axis: "y",
+            count: ny,
+        });
+    }
+    let nodes: Vec<usize> = line_x
+        .iter()
+        .zip(&line_y)
+        .map(|(i, j)| i * ny + j)
+        .collect();
+    let mut present = vec![false; nx * ny];
+    for n in &nodes {
+        if let Some(p) = present.get_mut(*n) {
+            *p = true;
+        }
+    }
+    let measured = present.iter().filter(|p| **p).count();
+    if 2 * measured < nx * ny {
+        return Err(ComplianceMapError::NotRectilinear {
+            nodes: measured,
+            distinct_x: nx,
+            distinct_y: ny,
+        });
+    }
+    if let Some(k) = present.iter().position(|p| !*p) {
+        return Err(ComplianceMapError::MissingNode {
+            x: cx.get(k / ny).copied().unwrap_or(f64::NAN),
+            y: cy.get(k % ny).copied().unwrap_or(f64::NAN),
+        });
+    }
+    Ok((cx, cy, nodes))
+}
+
+/// Fits a compliance map from static tests (Eq. 10-13).
+///
+/// Readings are grouped by node (coordinates within `position_tolerance` share a grid line)
+/// and by loaded force axis `f`. For each node, `f` and displacement axis `d`, the line
+/// `disp_d = slope[d][f] * F + offset[d][f]` is the least-squares solution
+/// `Q = (A^T A)^-1 A^T B` of Eq. 13 with `A = [F_k 1]`, computed in centred form. As in the
+/// paper (Eq. 10), each force axis keeps its own intercept as its offset, so the model's
+/// zero-force displacement is the sum of the offsets over the force axes.
+///
+/// Errors: non-finite values ([`ComplianceMapError::NonFinite`] with row and column `x`, `y`,
+/// `force` or `d<k>`), a force axis `>= n_force`, ambiguous or non-rectilinear positions, a
+/// missing node, a repeated (node, axis, force), fewer than 2 force levels for a line.
+pub fn fit(
+    measurements: &[Measurement],
+    options: &FitOptions,
+) -> Result<ComplianceMap, ComplianceMapError> {
+    let (nf, nd) = (options.n_force, options.n_displacement);
+    check_counts(nf, nd)?;
+    let tol = options.position_tolerance;
+    for (row, m) in measurements.iter().enumerate() {
+        for (column, v) in [("x", m.x), ("y", m.y), ("force", m.force)] {
+            if !v.is_finite() {
+                return Err(ComplianceMapError::NonFinite { row, column });
+            }
+        }
+        for (column, v) in DISPLACEMENT_COLUMNS
+            .iter()
+            .zip(m.displacement.iter())
+            .take(nd)
+        {
+            if !v.is_finite() {
+                return Err(ComplianceMapError::NonFinite { row, column });
+            }
+        }
+        if m.force_axis >= nf {
+            return Err(ComplianceMapError::ForceAxisOutOfRange {
+                row,
+                force_axis: m.force_axis,
+                n_force: nf,
+            });
+        }
+    }
+    let (cx, cy, nodes) = grid_of(measurements, tol)?;
+    let (nx, ny) = (cx.len(), cy.len());
+    let node_of = |r: usize| nodes.get(r).copied().unwrap_or(0);
+    // Rows sorted by (node, force axis, force, row): groups are contiguous.
+    let key = |r: usize| {
+        let m = measurements.get(r);
+        (
+            node_of(r),
+            m.map_or(0, |m| m.force_axis),
+            m.map_or(0.0, |m| m.force),
+        )
+    };
+    let mut order: Vec<usize> = (0..measurements.len()).collect();
+    order.sort_by(|a, b| {
+        let (ka, kb) = (key(*a), key(*b));
+        ka.0.cmp(&kb.0)
+            .then(ka.1.cmp(&kb.1))
+            .then(ka.2.total_cmp(&kb.2))
+            .then(a.cmp(b))
+    });
+    for w in order.windows(2) {
+        if let [a, b] = w {
+            if key(*a) == key(*b) {
+                return Err(ComplianceMapError::DuplicateMeasurement {
+                    row: *b,
+                    previous_row: *a,
+                });
+            }
+        }
+    }
+    let block = nd * nf;
+    let mut slopes = vec![0.0; nx * ny * block];
+    let mut offsets = vec![0.0; nx * ny * block];
+    let mut stats = Vec::with_capacity(nx * ny);
+    let mut pos = 0usize;
+    for node in 0..nx * ny {
+        let (node_x, node_y) = (
+            cx.get(node / ny).copied().unwrap_or(f64::NAN),
+            cy.get(node % ny).copied().unwrap_or(f64::NAN),
+        );
+        let mut nfit = NodeFit {
+            i: node / ny,
+            j: node % ny,
+            x: node_x,
+            y: node_y,
+            lines: vec![
+                LineStats {
+                    slope: 0.0,
+                    offset: 0.0,
+                    rms: 0.0,
+                    r_squared: 1.0
+                };
+                block
+            ],
+            condition: vec![0.0; nf],
+            samples: vec![0; nf],
+        };
+        for f in 0..nf {
+            let begin = pos;
+            while order
+                .get(pos)
+                .is_some_and(|r| key(*r).0 == node && key(*r).1 == f)
+            {
+                pos += 1;
+            }
+            let rows = order.get(begin..pos).unwrap_or(&[]);
+            if rows.len() < 2 {
+                return Err(ComplianceMapError::TooFewForceLevels {
+                    node_x,
+                    node_y,
+                    force_axis: f,
+                    levels: rows.len(),
+                });
+            }
+            let group: Vec<&Measurement> =
+                rows.iter().filter_map(|r| measurements.get(*r)).collect();
+            let k = group.len() as f64;
+            let f_mean = group.iter().map(|m| m.force).sum::<f64>() / k;
+            let sxx: f64 = group
+                .iter()
+                .map(|m| (m.force - f_mean) * (m.force - f_mean))
+                .sum();
+            // Condition number of A = [F 1]: eigenvalues of A^T A = [[sum F^2, sum F], [sum F, k]].
+            let (a, b, c) = (
+                group.iter().map(|m| m.force * m.force).sum::<f64>(),
+                group.iter().map(|m| m.force).sum::<f64>(),
+                k,
+            );
+            let lmax = 0.5 * (a + c + sqrt((a - c) * (a - c) + 4.0 * b * b));
+            // det(A^T A) = k * sum (F - mean)^2, computed without cancellation.
+            let lmin = k * sxx / lmax;
+            if let Some(slot) = nfit.condition.get_mut(f) {
+                *slot = sqrt(lmax / lmin);
+            }
+            if let Some(slot) = nfit.samples.get_mut(f) {
+                *slot = group.len();
+            }
+            for d in 0..nd {
+                let disp = |m: &Measurement| m.displacement.get(d).copied().unwrap_or(0.0);
+                let d_mean = group.iter().map(|m| disp(m)).sum::<f64>() / k;
+                let sxy: f64 = group
+                    .iter()
+                    .map(|m| (m.force - f_mean) * (disp(m) - d_mean))
+                    .sum();
+                let slope = sxy / sxx;
+                let offset = d_mean - slope * f_mean;
+                let ss_res: f64 = group
+                    .iter()
+                    .map(|m| {
+                        let r = disp(m) - (slope * m.force + offset);
+                        r * r
+                    })
+                    .sum();
+                let ss_tot: f64 = group
+                    .iter()
+                    .map(|m| (disp(m) - d_mean) * (disp(m) - d_mean))
+                    .sum();
+                let idx = node * block + d * nf + f;
+                if let Some(s) = slopes.get_mut(idx) {
+                    *s = slope;
+                }
+                if let Some(o) = offsets.get_mut(idx) {
+                    *o = offset;
+                }
+                if let Some(l) = nfit.lines.get_mut(d * nf + f) {
+                    *l = LineStats {
+                        slope,
+                        offset,
+                        rms: sqrt(ss_res / k),
+                        r_squared: if ss_tot > 0.0 {
+                            1.0 - ss_res / ss_tot
+                        } else {
+                            1.0
+                        },
+                    };
+                }
+            }
+        }
+        stats.push(nfit);
+    }
+    let mut map = ComplianceMap::new(cx, cy, nf, nd, slopes, offsets)?;
+    map.set_fit_stats(Some(stats));
+    Ok(map)
+}

@@ -1,0 +1,280 @@
+//! Grid axes: validation, cell lookup and the 1-D interpolation weights ("stencils") whose
+//! tensor product gives the 2-D weights of Eq. 14 (bilinear) or of the cubic Hermite option.
+//!
+//! Everything here is allocation-free and panic-free: indices are reached through `.get()`.
+
+use super::{ComplianceMapError, Interpolation, OutOfGrid, QueryError};
+
+/// Relative tolerance under which an axis counts as evenly spaced (O(1) cell lookup).
+const UNIFORM_RTOL: f64 = 1e-12;
+
+/// Where a coordinate fell relative to its axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Placement {
+    Inside,
+    Clamped,
+    Extrapolated,
+}
+
+/// One grid axis: strictly increasing finite node coordinates [m].
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Axis<'a> {
+    pub nodes: &'a [f64],
+    /// `1 / step` when the axis is evenly spaced, `0.0` otherwise (binary search).
+    pub inv_step: f64,
+}
+
+/// Checks an axis (at least 2 nodes, finite, strictly increasing) and returns `1/step` when
+/// it is evenly spaced, else `0.0`.
+pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, ComplianceMapError> {
+    if nodes.len() < 2 {
+        return Err(ComplianceMapError::TooFewNodes {
+            axis,
+            count: nodes.len(),
+        });
+    }
+    for (index, v) in nodes.iter().enumerate() {
+        if !v.is_finite() {
+            return Err(ComplianceMapError::NonFiniteValue { what: axis, index });
+        }
+    }
+    for (index, w) in nodes.windows(2).enumerate() {
+        if let [a, b] = w {
+            if b <= a {
+                return Err(ComplianceMapError::NotIncreasing {
+                    axis,
+                    index: index + 1,
+                });
+            }
+        }
+    }
+    Ok(uniform_inv_step(nodes))
+}
+
+fn uniform_inv_step(nodes: &[f64]) -> f64 {
+    let (Some(&first), Some(&last)) = (nodes.first(), nodes.last()) else {
+        return 0.0;
+    };
+    let n = nodes.len();
+    if n < 2 {
+        return 0.0;
+    }
+    let step = (last - first) / (n - 1) as f64;
+    let scale = first.abs().max(last.abs()).max(last - first);
+    let even = nodes
+        .iter()
+        .enumerate()
+        .all(|(k, v)| (v - (first + k as f64 * step)).abs() <= UNIFORM_RTOL * scale);
+    if even && step > 0.0 { 1.0 / step } else { 0.0 }
+}
+
+impl Axis<'_> {
+    #[inline(always)]
+    fn node(&self, k: usize) -> f64 {
+        self.nodes.get(k).copied().unwrap_or(0.0)
+    }
+
+    /// Index `i` of the cell `[x_i, x_{i+1}]` holding `v` (`v` already within the axis, or
+    /// the boundary cell when outside). O(1) on evenly spaced axes, binary search otherwise.
+    #[inline(always)]
+    fn cell(&self, v: f64) -> usize {
+        let n = self.nodes.len();
+        let last_cell = n.saturating_sub(2);
+        if self.inv_step > 0.0 {
+            // Saturating float->int cast; negative and NaN become 0.
+            let mut i = (((v - self.node(0)) * self.inv_step) as usize).min(last_cell);
+            // One step of correction against rounding at the node coordinates.
+            if i > 0 && v < self.node(i) {
+                i -= 1;
+            } else if i < last_cell && v > self.node(i + 1) {
+                i += 1;
+            }
+            i
+        } else {
+            // Number of nodes <= v, minus one, kept within the cells.
+            self.nodes
+                .partition_point(|x| *x <= v)
+                .saturating_sub(1)
+                .min(last_cell)
+        }
+    }
+
+    /// Locates `v`: the cell index, the coordinate to evaluate at (clamped if so asked) and
+    /// where it fell. `axis` (0 = x, 1 = y) names it in errors.
+    #[inline(always)]
+    fn locate(
+        &self,
+        axis: usize,
+        v: f64,
+        policy: OutOfGrid,
+    ) -> Result<(usize, f64, Placement), QueryError> {
+        let lo = self.node(0);
+        let hi = self.node(self.nodes.len().saturating_sub(1));
+        if v >= lo && v <= hi {
+            return Ok((self.cell(v), v, Placement::Inside));
+        }
+        match policy {
+            OutOfGrid::Error => Err(QueryError::OutOfGrid {
+                axis,
+                value: v,
+                min: lo,
+                max: hi,
+            }),
+            OutOfGrid::Clamp => {
+                let c = v.clamp(lo, hi);
+                Ok((self.cell(c), c, Placement::Clamped))
+            }
+            OutOfGrid::Extrapolate => Ok((self.cell(v), v, Placement::Extrapolated)),
+        }
+    }
+
+    /// Weights of the nodes for the derivative at node `k` of the cubic Hermite option:
+    /// the three-point finite difference that is exact for quadratics on uneven spacing
+    /// (central inside, one-sided at the ends; the plain secant when the axis has 2 nodes).
+    fn slope_weights(&self, k: usize) -> ([usize; 3], [f64; 3]) {
+        let n = self.nodes.len();
+        let x = |i: usize| self.node(i);
+        if n < 3 {
+            let h = x(1) - x(0);
+            return ([0, 1, 1], [-1.0 / h, 1.0 / h, 0.0]);
+        }
+        if k == 0 {
+            let (h0, h1) = (x(1) - x(0), x(2) - x(1));
+            let c = h0 / (h0 + h1);
+            let w0 = -(1.0 + c) / h0;
+            let w2 = -c / h1;
+            ([0, 1, 2], [w0, -(w0 + w2), w2])
+        } else if k >= n - 1 {
+            let (a, b) = (x(n - 2) - x(n - 3), x(n - 1) - x(n - 2));
+            let c = b / (a + b);
+            let wl = (1.0 + c) / b;
+            let wf = c / a;
+            ([n - 3, n - 2, n - 1], [wf, -(wl + wf), wl])
+        } else {
+            let (ha, hb) = (x(k) - x(k - 1), x(k + 1) - x(k));
+            let wm = -hb / ((ha + hb) * ha);
+            let wp = ha / ((ha + hb) * hb);
+            ([k - 1, k, k + 1], [wm, -(wm + wp), wp])
+        }
+    }
+
+    /// Cell index `i`, local coordinate `t = (v - x_i) / (x_{i+1} - x_i)` (outside `[0, 1]`
+    /// when extrapolating) and placement of `v`. Exact at nodes (`t` is 0 or 1 there); on
+    /// evenly spaced axes no division.
+    #[inline(always)]
+    pub(crate) fn cell_t(
+        &self,
+        axis: usize,
+        v: f64,
+        policy: OutOfGrid,
+    ) -> Result<(usize, f64, Placement), QueryError> {
+        let (i, v, place) = self.locate(axis, v, policy)?;
+        let (x0, x1) = (self.node(i), self.node(i + 1));
+        let t = if v == x1 {
+            1.0
+        } else if self.inv_step > 0.0 {
+            (v - x0) * self.inv_step
+        } else {
+            (v - x0) / (x1 - x0)
+        };
+        Ok((i, t, place))
+    }
+
+    /// [`Self::cell_t`] for a `v` known to lie within the axis.
+    #[inline(always)]
+    pub(crate) fn cell_t_inside(&self, v: f64) -> (usize, f64) {
+        let i = self.cell(v);
+        let (x0, x1) = (self.node(i), self.node(i + 1));
+        let t = if v == x1 {
+            1.0
+        } else if self.inv_step > 0.0 {
+            (v - x0) * self.inv_step
+        } else {
+            (v - x0) / (x1 - x0)
+        };
+        (i, t)
+    }
+
+    /// First node coordinate.
+    #[inline(always)]
+    pub(crate) fn first(&self) -> f64 {
+        self.node(0)
+    }
+
+    /// Last node coordinate.
+    #[inline(always)]
+    pub(crate) fn last(&self) -> f64 {
+        self.node(self.nodes.len().saturating_sub(1))
+    }
+
+    /// The 1-D weights for coordinate `v` along this axis.
+    #[inline]
+    pub(crate) fn stencil(
+        &self,
+        axis: usize,
+        v: f64,
+        method: Interpolation,
+        policy: OutOfGrid,
+    ) -> Result<(Stencil, Placement), QueryError> {
+        let (i, t, place) = self.cell_t(axis, v, policy)?;
+        // The coordinate actually evaluated (clamped if so asked).
+        let v = self.node(i) + t * (self.node(i + 1) - self.node(i));
+        let h = self.node(i + 1) - self.node(i);
+        let mut s = Stencil {
+            base: i,
+            len: 2,
+            w: [1.0 - t, t, 0.0, 0.0],
+        };
+        if method == Interpolation::Bilinear {
+            // Linear in the cell; outside the grid this is the boundary cell's line.
+            return Ok((s, place));
+        }
+        let n = self.nodes.len();
+        s.base = i.saturating_sub(1).min(n.saturating_sub(4));
+        s.len = n.min(4);
+        s.w = [0.0; 4];
+        if !(0.0..=1.0).contains(&t) {
+            // Extrapolation: C1 continuation with the boundary node's value and slope.
+            let b = if t < 0.0 { i } else { i + 1 };
+            let dist = v - self.node(b);
+            s.add(b, 1.0);
+            let (idx, w) = self.slope_weights(b);
+            for (k, wk) in idx.iter().zip(w.iter()) {
+                s.add(*k, dist * wk);
+            }
+            return Ok((s, place));
+        }
+        // Cubic Hermite on [x_i, x_{i+1}] with finite-difference node slopes.
+        let (t2, t3) = (t * t, t * t * t);
+        let h00 = 2.0 * t3 - 3.0 * t2 + 1.0;
+        let h10 = t3 - 2.0 * t2 + t;
+        let h01 = -2.0 * t3 + 3.0 * t2;
+        let h11 = t3 - t2;
+        s.add(i, h00);
+        s.add(i + 1, h01);
+        for (node, coef) in [(i, h * h10), (i + 1, h * h11)] {
+            let (idx, w) = self.slope_weights(node);
+            for (k, wk) in idx.iter().zip(w.iter()) {
+                s.add(*k, coef * wk);
+            }
+        }
+        Ok((s, place))
+    }
+}
+
+/// Up to 4 consecutive node weights along one axis, starting at node `base`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Stencil {
+    pub base: usize,
+    pub len: usize,
+    pub w: [f64; 4],
+}
+
+impl Stencil {
+    #[inline]
+    fn add(&mut self, node: usize, weight: f64) {
+        if let Some(slot) = node.checked_sub(self.base).and_then(|k| self.w.get_mut(k)) {
+            *slot += weight;
+        }
+    }
+}

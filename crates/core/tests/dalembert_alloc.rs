@@ -1,0 +1,79 @@
+//! 1e4 consecutive 2 kHz ticks of planner + compliance map + corrector + IK allocate nothing:
+//! a counting global allocator watches them. One test function only.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
+use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::mechanism::ParallelRobot2;
+use deflect_core::motion::{Trajectory, paper_limits};
+use nalgebra::Vector2;
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn corrector_ticks_do_not_allocate() {
+    let text = std::fs::read_to_string(format!(
+        "{}/../../data/paksoy2025_compliance_oc.csv",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap();
+    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)
+        .unwrap()
+        .with_options(QueryOptions {
+            out_of_grid: OutOfGrid::Clamp,
+            ..QueryOptions::default()
+        });
+    let robot = ParallelRobot2::paper();
+    let corr = DalembertCorrector::new(5.0)
+        .unwrap()
+        .with_fixed_point(3, 1e-12);
+    // y line of the paper, 150 mm at 5 g, back and forth until 1e4 ticks have run.
+    let up = Trajectory::line(
+        Vector2::new(0.222132, -0.075),
+        Vector2::new(0.222132, 0.075),
+        &paper_limits(5).unwrap(),
+    )
+    .unwrap();
+    let view = map.view();
+    let mut q = Vector2::zeros();
+    let mut ticks = 0usize;
+    let mut sink = 0.0;
+
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    while ticks < 10_000 {
+        let mut cursor = up.ticks(2000.0).unwrap();
+        while let Some(s) = cursor.step() {
+            let t = corr
+                .step(&robot, &view, &s.position, &s.acceleration, &q)
+                .unwrap();
+            q = t.joints;
+            sink += t.commanded.x;
+            ticks += 1;
+        }
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(sink.is_finite());
+    assert_eq!(after - before, 0, "allocations in {ticks} corrector ticks");
+}

@@ -1,0 +1,573 @@
+//! `deflect.ComplianceMap`: the static-test compliance map of deflect-core (Paksoy et al.
+//! 2025, Eq. 9-14). SI units in and out: positions m, forces N, displacements m.
+
+use deflect_core::compliance_map::{
+    self as cm, ComplianceMap as CoreMap, ComplianceMapError, FitOptions, ForceUnit, HoldOutAxis,
+    Interpolation, LengthUnit, Measurement, OutOfGrid, QueryError, QueryOptions,
+};
+use numpy::ndarray::{Array1, Array2, Array4};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray1, PyReadonlyArray2, ToPyArray,
+};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::{InputError, LoadError};
+
+/// Batches of at least this many rows use several threads.
+const PARALLEL_MIN_ROWS: usize = 20_000;
+
+fn load_err(e: ComplianceMapError) -> PyErr {
+    LoadError::new_err(e.to_string())
+}
+fn input_err(e: ComplianceMapError) -> PyErr {
+    InputError::new_err(e.to_string())
+}
+fn query_err(e: QueryError) -> PyErr {
+    InputError::new_err(e.to_string())
+}
+
+fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
+    match s.to_ascii_lowercase().as_str() {
+        "bilinear" | "linear" => Ok(Interpolation::Bilinear),
+        "bicubic" | "cubic" => Ok(Interpolation::Bicubic),
+        _ => Err(InputError::new_err(format!(
+            "interpolation must be \"bilinear\" or \"bicubic\", got {s:?}"
+        ))),
+    }
+}
+
+fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
+    match s.to_ascii_lowercase().as_str() {
+        "error" => Ok(OutOfGrid::Error),
+        "clamp" => Ok(OutOfGrid::Clamp),
+        "extrapolate" => Ok(OutOfGrid::Extrapolate),
+        _ => Err(InputError::new_err(format!(
+            "out_of_grid must be \"error\", \"clamp\" or \"extrapolate\", got {s:?}"
+        ))),
+    }
+}
+
+fn interpolation_name(i: Interpolation) -> &'static str {
+    match i {
+        Interpolation::Bicubic => "bicubic",
+        _ => "bilinear",
+    }
+}
+
+fn out_of_grid_name(o: OutOfGrid) -> &'static str {
+    match o {
+        OutOfGrid::Clamp => "clamp",
+        OutOfGrid::Extrapolate => "extrapolate",
+        _ => "error",
+    }
+}
+
+fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit)> {
+    let f = ForceUnit::parse(force_unit).ok_or_else(|| {
+        InputError::new_err(format!(
+            "force_unit must be \"N\" or \"kgf\", got {force_unit:?}"
+        ))
+    })?;
+    let l = LengthUnit::parse(length_unit).ok_or_else(|| {
+        InputError::new_err(format!(
+            "length_unit must be \"m\" or \"mm\", got {length_unit:?}"
+        ))
+    })?;
+    Ok((f, l))
+}
+
+fn read(path: &std::path::Path) -> PyResult<String> {
+    std::fs::read_to_string(path)
+        .map_err(|e| LoadError::new_err(format!("cannot read {}: {e}", path.display())))
+}
+
+/// A compliance map from static tests (Paksoy et al. 2025, Eq. 9-14): at each node of a
+/// rectilinear grid of positions, `disp_d = sum_f (slope[d, f] * F_f + offset[d, f])`; bilinear
+/// (Eq. 14) or C1 cubic Hermite interpolation between nodes. SI: positions m, forces N,
+/// displacements m.
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct ComplianceMap {
+    pub(crate) inner: CoreMap,
+}
+
+impl ComplianceMap {
+    fn wrap(mut inner: CoreMap, interpolation: &str, out_of_grid: &str) -> PyResult<Self> {
+        inner.set_options(QueryOptions {
+            interpolation: parse_interpolation(interpolation)?,
+            out_of_grid: parse_out_of_grid(out_of_grid)?,
+        });
+        Ok(Self { inner })
+    }
+
+    fn options(
+        &self,
+        interpolation: Option<&str>,
+        out_of_grid: Option<&str>,
+    ) -> PyResult<QueryOptions> {
+        let mut o = self.inner.options();
+        if let Some(s) = interpolation {
+            o.interpolation = parse_interpolation(s)?;
+        }
+        if let Some(s) = out_of_grid {
+            o.out_of_grid = parse_out_of_grid(s)?;
+        }
+        Ok(o)
+    }
+}
+
+/// Rows of a (N, k) float array as a contiguous row-major Vec.
+fn rows_of(a: &PyReadonlyArray2<'_, f64>) -> Vec<f64> {
+    a.as_array().as_standard_layout().iter().copied().collect()
+}
+
+#[pymethods]
+impl ComplianceMap {
+    /// Loads a coefficient table in the layout of the paper's Tables II/III: columns
+    /// `x_mm, y_mm` (or `x_m, y_m`, or `x, y` in `length_unit`) and `m, n, o, p, s, u, v, w`
+    /// with `dx = (m Fx + n) + (o Fy + p)`, `dy = (s Fx + u) + (v Fy + w)`.
+    /// `length_unit` ("mm" | "m") is the displacement unit, `force_unit` ("N" | "kgf") the
+    /// force unit the lines were fitted in.
+    #[staticmethod]
+    #[pyo3(signature = (path, force_unit="N", length_unit="mm", interpolation="bilinear", out_of_grid="error"))]
+    fn from_csv(
+        path: std::path::PathBuf,
+        force_unit: &str,
+        length_unit: &str,
+        interpolation: &str,
+        out_of_grid: &str,
+    ) -> PyResult<Self> {
+        let text = read(&path)?;
+        Self::from_csv_text(&text, force_unit, length_unit, interpolation, out_of_grid)
+    }
+
+    /// Same as `from_csv`, from the CSV text.
+    #[staticmethod]
+    #[pyo3(signature = (text, force_unit="N", length_unit="mm", interpolation="bilinear", out_of_grid="error"))]
+    fn from_csv_text(
+        text: &str,
+        force_unit: &str,
+        length_unit: &str,
+        interpolation: &str,
+        out_of_grid: &str,
+    ) -> PyResult<Self> {
+        let (f, l) = units(force_unit, length_unit)?;
+        let inner = CoreMap::from_paper_csv(text, f, l).map_err(load_err)?;
+        Self::wrap(inner, interpolation, out_of_grid)
+    }
+
+    /// Fits a map from static tests (Eq. 10-13), SI arrays, one reading per row:
+    /// `positions` (N, 2) [m] node x, y; `force_axis` (N,) int, the loaded axis
+    /// (0..n_force); `force` (N,) [N]; `displacement` (N, n_displacement) [m] measured at
+    /// the working point. Alternatively pass `upper` and `lower` (N, n_displacement), the
+    /// displacements of P_u and P_l, with `spacing` = |P_u P_l| [m] and `extension` [m] (the
+    /// working point's distance beyond P_l along the tool axis):
+    /// `d = lower + extension / spacing * (lower - upper)`.
+    #[staticmethod]
+    #[pyo3(signature = (positions, force_axis, force, displacement=None, *, upper=None, lower=None,
+        spacing=None, extension=0.0, n_force=None, position_tolerance=1e-6,
+        interpolation="bilinear", out_of_grid="error"))]
+    #[allow(clippy::too_many_arguments)] // reason: mirrors the documented Python signature
+    fn fit(
+        positions: PyReadonlyArray2<'_, f64>,
+        force_axis: PyReadonlyArray1<'_, i64>,
+        force: PyReadonlyArray1<'_, f64>,
+        displacement: Option<PyReadonlyArray2<'_, f64>>,
+        upper: Option<PyReadonlyArray2<'_, f64>>,
+        lower: Option<PyReadonlyArray2<'_, f64>>,
+        spacing: Option<f64>,
+        extension: f64,
+        n_force: Option<usize>,
+        position_tolerance: f64,
+        interpolation: &str,
+        out_of_grid: &str,
+    ) -> PyResult<Self> {
+        let p = positions.as_array();
+        let n = p.nrows();
+        if p.ncols() != 2 && p.ncols() != 3 {
+            return Err(InputError::new_err(format!(
+                "positions: expected shape (N, 2), got {:?}",
+                p.shape()
+            )));
+        }
+        let (axes, forces) = (force_axis.as_array(), force.as_array());
+        if axes.len() != n || forces.len() != n {
+            return Err(InputError::new_err(format!(
+                "force_axis and force: expected shape ({n},), got ({},) and ({},)",
+                axes.len(),
+                forces.len()
+            )));
+        }
+        let check_disp = |a: &PyReadonlyArray2<'_, f64>, what: &str| -> PyResult<usize> {
+            let s = a.as_array().shape().to_vec();
+            match s.as_slice() {
+                [r, c] if *r == n && (1..=cm::MAX_AXES).contains(c) => Ok(*c),
+                _ => Err(InputError::new_err(format!(
+                    "{what}: expected shape ({n}, 1..6), got {s:?}"
+                ))),
+            }
+        };
+        let (nd, disp): (usize, Vec<f64>) = match (displacement, upper, lower) {
+            (Some(d), None, None) => (check_disp(&d, "displacement")?, rows_of(&d)),
+            (None, Some(u), Some(l)) => {
+                let nd = check_disp(&u, "upper")?;
+                if check_disp(&l, "lower")? != nd {
+                    return Err(InputError::new_err("upper and lower: shapes differ"));
+                }
+                let spacing = spacing.ok_or_else(|| {
+                    InputError::new_err("spacing (|P_u P_l| [m]) is required with upper/lower")
+                })?;
+                let (u, l) = (rows_of(&u), rows_of(&l));
+                let mut d = vec![0.0; n * nd];
+                for ((o, uu), ll) in d.chunks_mut(nd).zip(u.chunks(nd)).zip(l.chunks(nd)) {
+                    cm::two_point_displacement(uu, ll, spacing, extension, o).map_err(input_err)?;
+                }
+                (nd, d)
+            }
+            _ => {
+                return Err(InputError::new_err(
+                    "give either displacement or both upper and lower",
+                ));
+            }
+        };
+        let mut ms = Vec::with_capacity(n);
+        for (r, ((prow, a), f)) in p
+            .rows()
+            .into_iter()
+            .zip(axes.iter())
+            .zip(forces.iter())
+            .enumerate()
+        {
+            let axis = usize::try_from(*a)
+                .map_err(|_| InputError::new_err(format!("force_axis[{r}] = {a} is negative")))?;
+            let d = disp.get(r * nd..(r + 1) * nd).unwrap_or(&[]);
+            let xy = |k: usize| prow.get(k).copied().unwrap_or(f64::NAN);
+            ms.push(Measurement::new(xy(0), xy(1), axis, *f, d));
+        }
+        let n_force =
+            n_force.unwrap_or_else(|| ms.iter().map(|m| m.force_axis + 1).max().unwrap_or(1));
+        let options = FitOptions {
+            n_force,
+            n_displacement: nd,
+            position_tolerance,
+        };
+        let inner = cm::fit(&ms, &options).map_err(input_err)?;
+        Self::wrap(inner, interpolation, out_of_grid)
+    }
+
+    /// Fits a map from a CSV of static tests, one reading a row, columns:
+    /// `x, y` [length_unit] node position; `force_axis` (0.. or x, y, z, mx, my, mz);
+    /// `force` [force_unit; moments force_unit * length_unit]; displacement columns, those
+    /// present in the order `dx, dy, dz` [length_unit], `rx, ry, rz` [rad].
+    /// `position_tolerance` [m] groups coordinates into grid lines.
+    #[staticmethod]
+    #[pyo3(signature = (path, force_unit="N", length_unit="mm", n_force=None, position_tolerance=1e-6,
+        interpolation="bilinear", out_of_grid="error"))]
+    fn fit_csv(
+        path: std::path::PathBuf,
+        force_unit: &str,
+        length_unit: &str,
+        n_force: Option<usize>,
+        position_tolerance: f64,
+        interpolation: &str,
+        out_of_grid: &str,
+    ) -> PyResult<Self> {
+        let text = read(&path)?;
+        let (f, l) = units(force_unit, length_unit)?;
+        let inner =
+            CoreMap::fit_static_csv(&text, f, l, n_force, position_tolerance).map_err(load_err)?;
+        Self::wrap(inner, interpolation, out_of_grid)
+    }
+
+    /// The map as versioned JSON (`"format_version": 1`, SI units recorded); exact round trip.
+    fn to_json(&self) -> PyResult<String> {
+        self.inner.to_json().map_err(load_err)
+    }
+
+    /// Loads a map saved by `to_json`.
+    #[staticmethod]
+    fn from_json(text: &str) -> PyResult<Self> {
+        Ok(Self {
+            inner: CoreMap::from_json(text).map_err(load_err)?,
+        })
+    }
+
+    /// The same map with other default options.
+    #[pyo3(signature = (interpolation=None, out_of_grid=None))]
+    fn with_options(
+        &self,
+        interpolation: Option<&str>,
+        out_of_grid: Option<&str>,
+    ) -> PyResult<Self> {
+        let o = self.options(interpolation, out_of_grid)?;
+        Ok(Self {
+            inner: self.inner.clone().with_options(o),
+        })
+    }
+
+    /// Displacement (n_displacement,) [m] at `position` (x, y) [m] (a 3rd entry, z, is
+    /// ignored: the map is planar) under `force` (n_force,) [N]. Keywords override the map's
+    /// default `interpolation` ("bilinear" | "bicubic") and `out_of_grid` ("error" | "clamp"
+    /// | "extrapolate") for this call.
+    #[pyo3(signature = (position, force, *, interpolation=None, out_of_grid=None))]
+    fn displacement<'py>(
+        &self,
+        py: Python<'py>,
+        position: PyReadonlyArray1<'py, f64>,
+        force: PyReadonlyArray1<'py, f64>,
+        interpolation: Option<&str>,
+        out_of_grid: Option<&str>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let o = self.options(interpolation, out_of_grid)?;
+        let p = position.as_array();
+        if p.len() != 2 && p.len() != 3 {
+            return Err(InputError::new_err(format!(
+                "position: expected shape (2,) or (3,), got ({},)",
+                p.len()
+            )));
+        }
+        let f: Vec<f64> = force.as_array().iter().copied().collect();
+        let mut out = vec![0.0; self.inner.n_displacement()];
+        self.inner
+            .displacement_with(
+                [
+                    p.get(0).copied().unwrap_or(f64::NAN),
+                    p.get(1).copied().unwrap_or(f64::NAN),
+                ],
+                &f,
+                &mut out,
+                o,
+            )
+            .map_err(query_err)?;
+        Ok(out.into_pyarray(py))
+    }
+
+    /// Displacements (N, n_displacement) [m] for positions `P` (N, 2) or (N, 3) [m] (z
+    /// ignored) and forces `F` (N, n_force) [N]. Runs without the GIL, on several threads for
+    /// N >= 20000. With
+    /// `out_of_grid="error"` the first row outside the grid raises `InputError`.
+    #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None))]
+    fn displacement_batch<'py>(
+        &self,
+        py: Python<'py>,
+        P: PyReadonlyArray2<'py, f64>,
+        F: PyReadonlyArray2<'py, f64>,
+        interpolation: Option<&str>,
+        out_of_grid: Option<&str>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let o = self.options(interpolation, out_of_grid)?;
+        let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
+        let (p, f) = (P.as_array(), F.as_array());
+        let n = p.nrows();
+        if p.ncols() != 2 && p.ncols() != 3 {
+            return Err(InputError::new_err(format!(
+                "P: expected shape (N, 2) or (N, 3), got {:?}",
+                p.shape()
+            )));
+        }
+        if f.shape() != [n, nf] {
+            return Err(InputError::new_err(format!(
+                "F: expected shape ({n}, {nf}), got {:?}",
+                f.shape()
+            )));
+        }
+        let map = &self.inner;
+        let out = py.detach(|| -> Result<Vec<f64>, String> {
+            let (p, f) = (p.as_standard_layout(), f.as_standard_layout());
+            let (Some(ps), Some(fs)) = (p.as_slice(), f.as_slice()) else {
+                return Err("internal: arrays not contiguous".to_string());
+            };
+            let view = map.view();
+            let mut out = vec![0.0; n * nd];
+            let pc = p.ncols().max(1);
+            // Large batches are split over the available cores (at most 8 threads).
+            let threads = if n >= PARALLEL_MIN_ROWS {
+                std::thread::available_parallelism().map_or(1, |t| t.get().min(8))
+            } else {
+                1
+            };
+            let rows = n.div_ceil(threads).max(1);
+            let results: Vec<Result<(), String>> = std::thread::scope(|scope| {
+                let handles: Vec<_> = out
+                    .chunks_mut(rows * nd)
+                    .zip(ps.chunks(rows * pc))
+                    .zip(fs.chunks(rows * nf))
+                    .enumerate()
+                    .map(|(k, ((oc, pchunk), fchunk))| {
+                        scope.spawn(move || {
+                            view.displacement_batch(pchunk, pc, fchunk, oc, o)
+                                .map(|_| ())
+                                .map_err(|e| format!("row {}: {}", k * rows + e.row, e.error))
+                        })
+                    })
+                    .collect();
+                handles
+                    .into_iter()
+                    .map(|h| {
+                        h.join()
+                            .unwrap_or_else(|_| Err("worker thread panicked".to_string()))
+                    })
+                    .collect()
+            });
+            // The first failing row in row order.
+            for r in results {
+                r?;
+            }
+            Ok(out)
+        });
+        let out = out.map_err(InputError::new_err)?;
+        let arr =
+            Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
+        Ok(arr.into_pyarray(py))
+    }
+
+    /// Leave-one-node-out cross-validation of bilinear vs bicubic: `forces` (K, n_force) [N];
+    /// `axis` "y" (remove the grid line y = y_j, predict along columns) or "x". Returns a dict
+    /// with `rms_bilinear`, `rms_bicubic` [m] and per-node errors.
+    #[pyo3(signature = (forces, axis="y"))]
+    fn cross_validate<'py>(
+        &self,
+        py: Python<'py>,
+        forces: PyReadonlyArray2<'py, f64>,
+        axis: &str,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let a = match axis {
+            "x" => HoldOutAxis::X,
+            "y" => HoldOutAxis::Y,
+            _ => {
+                return Err(InputError::new_err(format!(
+                    "axis must be \"x\" or \"y\", got {axis:?}"
+                )));
+            }
+        };
+        if forces.as_array().ncols() != self.inner.n_force() {
+            return Err(InputError::new_err(format!(
+                "forces: expected shape (K, {}), got {:?}",
+                self.inner.n_force(),
+                forces.as_array().shape()
+            )));
+        }
+        let cv = cm::leave_one_node_out(&self.inner, &rows_of(&forces), a).map_err(input_err)?;
+        let d = PyDict::new(py);
+        d.set_item("axis", axis)?;
+        d.set_item("rms_bilinear", cv.rms_bilinear)?;
+        d.set_item("rms_bicubic", cv.rms_bicubic)?;
+        d.set_item("better", interpolation_name(cv.better()))?;
+        let nodes: Vec<(usize, usize, f64, f64)> = cv
+            .nodes
+            .iter()
+            .map(|n| (n.i, n.j, n.rms_bilinear, n.rms_bicubic))
+            .collect();
+        d.set_item("nodes", nodes)?;
+        Ok(d)
+    }
+
+    /// Per-node fit statistics (a list in node order `i * ny + j` of dicts with `i, j, x, y`,
+    /// `slope, offset, rms, r_squared` arrays (n_displacement, n_force), `condition` and
+    /// `samples` (n_force,)), or None for a map not fitted here.
+    #[getter]
+    fn residuals<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyList>>> {
+        let Some(stats) = self.inner.fit_stats() else {
+            return Ok(None);
+        };
+        let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
+        let list = PyList::empty(py);
+        for s in stats {
+            let d = PyDict::new(py);
+            d.set_item("i", s.i)?;
+            d.set_item("j", s.j)?;
+            d.set_item("x", s.x)?;
+            d.set_item("y", s.y)?;
+            let field = |g: fn(&cm::LineStats) -> f64| {
+                Array2::from_shape_fn((nd, nf), |(a, b)| {
+                    s.lines.get(a * nf + b).map_or(f64::NAN, g)
+                })
+            };
+            d.set_item("slope", field(|l| l.slope).to_pyarray(py))?;
+            d.set_item("offset", field(|l| l.offset).to_pyarray(py))?;
+            d.set_item("rms", field(|l| l.rms).to_pyarray(py))?;
+            d.set_item("r_squared", field(|l| l.r_squared).to_pyarray(py))?;
+            d.set_item(
+                "condition",
+                Array1::from(s.condition.clone()).to_pyarray(py),
+            )?;
+            d.set_item("samples", s.samples.clone())?;
+            list.append(d)?;
+        }
+        Ok(Some(list))
+    }
+
+    /// Node x coordinates (nx,) [m].
+    #[getter]
+    fn x<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.x().to_pyarray(py)
+    }
+    /// Node y coordinates (ny,) [m].
+    #[getter]
+    fn y<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.y().to_pyarray(py)
+    }
+    /// Number of force axes.
+    #[getter]
+    fn n_force(&self) -> usize {
+        self.inner.n_force()
+    }
+    /// Number of displacement axes.
+    #[getter]
+    fn n_displacement(&self) -> usize {
+        self.inner.n_displacement()
+    }
+    /// Default interpolation ("bilinear" | "bicubic").
+    #[getter]
+    fn interpolation(&self) -> &'static str {
+        interpolation_name(self.inner.options().interpolation)
+    }
+    /// Default out-of-grid policy ("error" | "clamp" | "extrapolate").
+    #[getter]
+    fn out_of_grid(&self) -> &'static str {
+        out_of_grid_name(self.inner.options().out_of_grid)
+    }
+    /// Slopes (nx, ny, n_displacement, n_force) [m/N].
+    #[getter]
+    fn slopes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray4<f64>>> {
+        self.coefficients(py, self.inner.slopes())
+    }
+    /// Offsets (nx, ny, n_displacement, n_force) [m]; at zero force `disp_d = sum_f offset`.
+    #[getter]
+    fn offsets<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray4<f64>>> {
+        self.coefficients(py, self.inner.offsets())
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "ComplianceMap(grid={}x{}, n_force={}, n_displacement={}, interpolation='{}', out_of_grid='{}')",
+            self.inner.x().len(),
+            self.inner.y().len(),
+            self.inner.n_force(),
+            self.inner.n_displacement(),
+            self.interpolation(),
+            self.out_of_grid()
+        )
+    }
+}
+
+impl ComplianceMap {
+    fn coefficients<'py>(&self, py: Python<'py>, v: &[f64]) -> PyResult<Bound<'py, PyArray4<f64>>> {
+        let shape = (
+            self.inner.x().len(),
+            self.inner.y().len(),
+            self.inner.n_displacement(),
+            self.inner.n_force(),
+        );
+        let a = Array4::from_shape_vec(shape, v.to_vec())
+            .map_err(|e| InputError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ComplianceMap>()?;
+    Ok(())
+}
