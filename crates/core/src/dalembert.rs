@@ -218,7 +218,7 @@ impl<const J: usize> DisplacementModel<3, J> for VjmDisplacement<'_> {
         let mut data = Data::new(self.model);
         let d = vjm::deflection(self.model, &mut data, q.as_slice(), &w)
             .map_err(CorrectorError::Vjm)?;
-        Ok((Vector3::new(d[0], d[1], d[2]), ModelStatus::Inside))
+        Ok((Vector3::new(d.x, d.y, d.z), ModelStatus::Inside))
     }
 
     fn needs_joints(&self) -> bool {

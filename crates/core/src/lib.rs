@@ -29,9 +29,13 @@ extern crate alloc;
 #[cfg(feature = "std")]
 extern crate std;
 
+pub mod compensation;
 pub mod compliance_map;
 pub mod dalembert;
+pub mod drivetrain;
 pub mod error;
+#[cfg(feature = "std")]
+pub mod identification;
 pub mod mechanism;
 pub mod motion;
 pub mod vjm;

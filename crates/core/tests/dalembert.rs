@@ -15,11 +15,11 @@ fn constant_map(c: [[f64; 2]; 2], offsets: [f64; 2]) -> ComplianceMap {
     let mut slopes = Vec::new();
     let mut offs = Vec::new();
     for _ in 0..15 {
-        for d in 0..2 {
-            for f in 0..2 {
-                slopes.push(c[d][f]);
+        for (row, off) in c.iter().zip(offsets) {
+            for &cdf in row {
+                slopes.push(cdf);
                 // Split the offset between the two force axes, as the paper does.
-                offs.push(offsets[d] / 2.0);
+                offs.push(off / 2.0);
             }
         }
     }

@@ -16,6 +16,7 @@ use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod compensation;
 mod compliance_map;
 mod convert;
 mod dalembert;
@@ -63,6 +64,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     vjm::register(m)?;
+    compensation::register(m)?;
     compliance_map::register(m)?;
     motion::register(m)?;
     dalembert::register(m)?;

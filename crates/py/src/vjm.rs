@@ -17,7 +17,7 @@ fn load_err(e: CoreLoadError) -> PyErr {
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct SerialRobot {
-    inner: CoreRobot,
+    pub(crate) inner: CoreRobot,
 }
 
 #[pymethods]

@@ -46,6 +46,57 @@ pub struct JointCorrection {
     pub converged: bool,
 }
 
+/// Least-squares, minimum-norm `dq` with `J dq = delta` for the Jacobian in `data`
+/// (filled by [`joint_jacobian`]); also returns the smallest relevant singular value.
+fn solve_jacobian(
+    data: &Data,
+    dof: usize,
+    delta: &Vector6,
+) -> Result<(SVector<f64, MAX_DOF>, f64), TickError> {
+    let svd = SVD::try_new(data.jacobian, true, true, f64::EPSILON, SVD_MAX_ITERATIONS).ok_or(
+        TickError::NotConverged {
+            iterations: SVD_MAX_ITERATIONS,
+            residual: f64::NAN,
+        },
+    )?;
+    // The `min(dof, 6)` largest singular values span the reachable directions.
+    let mut sv = [0.0f64; 6];
+    for (dst, &s) in sv.iter_mut().zip(svd.singular_values.iter()) {
+        *dst = s;
+    }
+    sv.sort_unstable_by(|a, b| b.total_cmp(a));
+    let rank = dof.min(6);
+    let sigma_max = sv.first().copied().unwrap_or(0.0);
+    let sigma_min = sv.get(rank.saturating_sub(1)).copied().unwrap_or(0.0);
+    if !(sigma_min > 0.0 && sigma_max / sigma_min < MAX_CONDITION) {
+        return Err(TickError::Singular { sigma_min });
+    }
+    let step = svd
+        .solve(delta, sigma_max / MAX_CONDITION)
+        .map_err(|_| TickError::Singular { sigma_min })?;
+    Ok((step, sigma_min))
+}
+
+/// Axis-specific values for a Cartesian correction: the least-squares, minimum-norm `dq`
+/// [rad or m] with `J(q) dq = delta`, `delta = [dp; dr]` [m, rad] in the base frame (the
+/// paper's conversion of Cartesian correction values into axis values, section 2.2).
+/// Entries past [`Model::dof`] are zero. [`TickError::Singular`] near singular poses.
+pub fn joint_delta(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    delta: &Vector6,
+) -> Result<[f64; MAX_DOF], TickError> {
+    check_finite("delta", delta.as_slice())?;
+    joint_jacobian(model, data, q)?;
+    let (step, _) = solve_jacobian(data, model.dof, delta)?;
+    let mut out = [0.0; MAX_DOF];
+    for (dst, &v) in out.iter_mut().zip(step.iter()).take(model.dof) {
+        *dst = v;
+    }
+    Ok(out)
+}
+
 /// Axis-specific correction: the `dq` such that the robot commanded to `q + dq` and loaded by
 /// `wrench` puts its deflected TCP on the rigid TCP of `q`.
 ///
@@ -94,28 +145,8 @@ pub fn joint_correction(
             break;
         }
         joint_jacobian(model, data, qs)?;
-        let svd = SVD::try_new(data.jacobian, true, true, f64::EPSILON, SVD_MAX_ITERATIONS).ok_or(
-            TickError::NotConverged {
-                iterations: SVD_MAX_ITERATIONS,
-                residual: f64::NAN,
-            },
-        )?;
-        // The `min(dof, 6)` largest singular values span the reachable directions.
-        let mut sv = [0.0f64; 6];
-        for (dst, &s) in sv.iter_mut().zip(svd.singular_values.iter()) {
-            *dst = s;
-        }
-        sv.sort_unstable_by(|a, b| b.total_cmp(a));
-        let rank = dof.min(6);
-        let sigma_max = sv.first().copied().unwrap_or(0.0);
-        let sigma_min = sv.get(rank.saturating_sub(1)).copied().unwrap_or(0.0);
+        let (step, sigma_min) = solve_jacobian(data, dof, &(-e))?;
         out.sigma_min = sigma_min;
-        if !(sigma_min > 0.0 && sigma_max / sigma_min < MAX_CONDITION) {
-            return Err(TickError::Singular { sigma_min });
-        }
-        let step: SVector<f64, MAX_DOF> = svd
-            .solve(&(-e), sigma_max / MAX_CONDITION)
-            .map_err(|_| TickError::Singular { sigma_min })?;
         for (qi, si) in qk.iter_mut().zip(step.iter()).take(dof) {
             *qi += si;
         }

@@ -12,7 +12,7 @@ mod correction;
 mod deflection;
 mod model;
 
-pub use correction::{JointCorrection, commanded_pose, joint_correction};
+pub use correction::{JointCorrection, commanded_pose, joint_correction, joint_delta};
 pub use deflection::{compliance, deflection, forward, joint_jacobian};
 pub use model::{Data, Element, MAX_DOF, MAX_ELEMENTS, MAX_SPRINGS, Model, ModelBuilder};
 

@@ -1,0 +1,206 @@
+//! After init, the per-tick functions of the C API allocate nothing: a counting global
+//! allocator (counting on this test's thread only) sees zero allocations over whole loops.
+#![allow(unsafe_code)] // reason: a counting global allocator and calls into the extern "C" API.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+use std::path::Path;
+use std::ptr;
+
+use deflect::*;
+
+struct Counting;
+
+thread_local! {
+    static ALLOCATIONS: Cell<usize> = const { Cell::new(0) };
+}
+
+// SAFETY: forwards to the system allocator; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, p: *mut u8, layout: Layout) {
+        // SAFETY: same contract as the caller's.
+        unsafe { System.dealloc(p, layout) }
+    }
+    unsafe fn realloc(&self, p: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        let _ = ALLOCATIONS.try_with(|a| a.set(a.get() + 1));
+        // SAFETY: same contract as the caller's.
+        unsafe { System.realloc(p, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+fn allocations() -> usize {
+    ALLOCATIONS.with(Cell::get)
+}
+
+fn repo(rel: &str) -> std::ffi::CString {
+    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(rel);
+    std::ffi::CString::new(p.to_string_lossy().into_owned()).unwrap()
+}
+
+#[test]
+fn per_tick_calls_do_not_allocate() {
+    // Init: loads and plans allocate.
+    let (urdf, toml, csv) = (
+        repo("robots/kr300/kr300_r2500.urdf"),
+        repo("robots/kr300/kr300_r2500_stiffness.toml"),
+        repo("data/paksoy2025_compliance_oc.csv"),
+    );
+    let mut robot = ptr::null_mut();
+    let mut map = ptr::null_mut();
+    let mut traj = ptr::null_mut();
+    let mut corr = ptr::null_mut();
+    let mut lim = DeflectLimits::default();
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        assert_eq!(
+            deflect_serial_robot_load(
+                urdf.as_ptr(),
+                toml.as_ptr(),
+                c"tcp".as_ptr(),
+                &mut robot,
+                ptr::null_mut(),
+                0
+            ),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_compliance_map_load_paper_csv(
+                csv.as_ptr(),
+                DEFLECT_FORCE_UNIT_NEWTON,
+                DEFLECT_LENGTH_UNIT_MILLIMETRE,
+                &mut map,
+                ptr::null_mut(),
+                0
+            ),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_compliance_map_set_options(
+                map,
+                DEFLECT_INTERPOLATION_BILINEAR,
+                DEFLECT_OUT_OF_GRID_CLAMP
+            ),
+            DEFLECT_OK
+        );
+        assert_eq!(deflect_paper_limits(5, &mut lim), DEFLECT_OK);
+        let (a, b) = ([0.222132, -0.075], [0.222132, 0.075]);
+        assert_eq!(
+            deflect_trajectory2_line(a.as_ptr(), b.as_ptr(), &lim, &mut traj),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_dalembert_create(ptr::null(), DEFLECT_PAPER_MASS, 3, 0.0, &mut corr),
+            DEFLECT_OK
+        );
+    }
+
+    let before = allocations();
+    let mut q = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+    let w = [-386.1, 386.1, 0.0, 0.0, 0.0, 0.0];
+    let (mut d, mut c) = ([0.0; 6], [0.0; 36]);
+    let mut jc = DeflectJointCorrection::default();
+    let mut n = 0usize;
+    let mut st = DeflectState2::default();
+    let mut tick = DeflectCorrectedTick2::default();
+    let mut seed = [0.0; 2];
+    let mut out = [0.0; 2];
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        for i in 0..200 {
+            q[0] = 1e-4 * i as f64;
+            assert_eq!(
+                deflect_serial_robot_deflection(robot, q.as_ptr(), 6, w.as_ptr(), d.as_mut_ptr()),
+                DEFLECT_OK
+            );
+            assert_eq!(
+                deflect_serial_robot_compliance(robot, q.as_ptr(), 6, c.as_mut_ptr()),
+                DEFLECT_OK
+            );
+            assert_eq!(
+                deflect_serial_robot_joint_correction(
+                    robot,
+                    q.as_ptr(),
+                    6,
+                    w.as_ptr(),
+                    3,
+                    0.0,
+                    &mut jc
+                ),
+                DEFLECT_OK
+            );
+        }
+        assert_eq!(
+            deflect_trajectory2_tick_count(traj, 2000.0, &mut n),
+            DEFLECT_OK
+        );
+        for k in 0..n {
+            let mut t = 0.0;
+            assert_eq!(
+                deflect_trajectory2_tick_time(traj, 2000.0, k, &mut t),
+                DEFLECT_OK
+            );
+            assert_eq!(deflect_trajectory2_sample(traj, t, &mut st), DEFLECT_OK);
+            assert_eq!(
+                deflect_dalembert_step(
+                    corr,
+                    map,
+                    st.position.as_ptr(),
+                    st.acceleration.as_ptr(),
+                    seed.as_ptr(),
+                    &mut tick
+                ),
+                DEFLECT_OK
+            );
+            seed = tick.joints;
+            assert_eq!(
+                deflect_compliance_map_displacement(
+                    map,
+                    st.position.as_ptr(),
+                    tick.force.as_ptr(),
+                    2,
+                    out.as_mut_ptr(),
+                    2,
+                    ptr::null_mut()
+                ),
+                DEFLECT_OK
+            );
+        }
+        // Error paths do not allocate either.
+        let nan = [f64::NAN; 2];
+        assert_eq!(
+            deflect_dalembert_step(
+                corr,
+                map,
+                nan.as_ptr(),
+                nan.as_ptr(),
+                seed.as_ptr(),
+                &mut tick
+            ),
+            DEFLECT_ERR_NON_FINITE
+        );
+        assert_eq!(
+            deflect_serial_robot_deflection(robot, q.as_ptr(), 5, w.as_ptr(), d.as_mut_ptr()),
+            DEFLECT_ERR_WRONG_LENGTH
+        );
+    }
+    assert_eq!(allocations() - before, 0, "per-tick C API calls allocated");
+    assert!(n > 700);
+
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        deflect_dalembert_destroy(corr);
+        deflect_trajectory2_destroy(traj);
+        deflect_compliance_map_destroy(map);
+        deflect_serial_robot_destroy(robot);
+    }
+}
