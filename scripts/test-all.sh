@@ -17,15 +17,21 @@ if cargo tree -p deflect-core --no-default-features -e features -i nalgebra | gr
   echo "error: the no_std build of deflect-core enables nalgebra/std" >&2
   exit 1
 fi
-# Benchmarks and examples must keep compiling (they are run by hand, not timed here).
+# Benchmarks must keep compiling (they are run by hand, not timed here).
 cargo bench --workspace --no-run --quiet
+# The numbered examples run (built-in defaults), each next to its Python twin below.
+for ex in examples/[0-9][0-9]_*.rs; do
+  name=$(basename "$ex" .rs)
+  echo "-- $name"
+  cargo run --quiet --example "$name" > /dev/null
+done
 
 echo "== Python: build the wheel, run pytest =="
 if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest "example-robot-data>=4"
+"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest mcap "example-robot-data>=4"
 "$VENV/bin/python" -m pip install --quiet ./crates/py
 "$VENV/bin/python" -m pytest -q crates/py/tests
 for ex in examples/[0-9][0-9]_*.py; do

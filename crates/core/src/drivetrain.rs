@@ -564,12 +564,12 @@ macro_rules! square_stiffness {
         }
         vjm::joint_jacobian($model, $data, $q)?;
         let rows: [usize; $n] = $rows;
-        let mut j = <$mat>::zeros();
-        for (r, &src) in rows.iter().enumerate() {
-            for c in 0..$n {
-                j[(r, c)] = $data.jacobian.get((src, c)).copied().unwrap_or(0.0);
-            }
-        }
+        let j = <$mat>::from_fn(|r, c| {
+            rows.get(r)
+                .and_then(|&src| $data.jacobian.get((src, c)))
+                .copied()
+                .unwrap_or(0.0)
+        });
         let svd = SVD::try_new(j, true, true, f64::EPSILON, 100).ok_or(TickError::NotConverged {
             iterations: 100,
             residual: f64::NAN,
@@ -584,10 +584,13 @@ macro_rules! square_stiffness {
         let j_inv = svd
             .pseudo_inverse(0.0)
             .map_err(|_| TickError::Singular { sigma_min: smin })?;
-        let mut k_theta = <$mat>::zeros();
-        for (i, &k) in $drive.stiffness.iter().enumerate().take($n) {
-            k_theta[(i, i)] = k;
-        }
+        let k_theta = <$mat>::from_fn(|r, c| {
+            if r == c {
+                $drive.stiffness.get(r).copied().unwrap_or(0.0)
+            } else {
+                0.0
+            }
+        });
         let k = j_inv.transpose() * k_theta * j_inv;
         // Symmetrize away the rounding.
         Ok((k + k.transpose()) * 0.5)
@@ -633,11 +636,12 @@ pub fn cartesian_stiffness_planar(
 /// Schur complement `K_xx - K_xr K_rr^-1 K_rx`, for a probe that transmits no moment.
 /// `None` if `K_rr` is not positive.
 pub fn free_moment_xy(k: &Matrix3<f64>) -> Option<Matrix2<f64>> {
-    let krr = k[(2, 2)];
+    let at = |r: usize, c: usize| k.get((r, c)).copied().unwrap_or(f64::NAN);
+    let krr = at(2, 2);
     if !(krr > 0.0 && krr.is_finite()) {
         return None;
     }
-    let kxr = SMatrix::<f64, 2, 1>::new(k[(0, 2)], k[(1, 2)]);
-    let kxx = Matrix2::new(k[(0, 0)], k[(0, 1)], k[(1, 0)], k[(1, 1)]);
+    let kxr = SMatrix::<f64, 2, 1>::new(at(0, 2), at(1, 2));
+    let kxx = Matrix2::new(at(0, 0), at(0, 1), at(1, 0), at(1, 1));
     Some(kxx - kxr * kxr.transpose() / krr)
 }

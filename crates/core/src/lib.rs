@@ -31,6 +31,7 @@ extern crate std;
 
 pub mod compensation;
 pub mod compliance_map;
+pub mod contour;
 pub mod dalembert;
 pub mod drivetrain;
 pub mod error;
@@ -40,6 +41,8 @@ pub mod mechanism;
 pub mod motion;
 pub mod vjm;
 
+#[cfg(feature = "urdf")]
+pub mod drivetrain_io;
 #[cfg(feature = "urdf")]
 pub mod robot;
 

@@ -200,6 +200,9 @@ pub struct VirtualJointSpec {
 struct StiffnessFile {
     #[serde(default)]
     virtual_joint: Vec<VirtualJointSpec>,
+    // Drive-train `[[joint]]` entries may share the file; `crate::drivetrain_io` reads them.
+    #[serde(default, rename = "joint")]
+    _joint: Option<toml::Value>,
 }
 
 /// Parses a stiffness TOML text (format in the module docs). Values are checked when the

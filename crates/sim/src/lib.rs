@@ -7,6 +7,7 @@
 pub mod analysis;
 pub mod output;
 pub mod pipeline;
+pub mod report;
 pub mod robot;
 pub mod serial;
 

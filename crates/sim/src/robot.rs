@@ -31,7 +31,7 @@
 //! compliance (`1/kp`) the static tests (motors locked) do not see.
 
 use deflect_core::mechanism::ParallelRobot2;
-use nalgebra::{Matrix2, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use rapier3d_f64::prelude::*;
 
 use crate::SimError;
@@ -178,11 +178,43 @@ impl RobotParams {
 }
 
 /// The linearized static compliance of the model at the tool point for an in-plane force at
-/// G: `J K^-1 J^T` [m/N], `J` the robot Jacobian at joints `q`, `K = diag(k_a, k_b)`.
-pub fn linear_compliance(params: &RobotParams, q: &Vector2<f64>) -> Result<Matrix2<f64>, SimError> {
-    let j = ParallelRobot2::paper().jacobian_at(q)?;
-    let kinv = Matrix2::new(1.0 / params.k_a, 0.0, 0.0, 1.0 / params.k_b);
-    Ok(j * kinv * j.transpose())
+/// G: `J K^-1 J^T` [m/N] over the three elastic coordinates of the closed chain,
+/// `K = diag(k_a, k_b, k_orient)` (the two drive springs and the parallelograms' orientation
+/// spring) and `J = d(x, y, psi)/d(theta_a, theta_b, psi)` at the tool point `p` [m] (x, y
+/// block returned). Without the orientation spring (`k_orient -> inf`) this is the robot's
+/// 2 x 2 `J K^-1 J^T` with [`ParallelRobot2::jacobian_at`].
+///
+/// `J^-1` is built by central differences of the arms' closed-form IK: with the platform
+/// rotated by `psi`, arm A reaches `D - A0 = p + R(psi) (0, h) - (0, h)` and arm B
+/// `E - B0 = p + R(psi) (0, -h) - (0, -h)`.
+pub fn linear_compliance(params: &RobotParams, p: &Vector2<f64>) -> Result<Matrix2<f64>, SimError> {
+    let mech = ParallelRobot2::paper();
+    let h = HALF_WIDTH;
+    let joints = |x: f64, y: f64, psi: f64| -> Result<Vector3<f64>, SimError> {
+        let (s, c) = psi.sin_cos();
+        let ta = Vector2::new(x - h * s, y + h * c - h);
+        let tb = Vector2::new(x + h * s, y - h * c + h);
+        Ok(Vector3::new(mech.ik(&ta)?.x, mech.ik(&tb)?.y, psi))
+    };
+    let e = 1e-7;
+    let mut jinv = Matrix3::zeros();
+    for k in 0..3 {
+        let mut dp = Vector3::zeros();
+        dp[k] = e;
+        let plus = joints(p.x + dp.x, p.y + dp.y, dp.z)?;
+        let minus = joints(p.x - dp.x, p.y - dp.y, -dp.z)?;
+        jinv.set_column(k, &((plus - minus) / (2.0 * e)));
+    }
+    let j = jinv
+        .try_inverse()
+        .ok_or_else(|| SimError::new("singular pose in linear_compliance"))?;
+    let kinv = Matrix3::from_diagonal(&Vector3::new(
+        1.0 / params.k_a,
+        1.0 / params.k_b,
+        1.0 / params.k_orient,
+    ));
+    let c = j * kinv * j.transpose();
+    Ok(Matrix2::new(c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(1, 1)]))
 }
 
 /// Mass properties of a set of point masses / rods along a body's local x axis:
