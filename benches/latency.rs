@@ -35,7 +35,28 @@ pub fn report(name: &str, n: usize, budget_ns: f64, mut tick: impl FnMut(usize))
     );
 }
 
+/// Asks for what a servo thread gets on a real-time controller: SCHED_FIFO priority 80 and
+/// locked memory. Returns a description of what was granted (a container may refuse).
+fn realtime_setup() -> &'static str {
+    #[allow(unsafe_code)] // reason: plain libc calls with valid arguments
+    // SAFETY: `sched_param` is fully initialised; both calls only read their arguments.
+    let (fifo, locked) = unsafe {
+        let param = libc::sched_param { sched_priority: 80 };
+        (
+            libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) == 0,
+            libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) == 0,
+        )
+    };
+    match (fifo, locked) {
+        (true, true) => "SCHED_FIFO 80, memory locked",
+        (true, false) => "SCHED_FIFO 80, memory not locked",
+        (false, true) => "normal scheduling (SCHED_FIFO refused), memory locked",
+        (false, false) => "normal scheduling (SCHED_FIFO and mlockall refused)",
+    }
+}
+
 fn main() {
+    let rt = realtime_setup();
     let n: usize = std::env::args()
         .skip(1)
         .find_map(|a| a.parse().ok())
@@ -47,7 +68,7 @@ fn main() {
     let mut data = Data::new(model);
     let w = Vector6::from_row_slice(&MILLING_WRENCH);
     let mut q = KR300_MILLING_POSE;
-    println!("deflect latency harness: KR 300 model (6 joints, 11 virtual joints)");
+    println!("deflect latency harness ({rt}); KR 300 model (6 joints, 11 virtual joints)");
     report("vjm::deflection", n, budget, |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::deflection(model, &mut data, black_box(&q), &w).ok());

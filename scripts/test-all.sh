@@ -12,9 +12,14 @@ cargo clippy --workspace --all-targets --quiet -- -D warnings
 cargo test --workspace --quiet
 # The real-time core must build without std (no_std, no alloc) ...
 cargo build -p deflect-core --no-default-features --quiet
-# ... and no `std` feature may reach nalgebra in that build.
-if cargo tree -p deflect-core --no-default-features -e features -i nalgebra | grep -q 'nalgebra feature "std"'; then
-  echo "error: the no_std build of deflect-core enables nalgebra/std" >&2
+# ... and its per-tick paths must work from a #![no_std] crate without alloc. Build that crate
+# alone: built with the workspace, cargo unifies deflect-core's features and proves nothing.
+cargo build -p deflect-nostd-check --quiet
+# No std/alloc feature may reach nalgebra or deflect-core in that build (normal edges only:
+# deflect-core's dev-dependencies enable nalgebra/std for its own tests).
+if cargo tree -p deflect-nostd-check -e normal,features \
+     | grep -E 'nalgebra feature "(std|alloc)"|deflect-core feature "(std|alloc)"'; then
+  echo "error: the no_std build of deflect-core enables std/alloc" >&2
   exit 1
 fi
 # Benchmarks must keep compiling (they are run by hand, not timed here).

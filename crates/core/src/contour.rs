@@ -630,8 +630,8 @@ impl ContourTracer {
             }
         }
         // Eq. 24 plus a move along the force that steers |F| to the target.
-        let correction = ((cfg.target_force - magnitude) / self.normal_stiffness(&n))
-            .clamp(-cfg.step, cfg.step);
+        let correction =
+            ((cfg.target_force - magnitude) / self.normal_stiffness(&n)).clamp(-cfg.step, cfg.step);
         out.command = position + tangent * cfg.step + n * correction;
         self.anchor = *position;
         self.anchor_tangent = tangent;

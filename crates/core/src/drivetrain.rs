@@ -111,7 +111,10 @@ impl fmt::Display for DriveTrainError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Self::CapacityExceeded { capacity } => {
-                write!(f, "too many point masses: the table holds at most {capacity}")
+                write!(
+                    f,
+                    "too many point masses: the table holds at most {capacity}"
+                )
             }
             Self::InvalidMass { index, value } => {
                 write!(f, "mass #{index} is {value} kg; it must be finite and >= 0")
@@ -125,7 +128,10 @@ impl fmt::Display for DriveTrainError {
                 what,
                 expected,
                 got,
-            } => write!(f, "{what}: expected {expected} entries (one per joint), got {got}"),
+            } => write!(
+                f,
+                "{what}: expected {expected} entries (one per joint), got {got}"
+            ),
             Self::NonPositiveStiffness { joint, value } => write!(
                 f,
                 "joint {joint}: stiffness {value} must be finite and > 0 (N m/rad)"
@@ -255,7 +261,11 @@ impl DriveTrain {
     /// Joint stiffnesses `K_i` (finite, > 0) and backlashes `theta_b_i` (finite, >= 0), one
     /// per actuated joint of `model`, in `q` order. No masses, gravity (0, 0, -9.81) m/s^2,
     /// no torque deadband, [`DEFAULT_MAX_CONDITION`].
-    pub fn new(model: &Model, stiffness: &[f64], backlash: &[f64]) -> Result<Self, DriveTrainError> {
+    pub fn new(
+        model: &Model,
+        stiffness: &[f64],
+        backlash: &[f64],
+    ) -> Result<Self, DriveTrainError> {
         let dof = model.dof();
         let stiffness = copy_checked(
             "stiffness",
@@ -570,10 +580,11 @@ macro_rules! square_stiffness {
                 .copied()
                 .unwrap_or(0.0)
         });
-        let svd = SVD::try_new(j, true, true, f64::EPSILON, 100).ok_or(TickError::NotConverged {
-            iterations: 100,
-            residual: f64::NAN,
-        })?;
+        let svd =
+            SVD::try_new(j, true, true, f64::EPSILON, 100).ok_or(TickError::NotConverged {
+                iterations: 100,
+                residual: f64::NAN,
+            })?;
         let s = &svd.singular_values;
         let (smin, smax) = s
             .iter()

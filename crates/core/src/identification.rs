@@ -186,7 +186,7 @@ impl AxisEstimate {
     pub fn stiffness(&self) -> Option<f64> {
         match self.compliance {
             Some(c) if c > 0.0 => Some(1.0 / c),
-            Some(c) if c == 0.0 => Some(f64::INFINITY),
+            Some(0.0) => Some(f64::INFINITY),
             _ => None,
         }
     }
@@ -201,11 +201,11 @@ pub struct StiffnessIdentification {
     pub fit: LeastSquares,
 }
 
+/// A spring frame's rigid pose (base frame) and its compliances.
+type SpringFrame = (Isometry3<f64>, Vector3<f64>);
+
 /// Poses of every spring frame and of the TCP at `q` (rigid).
-fn spring_frames(
-    model: &Model,
-    q: &[f64],
-) -> Result<(Vec<(Isometry3<f64>, Vector3<f64>)>, Isometry3<f64>), TickError> {
+fn spring_frames(model: &Model, q: &[f64]) -> Result<(Vec<SpringFrame>, Isometry3<f64>), TickError> {
     let mut data = Data::new(model);
     let tcp = forward(model, &mut data, q)?;
     let mut frames = Vec::new();
@@ -230,7 +230,7 @@ fn spring_frames(
 
 /// The moment on each spring in its own frame under `wrench` (Eq. 5-6, undeformed pose).
 fn spring_moments(
-    frames: &[(Isometry3<f64>, Vector3<f64>)],
+    frames: &[SpringFrame],
     tcp: &Isometry3<f64>,
     wrench: &Vector6,
 ) -> Vec<Vector3<f64>> {

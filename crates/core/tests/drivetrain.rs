@@ -17,23 +17,43 @@ fn arm_joints() -> [(Vector3<f64>, bool, Vector3<f64>); 6] {
     [
         (Vector3::z(), true, Vector3::new(0.1, 0.0, 0.4)),
         (Vector3::y(), true, Vector3::new(0.6, 0.05, 0.0)),
-        (Vector3::new(1.0, 0.0, 0.0), false, Vector3::new(0.0, 0.0, 0.1)),
+        (
+            Vector3::new(1.0, 0.0, 0.0),
+            false,
+            Vector3::new(0.0, 0.0, 0.1),
+        ),
         (Vector3::y(), true, Vector3::new(0.5, 0.0, 0.05)),
-        (Vector3::new(1.0, 1.0, 0.0), true, Vector3::new(0.2, -0.1, 0.0)),
+        (
+            Vector3::new(1.0, 1.0, 0.0),
+            true,
+            Vector3::new(0.2, -0.1, 0.0),
+        ),
         (Vector3::x(), true, Vector3::new(0.1, 0.0, 0.0)),
     ]
 }
 
 /// The chain up to (and including) joint `upto`, then a fixed offset `tail`.
 fn arm(upto: usize, tail: Vector3<f64>) -> Model {
-    let mut b = ModelBuilder::new().fixed(Isometry3::translation(0.0, 0.0, 0.3)).unwrap();
+    let mut b = ModelBuilder::new()
+        .fixed(Isometry3::translation(0.0, 0.0, 0.3))
+        .unwrap();
     for (i, (axis, rev, off)) in arm_joints().into_iter().enumerate().take(upto + 1) {
-        b = if rev { b.revolute(axis) } else { b.prismatic(axis) }.unwrap();
+        b = if rev {
+            b.revolute(axis)
+        } else {
+            b.prismatic(axis)
+        }
+        .unwrap();
         if i < upto {
-            b = b.fixed(Isometry3::translation(off.x, off.y, off.z)).unwrap();
+            b = b
+                .fixed(Isometry3::translation(off.x, off.y, off.z))
+                .unwrap();
         }
     }
-    b.fixed(Isometry3::translation(tail.x, tail.y, tail.z)).unwrap().build().unwrap()
+    b.fixed(Isometry3::translation(tail.x, tail.y, tail.z))
+        .unwrap()
+        .build()
+        .unwrap()
 }
 
 /// The masses: (after joint, kg, CoM in the frame after that joint).
@@ -119,8 +139,14 @@ fn eq10_gravity_hand_example() {
     // Gravity pulls both links down (-z); about +y that is +x m g on the links, so the
     // drives hold u = -(x m g): u1 = -(0.5*2 + 1.25*1)*9.81 = -22.0725,
     // u2 = -(0.25*1)*9.81 = -2.4525 N m.
-    let c = correct_joints(&model, &mut Data::new(&model), &drive, &[0.0, 0.0], &Vector6::zeros())
-        .unwrap();
+    let c = correct_joints(
+        &model,
+        &mut Data::new(&model),
+        &drive,
+        &[0.0, 0.0],
+        &Vector6::zeros(),
+    )
+    .unwrap();
     assert_relative_eq!(c.torque[0], -22.0725, epsilon = 1e-12);
     assert_relative_eq!(c.torque[1], -2.4525, epsilon = 1e-12);
     assert_eq!(&c.backlash_sign[..2], &[-1.0, -1.0]);
@@ -148,12 +174,18 @@ fn eq10_contact_hand_example() {
         .unwrap()
         .build()
         .unwrap();
-    let masses = LinkMasses::new().with(1, 3.0, Vector3::new(0.2, 0.0, 0.0)).unwrap();
+    let masses = LinkMasses::new()
+        .with(1, 3.0, Vector3::new(0.2, 0.0, 0.0))
+        .unwrap();
     let drive = DriveTrain::new(&model, &[1000.0, 500.0, 200.0], &[1e-3, 2e-3, 0.0])
         .unwrap()
         .with_masses(masses)
         .unwrap();
-    let q = [0.0, core::f64::consts::FRAC_PI_2, -core::f64::consts::FRAC_PI_2];
+    let q = [
+        0.0,
+        core::f64::consts::FRAC_PI_2,
+        -core::f64::consts::FRAC_PI_2,
+    ];
     // Joints at (0,0), (1,0), (1,0.5); TCP at (1.2, 0.5). J columns (v_x, v_y) = z x (p - o):
     // (-0.5, 1.2), (-0.5, 0.2), (0, 0.2). F = (10, 4): J^T F = [-5 + 4.8, -5 + 0.8, 0.8]
     // = [-0.2, -4.2, 0.8] N m.
@@ -168,7 +200,14 @@ fn eq10_contact_hand_example() {
     assert_relative_eq!(c.q[1], q[1] + 1.04e-2, epsilon = 1e-15);
     assert_relative_eq!(c.q[2], q[2] - 4.0e-3, epsilon = 1e-15);
     // sgn(0) = 0: no force, no gravity about z -> the readings come back unchanged.
-    let c0 = correct_joints(&model, &mut Data::new(&model), &drive, &q, &Vector6::zeros()).unwrap();
+    let c0 = correct_joints(
+        &model,
+        &mut Data::new(&model),
+        &drive,
+        &q,
+        &Vector6::zeros(),
+    )
+    .unwrap();
     assert_eq!(&c0.q[..3], &q);
     assert_eq!(&c0.backlash_sign[..3], &[0.0, 0.0, 0.0]);
     // A deadband keeps small torques from taking up backlash.
@@ -336,7 +375,13 @@ fn bad_inputs_are_statuses() {
         Err(TickError::WrongLength { .. })
     ));
     assert!(matches!(
-        correct_joints(&model, &mut data, &drive, &[0.0, f64::NAN], &Vector6::zeros()),
+        correct_joints(
+            &model,
+            &mut data,
+            &drive,
+            &[0.0, f64::NAN],
+            &Vector6::zeros()
+        ),
         Err(TickError::NonFinite { .. })
     ));
     let mut w = Vector6::zeros();
@@ -443,11 +488,16 @@ fn drive_file_errors_name_the_entry() {
         ),
         ("[[joint]]\nname = \"mount\"\nstiffness = 1.0\n", "mount"),
         ("[[joint]]\nname = \"a1\"\nstiffness = -1.0\n", "a1"),
-        ("[[joint]]\nname = \"a1\"\nstiffness = 1.0\nbacklash = -0.1\n", "backlash"),
+        (
+            "[[joint]]\nname = \"a1\"\nstiffness = 1.0\nbacklash = -0.1\n",
+            "backlash",
+        ),
         ("[[joint]]\nname = \"a1\"\nstifness = 1.0\n", "stifness"),
     ];
     for (text, needle) in cases {
-        let e = drive_train_from_strs(&robot, URDF, text).unwrap_err().to_string();
+        let e = drive_train_from_strs(&robot, URDF, text)
+            .unwrap_err()
+            .to_string();
         assert!(e.contains(needle), "{e} should mention {needle}");
     }
     assert_eq!(parse_joint_drives(STIFFNESS).unwrap().len(), 2);

@@ -135,8 +135,10 @@ pub struct RobotParams {
     pub com_height: f64,
     /// Tool point below G [m].
     pub z_tool: f64,
-    /// rapier solver iterations.
+    /// rapier solver iterations (substeps).
     pub solver_iterations: usize,
+    /// rapier internal PGS iterations per substep.
+    pub pgs_iterations: usize,
 }
 
 impl RobotParams {
@@ -167,7 +169,8 @@ impl RobotParams {
             kd: 2.0 * 0.7 * w * j_motor,
             com_height: head.com_height(),
             z_tool: Z_TOOL,
-            solver_iterations: 8,
+            solver_iterations: 1,
+            pgs_iterations: 8,
         }
     }
 
@@ -276,6 +279,7 @@ impl ParallelSim {
         world.gravity = Vector::new(0.0, 0.0, -9.81);
         world.integration_parameters.dt = DT;
         world.integration_parameters.num_solver_iterations = params.solver_iterations;
+        world.integration_parameters.num_internal_pgs_iterations = params.pgs_iterations;
 
         let base = world.insert_body(RigidBodyBuilder::fixed());
         // Actuated link: rod + intermediate platform at the elbow.

@@ -2,9 +2,10 @@ use deflect_sim::robot::*;
 use nalgebra::Vector2;
 #[test]
 fn probe() {
-    for it in [1usize, 2, 4, 16] {
+    for (it, pgs) in [(1usize, 1usize), (1, 4), (1, 16), (1, 64), (2, 16), (4, 1)] {
         let mut p = RobotParams::new(Constraint::Nc, Head::Upper);
         p.solver_iterations = it;
+        p.pgs_iterations = pgs;
         let mut worst: f64 = 0.0;
         let t0 = std::time::Instant::now();
         let mut steps = 0;
@@ -19,6 +20,6 @@ fn probe() {
         let rel = (d - lin).norm() / lin.norm();
         worst = worst.max(rel);
         }}}
-        println!("it {it} worst rel {worst:.2e} {:?}/step", t0.elapsed() / steps);
+        println!("it {it} pgs {pgs} worst rel {worst:.2e} {:?}/step", t0.elapsed() / steps);
     }
 }

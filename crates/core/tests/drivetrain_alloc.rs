@@ -1,0 +1,118 @@
+//! The drive-train correction and the contour tracer step allocate nothing: a counting
+//! global allocator watches many calls. One test function only, so no other test thread
+//! allocates meanwhile.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use deflect_core::contour::{self, ContourTracer, TracerConfig};
+use deflect_core::drivetrain::{
+    DriveTrain, LinkMasses, cartesian_stiffness, cartesian_stiffness_xy, compensated_forward,
+    correct_joints, gravity_torques,
+};
+use deflect_core::vjm::Data;
+use deflect_core::{ModelBuilder, TickError};
+use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
+
+struct Counting;
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to the system allocator; only counts.
+#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+#[test]
+fn drive_train_and_tracer_do_not_allocate() {
+    let mut b = ModelBuilder::new();
+    let mut masses = LinkMasses::new();
+    for (i, axis) in [
+        Vector3::z(),
+        Vector3::y(),
+        Vector3::y(),
+        Vector3::x(),
+        Vector3::y(),
+        Vector3::x(),
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        b = b
+            .revolute(axis)
+            .unwrap()
+            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
+            .unwrap();
+        masses
+            .push(i, 10.0 - i as f64, Vector3::new(0.1, 0.0, 0.02))
+            .unwrap();
+    }
+    let model = b.build().unwrap();
+    let drive = DriveTrain::new(&model, &[1e5; 6], &[1e-4; 6])
+        .unwrap()
+        .with_masses(masses)
+        .unwrap();
+    let planar = ModelBuilder::new()
+        .revolute(Vector3::z())
+        .unwrap()
+        .fixed(Isometry3::translation(0.5, 0.0, 0.0))
+        .unwrap()
+        .revolute(Vector3::z())
+        .unwrap()
+        .fixed(Isometry3::translation(0.4, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap();
+    let pdrive = DriveTrain::new(&planar, &[2000.0, 1000.0], &[0.0; 2]).unwrap();
+    let mut data = Data::new(&model);
+    let mut pdata = Data::new(&planar);
+    let wrench = Vector6::new(30.0, -20.0, -50.0, 1.0, 0.0, -0.5);
+    let mut q = [0.1, -0.4, 0.9, 0.2, 0.6, -0.3];
+    let k = Matrix2::new(8000.0, 500.0, 500.0, 3000.0);
+    let mut tracer = ContourTracer::new(TracerConfig::new(1e-3, 2.0, 30.0), &k).unwrap();
+    let mut p = Vector2::new(0.4, 0.0);
+    let mut sink = 0.0;
+
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for i in 0..10_000 {
+        q[0] = 1e-4 * i as f64;
+        sink += gravity_torques(&model, &drive, &q).unwrap()[1];
+        sink += correct_joints(&model, &mut data, &drive, &q, &wrench)
+            .unwrap()
+            .q[2];
+        sink += compensated_forward(&model, &mut data, &drive, &q, &wrench)
+            .unwrap()
+            .translation
+            .x;
+        sink += cartesian_stiffness(&model, &mut data, &drive, &q).unwrap()[(0, 0)];
+        sink += cartesian_stiffness_xy(&planar, &mut pdata, &pdrive, &[q[0], 1.2]).unwrap()[(0, 0)];
+        sink += contour::edge_direction(&k, &Vector2::new(1e-3, 2e-4), &Vector2::new(0.0, 1.0))
+            .unwrap();
+        // A wall at x = 0.45: the tracer approaches, then slides along it.
+        let f = Vector2::new(f64::max(p.x - 0.45, 0.0) * 8000.0, 0.0);
+        let out = tracer.step(&p, &f).unwrap();
+        p = out.command;
+        tracer.set_stiffness(&k).unwrap();
+        // Error paths allocate nothing either.
+        let bad = correct_joints(&model, &mut data, &drive, &q[..5], &wrench);
+        assert!(matches!(bad, Err(TickError::WrongLength { .. })));
+        assert!(tracer.step(&Vector2::new(f64::NAN, 0.0), &f).is_err());
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(sink.is_finite());
+    assert!(tracer.stats().contacts > 100, "the tracer did trace");
+    assert_eq!(after - before, 0, "allocations on the per-call path");
+}
