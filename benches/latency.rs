@@ -128,14 +128,21 @@ fn main() {
     // The online compensation cycle of the VJM paper on the KR 300 (sensor processing,
     // low-pass + moving average, pilot control, VJM deflection, projection, limits) at the
     // paper's 4 ms cycle and at 2 kHz; the cost per cycle does not depend on the rate.
-    for (name, dt) in [("compensation cycle (4 ms)", 0.004), ("compensation cycle (2 kHz)", 0.0005)] {
+    for (name, dt) in [
+        ("compensation cycle (4 ms)", 0.004),
+        ("compensation cycle (2 kHz)", 0.0005),
+    ] {
         let cfg = CompensatorConfig::paper(dt, SensorCalibration::default());
         let mut comp = OnlineCompensator::new(model, cfg).expect("valid config");
         let feed = Vector3::new(0.0, 0.025, 0.0);
         let estimated = Vector6::from_row_slice(&MILLING_WRENCH);
         report(name, n, budget, |i| {
             // A cutter exit every 250 cycles: the reading drops to zero.
-            let reading = if (i / 250) % 2 == 0 { w } else { Vector6::zeros() };
+            let reading = if (i / 250) % 2 == 0 {
+                w
+            } else {
+                Vector6::zeros()
+            };
             black_box(
                 comp.step(model, &q, black_box(&reading), Some(&estimated), &feed)
                     .ok(),

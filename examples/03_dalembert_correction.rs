@@ -21,7 +21,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..QueryOptions::default()
         });
     let robot = ParallelRobot2::paper();
-    let corrector = DalembertCorrector::new(DalembertCorrector::PAPER_MASS)?.with_fixed_point(3, 1e-12);
+    let corrector =
+        DalembertCorrector::new(DalembertCorrector::PAPER_MASS)?.with_fixed_point(3, 1e-12);
     println!("g   duration [ms]  ticks  max |correction| [mm]  max |F_D| [N]  clamped ticks");
     for g in 1..=5u8 {
         let traj = Trajectory::line(
@@ -30,13 +31,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &paper_limits(g)?,
         )?;
         let (mut max_c, mut max_f, mut clamped) = (0.0f64, 0.0f64, 0);
-        let ticks = corrector.correct_each(&robot, &map.view(), &traj, 2000.0, &Vector2::zeros(), |_, t| {
-            max_c = max_c.max((t.commanded - t.desired).norm());
-            max_f = max_f.max(t.force.norm());
-            if t.model_status != deflect_core::dalembert::ModelStatus::Inside {
-                clamped += 1;
-            }
-        })?;
+        let ticks = corrector.correct_each(
+            &robot,
+            &map.view(),
+            &traj,
+            2000.0,
+            &Vector2::zeros(),
+            |_, t| {
+                max_c = max_c.max((t.commanded - t.desired).norm());
+                max_f = max_f.max(t.force.norm());
+                if t.model_status != deflect_core::dalembert::ModelStatus::Inside {
+                    clamped += 1;
+                }
+            },
+        )?;
         println!(
             "{g}   {:>13.1}  {ticks:>5}  {:>21.4}  {max_f:>13.1}  {clamped:>13}",
             traj.duration() * 1e3,

@@ -51,7 +51,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // changes 10 cycles earlier.
             let true_w = if k < 100 { cutting } else { Vector6::zeros() };
             let estimate = if k < 90 { cutting } else { Vector6::zeros() };
-            let out = comp.step(model, &q, &sensor_reading(&true_w), Some(&estimate), &Vector3::zeros())?;
+            let out = comp.step(
+                model,
+                &q,
+                &sensor_reading(&true_w),
+                Some(&estimate),
+                &Vector3::zeros(),
+            )?;
             sent.push_back(out.correction);
             let applied = sent.pop_front().unwrap_or_else(Vector6::zeros);
             // Path error: what the true load deflects minus what the applied correction cancels.

@@ -63,6 +63,26 @@
 // The paper's correction rate [Hz].
 #define DEFLECT_PAPER_RATE_HZ 2000.0
 
+// Largest moving-average window of the online compensator [cycles].
+#define DEFLECT_MAX_AVERAGE_WINDOW 64
+
+// Number of terms of the sensor's residual-offset polynomial (Eq. 17).
+#define DEFLECT_RESIDUAL_TERMS 15
+
+// Compensator output: Cartesian correction values only.
+#define DEFLECT_OUTPUT_CARTESIAN 0
+
+// Compensator output: also axis-specific values `dq` through the joint Jacobian.
+#define DEFLECT_OUTPUT_JOINT 1
+
+// The online-compensation paper's control cycle [s] (KUKA RSI, 4 ms).
+#define DEFLECT_PAPER_CYCLE 0.004
+
+// The online force-compensation chain of one serial robot with its filter, pilot and
+// rate-limiter states and its own workspace. Opaque; create with `deflect_compensator_create`,
+// free with `deflect_compensator_destroy`. Not thread-safe: one thread at a time.
+typedef struct DeflectCompensator DeflectCompensator;
+
 // A compliance map (per-node force-displacement lines over an (x, y) grid). Opaque; create
 // with `deflect_compliance_map_from_paper_csv`, `_load_paper_csv`, `_from_json` or
 // `_load_json`, free with `deflect_compliance_map_destroy`.
@@ -165,6 +185,87 @@ typedef struct DeflectCorrectedTick2 {
   // Worst map status met: `DEFLECT_QUERY_INSIDE`, `_CLAMPED` or `_EXTRAPOLATED`.
   int32_t model_status;
 } DeflectCorrectedTick2;
+
+// Sensor calibration and the fixed sensor-to-TCP transform of the online compensation
+// (Eq. 12-20), plain data. `deflect_sensor_calibration_default` fills the neutral one (no
+// offsets, no weight, no residual, TCP at the sensor).
+//
+// The transform `^S T_TCP` (pose of the TCP in the sensor frame) is given as a translation
+// `sensor_to_tcp_translation[3] = (x, y, z)` [m] and a rotation quaternion
+// `sensor_to_tcp_rotation[4] = (w, x, y, z)` (scalar first). The quaternion must be finite
+// and not zero; it is normalised on use (a quaternion of norm exactly 1 is used as is).
+typedef struct DeflectSensorCalibration {
+  // Internal force offset `F_SI` [N], sensor frame.
+  double force_offset[3];
+  // Internal moment offset `M_SI` [N m], sensor frame.
+  double moment_offset[3];
+  // Weight of everything beyond the sensor, `G` [N] (>= 0; gravity is `-z` of the base).
+  double weight;
+  // Centre of gravity `r_G` [m], sensor frame.
+  double center_of_gravity[3];
+  // Residual-offset polynomial coefficients `a_1..a_15` (Eq. 17) per sensor-frame wrench
+  // component: `residual[i][k]`, `i` in `[Fx, Fy, Fz, Mx, My, Mz]`, `k` over the terms `1,
+  // q1..q4, q1^2..q4^2, q1 q2, q1 q3, q1 q4, q2 q3, q2 q4, q3 q4` of the sensor
+  // orientation's quaternion (w >= 0). Zeros disable it.
+  double residual[6][DEFLECT_RESIDUAL_TERMS];
+  // Translation of `^S T_TCP`: the TCP's position in the sensor frame [m].
+  double sensor_to_tcp_translation[3];
+  // Rotation of `^S T_TCP` as a quaternion `(w, x, y, z)`, scalar first.
+  double sensor_to_tcp_rotation[4];
+} DeflectSensorCalibration;
+
+// Settings of the online compensation chain (`deflect_compensator_config_paper` fills the
+// paper's). Flags are 0 or 1; any other value is `DEFLECT_ERR_INVALID_ARGUMENT`.
+typedef struct DeflectCompensatorConfig {
+  // Cycle time [s], > 0 (0.004 in the paper, 0.0005 at 2 kHz).
+  double dt;
+  // Sensor offsets, weight, residual polynomial and sensor-to-TCP transform.
+  struct DeflectSensorCalibration calibration;
+  // Low-pass cut-off [Hz], > 0.
+  double lowpass_cutoff_hz;
+  // Moving-average window [cycles], 1..=`DEFLECT_MAX_AVERAGE_WINDOW`.
+  size_t moving_average_window;
+  // 1: pilot control (blend to the estimated wrench when it differs from the measured one
+  // by more than `pilot_threshold`); 0: measured forces only.
+  uint8_t pilot_enabled;
+  // Pilot-control switching threshold [N], >= 0 (paper: 150).
+  double pilot_threshold;
+  // Pilot-control blending time [s], >= 0 (paper: 0.080; 0 switches in one cycle).
+  double pilot_ramp;
+  // 1: project the translational correction onto the plane normal to the feed (Eq. 10-11).
+  uint8_t project_on_feed;
+  // Largest translational correction [m], >= 0; larger ones are scaled down and reported.
+  double max_correction;
+  // Largest change of the translational correction per second [m/s], >= 0.
+  double max_rate;
+  // `DEFLECT_OUTPUT_CARTESIAN` or `DEFLECT_OUTPUT_JOINT`.
+  int32_t output;
+} DeflectCompensatorConfig;
+
+// What one compensation cycle produced (`deflect_compensator_step`).
+typedef struct DeflectCycleOutput {
+  // The wrench fed to the model `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m]: TCP, base frame,
+  // filtered (and piloted).
+  double wrench[6];
+  // The wrench before pilot control (filtered measurement) [N, N m].
+  double measured_wrench[6];
+  // Model deflection `[dx, dy, dz, rx, ry, rz]` [m, rad] under `wrench` (Eq. 9).
+  double deflection[6];
+  // Correction to add to the commanded pose `[dx, dy, dz, rx, ry, rz]` [m, rad], base
+  // frame, after projection and limits.
+  double correction[6];
+  // Axis-specific correction [rad or m]; zeros unless the output is `DEFLECT_OUTPUT_JOINT`,
+  // entries past the robot's dof are 0.
+  double dq[DEFLECT_MAX_DOF];
+  // Weight of the estimated wrench in the blend (0 = measured only .. 1 = estimated only).
+  double pilot_weight;
+  // 1 if the feed direction was removed (0 when standing still or projection is off).
+  uint8_t projected;
+  // 1 if the size limit acted this cycle.
+  uint8_t size_limited;
+  // 1 if the rate limit acted this cycle.
+  uint8_t rate_limited;
+} DeflectCycleOutput;
 
 // Success.
 #define DEFLECT_OK 0
@@ -539,6 +640,89 @@ DeflectStatus deflect_dalembert_step(const struct DeflectDalembert *corrector,
                                      const double *acceleration,
                                      const double *seed,
                                      struct DeflectCorrectedTick2 *out);
+
+// Writes the neutral calibration to `*out`: no offsets, no weight, no residual, TCP at the
+// sensor (translation 0, rotation (1, 0, 0, 0)).
+//
+// # Safety
+// `out` is NULL or writable.
+DeflectStatus deflect_sensor_calibration_default(struct DeflectSensorCalibration *out);
+
+// Writes the paper's chain at cycle time `dt` [s] to `*out`: the neutral calibration (set
+// `out->calibration` afterwards), 10 Hz low-pass, 5-cycle moving average, pilot control
+// 150 N / 80 ms, projection on, 3 mm and 50 mm/s limits, Cartesian output. `dt` is checked
+// by `deflect_compensator_create`, not here.
+//
+// # Safety
+// `out` is NULL or writable.
+DeflectStatus deflect_compensator_config_paper(double dt, struct DeflectCompensatorConfig *out);
+
+// Creates the online compensation chain for `robot` with settings `*config`. The handle keeps
+// its own filter states and workspace (it only reads the robot's model); every
+// `deflect_compensator_step` must be given this same robot. Init time: allocates. On failure
+// `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` (a non-finite setting or calibration
+// value) or `DEFLECT_ERR_INVALID_ARGUMENT` (dt or cut-off not > 0, window outside
+// 1..=`DEFLECT_MAX_AVERAGE_WINDOW`, negative threshold, ramp, limit or weight, a zero
+// quaternion, a flag other than 0/1, an unknown output code).
+//
+// # Safety
+// `robot` is NULL or a live handle; `config` is NULL or readable; `out` is NULL or writable.
+DeflectStatus deflect_compensator_create(const struct DeflectSerialRobot *robot,
+                                         const struct DeflectCompensatorConfig *config,
+                                         struct DeflectCompensator **out);
+
+// Frees a compensator handle. NULL is a no-op.
+//
+// # Safety
+// `compensator` is NULL or a live handle, not used afterwards.
+void deflect_compensator_destroy(struct DeflectCompensator *compensator);
+
+// Low-frequency delay of the filter chain (low-pass plus moving average): `*samples` in
+// cycles and `*seconds` in s (either output may be NULL).
+//
+// # Safety
+// `compensator` is NULL or a live handle; the outputs are NULL or writable.
+DeflectStatus deflect_compensator_delay(const struct DeflectCompensator *compensator,
+                                        double *samples,
+                                        double *seconds);
+
+// Clears the filter, pilot-control and rate-limiter states (as after create). No allocation.
+//
+// # Safety
+// `compensator` is NULL or a live handle not used by another thread.
+DeflectStatus deflect_compensator_reset(struct DeflectCompensator *compensator);
+
+// One control cycle of the online compensation: joints `q[q_len]` [rad or m], the raw sensor
+// reading `reading[6] = [Fx, Fy, Fz, Mx, My, Mz]` [N, N m] (sensor frame), the offline
+// estimate `estimated[6]` of the TCP wrench (base frame; NULL if the program provides none,
+// which also skips pilot control) and the feed velocity `feed_velocity[3]` [m/s] (base
+// frame). The sensor reading is compensated (Eq. 18) and carried to the TCP (Eq. 19-20),
+// low-pass filtered and averaged, piloted, turned into a deflection (Eq. 9), and the opposite
+// correction projected (Eq. 10-11), limited and written to `*out`. Per cycle: no allocation,
+// bounded time.
+//
+// Returns `DEFLECT_ERR_NULL` (handles, `q`, `reading`, `feed_velocity` or `out`; nothing is
+// changed then), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_WRONG_LENGTH` (`q_len` is not the
+// robot's dof), `DEFLECT_ERR_INVALID_ARGUMENT` (`robot` has another dof or spring count than
+// the robot the compensator was created for) or `DEFLECT_ERR_SINGULAR` (joint output
+// at a singular pose). Invalid inputs are refused before any state changes, except a
+// singular pose with joint output, which is met after the filter states have advanced.
+//
+// # Safety
+// `compensator` is NULL or a live handle not used by another thread; `robot` is NULL or a
+// live handle (only read, not used by another thread meanwhile); `q` holds `q_len`
+// doubles, `reading` 6, `estimated` 6 (or is NULL), `feed_velocity` 3; `out` is NULL or
+// writable.
+DeflectStatus deflect_compensator_step(struct DeflectCompensator *compensator,
+                                       const struct DeflectSerialRobot *robot,
+                                       const double *q,
+                                       size_t q_len,
+                                       const double *reading,
+                                       const double *estimated,
+                                       const double *feed_velocity,
+                                       struct DeflectCycleOutput *out);
 
 #ifdef __cplusplus
 }  // extern "C"

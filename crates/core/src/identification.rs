@@ -205,7 +205,10 @@ pub struct StiffnessIdentification {
 type SpringFrame = (Isometry3<f64>, Vector3<f64>);
 
 /// Poses of every spring frame and of the TCP at `q` (rigid).
-fn spring_frames(model: &Model, q: &[f64]) -> Result<(Vec<SpringFrame>, Isometry3<f64>), TickError> {
+fn spring_frames(
+    model: &Model,
+    q: &[f64],
+) -> Result<(Vec<SpringFrame>, Isometry3<f64>), TickError> {
     let mut data = Data::new(model);
     let tcp = forward(model, &mut data, q)?;
     let mut frames = Vec::new();

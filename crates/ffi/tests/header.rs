@@ -47,6 +47,9 @@ fn header_carries_the_docs_and_every_entry_point() {
         "DeflectStatus deflect_serial_robot_deflection(",
         "DeflectStatus deflect_compliance_map_displacement(",
         "typedef struct DeflectSerialRobot DeflectSerialRobot;",
+        "typedef struct DeflectCompensator DeflectCompensator;",
+        "DeflectStatus deflect_compensator_step(",
+        "double residual[6][DEFLECT_RESIDUAL_TERMS];",
     ] {
         assert!(h.contains(needle), "header lacks `{needle}`");
     }

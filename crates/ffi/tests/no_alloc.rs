@@ -59,6 +59,7 @@ fn per_tick_calls_do_not_allocate() {
     let mut map = ptr::null_mut();
     let mut traj = ptr::null_mut();
     let mut corr = ptr::null_mut();
+    let mut comp = ptr::null_mut();
     let mut lim = DeflectLimits::default();
     // SAFETY: live handles from this test, arrays of the documented lengths.
     unsafe {
@@ -100,6 +101,20 @@ fn per_tick_calls_do_not_allocate() {
         );
         assert_eq!(
             deflect_dalembert_create(ptr::null(), DEFLECT_PAPER_MASS, 3, 0.0, &mut corr),
+            DEFLECT_OK
+        );
+        let mut cfg = std::mem::MaybeUninit::<DeflectCompensatorConfig>::uninit();
+        assert_eq!(
+            deflect_compensator_config_paper(0.0005, cfg.as_mut_ptr()),
+            DEFLECT_OK
+        );
+        let mut cfg = cfg.assume_init();
+        cfg.output = DEFLECT_OUTPUT_JOINT;
+        cfg.calibration.weight = 180.0;
+        cfg.calibration.sensor_to_tcp_translation = [0.0, 0.0, 0.4];
+        cfg.calibration.residual[2][5] = -1.5;
+        assert_eq!(
+            deflect_compensator_create(robot, &cfg, &mut comp),
             DEFLECT_OK
         );
     }
@@ -175,7 +190,75 @@ fn per_tick_calls_do_not_allocate() {
                 DEFLECT_OK
             );
         }
+        // The online compensation cycle: cutter exit at cycle 150, an estimate (pilot
+        // control) that knows it 20 cycles early, joint output, a reset.
+        let mut cycle = DeflectCycleOutput::default();
+        let (mut samples, mut seconds) = (0.0, 0.0);
+        assert_eq!(
+            deflect_compensator_delay(comp, &mut samples, &mut seconds),
+            DEFLECT_OK
+        );
+        for k in 0..300 {
+            if k == 250 {
+                assert_eq!(deflect_compensator_reset(comp), DEFLECT_OK);
+            }
+            q[0] = 1e-4 * k as f64;
+            let f = if k < 150 { 800.0 } else { 0.0 };
+            let reading = [0.5 * f, -0.7 * f, 180.0, 0.0, 0.02 * f, 0.0];
+            let est = if k < 130 {
+                [-400.0, 560.0, 0.0, 0.0, 0.0, 0.0]
+            } else {
+                [0.0; 6]
+            };
+            let feed = [0.0, 0.02, 0.0];
+            assert_eq!(
+                deflect_compensator_step(
+                    comp,
+                    robot,
+                    q.as_ptr(),
+                    6,
+                    reading.as_ptr(),
+                    if k % 2 == 0 {
+                        est.as_ptr()
+                    } else {
+                        ptr::null()
+                    },
+                    feed.as_ptr(),
+                    &mut cycle
+                ),
+                DEFLECT_OK
+            );
+        }
+        assert!(cycle.dq.iter().any(|d| *d != 0.0));
         // Error paths do not allocate either.
+        let nan6 = [f64::NAN; 6];
+        let feed = [0.0; 3];
+        assert_eq!(
+            deflect_compensator_step(
+                comp,
+                robot,
+                q.as_ptr(),
+                6,
+                nan6.as_ptr(),
+                ptr::null(),
+                feed.as_ptr(),
+                &mut cycle
+            ),
+            DEFLECT_ERR_NON_FINITE
+        );
+        assert_eq!(
+            deflect_compensator_step(
+                comp,
+                robot,
+                q.as_ptr(),
+                5,
+                w.as_ptr(),
+                ptr::null(),
+                feed.as_ptr(),
+                &mut cycle
+            ),
+            DEFLECT_ERR_WRONG_LENGTH
+        );
         let nan = [f64::NAN; 2];
         assert_eq!(
             deflect_dalembert_step(
@@ -198,6 +281,7 @@ fn per_tick_calls_do_not_allocate() {
 
     // SAFETY: live handles from this test, arrays of the documented lengths.
     unsafe {
+        deflect_compensator_destroy(comp);
         deflect_dalembert_destroy(corr);
         deflect_trajectory2_destroy(traj);
         deflect_compliance_map_destroy(map);

@@ -185,7 +185,8 @@ pub fn evaluate_line(points: &[[f64; 2]], start: [f64; 2], end: [f64; 2]) -> Lin
     let (a, b) = line_fit(&us, &vs);
     let f = |u: f64| a + b * u;
     let (ui, uf) = (us[0], us[n - 1]);
-    out.length_mm = ((uf - ui).powi(2) + (s[n - 1] - s[0]).powi(2)).sqrt();
+    // Eq. C2 between the path's first and last points (u0, u1), the spline's ends for v.
+    out.length_mm = ((u1 - u0).powi(2) + (s[n - 1] - s[0]).powi(2)).sqrt();
     // Eq. C3-C6.
     let bvec = (uf - ui, f(uf) - f(ui));
     let bn = (bvec.0 * bvec.0 + bvec.1 * bvec.1).sqrt();
@@ -236,7 +237,11 @@ mod tests {
                 (0.1 * (core::f64::consts::PI * u / 100.0).sin() - mean).abs() * 100.0 / n as f64
             })
             .sum();
-        assert!((m.area_mm2 - exact).abs() < 0.02 * exact, "{} vs {exact}", m.area_mm2);
+        assert!(
+            (m.area_mm2 - exact).abs() < 0.02 * exact,
+            "{} vs {exact}",
+            m.area_mm2
+        );
         assert!((m.max_dev_mm - 0.1).abs() < 1e-6);
     }
 }

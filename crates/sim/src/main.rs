@@ -175,7 +175,10 @@ fn calibrate(
     let opts = StaticOptions::default();
     let readings = pipeline::static_tests(&params, &opts, || pb.inc(1))?;
     let tag = constraint.label().to_lowercase();
-    std::fs::write(out.join(format!("static_tests_{tag}.csv")), static_csv(&readings))?;
+    std::fs::write(
+        out.join(format!("static_tests_{tag}.csv")),
+        static_csv(&readings),
+    )?;
     let (worst_small, rms_small) = pipeline::linear_agreement(&readings, 50.0);
     let (worst, rms) = pipeline::linear_agreement(&readings, f64::INFINITY);
     let dmax = readings
@@ -193,7 +196,10 @@ fn calibrate(
         rms
     );
     let map = pipeline::fit_map(&readings)?;
-    std::fs::write(out.join(format!("compliance_map_{tag}.json")), map.to_json()?)?;
+    std::fs::write(
+        out.join(format!("compliance_map_{tag}.json")),
+        map.to_json()?,
+    )?;
     let ho = pipeline::held_out(&params, &map, &opts)?;
     pb.inc(1);
     text.push_str(&format!(
@@ -347,7 +353,10 @@ fn reproduce(args: &ReproduceArgs, out: &Path) -> Result<(), SimError> {
 
 fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimError> {
     std::fs::write(out.join("summary.csv"), output::summary_csv(runs))?;
-    std::fs::write(out.join("summary.json"), serde_json::to_string_pretty(runs)?)?;
+    std::fs::write(
+        out.join("summary.json"),
+        serde_json::to_string_pretty(runs)?,
+    )?;
     std::fs::write(out.join("summary.txt"), table)?;
     let gmax = runs.iter().map(|r| r.g).max().unwrap_or(5);
     let top: Vec<&RunResult> = runs.iter().filter(|r| r.g == gmax).collect();
@@ -359,7 +368,11 @@ fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimE
         }
         output::plot_paths(
             &out.join(format!("paths_{}_{}g.png", motion.label(), gmax)),
-            &format!("{} at {} g: tool path across the line", motion.label(), gmax),
+            &format!(
+                "{} at {} g: tool path across the line",
+                motion.label(),
+                gmax
+            ),
             &sel,
         )?;
         output::plot_error_vs_g(
@@ -403,7 +416,13 @@ fn run_one(args: &RunArgs, out: &Path) -> Result<(), SimError> {
         };
         if wanted {
             let t = Instant::now();
-            let r = pipeline::run(&params, motion, args.g, map.as_ref().filter(|_| corrected), &opts)?;
+            let r = pipeline::run(
+                &params,
+                motion,
+                args.g,
+                map.as_ref().filter(|_| corrected),
+                &opts,
+            )?;
             let sim = r.samples.last().map_or(0.0, |s| s.t);
             println!(
                 "{} {} {} g {}: max path dev {:.4} mm, RMS {:.4} mm, area {:.4} mm2, length dev \
@@ -411,7 +430,11 @@ fn run_one(args: &RunArgs, out: &Path) -> Result<(), SimError> {
                 r.config,
                 motion.label(),
                 r.g,
-                if corrected { "corrected" } else { "uncorrected" },
+                if corrected {
+                    "corrected"
+                } else {
+                    "uncorrected"
+                },
                 r.metrics.max_dev_mm,
                 r.metrics.rms_dev_mm,
                 r.metrics.area_mm2,
@@ -433,7 +456,10 @@ fn run_one(args: &RunArgs, out: &Path) -> Result<(), SimError> {
     let mcap_path = out.join(format!("{name}.mcap"));
     let n = output::write_mcap(&mcap_path, &refs, runs.len() > 1)?;
     output::plot_paths(&out.join(format!("{name}.png")), &name, &refs)?;
-    std::fs::write(out.join(format!("{name}.json")), serde_json::to_string_pretty(&runs)?)?;
+    std::fs::write(
+        out.join(format!("{name}.json")),
+        serde_json::to_string_pretty(&runs)?,
+    )?;
     println!("{} messages in {}", n, mcap_path.display());
     Ok(())
 }
@@ -456,7 +482,10 @@ fn fit_cmd(mech: Mech, input: Option<&Path>, out: &Path) -> Result<(), SimError>
             )?
             .with_options(pipeline::map_options());
             let tag = constraint.label().to_lowercase();
-            std::fs::write(out.join(format!("compliance_map_{tag}.json")), map.to_json()?)?;
+            std::fs::write(
+                out.join(format!("compliance_map_{tag}.json")),
+                map.to_json()?,
+            )?;
             let ho = pipeline::held_out(
                 &RobotParams::new(constraint, Head::Upper),
                 &map,
@@ -515,7 +544,9 @@ fn main() -> std::process::ExitCode {
                 );
                 Ok(())
             }
-            Some(Command::Fit { mechanism, input }) => fit_cmd(*mechanism, input.as_deref(), &cli.out),
+            Some(Command::Fit { mechanism, input }) => {
+                fit_cmd(*mechanism, input.as_deref(), &cli.out)
+            }
             Some(Command::Run(a)) => run_one(a, &cli.out),
         });
     match result {

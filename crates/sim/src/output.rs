@@ -38,10 +38,22 @@ fn point_schema(title: &str, unit: &str, z: bool) -> serde_json::Value {
 
 fn schemas() -> [(String, serde_json::Value); 5] {
     [
-        ("deflect.DesiredPoint".into(), point_schema("desired tool point", "m", false)),
-        ("deflect.CommandedPoint".into(), point_schema("commanded tool point", "m", false)),
-        ("deflect.ActualPoint".into(), point_schema("actual tool point", "m", true)),
-        ("deflect.DalembertForce".into(), point_schema("D'Alembert force -m* a", "N", false)),
+        (
+            "deflect.DesiredPoint".into(),
+            point_schema("desired tool point", "m", false),
+        ),
+        (
+            "deflect.CommandedPoint".into(),
+            point_schema("commanded tool point", "m", false),
+        ),
+        (
+            "deflect.ActualPoint".into(),
+            point_schema("actual tool point", "m", true),
+        ),
+        (
+            "deflect.DalembertForce".into(),
+            point_schema("D'Alembert force -m* a", "N", false),
+        ),
         (
             "deflect.Joints".into(),
             json!({"title": "joint angles", "type": "object", "properties": {
@@ -85,11 +97,19 @@ pub fn run_name(r: &RunResult) -> String {
 /// Writes `runs` into one MCAP file (zstd chunks). With `prefix_topics`, each run gets its own
 /// topics `/<run>/<topic>`; otherwise the topics are `/<topic>` (single-run logs). Runs follow
 /// each other in log time.
-pub fn write_mcap(path: &Path, runs: &[&RunResult], prefix_topics: bool) -> Result<usize, SimError> {
+pub fn write_mcap(
+    path: &Path,
+    runs: &[&RunResult],
+    prefix_topics: bool,
+) -> Result<usize, SimError> {
     let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
     let mut schema_ids = Vec::new();
     for (name, s) in schemas() {
-        schema_ids.push(w.add_schema(&name, "jsonschema", serde_json::to_string(&s)?.as_bytes())?);
+        schema_ids.push(w.add_schema(
+            &name,
+            "jsonschema",
+            serde_json::to_string(&s)?.as_bytes(),
+        )?);
     }
     let mut offset = 0.0;
     let mut count = 0;
@@ -106,9 +126,8 @@ pub fn write_mcap(path: &Path, runs: &[&RunResult], prefix_topics: bool) -> Resu
             meta.insert("run".to_string(), name.clone());
             channels.push(w.add_channel(*schema, &full, "json", &meta)?);
         }
-        let mut seq = 0u32;
         let mut last = 0.0;
-        for s in &r.samples {
+        for (seq, s) in (0u32..).zip(&r.samples) {
             let t = offset + s.t;
             let ns = (t * 1e9).round() as u64;
             for (ch, msg) in channels.iter().zip(messages(&name, s, t)) {
@@ -121,7 +140,6 @@ pub fn write_mcap(path: &Path, runs: &[&RunResult], prefix_topics: bool) -> Resu
                 w.write_to_known_channel(&header, serde_json::to_string(&msg)?.as_bytes())?;
                 count += 1;
             }
-            seq += 1;
             last = s.t;
         }
         offset += last + 0.1;
@@ -213,23 +231,38 @@ pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), S
         .draw()
         .map_err(perr)?;
     let colors = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
-    for (k, r) in runs.iter().enumerate() {
+    let mut configs: Vec<&str> = Vec::new();
+    for r in runs {
+        if !configs.contains(&r.config.as_str()) {
+            configs.push(&r.config);
+        }
+    }
+    for r in runs {
+        let k = configs.iter().position(|c| *c == r.config).unwrap_or(0);
         let c = colors[k % colors.len()];
+        let width = if r.corrected { 3 } else { 1 };
         let series: Vec<(f64, f64)> = r.samples.iter().filter(seg0).map(along_across).collect();
         let label = format!(
             "{} {}g {}",
             r.config,
             r.g,
-            if r.corrected { "corrected" } else { "uncorrected" }
+            if r.corrected {
+                "corrected"
+            } else {
+                "uncorrected"
+            }
         );
         chart
-            .draw_series(LineSeries::new(series, c.stroke_width(2)))
+            .draw_series(LineSeries::new(series, c.stroke_width(width)))
             .map_err(perr)?
             .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width))
+            });
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 15))
@@ -280,7 +313,14 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
             let width = if corrected { 3 } else { 1 };
-            let label = format!("{cfg} {}", if corrected { "corrected" } else { "uncorrected" });
+            let label = format!(
+                "{cfg} {}",
+                if corrected {
+                    "corrected"
+                } else {
+                    "uncorrected"
+                }
+            );
             chart
                 .draw_series(LineSeries::new(pts.clone(), c.stroke_width(width)))
                 .map_err(perr)?
@@ -295,6 +335,7 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
     }
     chart
         .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
         .background_style(WHITE.mix(0.8))
         .border_style(BLACK)
         .label_font(("sans-serif", 14))

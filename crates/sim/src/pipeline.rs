@@ -374,14 +374,21 @@ pub fn run(
         let desired = state.position;
         let (commanded, force, q) = match &view {
             Some(v) => {
-                let tick =
-                    corrector.step(&mech, v, &desired, &state.acceleration, &q_prev)?;
+                let tick = corrector.step(&mech, v, &desired, &state.acceleration, &q_prev)?;
                 (tick.commanded, tick.force, tick.joints)
             }
             None => (desired, -opts.mass * state.acceleration, mech.ik(&desired)?),
         };
-        let qd = if k == 0 { Vector2::zeros() } else { (q - q_prev) / DT };
-        let qdd = if k == 0 { Vector2::zeros() } else { (qd - qd_prev) / DT };
+        let qd = if k == 0 {
+            Vector2::zeros()
+        } else {
+            (q - q_prev) / DT
+        };
+        let qdd = if k == 0 {
+            Vector2::zeros()
+        } else {
+            (qd - qd_prev) / DT
+        };
         sim.step_servo(&q, &qd, &qdd);
         q_prev = q;
         qd_prev = qd;
@@ -468,4 +475,21 @@ pub fn configurations() -> Vec<RobotParams> {
         }
     }
     v
+}
+
+/// The compliance map the static tests would give if the robot were exactly linear: the
+/// nodes' `J K^-1 J^T` (no offsets). For quick tests and as a reference.
+pub fn linear_map(params: &RobotParams) -> Result<ComplianceMap, SimError> {
+    let xs: Vec<f64> = (1..=3).map(|i| grid_node(i, 1).x).collect();
+    let ys: Vec<f64> = (1..=5).map(|j| grid_node(1, j).y).collect();
+    let mut slopes = Vec::new();
+    for x in &xs {
+        for y in &ys {
+            let c = linear_compliance(params, &Vector2::new(*x, *y))?;
+            // (node * n_displacement + d) * n_force + f
+            slopes.extend_from_slice(&[c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(1, 1)]]);
+        }
+    }
+    let offsets = vec![0.0; slopes.len()];
+    Ok(ComplianceMap::new(xs, ys, 2, 2, slopes, offsets)?.with_options(map_options()))
 }

@@ -100,7 +100,12 @@ pub fn tables(runs: &[RunResult]) -> String {
     let _ = writeln!(
         s,
         "{:<10} {:<9} | {:>22} | {:>22} | {:>22} | {:>22}",
-        "config", "motion", "max path dev [mm]", "rms path dev [mm]", "area [mm2]", "max tracking [mm]"
+        "config",
+        "motion",
+        "max path dev [mm]",
+        "rms path dev [mm]",
+        "area [mm2]",
+        "max tracking [mm]"
     );
     for cfg in configs(runs) {
         for motion in [Motion::XLine, Motion::YLine, Motion::Triangle] {
@@ -111,7 +116,14 @@ pub fn tables(runs: &[RunResult]) -> String {
                 continue;
             };
             let (ma, mb) = (&a.metrics, &b.metrics);
-            let cell = |x: f64, y: f64| format!("{x:.4}->{y:.4} {:>5.1}%", reduction(x, y));
+            // Below 1 um (the OC x-line, symmetric) a percentage means nothing.
+            let cell = |x: f64, y: f64| {
+                if x < 1e-3 {
+                    format!("{x:.4}->{y:.4}   n/a")
+                } else {
+                    format!("{x:.4}->{y:.4} {:>5.1}%", reduction(x, y))
+                }
+            };
             let _ = writeln!(
                 s,
                 "{:<10} {:<9} | {:>22} | {:>22} | {:>22} | {:>22}",

@@ -170,7 +170,7 @@ impl RobotParams {
             com_height: head.com_height(),
             z_tool: Z_TOOL,
             solver_iterations: 1,
-            pgs_iterations: 8,
+            pgs_iterations: 4,
         }
     }
 
@@ -528,7 +528,11 @@ impl ParallelSim {
 
     /// Sets the drive springs' rest angles to the motors and applies the relative damping
     /// torques (and an optional static force at G).
-    fn apply_drive(&mut self, wl: &Vector2<f64>, force: Option<(&Vector2<f64>, f64, Vector3<f64>)>) {
+    fn apply_drive(
+        &mut self,
+        wl: &Vector2<f64>,
+        force: Option<(&Vector2<f64>, f64, Vector3<f64>)>,
+    ) {
         let scale = force.map_or(1.0, |f| f.1);
         let k = [self.params.k_a, self.params.k_b];
         for i in 0..2 {
@@ -549,7 +553,11 @@ impl ParallelSim {
             rb.reset_forces(false);
             rb.reset_torques(false);
             if let Some((f, _, g)) = force {
-                rb.add_force_at_point(Vector::new(f.x, f.y, 0.0), Vector::new(g.x, g.y, g.z), false);
+                rb.add_force_at_point(
+                    Vector::new(f.x, f.y, 0.0),
+                    Vector::new(g.x, g.y, g.z),
+                    false,
+                );
             }
         }
     }

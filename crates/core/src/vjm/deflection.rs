@@ -27,10 +27,15 @@ fn sin_cos_small(x: f64) -> (f64, f64) {
     if x.abs() < 1.0e-2 {
         let x2 = x * x;
         let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
-        let c = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0))));
+        let c = 1.0
+            - x2 / 2.0
+                * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0))));
         (s, c)
     } else {
-        (nalgebra::ComplexField::sin(x), nalgebra::ComplexField::cos(x))
+        (
+            nalgebra::ComplexField::sin(x),
+            nalgebra::ComplexField::cos(x),
+        )
     }
 }
 
@@ -254,7 +259,10 @@ mod tests {
         for i in -100..=100 {
             let x = i as f64 * 1.0e-4; // up to 0.01
             let (s, c) = sin_cos_small(x);
-            assert!((s - x.sin()).abs() <= 1e-18 + 2.0 * f64::EPSILON * x.abs(), "{x}");
+            assert!(
+                (s - x.sin()).abs() <= 1e-18 + 2.0 * f64::EPSILON * x.abs(),
+                "{x}"
+            );
             assert!((c - x.cos()).abs() <= 2.0 * f64::EPSILON, "{x}");
         }
     }
