@@ -3,37 +3,14 @@
 #![allow(unsafe_code)] // reason: a GlobalAlloc impl is unsafe by definition; it only forwards to System
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use deflect_core::compliance_map::{
     ComplianceMap, ForceUnit, Interpolation, LengthUnit, OutOfGrid, QueryOptions,
 };
 
-struct Counting;
-
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards every call unchanged to the system allocator; only counts.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: same contract as the caller's.
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        // SAFETY: same contract as the caller's.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn displacement_allocates_nothing() {
@@ -70,7 +47,7 @@ fn displacement_allocates_nothing() {
     );
     let mut out = [0.0; 2];
     let (mut ok, mut refused, mut checksum) = (0usize, 0usize, 0.0);
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = common::allocations();
     for k in 0..10_000 {
         let t = k as f64 * 0.618_033_988_749_895;
         // Mostly inside, some outside the grid (x 0.15..0.29 m, y -0.09..0.09 m).
@@ -91,7 +68,7 @@ fn displacement_allocates_nothing() {
     // The batch path, into buffers allocated before counting started.
     let (pos, force, mut batch_out) = prepared;
     let batch = oc.displacement_batch(&pos, 2, &force, &mut batch_out, QueryOptions::default());
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = common::allocations();
     assert_eq!(batch.map(|s| s.inside), Ok(1000));
     assert_eq!(
         after - before,

@@ -1,36 +1,16 @@
 //! 1e4 consecutive 2 kHz ticks of planner + compliance map + corrector + IK allocate nothing:
 //! a counting global allocator watches them. One test function only.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
 use deflect_core::dalembert::DalembertCorrector;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
 use nalgebra::Vector2;
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn corrector_ticks_do_not_allocate() {
@@ -61,7 +41,7 @@ fn corrector_ticks_do_not_allocate() {
     let mut ticks = 0usize;
     let mut sink = 0.0;
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = common::allocations();
     while ticks < 10_000 {
         let mut cursor = up.ticks(2000.0).unwrap();
         while let Some(s) = cursor.step() {
@@ -73,7 +53,7 @@ fn corrector_ticks_do_not_allocate() {
             ticks += 1;
         }
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = common::allocations();
     assert!(sink.is_finite());
     assert_eq!(after - before, 0, "allocations in {ticks} corrector ticks");
 }

@@ -1,34 +1,14 @@
 //! The per-call VJM paths allocate nothing: a counting global allocator watches 1e4 calls.
 //! One test function only, so no other test thread allocates meanwhile.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use deflect_core::vjm::{self, Data, Vector6};
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Vector3};
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn vjm_calls_do_not_allocate() {
@@ -58,7 +38,7 @@ fn vjm_calls_do_not_allocate() {
     let mut q = [0.1, -0.4, 0.9, 0.2, 0.6, -0.3];
     let mut sink = 0.0;
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = common::allocations();
     for i in 0..10_000 {
         q[0] = 1e-4 * i as f64;
         sink += vjm::forward(&model, &mut data, &q).unwrap().translation.x;
@@ -74,7 +54,7 @@ fn vjm_calls_do_not_allocate() {
         let bad = vjm::deflection(&model, &mut data, &q[..5], &wrench);
         assert!(matches!(bad, Err(TickError::WrongLength { .. })));
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = common::allocations();
     assert!(sink.is_finite());
     assert_eq!(after - before, 0, "allocations on the per-call path");
 }
