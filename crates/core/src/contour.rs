@@ -197,6 +197,12 @@ pub struct TracerConfig {
     pub max_turn: f64,
     /// Shortest tool motion, as a fraction of `step`, for Eq. 21 to be used.
     pub min_motion_fraction: f64,
+    /// Position-discretization guard (section 3.2c): every move is shortened so that, were
+    /// it blocked outright, the force would stay below `jam_margin * jam_force`
+    /// (`|F + K d| <= |F| + |K d|`). In (0, 1].
+    pub jam_margin: f64,
+    /// Shortest move along the edge, as a fraction of `step`, that the guard may leave.
+    pub min_step_fraction: f64,
     /// Bisections (Figure 4) tried after contact is lost before giving up.
     pub max_bisections: usize,
     /// Consecutive readings at or above the jam force before giving up.
@@ -211,8 +217,9 @@ impl TracerConfig {
     /// Defaults for a step of `step` [m] and a force window `contact_force < |F| <
     /// jam_force` [N]: approach along +x with the same step, target force in the window's
     /// middle, 10 bias samples, stop radius 1.5 steps, counter-clockwise, Eq. 21 trusted
-    /// within 45 degrees and above 25 % of the step, 6 bisections, 10 jammed readings,
-    /// 10 000 approach steps, 100 000 steps.
+    /// within 45 degrees and above 25 % of the commanded move, moves shortened to keep a
+    /// blocked move below 80 % of the jam force (down to 10 % of the step), 6 bisections,
+    /// 10 jammed readings, 10 000 approach steps, 100 000 steps.
     pub fn new(step: f64, contact_force: f64, jam_force: f64) -> Self {
         Self {
             step,
@@ -226,6 +233,8 @@ impl TracerConfig {
             direction: TraceDirection::CounterClockwise,
             max_turn: core::f64::consts::FRAC_PI_4,
             min_motion_fraction: 0.25,
+            jam_margin: 0.8,
+            min_step_fraction: 0.1,
             max_bisections: 6,
             max_jam_steps: 10,
             max_approach_steps: 10_000,
@@ -235,7 +244,8 @@ impl TracerConfig {
 
     fn validate(&self) -> Result<(), ContourError> {
         let pos = |v: f64| v.is_finite() && v > 0.0;
-        let checks: [(bool, &'static str); 9] = [
+        let fraction = |v: f64| v.is_finite() && v > 0.0 && v <= 1.0;
+        let checks: [(bool, &'static str); 10] = [
             (pos(self.step), "step"),
             (pos(self.approach_step), "approach_step"),
             (
@@ -257,6 +267,10 @@ impl TracerConfig {
             (
                 pos(self.max_turn) && pos(self.min_motion_fraction),
                 "max_turn / min_motion_fraction",
+            ),
+            (
+                fraction(self.jam_margin) && fraction(self.min_step_fraction),
+                "jam_margin / min_step_fraction (must lie in (0, 1])",
             ),
         ];
         match checks.iter().find(|(ok, _)| !ok) {
@@ -352,6 +366,8 @@ pub struct TracerStats {
     pub normal_steps: usize,
     /// Bisected moves (Figure 4).
     pub bisections: usize,
+    /// Moves shortened by the jam guard ([`TracerConfig::jam_margin`]).
+    pub shortened: usize,
     /// Readings at or above the jam force.
     pub jams: usize,
     /// Longest run of consecutive readings out of contact after the first contact.
@@ -369,7 +385,9 @@ pub struct TracerStats {
 /// 2. `Approach`: step along `approach_direction` until `|F| > contact_force` (Eq. 22).
 /// 3. `Trace`: with the force in the window (Eq. 23) move `step` along the edge (Eq. 24), its
 ///    direction from Eq. 21 on the last step (or normal to the force at corners and right
-///    after contact), plus a move along the force that steers `|F|` to `target_force`.
+///    after contact), plus a move along the force that steers `|F|` to `target_force`; the
+///    move along the edge is shortened when, blocked outright, it would push the force past
+///    `jam_margin * jam_force` (a corner ahead in a stiff direction).
 /// 4. `Recover`: out of contact, retry from the last contact point with the direction turned
 ///    towards the object by 45, 90, 135, 157.5, ... degrees (Figure 4).
 /// 5. `Retreat`: at or above the jam force, back off along the force.
@@ -393,6 +411,7 @@ pub struct ContourTracer {
     left_start: bool,
     anchor: Vector2<f64>,
     anchor_tangent: Vector2<f64>,
+    anchor_force: Vector2<f64>,
     prev: Option<(Vector2<f64>, Vector2<f64>, Vector2<f64>)>,
     bisections: usize,
     jam_run: usize,
@@ -420,6 +439,7 @@ impl ContourTracer {
             left_start: false,
             anchor: Vector2::zeros(),
             anchor_tangent: Vector2::zeros(),
+            anchor_force: Vector2::zeros(),
             prev: None,
             bisections: 0,
             jam_run: 0,
@@ -461,6 +481,24 @@ impl ContourTracer {
     /// Normal stiffness `n^T K n` along the unit `n`, floored to stay positive.
     fn normal_stiffness(&self, n: &Vector2<f64>) -> f64 {
         (n.dot(&(self.stiffness * n))).max(f64::MIN_POSITIVE)
+    }
+
+    /// Scale in `[min_step_fraction, 1]` for the move `d` from a reading with force `f`:
+    /// a blocked move must stay below the jam guard.
+    fn guard(&mut self, f: &Vector2<f64>, d: &Vector2<f64>) -> f64 {
+        let cfg = &self.config;
+        let worst = (self.stiffness * d).norm();
+        let room = cfg.jam_margin * cfg.jam_force - f.norm();
+        if worst <= room {
+            return 1.0;
+        }
+        self.stats.shortened += 1;
+        let s = room / worst;
+        if s.is_finite() {
+            s.clamp(cfg.min_step_fraction, 1.0)
+        } else {
+            cfg.min_step_fraction
+        }
     }
 
     /// Consumes one steady-state reading and returns the next command (see the type docs).
@@ -576,9 +614,11 @@ impl ContourTracer {
                 let halvings = i32::try_from(k - 1).unwrap_or(i32::MAX);
                 core::f64::consts::PI * (1.0 - ComplexField::powi(0.5f64, halvings))
             };
-            let dir = rotate(&self.anchor_tangent, side * turn);
+            let dir = rotate(&self.anchor_tangent, side * turn) * cfg.step;
+            let anchor_force = self.anchor_force;
+            let scale = self.guard(&anchor_force, &dir);
             self.state = TracerState::Recover;
-            out.command = self.anchor + dir * cfg.step;
+            out.command = self.anchor + dir * scale;
             out.state = self.state;
             return Ok(out);
         }
@@ -599,9 +639,10 @@ impl ContourTracer {
         let mut from_eq21 = false;
         if let (TracerState::Trace, Some((p_prev, f_prev, _))) = (self.state, self.prev) {
             // Eq. 21 on the last commanded step and the change of the steady force.
-            let a = (position - p_prev) - self.compliance * (f - f_prev);
+            let commanded = position - p_prev;
+            let a = commanded - self.compliance * (f - f_prev);
             let len = a.norm();
-            if len >= cfg.min_motion_fraction * cfg.step {
+            if len >= cfg.min_motion_fraction * commanded.norm() && len > 0.0 {
                 let cand = a / len;
                 let cos = cand.dot(&t_normal).clamp(-1.0, 1.0);
                 if ComplexField::acos(cos) <= cfg.max_turn {
@@ -632,9 +673,13 @@ impl ContourTracer {
         // Eq. 24 plus a move along the force that steers |F| to the target.
         let correction =
             ((cfg.target_force - magnitude) / self.normal_stiffness(&n)).clamp(-cfg.step, cfg.step);
-        out.command = position + tangent * cfg.step + n * correction;
+        let push = n * correction;
+        let along = tangent * cfg.step;
+        let scale = self.guard(&(f + self.stiffness * push), &along);
+        out.command = position + along * scale + push;
         self.anchor = *position;
         self.anchor_tangent = tangent;
+        self.anchor_force = f;
         self.prev = Some((*position, f, tangent));
         self.state = TracerState::Trace;
         out.state = self.state;

@@ -116,7 +116,7 @@ impl Arm {
     fn new() -> Self {
         let l = [0.5, 0.4];
         let k = [2000.0, 1000.0];
-        let backlash = [2.0e-4, 3.0e-4];
+        let backlash = [0.0, 0.0];
         let model = ModelBuilder::new()
             .revolute(Vector3::z())
             .unwrap()
@@ -303,6 +303,7 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
         let q_cmd = arm.ik(&cmd);
         let (q_true, f) = equilibrium(&arm, shape, &q_cmd);
         max_true_force = max_true_force.max(f.norm());
+        if f.norm() > 20.0 || std::env::var("DBG_ALL").is_ok() { eprintln!("DEBUG step {steps} cmd {cmd:?} tool {:?} f {f:?} state {:?}", arm.fk(&q_true), tracer.state()); }
         let sensed =
             f + bias + Vector2::new(rng.uniform(-noise, noise), rng.uniform(-noise, noise));
         let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q_cmd).unwrap();
@@ -336,7 +337,7 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
 fn check(name: &str, shape: &Shape, start: Vector2<f64>, perimeter: f64) {
     let r = trace(shape, start, 0.05);
     println!(
-        "{name}: {:?} after {} steps; {} contacts, eq21 {} / normal {} / bisections {} / jams {}, \
+        "{name}: {:?} after {} steps; {} contacts, eq21 {} / normal {} / bisections {} / shortened {} / jams {}, \
          longest loss {}, max force {:.1} N (sensed {:.1}), path {:.4} m (perimeter {:.4})\n  \
          raw rms {:.3} mm max {:.3} mm | compensated rms {:.4} mm max {:.4} mm | true tool rms {:.4} mm",
         r.state,
@@ -345,6 +346,7 @@ fn check(name: &str, shape: &Shape, start: Vector2<f64>, perimeter: f64) {
         r.stats.eq21_steps,
         r.stats.normal_steps,
         r.stats.bisections,
+        r.stats.shortened,
         r.stats.jams,
         r.stats.longest_loss,
         r.max_true_force,

@@ -321,7 +321,8 @@ impl ContourTracer {
     #[pyo3(signature = (stiffness, step, contact_force, jam_force, *, target_force=None,
                         approach_direction=(1.0, 0.0), approach_step=None, bias_samples=10,
                         stop_radius=None, clockwise=false, max_turn=std::f64::consts::FRAC_PI_4,
-                        min_motion_fraction=0.25, max_bisections=6, max_jam_steps=10,
+                        min_motion_fraction=0.25, jam_margin=0.8, min_step_fraction=0.1,
+                        max_bisections=6, max_jam_steps=10,
                         max_approach_steps=10_000, max_steps=100_000))]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
@@ -337,6 +338,8 @@ impl ContourTracer {
         clockwise: bool,
         max_turn: f64,
         min_motion_fraction: f64,
+        jam_margin: f64,
+        min_step_fraction: f64,
         max_bisections: usize,
         max_jam_steps: usize,
         max_approach_steps: usize,
@@ -362,6 +365,8 @@ impl ContourTracer {
         };
         cfg.max_turn = max_turn;
         cfg.min_motion_fraction = min_motion_fraction;
+        cfg.jam_margin = jam_margin;
+        cfg.min_step_fraction = min_step_fraction;
         cfg.max_bisections = max_bisections;
         cfg.max_jam_steps = max_jam_steps;
         cfg.max_approach_steps = max_approach_steps;
@@ -429,8 +434,8 @@ impl ContourTracer {
     fn start(&self) -> Option<(f64, f64)> {
         self.inner.start().map(|s| (s.x, s.y))
     }
-    /// Counters: steps, contacts, eq21_steps, normal_steps, bisections, jams, longest_loss,
-    /// max_force, path_length.
+    /// Counters: steps, contacts, eq21_steps, normal_steps, bisections, shortened, jams,
+    /// longest_loss, max_force, path_length.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let s = self.inner.stats();
         let d = PyDict::new(py);
@@ -439,6 +444,7 @@ impl ContourTracer {
         d.set_item("eq21_steps", s.eq21_steps)?;
         d.set_item("normal_steps", s.normal_steps)?;
         d.set_item("bisections", s.bisections)?;
+        d.set_item("shortened", s.shortened)?;
         d.set_item("jams", s.jams)?;
         d.set_item("longest_loss", s.longest_loss)?;
         d.set_item("max_force", s.max_force)?;

@@ -347,7 +347,51 @@ fn reproduce(args: &ReproduceArgs, out: &Path) -> Result<(), SimError> {
         t_static
     );
     write_outputs(&runs, out, &table)?;
+    mass_sweep(&maps, out)?;
     println!("outputs in {}", out.display());
+    Ok(())
+}
+
+/// The paper's preliminary tuning of m* (section 5.1), redone in simulation: y-line at 5 g,
+/// corrected, for several mass parameters.
+fn mass_sweep(maps: &[(Constraint, ComplianceMap)], out: &Path) -> Result<(), SimError> {
+    let masses = [3.6, 4.0, 4.5, 5.0, 5.5, 6.0, 7.0];
+    let mut text =
+        String::from("\nm* tuning (y-line, 5 g, corrected): max path dev / max tracking [mm]\n");
+    text.push_str(&format!("{:<8}", "m* [kg]"));
+    for m in masses {
+        text.push_str(&format!(" {m:>13.1}"));
+    }
+    text.push('\n');
+    let mut csv = String::from("config,mass_kg,max_dev_mm,rms_dev_mm,area_mm2,max_track_mm\n");
+    for params in configurations() {
+        let Some((_, map)) = maps.iter().find(|(c, _)| *c == params.constraint) else {
+            continue;
+        };
+        text.push_str(&format!("{:<8}", params.label()));
+        for mass in masses {
+            let opts = RunOptions {
+                mass,
+                ..Default::default()
+            };
+            let r = pipeline::run(&params, Motion::YLine, 5, Some(map), &opts)?;
+            let m = &r.metrics;
+            text.push_str(&format!(" {:>6.4}/{:.4}", m.max_dev_mm, m.max_track_mm));
+            csv.push_str(&format!(
+                "{},{},{:.6},{:.6},{:.6},{:.6}\n",
+                params.label(),
+                mass,
+                m.max_dev_mm,
+                m.rms_dev_mm,
+                m.area_mm2,
+                m.max_track_mm
+            ));
+        }
+        text.push('\n');
+    }
+    println!("{text}");
+    std::fs::write(out.join("mass_sweep.csv"), csv)?;
+    std::fs::write(out.join("mass_sweep.txt"), text)?;
     Ok(())
 }
 
