@@ -168,38 +168,49 @@ enum Shape {
 }
 
 impl Shape {
-    /// Boundary distance, and for points inside: (depth, unit direction into the object).
+    /// Boundary distance.
     fn distance(&self, p: &Vector2<f64>) -> f64 {
         match self {
             Shape::Circle(c, r) => shape::distance_to_circle(p, c, *r),
             Shape::Polygon(v) => shape::distance_to_polygon(p, v),
         }
     }
-    fn penetration(&self, p: &Vector2<f64>) -> Option<(f64, Vector2<f64>)> {
+    /// For points inside: (depth d, unit gradient u of d, i.e. into the object, Hessian of
+    /// d), d being the distance to the boundary.
+    fn penetration(&self, p: &Vector2<f64>) -> Option<(f64, Vector2<f64>, Matrix2<f64>)> {
         match self {
             Shape::Circle(c, r) => {
                 let d = p - c;
                 let n = d.norm();
-                (n < *r).then(|| (r - n, -d / n))
+                let u = -d / n;
+                (n < *r).then(|| (r - n, u, -(Matrix2::identity() - u * u.transpose()) / n))
             }
             Shape::Polygon(v) => {
                 if !shape::inside_polygon(p, v) {
                     return None;
                 }
                 // Nearest boundary point.
-                let mut best = (f64::INFINITY, Vector2::zeros());
+                let mut best = (f64::INFINITY, Vector2::zeros(), false);
                 for i in 0..v.len() {
                     let (a, b) = (v[i], v[(i + 1) % v.len()]);
                     let ab = b - a;
-                    let t = ((p - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
+                    let t_raw = (p - a).dot(&ab) / ab.norm_squared();
+                    let t = t_raw.clamp(0.0, 1.0);
                     let q = a + ab * t;
                     let d = (p - q).norm();
                     if d < best.0 {
-                        best = (d, q);
+                        best = (d, q, t != t_raw);
                     }
                 }
-                let (d, q) = best;
-                (d > 0.0).then(|| (d, (p - q) / d))
+                let (d, q, at_vertex) = best;
+                let u = (p - q) / d;
+                // Distance to a vertex curves (|p - v|); to an edge it is flat.
+                let h = if at_vertex {
+                    (Matrix2::identity() - u * u.transpose()) / d
+                } else {
+                    Matrix2::zeros()
+                };
+                (d > 0.0).then(|| (d, u, h))
             }
         }
     }
@@ -208,12 +219,18 @@ impl Shape {
 /// Contact stiffness of the rigid object [N/m] (penalty).
 const K_CONTACT: f64 = 1.0e7;
 
-/// Static equilibrium of the arm with motors at `q_cmd` against `shape`: the link angles and
-/// the force the tool exerts on the object. Minimizes spring + contact energy by damped
-/// Gauss-Newton; the backlash is taken up in the direction of the resulting joint torque.
-fn equilibrium(arm: &Arm, shape: &Shape, q_cmd: &[f64; 2]) -> ([f64; 2], Vector2<f64>) {
+/// Quasi-static equilibrium of the arm with motors at `q_cmd` against `shape`, reached from
+/// the previous link angles `q_from` (the tool slides on from where it was): the link angles
+/// and the force the tool exerts on the object. Minimizes spring + contact energy by Newton
+/// with a line search; the backlash is taken up in the direction of the joint torque.
+fn equilibrium(
+    arm: &Arm,
+    shape: &Shape,
+    q_cmd: &[f64; 2],
+    q_from: &[f64; 2],
+) -> ([f64; 2], Vector2<f64>) {
     let mut sgn = [0.0f64; 2];
-    let mut q = *q_cmd;
+    let mut q = *q_from;
     let mut force = Vector2::zeros();
     for _ in 0..6 {
         let q_ref = [
@@ -226,7 +243,7 @@ fn equilibrium(arm: &Arm, shape: &Shape, q_cmd: &[f64; 2]) -> ([f64; 2], Vector2
                 .sum();
             let contact = shape
                 .penetration(&arm.fk(q))
-                .map_or(0.0, |(d, _)| 0.5 * K_CONTACT * d * d);
+                .map_or(0.0, |(d, _, _)| 0.5 * K_CONTACT * d * d);
             spring + contact
         };
         for _ in 0..200 {
@@ -234,10 +251,12 @@ fn equilibrium(arm: &Arm, shape: &Shape, q_cmd: &[f64; 2]) -> ([f64; 2], Vector2
             let kd = Matrix2::new(arm.k[0], 0.0, 0.0, arm.k[1]);
             let dq = Vector2::new(q[0] - q_ref[0], q[1] - q_ref[1]);
             let (mut g, mut h) = (kd * dq, kd);
-            if let Some((d, u)) = shape.penetration(&arm.fk(&q)) {
-                let ju = j.transpose() * u;
-                g += ju * (K_CONTACT * d);
-                h += ju * ju.transpose() * K_CONTACT;
+            if let Some((d, u, hd)) = shape.penetration(&arm.fk(&q)) {
+                g += j.transpose() * u * (K_CONTACT * d);
+                h += j.transpose() * (u * u.transpose() + hd * d) * j * K_CONTACT;
+            }
+            if g.norm() < 1e-10 {
+                break;
             }
             let step = -h.try_inverse().unwrap() * g;
             let e0 = energy(&q);
@@ -255,8 +274,13 @@ fn equilibrium(arm: &Arm, shape: &Shape, q_cmd: &[f64; 2]) -> ([f64; 2], Vector2
         }
         force = shape
             .penetration(&arm.fk(&q))
-            .map_or(Vector2::zeros(), |(d, u)| u * (K_CONTACT * d));
+            .map_or(Vector2::zeros(), |(d, u, _)| u * (K_CONTACT * d));
         let u = arm.jac(&q).transpose() * force;
+        let residual = (0..2)
+            .map(|i| (arm.k[i] * (q[i] - q_ref[i]) + u[i]).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        assert!(residual < 1e-4, "equilibrium not found: residual {residual:e} N m");
         let new_sgn = [
             u[0].signum() * (u[0] != 0.0) as u8 as f64,
             u[1].signum() * (u[1] != 0.0) as u8 as f64,
@@ -295,13 +319,15 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
     let k0 = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q0).unwrap();
     let mut tracer = ContourTracer::new(cfg, &k0).unwrap();
     let mut cmd = start;
+    let mut q_prev = q0;
     let (mut raw, mut comp, mut truth) = (Vec::new(), Vec::new(), Vec::new());
     let mut max_true_force = 0.0f64;
     let mut steps = 0;
     let state = loop {
         steps += 1;
         let q_cmd = arm.ik(&cmd);
-        let (q_true, f) = equilibrium(&arm, shape, &q_cmd);
+        let (q_true, f) = equilibrium(&arm, shape, &q_cmd, &q_prev);
+        q_prev = q_true;
         max_true_force = max_true_force.max(f.norm());
         if f.norm() > 20.0 || std::env::var("DBG_ALL").is_ok() { eprintln!("DEBUG step {steps} cmd {cmd:?} tool {:?} f {f:?} state {:?}", arm.fk(&q_true), tracer.state()); }
         let sensed =
@@ -448,9 +474,11 @@ fn traces_clockwise_and_reports_failures() {
     let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &arm.ik(&cmd)).unwrap();
     let mut tracer = ContourTracer::new(cfg, &k).unwrap();
     let mut state = tracer.state();
+    let mut q_prev = arm.ik(&cmd);
     for _ in 0..5000 {
         let q = arm.ik(&cmd);
-        let (_, f) = equilibrium(&arm, &shape, &q);
+        let (q_true, f) = equilibrium(&arm, &shape, &q, &q_prev);
+        q_prev = q_true;
         let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q).unwrap();
         tracer.set_stiffness(&k).unwrap();
         let out = tracer.step(&cmd, &f).unwrap();
