@@ -116,7 +116,7 @@ impl Arm {
     fn new() -> Self {
         let l = [0.5, 0.4];
         let k = [2000.0, 1000.0];
-        let backlash = [0.0, 0.0];
+        let backlash = [2.0e-4, 3.0e-4];
         let model = ModelBuilder::new()
             .revolute(Vector3::z())
             .unwrap()
@@ -329,7 +329,6 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
         let (q_true, f) = equilibrium(&arm, shape, &q_cmd, &q_prev);
         q_prev = q_true;
         max_true_force = max_true_force.max(f.norm());
-        if f.norm() > 20.0 || std::env::var("DBG_ALL").is_ok() { eprintln!("DEBUG step {steps} cmd {cmd:?} tool {:?} f {f:?} state {:?}", arm.fk(&q_true), tracer.state()); }
         let sensed =
             f + bias + Vector2::new(rng.uniform(-noise, noise), rng.uniform(-noise, noise));
         let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q_cmd).unwrap();

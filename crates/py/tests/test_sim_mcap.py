@@ -11,7 +11,7 @@ import subprocess
 
 import pytest
 
-mcap_reader = pytest.importorskip("mcap.reader")
+import mcap.reader as mcap_reader  # installed by scripts/test-all.sh
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 TOPICS = ["/desired", "/commanded", "/actual", "/dalembert_force", "/joints"]
