@@ -218,8 +218,14 @@ impl DriveTrain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let q = self.q(&q)?;
         let w = Self::wrench(&wrench)?;
-        let c = dt::correct_joints(&self.model, &mut Data::new(&self.model), &self.inner, &q, &w)
-            .map_err(tick_err)?;
+        let c = dt::correct_joints(
+            &self.model,
+            &mut Data::new(&self.model),
+            &self.inner,
+            &q,
+            &w,
+        )
+        .map_err(tick_err)?;
         Ok(self.out(py, &c.torque))
     }
 
@@ -233,8 +239,14 @@ impl DriveTrain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let q = self.q(&q)?;
         let w = Self::wrench(&wrench)?;
-        let c = dt::correct_joints(&self.model, &mut Data::new(&self.model), &self.inner, &q, &w)
-            .map_err(tick_err)?;
+        let c = dt::correct_joints(
+            &self.model,
+            &mut Data::new(&self.model),
+            &self.inner,
+            &q,
+            &w,
+        )
+        .map_err(tick_err)?;
         Ok(self.out(py, &c.q))
     }
 
@@ -481,7 +493,11 @@ fn edge_contact_force<'py>(
     if !edge_angle.is_finite() {
         return Err(InputError::new_err("edge_angle is not finite"));
     }
-    let f = contour::edge_contact_force(&m2(&stiffness, "stiffness")?, &v2(&step, "step")?, edge_angle);
+    let f = contour::edge_contact_force(
+        &m2(&stiffness, "stiffness")?,
+        &v2(&step, "step")?,
+        edge_angle,
+    );
     Ok(f.as_slice().to_pyarray(py))
 }
 

@@ -20,6 +20,7 @@ mod compensation;
 mod compliance_map;
 mod convert;
 mod dalembert;
+mod drivetrain;
 mod motion;
 mod vjm;
 
@@ -68,5 +69,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     compliance_map::register(m)?;
     motion::register(m)?;
     dalembert::register(m)?;
+    drivetrain::register(m)?;
     Ok(())
 }

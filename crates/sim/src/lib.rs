@@ -5,6 +5,8 @@
 //! and the paper's evaluation (Appendix C).
 
 pub mod analysis;
+pub mod milling;
+pub mod milling_output;
 pub mod output;
 pub mod pipeline;
 pub mod report;

@@ -54,6 +54,39 @@ enum Command {
     },
     /// One motion on one configuration, uncorrected and/or corrected; writes an MCAP log.
     Run(RunArgs),
+    /// Milling scenario for the online force-based compensation (Hähn & Weigold): a 4-axis
+    /// flexible arm mills a groove; uncompensated, Cartesian compensation and pilot control;
+    /// stiffness and sensor identification. Writes milling_summary.{txt,csv,json},
+    /// milling.mcap and PNG plots.
+    Milling(MillingArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct MillingArgs {
+    /// Feed speed [mm/s] (paper: 25).
+    #[arg(long, default_value_t = 25.0)]
+    feed: f64,
+    /// Magnitude of the process force [N] (direction as the default [-386, 386, -60] N).
+    #[arg(long, default_value_t = 550.0)]
+    force: f64,
+    /// Cutting time [s].
+    #[arg(long, default_value_t = 1.2)]
+    cut: f64,
+    /// Rise and fall time of the force at cutter entry and exit [ms].
+    #[arg(long, default_value_t = 100.0)]
+    rise_ms: f64,
+    /// Control cycle [ms] (paper: 4, KUKA RSI).
+    #[arg(long, default_value_t = 4.0)]
+    cycle_ms: f64,
+    /// Lead of the offline force estimate over the real force [ms].
+    #[arg(long, default_value_t = 40.0)]
+    lead_ms: f64,
+    /// Relative error of the offline force estimate (0.1 = 10 % too large).
+    #[arg(long, default_value_t = 0.1)]
+    estimate_error: f64,
+    /// Seed of the sensor and measurement noise.
+    #[arg(long, default_value_t = 6)]
+    seed: u64,
 }
 
 #[derive(clap::Args, Debug)]
@@ -553,6 +586,39 @@ fn fit_cmd(mech: Mech, input: Option<&Path>, out: &Path) -> Result<(), SimError>
     Ok(())
 }
 
+fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
+    use deflect_sim::{milling, milling_output};
+    let mut opts = milling::MillingOptions::default();
+    let dir = nalgebra::Vector3::from(opts.force).normalize();
+    opts.force = (dir * a.force).into();
+    opts.feed = a.feed * 1e-3;
+    opts.cut = a.cut;
+    opts.cycle = a.cycle_ms * 1e-3;
+    opts.force_rise = a.rise_ms * 1e-3;
+    opts.estimate_lead = a.lead_ms * 1e-3;
+    opts.estimate_error = a.estimate_error;
+    opts.seed = a.seed;
+    let ok = |v: f64, lo: f64| v.is_finite() && v >= lo;
+    if !(ok(opts.feed, 1e-6) && ok(a.force, 0.0) && ok(opts.cut, 0.01) && ok(opts.cycle, 5e-4))
+        || !ok(opts.estimate_lead, 0.0)
+        || !ok(opts.force_rise, 1e-4)
+        || !opts.estimate_error.is_finite()
+    {
+        return Err(SimError::new(
+            "milling: feed > 0, force >= 0, cut >= 0.01 s, cycle >= 0.5 ms, lead >= 0, rise >= 0.1 ms",
+        ));
+    }
+    let r = milling::milling(&opts)?;
+    let table = milling_output::table(&r);
+    print!("{table}");
+    milling_output::write_all(out, &r)?;
+    println!(
+        "wrote {}/milling_summary.{{txt,csv,json}}, milling.mcap, milling_error.png, milling_stiffness.png",
+        out.display()
+    );
+    Ok(())
+}
+
 fn main() -> std::process::ExitCode {
     let cli = Cli::parse();
     let result = std::fs::create_dir_all(&cli.out)
@@ -592,6 +658,7 @@ fn main() -> std::process::ExitCode {
                 fit_cmd(*mechanism, input.as_deref(), &cli.out)
             }
             Some(Command::Run(a)) => run_one(a, &cli.out),
+            Some(Command::Milling(a)) => milling_cmd(a, &cli.out),
         });
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

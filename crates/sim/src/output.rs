@@ -176,7 +176,8 @@ pub fn summary_csv(runs: &[RunResult]) -> String {
 
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
-fn register_font() {
+/// Registers the embedded font for plotters (once).
+pub(crate) fn register_font() {
     use std::sync::Once;
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
@@ -184,7 +185,8 @@ fn register_font() {
     });
 }
 
-fn perr<E: std::fmt::Display>(e: E) -> SimError {
+/// A plotting error as a [`SimError`].
+pub(crate) fn perr<E: std::fmt::Display>(e: E) -> SimError {
     SimError::new(format!("plot: {e}"))
 }
 

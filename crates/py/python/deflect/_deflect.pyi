@@ -323,3 +323,84 @@ def identify_stiffness_from_frames(
 def identify_sensor(
     rotations: ArrayLike, readings: ArrayLike, fit_polynomial: bool = False, sensor_to_tcp: Optional[ArrayLike] = None
 ) -> Tuple[SensorCalibration, Dict[str, Any]]: ...
+
+class DriveTrain:
+    """Drive-train errors of a serial robot (contour-tracking paper, Eq. 3-13). Wrenches are the
+    wrench the tool exerts on the environment (base frame); torques are drive torques."""
+    def __init__(
+        self,
+        robot: SerialRobot,
+        stiffness: ArrayLike,
+        backlash: Optional[ArrayLike] = None,
+        masses: Optional[List[Tuple[int, float, Tuple[float, float, float]]]] = None,
+        gravity: Optional[Tuple[float, float, float]] = None,
+        torque_deadband: float = 0.0,
+        max_condition: float = 1.0e6,
+    ) -> None: ...
+    @staticmethod
+    def from_urdf(robot: SerialRobot, urdf_path: StrPath, drive_path: StrPath) -> "DriveTrain": ...
+    @staticmethod
+    def from_strings(robot: SerialRobot, urdf: str, drive_toml: str) -> "DriveTrain": ...
+    @property
+    def stiffness(self) -> List[float]: ...
+    @property
+    def backlash(self) -> List[float]: ...
+    @property
+    def masses(self) -> List[Tuple[int, float, Tuple[float, float, float]]]: ...
+    @property
+    def gravity(self) -> Tuple[float, float, float]: ...
+    def gravity_torques(self, q: ArrayLike) -> FloatArray: ...
+    def contact_torques(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray: ...
+    def joint_torques(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray: ...
+    def correct_joints(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray:
+        """Eq. 10: theta - sgn(u) theta_b - u / K."""
+    def compensated_forward(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray: ...
+    def cartesian_stiffness(self, q: ArrayLike, planar: Optional[str] = None) -> FloatArray:
+        """Eq. 12: K = J^-T K_theta J^-1 (6x6, or planar "xy" 2x2 / "xyrz" 3x3)."""
+
+class ContourTracer:
+    """Force-feedback contour tracing (Figures 3-4): step(position, force) -> (command, state)."""
+    def __init__(
+        self,
+        stiffness: ArrayLike,
+        step: float,
+        contact_force: float,
+        jam_force: float,
+        *,
+        target_force: Optional[float] = None,
+        approach_direction: Tuple[float, float] = (1.0, 0.0),
+        approach_step: Optional[float] = None,
+        bias_samples: int = 10,
+        stop_radius: Optional[float] = None,
+        clockwise: bool = False,
+        max_turn: float = 0.7853981633974483,
+        min_motion_fraction: float = 0.25,
+        jam_margin: float = 0.8,
+        min_step_fraction: float = 0.1,
+        max_bisections: int = 6,
+        max_jam_steps: int = 10,
+        max_approach_steps: int = 10000,
+        max_steps: int = 100000,
+    ) -> None: ...
+    def set_stiffness(self, stiffness: ArrayLike) -> None: ...
+    def step(self, position: ArrayLike, force: ArrayLike) -> Tuple[FloatArray, str]: ...
+    @property
+    def state(self) -> str: ...
+    @property
+    def finished(self) -> bool: ...
+    @property
+    def contact(self) -> bool: ...
+    @property
+    def tool(self) -> Optional[Tuple[float, float]]: ...
+    @property
+    def force(self) -> Optional[Tuple[float, float]]: ...
+    @property
+    def bias(self) -> Tuple[float, float]: ...
+    @property
+    def start(self) -> Optional[Tuple[float, float]]: ...
+    def stats(self) -> Dict[str, Any]: ...
+
+def edge_direction(stiffness: ArrayLike, step: ArrayLike, force: ArrayLike) -> float:
+    """Eq. 21: the edge angle from a commanded step and the steady-state force."""
+def edge_contact_force(stiffness: ArrayLike, step: ArrayLike, edge_angle: float) -> FloatArray:
+    """Eq. 16-20: the contact force of a step blocked by an edge."""

@@ -1,0 +1,447 @@
+//! Outputs of the milling scenario: summary table (text, CSV, JSON), MCAP log and PNG plots.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use mcap::records::MessageHeader;
+use plotters::prelude::*;
+use serde_json::json;
+
+use crate::SimError;
+use crate::milling::{MillingResult, Sample};
+use crate::output::{perr, register_font};
+
+/// Topics written per run, as `/milling/<run>/<topic>`.
+pub const TOPICS: [&str; 7] = [
+    "nominal",
+    "actual",
+    "commanded",
+    "force_measured",
+    "force_filtered",
+    "correction",
+    "error",
+];
+
+/// The summary table printed on stdout and written to `milling_summary.txt`.
+pub fn table(r: &MillingResult) -> String {
+    let o = &r.options;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "milling: 4-axis flexible arm (rapier), groove along +x at {:.0} mm/s, {:.1} s cut, \
+         force [{:.0}, {:.0}, {:.0}] N (|F| = {:.0} N), cycle {:.1} ms, correction delay {} cycles \
+         + {:.0} ms servo lag",
+        o.feed * 1e3,
+        o.cut,
+        o.force[0],
+        o.force[1],
+        o.force[2],
+        nalgebra::Vector3::from(o.force).norm(),
+        o.cycle * 1e3,
+        o.delay_cycles,
+        o.servo_tau * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "pilot: estimate leads by {:.0} ms, {:+.0} % off; threshold {:.0} N, ramp {:.0} ms\n",
+        o.estimate_lead * 1e3,
+        o.estimate_error * 100.0,
+        o.pilot.0,
+        o.pilot.1 * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "path error across the feed [mm] (window: entry .. 0.1 s after the force has fallen at exit)"
+    );
+    let _ = writeln!(
+        s,
+        "run            |   max |   RMS | steady max | entry max | exit max"
+    );
+    for run in &r.runs {
+        let m = &run.metrics;
+        let _ = writeln!(
+            s,
+            "{:<14} | {:5.3} | {:5.3} |      {:5.3} |     {:5.3} |    {:5.3}",
+            run.mode.label(),
+            m.max_mm,
+            m.rms_mm,
+            m.steady_max_mm,
+            m.entry_max_mm,
+            m.exit_max_mm
+        );
+    }
+    let _ = writeln!(
+        s,
+        "\nstiffness identification ({} N static loads in rapier) [kN m/rad]",
+        o.id_load
+    );
+    let _ = writeln!(
+        s,
+        "joint | true    | frames (+- se)      | err %  | TCP (+- se)         | err %"
+    );
+    for e in &r.stiffness {
+        let _ = writeln!(
+            s,
+            "{:<5} | {:7.1} | {:7.1} (+- {:6.2}) | {:+6.2} | {:7.1} (+- {:6.2}) | {:+6.2}",
+            ["yaw", "q2", "q3", "q4"].get(e.joint).copied().unwrap_or("?"),
+            e.k_true * 1e-3,
+            e.k_frames * 1e-3,
+            e.se_frames * 1e-3,
+            (e.k_frames / e.k_true - 1.0) * 100.0,
+            e.k_tcp * 1e-3,
+            e.se_tcp * 1e-3,
+            (e.k_tcp / e.k_true - 1.0) * 100.0
+        );
+    }
+    let c = &r.sensor;
+    let _ = writeln!(
+        s,
+        "\nsensor identification ({} orientations, unloaded; force RMS {:.3} N)",
+        c.orientations, c.force_rms
+    );
+    let v = |a: &[f64; 3], k: f64| format!("[{:.3}, {:.3}, {:.3}]", a[0] * k, a[1] * k, a[2] * k);
+    let _ = writeln!(
+        s,
+        "force offset [N]   true {}  identified {}",
+        v(&c.force_offset.0, 1.0),
+        v(&c.force_offset.1, 1.0)
+    );
+    let _ = writeln!(
+        s,
+        "moment offset [Nm] true {}  identified {}",
+        v(&c.moment_offset.0, 1.0),
+        v(&c.moment_offset.1, 1.0)
+    );
+    let _ = writeln!(
+        s,
+        "weight [N]         true {:.3}  identified {:.3}",
+        c.weight.0, c.weight.1
+    );
+    let _ = writeln!(
+        s,
+        "CoG [mm]           true {}  identified {}",
+        v(&c.center_of_gravity.0, 1e3),
+        v(&c.center_of_gravity.1, 1e3)
+    );
+    let _ = writeln!(
+        s,
+        "\n{:.1} s simulated ({} steps of 0.5 ms) in {:.2} s wall clock, identification included",
+        r.sim_seconds,
+        (r.sim_seconds / crate::robot::DT).round(),
+        r.wall_seconds
+    );
+    s
+}
+
+/// CSV: one row per run (errors), then one row per joint (identification).
+pub fn csv(r: &MillingResult) -> String {
+    let mut s = String::from("run,max_mm,rms_mm,steady_max_mm,entry_max_mm,exit_max_mm\n");
+    for run in &r.runs {
+        let m = &run.metrics;
+        let _ = writeln!(
+            s,
+            "{},{:.6},{:.6},{:.6},{:.6},{:.6}",
+            run.mode.label(),
+            m.max_mm,
+            m.rms_mm,
+            m.steady_max_mm,
+            m.entry_max_mm,
+            m.exit_max_mm
+        );
+    }
+    s.push_str("\njoint,k_true,k_frames,se_frames,k_tcp,se_tcp\n");
+    for e in &r.stiffness {
+        let _ = writeln!(
+            s,
+            "{},{:.3},{:.3},{:.3},{:.3},{:.3}",
+            e.joint, e.k_true, e.k_frames, e.se_frames, e.k_tcp, e.se_tcp
+        );
+    }
+    s
+}
+
+/// JSON summary (without the per-cycle logs).
+pub fn json(r: &MillingResult) -> serde_json::Value {
+    json!({
+        "options": r.options,
+        "runs": r.runs.iter().map(|x| json!({"run": x.mode.label(), "metrics": x.metrics})).collect::<Vec<_>>(),
+        "stiffness": r.stiffness,
+        "sensor": r.sensor,
+        "sim_seconds": r.sim_seconds,
+        "wall_seconds": r.wall_seconds,
+    })
+}
+
+fn stamp(t: f64) -> serde_json::Value {
+    let ns = (t * 1e9).round() as u64;
+    json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
+}
+
+fn schema(title: &str, fields: &[(&str, &str)]) -> serde_json::Value {
+    let mut props = json!({
+        "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+        "run": {"type": "string"},
+    });
+    for (f, unit) in fields {
+        props[*f] = json!({"type": "number", "description": unit});
+    }
+    json!({"title": title, "type": "object", "properties": props})
+}
+
+const XYZ: [&str; 3] = ["x", "y", "z"];
+const WRENCH: [&str; 6] = ["fx", "fy", "fz", "mx", "my", "mz"];
+const TWIST: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
+
+fn fields(topic: &str) -> Vec<(&'static str, &'static str)> {
+    match topic {
+        "nominal" | "actual" | "commanded" => XYZ.iter().map(|f| (*f, "m")).collect(),
+        "force_measured" | "force_filtered" => WRENCH
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (*f, if i < 3 { "N" } else { "N m" }))
+            .collect(),
+        "correction" => TWIST
+            .iter()
+            .enumerate()
+            .map(|(i, f)| (*f, if i < 3 { "m" } else { "rad" }))
+            .collect(),
+        _ => vec![("error_mm", "mm"), ("pilot_weight", "1"), ("force_true_norm", "N")],
+    }
+}
+
+fn message(topic: &str, run: &str, s: &Sample) -> serde_json::Value {
+    let mut m = json!({"timestamp": stamp(s.t), "run": run});
+    let put = |m: &mut serde_json::Value, names: &[&str], v: &[f64]| {
+        for (n, x) in names.iter().zip(v) {
+            m[*n] = json!(x);
+        }
+    };
+    match topic {
+        "nominal" => put(&mut m, &XYZ, &s.nominal),
+        "actual" => put(&mut m, &XYZ, &s.actual),
+        "commanded" => put(&mut m, &XYZ, &s.commanded),
+        "force_measured" => put(&mut m, &WRENCH, &s.force_measured),
+        "force_filtered" => put(&mut m, &WRENCH, &s.force_filtered),
+        "correction" => put(&mut m, &TWIST, &s.correction),
+        _ => {
+            let f = nalgebra::Vector3::from(s.force_true).norm();
+            put(
+                &mut m,
+                &["error_mm", "pilot_weight", "force_true_norm"],
+                &[s.error_mm, s.pilot_weight, f],
+            );
+        }
+    }
+    m
+}
+
+/// Writes the three runs to `path`, topics `/milling/<run>/<topic>`; all runs share the
+/// scenario's time axis. Returns the number of messages.
+pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
+    let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
+    let mut schema_ids = Vec::new();
+    for topic in TOPICS {
+        let s = schema(&format!("milling {topic}"), &fields(topic));
+        schema_ids.push(w.add_schema(
+            &format!("deflect.milling.{topic}"),
+            "jsonschema",
+            serde_json::to_string(&s)?.as_bytes(),
+        )?);
+    }
+    let mut count = 0;
+    for run in &r.runs {
+        let name = run.mode.label();
+        let mut meta = BTreeMap::new();
+        meta.insert("run".to_string(), name.to_string());
+        let mut channels = Vec::new();
+        for (topic, schema) in TOPICS.iter().zip(&schema_ids) {
+            channels.push(w.add_channel(
+                *schema,
+                &format!("/milling/{name}/{topic}"),
+                "json",
+                &meta,
+            )?);
+        }
+        for (seq, s) in (0u32..).zip(&run.samples) {
+            let ns = (s.t * 1e9).round() as u64;
+            for (topic, ch) in TOPICS.iter().zip(&channels) {
+                let header = MessageHeader {
+                    channel_id: *ch,
+                    sequence: seq,
+                    log_time: ns,
+                    publish_time: ns,
+                };
+                let msg = message(topic, name, s);
+                w.write_to_known_channel(&header, serde_json::to_string(&msg)?.as_bytes())?;
+                count += 1;
+            }
+        }
+    }
+    w.finish()?;
+    Ok(count)
+}
+
+/// Path error against time for the three runs, with the cutter entry and exit marked.
+pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
+    register_font();
+    let root = BitMapBackend::new(path, (1100, 620)).into_drawing_area();
+    root.fill(&WHITE).map_err(perr)?;
+    let t_end = r.options.t_end();
+    let ymax = r
+        .runs
+        .iter()
+        .flat_map(|x| x.samples.iter().map(|s| s.error_mm))
+        .fold(0.1, f64::max)
+        * 1.1;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "milling: tool-point deviation across the feed",
+            ("sans-serif", 22),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(0.0..t_end, 0.0..ymax)
+        .map_err(perr)?;
+    chart
+        .configure_mesh()
+        .x_desc("time [s]")
+        .y_desc("path error [mm]")
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(perr)?;
+    for t in [r.options.t_entry(), r.options.t_exit()] {
+        chart
+            .draw_series(LineSeries::new(
+                vec![(t, 0.0), (t, ymax)],
+                BLACK.mix(0.4).stroke_width(1),
+            ))
+            .map_err(perr)?;
+    }
+    let colors = [RED, BLUE, GREEN];
+    for (run, c) in r.runs.iter().zip(colors) {
+        let m = &run.metrics;
+        let label = format!(
+            "{}: max {:.2} mm, RMS {:.2} mm",
+            run.mode.label(),
+            m.max_mm,
+            m.rms_mm
+        );
+        chart
+            .draw_series(LineSeries::new(
+                run.samples.iter().map(|s| (s.t, s.error_mm)),
+                c.stroke_width(2),
+            ))
+            .map_err(perr)?
+            .label(label)
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .draw()
+        .map_err(perr)?;
+    root.present().map_err(perr)?;
+    Ok(())
+}
+
+/// Identified vs true stiffness per joint (frames and TCP, with +- 2 se bars).
+pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
+    register_font();
+    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
+    root.fill(&WHITE).map_err(perr)?;
+    let kmax = r
+        .stiffness
+        .iter()
+        .flat_map(|e| [e.k_true, e.k_frames, e.k_tcp])
+        .filter(|k| k.is_finite())
+        .fold(1.0, f64::max)
+        * 1.2e-3;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "joint stiffness: identified vs true",
+            ("sans-serif", 22),
+        )
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(-0.5f64..3.5f64, 0.0..kmax)
+        .map_err(perr)?;
+    chart
+        .configure_mesh()
+        .x_desc("joint (0 = yaw, 1-3 = pitch)")
+        .y_desc("stiffness [kN m/rad]")
+        .label_style(("sans-serif", 15))
+        .draw()
+        .map_err(perr)?;
+    let true_pts: Vec<(f64, f64)> = r
+        .stiffness
+        .iter()
+        .map(|e| (e.joint as f64, e.k_true * 1e-3))
+        .collect();
+    chart
+        .draw_series(
+            true_pts
+                .iter()
+                .map(|p| Rectangle::new([(p.0 - 0.3, 0.0), (p.0 + 0.3, p.1)], BLACK.mix(0.15).filled())),
+        )
+        .map_err(perr)?
+        .label("true")
+        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BLACK.mix(0.15).filled()));
+    for (dx, c, label, tcp) in [(-0.1, BLUE, "frame pairs", false), (0.1, RED, "TCP deflection", true)] {
+        let pts: Vec<(f64, f64, f64)> = r
+            .stiffness
+            .iter()
+            .map(|e| {
+                let (k, se) = if tcp { (e.k_tcp, e.se_tcp) } else { (e.k_frames, e.se_frames) };
+                (e.joint as f64 + dx, k * 1e-3, se * 1e-3)
+            })
+            .filter(|p| p.1.is_finite())
+            .collect();
+        chart
+            .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 5, c.filled())))
+            .map_err(perr)?
+            .label(label)
+            .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+        chart
+            .draw_series(pts.iter().filter(|p| p.2.is_finite()).map(|p| {
+                PathElement::new(
+                    vec![(p.0, p.1 - 2.0 * p.2), (p.0, p.1 + 2.0 * p.2)],
+                    c.stroke_width(2),
+                )
+            }))
+            .map_err(perr)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(0.8))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 15))
+        .draw()
+        .map_err(perr)?;
+    root.present().map_err(perr)?;
+    Ok(())
+}
+
+/// Writes `milling_summary.{txt,csv,json}`, `milling.mcap`, `milling_error.png` and
+/// `milling_stiffness.png` into `out`.
+pub fn write_all(out: &Path, r: &MillingResult) -> Result<(), SimError> {
+    std::fs::create_dir_all(out)?;
+    std::fs::write(out.join("milling_summary.txt"), table(r))?;
+    std::fs::write(out.join("milling_summary.csv"), csv(r))?;
+    std::fs::write(
+        out.join("milling_summary.json"),
+        serde_json::to_string_pretty(&json(r))?,
+    )?;
+    write_mcap(&out.join("milling.mcap"), r)?;
+    plot_error(&out.join("milling_error.png"), r)?;
+    plot_stiffness(&out.join("milling_stiffness.png"), r)?;
+    Ok(())
+}
