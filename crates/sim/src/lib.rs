@@ -5,6 +5,8 @@
 //! and the paper's evaluation (Appendix C).
 
 pub mod analysis;
+pub mod contour_output;
+pub mod contour_scene;
 pub mod milling;
 pub mod milling_output;
 pub mod output;

@@ -59,6 +59,29 @@ enum Command {
     /// stiffness and sensor identification. Writes milling_summary.{txt,csv,json},
     /// milling.mcap and PNG plots.
     Milling(MillingArgs),
+    /// Force-feedback contour tracing (ContourTracer, Eq. 21) of a circle, a rectangle and an
+    /// L-shape by a 2R arm with compliant, backlashed joints; shape recovered raw and with the
+    /// Eq. 10 compensation. Writes contour_summary.{txt,csv,json}, contour.mcap, contour_*.png.
+    Contour(ContourArgs),
+}
+
+#[derive(clap::Args, Debug)]
+struct ContourArgs {
+    /// Tracer step along the edge [mm].
+    #[arg(long, default_value_t = 1.5)]
+    step_mm: f64,
+    /// Target contact force [N] (window: 1.5 N .. 30 N).
+    #[arg(long, default_value_t = 6.0)]
+    target_force: f64,
+    /// Force sensor noise, standard deviation per sample and axis [N].
+    #[arg(long, default_value_t = 0.3)]
+    noise: f64,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 7)]
+    seed: u64,
+    /// Worker threads (one object each; results do not depend on it).
+    #[arg(long, default_value_t = 2)]
+    jobs: usize,
 }
 
 #[derive(clap::Args, Debug)]
@@ -599,11 +622,14 @@ fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
     opts.estimate_error = a.estimate_error;
     opts.seed = a.seed;
     let ok = |v: f64, lo: f64| v.is_finite() && v >= lo;
-    if !(ok(opts.feed, 1e-6) && ok(a.force, 0.0) && ok(opts.cut, 0.01) && ok(opts.cycle, 5e-4))
-        || !ok(opts.estimate_lead, 0.0)
-        || !ok(opts.force_rise, 1e-4)
-        || !opts.estimate_error.is_finite()
-    {
+    let valid = ok(opts.feed, 1e-6)
+        && ok(a.force, 0.0)
+        && ok(opts.cut, 0.01)
+        && ok(opts.cycle, 5e-4)
+        && ok(opts.estimate_lead, 0.0)
+        && ok(opts.force_rise, 1e-4)
+        && opts.estimate_error.is_finite();
+    if !valid {
         return Err(SimError::new(
             "milling: feed > 0, force >= 0, cut >= 0.01 s, cycle >= 0.5 ms, lead >= 0, rise >= 0.1 ms",
         ));
@@ -614,6 +640,51 @@ fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
     milling_output::write_all(out, &r)?;
     println!(
         "wrote {}/milling_summary.{{txt,csv,json}}, milling.mcap, milling_error.png, milling_stiffness.png",
+        out.display()
+    );
+    Ok(())
+}
+
+fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
+    use deflect_sim::{contour_output, contour_scene};
+    let mut opts = contour_scene::TraceOptions {
+        step: a.step_mm * 1e-3,
+        target_force: a.target_force,
+        noise: a.noise,
+        seed: a.seed,
+        ..Default::default()
+    };
+    opts.approach_step = opts.approach_step.min(opts.step);
+    let ok = |v: f64| v.is_finite() && v > 0.0;
+    if !(ok(opts.step) && opts.step <= 0.02)
+        || !(opts.target_force > opts.contact_force && opts.target_force < opts.jam_force)
+        || !(opts.noise.is_finite() && opts.noise >= 0.0)
+    {
+        return Err(SimError::new(
+            "contour: 0 < step <= 20 mm, 1.5 N < target force < 30 N, noise >= 0",
+        ));
+    }
+    let t = Instant::now();
+    let runs = contour_scene::trace_all(&contour_scene::default_objects(), &opts, a.jobs)?;
+    let wall = t.elapsed().as_secs_f64();
+    let table = contour_output::table(&runs);
+    print!("{table}");
+    let sim: f64 = runs.iter().map(|r| r.sim_time).sum();
+    let steps: usize = runs.iter().map(|r| r.physics_steps).sum();
+    println!(
+        "{} shapes, {:.1} s simulated ({} physics steps at {:.1} kHz) in {:.2} s wall on {} \
+         thread(s): {:.1}x real time",
+        runs.len(),
+        sim,
+        steps,
+        1e-3 / contour_scene::DT,
+        wall,
+        a.jobs.max(1),
+        sim / wall
+    );
+    let n = contour_output::write_all(out, &runs, &table)?;
+    println!(
+        "wrote {0}/contour_summary.{{txt,csv,json}}, {0}/contour.mcap ({n} messages), {0}/contour_<shape>.png",
         out.display()
     );
     Ok(())
@@ -659,6 +730,7 @@ fn main() -> std::process::ExitCode {
             }
             Some(Command::Run(a)) => run_one(a, &cli.out),
             Some(Command::Milling(a)) => milling_cmd(a, &cli.out),
+            Some(Command::Contour(a)) => contour_cmd(a, &cli.out),
         });
     match result {
         Ok(()) => std::process::ExitCode::SUCCESS,

@@ -128,10 +128,7 @@ fn rot_na(q: Rotation) -> UnitQuaternion<f64> {
 }
 
 fn pose_na(p: &Pose) -> Isometry3<f64> {
-    Isometry3::from_parts(
-        Translation3::from(to_na(p.translation)),
-        rot_na(p.rotation),
-    )
+    Isometry3::from_parts(Translation3::from(to_na(p.translation)), rot_na(p.rotation))
 }
 
 /// Joint axis of joint `i` in its own frame.
@@ -160,10 +157,15 @@ impl core::fmt::Debug for FlexArm {
 impl FlexArm {
     /// The arm at rest at joint angles `q`, with the damping scaled by `damping_scale` (> 1 to
     /// settle static tests quickly).
-    pub fn new(params: &ArmParams, q: &[f64; JOINTS], damping_scale: f64) -> Result<Self, SimError> {
+    pub fn new(
+        params: &ArmParams,
+        q: &[f64; JOINTS],
+        damping_scale: f64,
+        dt: f64,
+    ) -> Result<Self, SimError> {
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::ZERO;
-        world.integration_parameters.dt = DT;
+        world.integration_parameters.dt = dt;
         let ground = world.insert_body(RigidBodyBuilder::fixed());
         let p = params;
         let lengths = [0.0, p.upper_arm, p.forearm, p.wrist_to_tcp()];
@@ -176,23 +178,32 @@ impl FlexArm {
         let mut parent = ground;
         let mut pose = Pose::IDENTITY;
         let (mut joints, mut bodies) = (Vec::new(), Vec::new());
-        for i in 0..JOINTS {
+        for (i, &qi) in q.iter().enumerate() {
             let rot = if i == 0 {
-                Rotation::from_rotation_z(q[i])
+                Rotation::from_rotation_z(qi)
             } else {
-                Rotation::from_rotation_y(q[i])
+                Rotation::from_rotation_y(qi)
             };
             let frame1 = Pose::from_parts(offsets[i], rot);
-            pose = pose * frame1;
+            pose *= frame1;
             let (l, m) = (lengths[i], p.masses[i]);
             let (com, inertia) = if i == 0 {
-                (Vector::ZERO, Vector::new(0.5 * m * 0.04, 0.5 * m * 0.04, 0.5 * m * 0.04))
+                (
+                    Vector::ZERO,
+                    Vector::new(0.5 * m * 0.04, 0.5 * m * 0.04, 0.5 * m * 0.04),
+                )
             } else if i == 3 {
                 // wrist and spindle: centre of mass 0.2 m along the link
-                (Vector::new(0.2, 0.0, 0.0), Vector::new(0.05 * m, 0.02 * m, 0.02 * m))
+                (
+                    Vector::new(0.2, 0.0, 0.0),
+                    Vector::new(0.05 * m, 0.02 * m, 0.02 * m),
+                )
             } else {
                 let i_t = m * l * l / 12.0;
-                (Vector::new(0.5 * l, 0.0, 0.0), Vector::new(0.01 * m, i_t, i_t))
+                (
+                    Vector::new(0.5 * l, 0.0, 0.0),
+                    Vector::new(0.01 * m, i_t, i_t),
+                )
             };
             let body = world.insert_body(
                 RigidBodyBuilder::dynamic()
@@ -387,7 +398,8 @@ impl SensorParams {
         let r_inv = sensor.rotation.inverse();
         let f = r_inv * force;
         let m = r_inv * (tcp - sensor.translation.vector).cross(force);
-        let mut w = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z) + cal.unloaded_reading(&sensor.rotation);
+        let mut w =
+            Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z) + cal.unloaded_reading(&sensor.rotation);
         for (k, v) in w.iter_mut().enumerate() {
             *v += scale * self.noise[usize::from(k >= 3)] * noise.gauss();
         }
@@ -433,8 +445,14 @@ pub struct MillingOptions {
     pub estimate_error: f64,
     /// Pilot control `(threshold [N], ramp [s])` (paper: 150 N, 80 ms).
     pub pilot: (f64, f64),
+    /// Physics step [s] (0.5 ms; tests use 2 ms).
+    pub dt: f64,
     /// Static test loads for the stiffness identification [N].
     pub id_load: f64,
+    /// Number of poses for the stiffness identification (1..=3).
+    pub id_poses: usize,
+    /// Hold time of each static load before reading [s].
+    pub id_hold: f64,
     /// Noise of the frame-pair rotation measurements [rad] and TCP deflections [m].
     pub id_noise: [f64; 2],
     /// Seed of all noise.
@@ -461,7 +479,10 @@ impl Default for MillingOptions {
             estimate_lead: 0.04,
             estimate_error: 0.1,
             pilot: (150.0, 0.08),
+            dt: DT,
             id_load: 800.0,
+            id_poses: 3,
+            id_hold: 0.2,
             id_noise: [2.0e-6, 2.0e-6],
             seed: 6,
         }
@@ -469,12 +490,19 @@ impl Default for MillingOptions {
 }
 
 impl MillingOptions {
-    /// A short scenario for tests: shorter cut and run-out, noise-free identification.
+    /// A short scenario for tests (seconds in a debug build): 2 ms physics step, shorter
+    /// approach, cut and run-out, one identification pose with shorter holds, noise-free
+    /// identification.
     pub fn short() -> Self {
         Self {
-            approach: 0.2,
-            cut: 0.4,
-            runout: 0.25,
+            settle: 0.02,
+            ramp: 0.05,
+            approach: 0.1,
+            cut: 0.35,
+            runout: 0.2,
+            dt: 0.002,
+            id_poses: 1,
+            id_hold: 0.12,
             id_noise: [0.0, 0.0],
             ..Self::default()
         }
@@ -509,7 +537,10 @@ impl MillingOptions {
                 0.5 * self.feed * (1.0 - (w * tm).cos()),
             )
         } else {
-            (0.5 * self.feed * self.ramp + self.feed * (tm - self.ramp), self.feed)
+            (
+                0.5 * self.feed * self.ramp + self.feed * (tm - self.ramp),
+                self.feed,
+            )
         };
         (start + Vector3::x() * s, Vector3::x() * v)
     }
@@ -539,6 +570,9 @@ pub enum Mode {
     Cartesian,
     /// Online compensation with pilot control from the offline estimate.
     Pilot,
+    /// As `Cartesian`, but with an empty sensor calibration (offsets and tool weight not
+    /// removed): shows why the sensor identification matters.
+    Uncalibrated,
 }
 
 impl Mode {
@@ -548,6 +582,7 @@ impl Mode {
             Self::Uncompensated => "uncompensated",
             Self::Cartesian => "cartesian",
             Self::Pilot => "pilot",
+            Self::Uncalibrated => "uncalibrated",
         }
     }
 }
@@ -651,9 +686,9 @@ pub struct MillingResult {
     pub stiffness: Vec<JointEstimate>,
     /// Sensor identification.
     pub sensor: SensorEstimate,
-    /// The three runs.
+    /// The runs: uncompensated, Cartesian, pilot, uncalibrated.
     pub runs: Vec<Run>,
-    /// Simulated time and wall-clock time of the runs [s].
+    /// Simulated time of the runs and the static tests [s].
     pub sim_seconds: f64,
     /// Wall-clock seconds.
     pub wall_seconds: f64,
@@ -694,12 +729,13 @@ pub fn identify_stiffness(opts: &MillingOptions) -> Result<Vec<JointEstimate>, S
     let mut qs = Vec::new();
     let mut frame_data = Vec::new(); // (pose, wrench, spring, rotation)
     let mut tcp_data = Vec::new(); // (pose, wrench, deflection)
-    let hold = (0.2 / DT).round() as usize;
-    let ramp = (0.05 / DT).round() as usize;
-    for (pi, p) in poses.iter().enumerate() {
+    let hold = (opts.id_hold / opts.dt).round().max(1.0) as usize;
+    let ramp = (0.03 / opts.dt).round().max(1.0) as usize;
+    for (pi, p) in poses.iter().take(opts.id_poses.clamp(1, 3)).enumerate() {
         let q = arm.ik(p);
         qs.push(q);
-        let mut sim = FlexArm::new(arm, &q, 6.0)?;
+        // Critically damped (about) so that each load settles quickly.
+        let mut sim = FlexArm::new(arm, &q, 4.0, opts.dt)?;
         sim.step(&q, &Vector3::zeros());
         let rot0 = sim.spring_rotations(&q);
         let tcp0 = sim.tcp();
@@ -716,8 +752,8 @@ pub fn identify_stiffness(opts: &MillingOptions) -> Result<Vec<JointEstimate>, S
             prev = target;
             let rot = sim.spring_rotations(&q);
             let w = Vector6::new(target.x, target.y, target.z, 0.0, 0.0, 0.0);
-            for j in 0..JOINTS {
-                let mut r = rot[j] - rot0[j];
+            for (j, (r1, r0)) in rot.iter().zip(&rot0).enumerate() {
+                let mut r = r1 - r0;
                 for v in r.iter_mut() {
                     *v += opts.id_noise[0] * noise.gauss();
                 }
@@ -856,11 +892,19 @@ pub fn run(
     let truth = opts.sensor.calibration(arm.sensor_to_tcp());
     let (p0, _) = opts.nominal(0.0);
     let q0 = arm.ik(&p0);
-    let mut sim = FlexArm::new(arm, &q0, 1.0)?;
+    let mut sim = FlexArm::new(arm, &q0, 1.0, opts.dt)?;
     let mut comp = match mode {
         Mode::Uncompensated => None,
-        Mode::Cartesian | Mode::Pilot => {
-            let mut cfg = CompensatorConfig::paper(opts.cycle, *calibration);
+        Mode::Cartesian | Mode::Pilot | Mode::Uncalibrated => {
+            let cal = if mode == Mode::Uncalibrated {
+                SensorCalibration {
+                    sensor_to_tcp: calibration.sensor_to_tcp,
+                    ..SensorCalibration::default()
+                }
+            } else {
+                *calibration
+            };
+            let mut cfg = CompensatorConfig::paper(opts.cycle, cal);
             cfg.pilot = (mode == Mode::Pilot).then_some(opts.pilot);
             Some(
                 OnlineCompensator::new(model, cfg)
@@ -869,19 +913,20 @@ pub fn run(
         }
     };
     let mut noise = Noise::new(opts.seed);
-    let sub = ((opts.cycle / DT).round() as usize).max(1);
-    let cycles = (opts.t_end() / (sub as f64 * DT)).ceil() as usize;
+    let dt = opts.dt;
+    let sub = ((opts.cycle / dt).round() as usize).max(1);
+    let cycles = (opts.t_end() / (sub as f64 * dt)).ceil() as usize;
     // Corrections (joint offsets) in flight to the servos, and the servo's lagged offset.
     let mut queue: std::collections::VecDeque<[f64; JOINTS]> =
         std::iter::repeat_n([0.0; JOINTS], opts.delay_cycles).collect();
     let mut lagged = [0.0; JOINTS];
-    let alpha = DT / (opts.servo_tau + DT);
+    let alpha = dt / (opts.servo_tau + dt);
     let mut dq_target = [0.0; JOINTS];
     let mut samples = Vec::with_capacity(cycles);
     let mut q_motor = q0;
     let mut step_index = 0usize;
     for c in 0..cycles {
-        let t = c as f64 * sub as f64 * DT;
+        let t = c as f64 * sub as f64 * dt;
         let (p_nom, v_nom) = opts.nominal(t);
         let q_nom = arm.ik(&p_nom);
         // The sensor is read at the start of the cycle.
@@ -913,9 +958,7 @@ pub fn run(
                 .map_err(|e| SimError::new(format!("compensator step: {e}")))?;
             let target = p_nom + out.correction.fixed_rows::<3>(0).into_owned();
             let q_cmd = arm.ik(&target);
-            for j in 0..JOINTS {
-                dq_target[j] = q_cmd[j] - q_nom[j];
-            }
+            dq_target = core::array::from_fn(|j| q_cmd[j] - q_nom[j]);
             sample.commanded = target.into();
             sample.force_filtered = out.measured_wrench.into();
             sample.force_used = out.wrench.into();
@@ -926,12 +969,12 @@ pub fn run(
         queue.push_back(dq_target);
         let dq_servo = queue.pop_front().unwrap_or([0.0; JOINTS]);
         for _ in 0..sub {
-            let ts = step_index as f64 * DT;
+            let ts = step_index as f64 * dt;
             let (p, _) = opts.nominal(ts);
             let qn = arm.ik(&p);
-            for j in 0..JOINTS {
-                lagged[j] += alpha * (dq_servo[j] - lagged[j]);
-                q_motor[j] = qn[j] + lagged[j];
+            for (((l, m), d), n) in lagged.iter_mut().zip(&mut q_motor).zip(&dq_servo).zip(&qn) {
+                *l += alpha * (d - *l);
+                *m = n + *l;
             }
             sim.step(&q_motor, &opts.process_force(ts));
             step_index += 1;
@@ -945,7 +988,7 @@ pub fn run(
 }
 
 /// The whole scenario: identification of stiffnesses and sensor, then the three runs with the
-/// identified values.
+/// identified values (and a fourth, Cartesian compensation without sensor calibration).
 pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
     let start = std::time::Instant::now();
     let stiffness = identify_stiffness(opts)?;
@@ -960,7 +1003,12 @@ pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
     let model = vjm_model(&opts.arm, &k)?;
     let (calibration, sensor) = identify_sensor_calibration(opts)?;
     let mut runs = Vec::new();
-    for mode in [Mode::Uncompensated, Mode::Cartesian, Mode::Pilot] {
+    for mode in [
+        Mode::Uncompensated,
+        Mode::Cartesian,
+        Mode::Pilot,
+        Mode::Uncalibrated,
+    ] {
         runs.push(run(opts, mode, &model, &calibration)?);
     }
     Ok(MillingResult {
@@ -968,7 +1016,8 @@ pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
         stiffness,
         sensor,
         runs,
-        sim_seconds: opts.t_end() * 3.0,
+        sim_seconds: opts.t_end() * 4.0
+            + opts.id_poses.clamp(1, 3) as f64 * 6.0 * (opts.id_hold + 0.03),
         wall_seconds: start.elapsed().as_secs_f64(),
     })
 }

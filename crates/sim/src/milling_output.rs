@@ -86,7 +86,10 @@ pub fn table(r: &MillingResult) -> String {
         let _ = writeln!(
             s,
             "{:<5} | {:7.1} | {:7.1} (+- {:6.2}) | {:+6.2} | {:7.1} (+- {:6.2}) | {:+6.2}",
-            ["yaw", "q2", "q3", "q4"].get(e.joint).copied().unwrap_or("?"),
+            ["yaw", "q2", "q3", "q4"]
+                .get(e.joint)
+                .copied()
+                .unwrap_or("?"),
             e.k_true * 1e-3,
             e.k_frames * 1e-3,
             e.se_frames * 1e-3,
@@ -128,9 +131,10 @@ pub fn table(r: &MillingResult) -> String {
     );
     let _ = writeln!(
         s,
-        "\n{:.1} s simulated ({} steps of 0.5 ms) in {:.2} s wall clock, identification included",
+        "\n{:.1} s simulated ({} steps of {} ms) in {:.2} s wall clock, identification included",
         r.sim_seconds,
-        (r.sim_seconds / crate::robot::DT).round(),
+        (r.sim_seconds / o.dt).round(),
+        o.dt * 1e3,
         r.wall_seconds
     );
     s
@@ -208,7 +212,11 @@ fn fields(topic: &str) -> Vec<(&'static str, &'static str)> {
             .enumerate()
             .map(|(i, f)| (*f, if i < 3 { "m" } else { "rad" }))
             .collect(),
-        _ => vec![("error_mm", "mm"), ("pilot_weight", "1"), ("force_true_norm", "N")],
+        _ => vec![
+            ("error_mm", "mm"),
+            ("pilot_weight", "1"),
+            ("force_true_norm", "N"),
+        ],
     }
 }
 
@@ -238,7 +246,7 @@ fn message(topic: &str, run: &str, s: &Sample) -> serde_json::Value {
     m
 }
 
-/// Writes the three runs to `path`, topics `/milling/<run>/<topic>`; all runs share the
+/// Writes the runs to `path`, topics `/milling/<run>/<topic>`; all runs share the
 /// scenario's time axis. Returns the number of messages.
 pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
     let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
@@ -284,7 +292,7 @@ pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
     Ok(count)
 }
 
-/// Path error against time for the three runs, with the cutter entry and exit marked.
+/// Path error against time for the runs, with the cutter entry and exit marked.
 pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
     register_font();
     let root = BitMapBackend::new(path, (1100, 620)).into_drawing_area();
@@ -321,7 +329,7 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             ))
             .map_err(perr)?;
     }
-    let colors = [RED, BLUE, GREEN];
+    let colors = [RED, BLUE, GREEN, MAGENTA];
     for (run, c) in r.runs.iter().zip(colors) {
         let m = &run.metrics;
         let label = format!(
@@ -364,10 +372,7 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
         .fold(1.0, f64::max)
         * 1.2e-3;
     let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "joint stiffness: identified vs true",
-            ("sans-serif", 22),
-        )
+        .caption("joint stiffness: identified vs true", ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(45)
         .y_label_area_size(70)
@@ -386,20 +391,28 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
         .map(|e| (e.joint as f64, e.k_true * 1e-3))
         .collect();
     chart
-        .draw_series(
-            true_pts
-                .iter()
-                .map(|p| Rectangle::new([(p.0 - 0.3, 0.0), (p.0 + 0.3, p.1)], BLACK.mix(0.15).filled())),
-        )
+        .draw_series(true_pts.iter().map(|p| {
+            Rectangle::new(
+                [(p.0 - 0.3, 0.0), (p.0 + 0.3, p.1)],
+                BLACK.mix(0.15).filled(),
+            )
+        }))
         .map_err(perr)?
         .label("true")
         .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BLACK.mix(0.15).filled()));
-    for (dx, c, label, tcp) in [(-0.1, BLUE, "frame pairs", false), (0.1, RED, "TCP deflection", true)] {
+    for (dx, c, label, tcp) in [
+        (-0.1, BLUE, "frame pairs", false),
+        (0.1, RED, "TCP deflection", true),
+    ] {
         let pts: Vec<(f64, f64, f64)> = r
             .stiffness
             .iter()
             .map(|e| {
-                let (k, se) = if tcp { (e.k_tcp, e.se_tcp) } else { (e.k_frames, e.se_frames) };
+                let (k, se) = if tcp {
+                    (e.k_tcp, e.se_tcp)
+                } else {
+                    (e.k_frames, e.se_frames)
+                };
                 (e.joint as f64 + dx, k * 1e-3, se * 1e-3)
             })
             .filter(|p| p.1.is_finite())

@@ -2,7 +2,7 @@
 //! it further (overall and at the cutter exit), and identification recovers the stiffnesses
 //! and the sensor. Seconds in a debug build.
 
-use deflect_sim::milling::{self, Mode, MillingOptions};
+use deflect_sim::milling::{self, MillingOptions, Mode};
 
 #[test]
 fn short_milling_scenario() {
@@ -19,8 +19,8 @@ fn short_milling_scenario() {
     // Sensor: weight within 1 %, force offsets within 1 N (averaged noisy readings).
     let s = &r.sensor;
     assert!((s.weight.1 / s.weight.0 - 1.0).abs() < 0.01, "{s:?}");
-    for k in 0..3 {
-        assert!((s.force_offset.0[k] - s.force_offset.1[k]).abs() < 1.0, "{s:?}");
+    for (t, i) in s.force_offset.0.iter().zip(&s.force_offset.1) {
+        assert!((t - i).abs() < 1.0, "{s:?}");
     }
 
     let get = |m: Mode| {
@@ -34,6 +34,10 @@ fn short_milling_scenario() {
         get(Mode::Uncompensated),
         get(Mode::Cartesian),
         get(Mode::Pilot),
+    );
+    println!(
+        "uncompensated {u:?}\ncartesian {c:?}\npilot {p:?}\n{:#?}",
+        r.stiffness
     );
     // The uncompensated error is of the order of a millimetre.
     assert!(u.steady_max_mm > 0.7 && u.steady_max_mm < 1.4, "{u:?}");
@@ -61,11 +65,11 @@ fn rapier_static_compliance_matches_vjm() {
     let f = Vector3::new(-300.0, 250.0, -200.0);
     let w = Vector6::new(f.x, f.y, f.z, 0.0, 0.0, 0.0);
     let d = vjm::deflection(&model, &mut data, &q, &w).expect("deflection");
-    let mut sim = FlexArm::new(arm, &q, 6.0).expect("arm");
+    let mut sim = FlexArm::new(arm, &q, 4.0, opts.dt).expect("arm");
     sim.step(&q, &Vector3::zeros());
     let p0 = sim.tcp();
-    for k in 0..800 {
-        let s = ((k + 1) as f64 / 100.0).min(1.0);
+    for k in 0..120 {
+        let s = ((k + 1) as f64 / 15.0).min(1.0);
         sim.step(&q, &(f * s));
     }
     let dp = sim.tcp() - p0;
