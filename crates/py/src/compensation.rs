@@ -16,37 +16,20 @@ use deflect_core::identification::{
 use deflect_core::vjm::{Model, Vector6};
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, UnitQuaternion, Vector3};
 use numpy::ndarray::{Array1, Array2, ArrayView2};
-use numpy::{AllowTypeChange, PyArray1, PyArrayLike1, PyArrayLike2, PyArrayLikeDyn, ToPyArray};
+use numpy::{AllowTypeChange, PyArray1, PyArrayLikeDyn, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
-use crate::convert::{iso_to_py, tick_err};
+use crate::convert::{Arr1, Arr2, finite_vec, iso_to_py, tick_err};
 use crate::vjm::SerialRobot;
 
-type Arr1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
-type Arr2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
-
-fn vecn(a: &Arr1<'_>, what: &str, n: usize) -> PyResult<Vec<f64>> {
-    let v = a.as_array();
-    if v.len() != n {
-        return Err(InputError::new_err(format!(
-            "{what}: expected shape ({n},), got ({},)",
-            v.len()
-        )));
-    }
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(InputError::new_err(format!("{what}[{i}] is not finite")));
-    }
-    Ok(v.to_vec())
-}
-
 fn v3(a: &Arr1<'_>, what: &str) -> PyResult<Vector3<f64>> {
-    Ok(Vector3::from_column_slice(&vecn(a, what, 3)?))
+    Ok(Vector3::from_column_slice(&finite_vec(a, what, 3)?))
 }
 
 fn v6(a: &Arr1<'_>, what: &str) -> PyResult<Vector6> {
-    Ok(Vector6::from_column_slice(&vecn(a, what, 6)?))
+    Ok(Vector6::from_column_slice(&finite_vec(a, what, 6)?))
 }
 
 fn mat3(m: ArrayView2<'_, f64>, what: &str) -> PyResult<Matrix3<f64>> {
@@ -407,7 +390,7 @@ impl OnlineCompensator {
         estimated: Option<Arr1<'py>>,
         feed_velocity: Option<Arr1<'py>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let q = vecn(&q, "q", self.model.dof())?;
+        let q = finite_vec(&q, "q", self.model.dof())?;
         let reading = v6(&reading, "reading")?;
         let est = estimated.map(|e| v6(&e, "estimated")).transpose()?;
         let feed = feed_velocity

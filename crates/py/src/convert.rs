@@ -3,7 +3,7 @@
 use deflect_core::TickError;
 use nalgebra::{Isometry3, Matrix4, Vector6};
 use numpy::ndarray::Array2;
-use numpy::{PyArray2, PyReadonlyArray1, ToPyArray};
+use numpy::{AllowTypeChange, PyArray2, PyArrayLike1, PyArrayLike2, PyReadonlyArray1, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::{ConvergenceError, InputError, SingularError};
@@ -46,4 +46,24 @@ pub fn check_finite6(v: &Vector6<f64>, what: &str) -> PyResult<()> {
         Some(i) => Err(InputError::new_err(format!("{what}[{i}] is not finite"))),
         None => Ok(()),
     }
+}
+
+/// A 1-D array-like of floats (lists accepted, converted to f64).
+pub type Arr1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
+/// A 2-D array-like of floats (lists accepted, converted to f64).
+pub type Arr2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+
+/// A finite 1-D array of exactly `n` entries, copied into a `Vec`; errors name `what`.
+pub fn finite_vec(a: &Arr1<'_>, what: &str, n: usize) -> PyResult<Vec<f64>> {
+    let v = a.as_array();
+    if v.len() != n {
+        return Err(InputError::new_err(format!(
+            "{what}: expected shape ({n},), got ({},)",
+            v.len()
+        )));
+    }
+    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
+        return Err(InputError::new_err(format!("{what}[{i}] is not finite")));
+    }
+    Ok(v.to_vec())
 }

@@ -8,12 +8,13 @@ use deflect_core::dalembert::{
 use deflect_core::mechanism::ParallelRobot2 as CoreRobot2;
 use nalgebra::Vector2;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, ToPyArray};
+use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::compliance_map::ComplianceMap;
+use crate::convert::{Arr1, finite_vec};
 use crate::motion::{ParallelRobot2, Trajectory, mech_err};
 
 fn corr_err(e: CorrectorError) -> PyErr {
@@ -32,15 +33,8 @@ fn status_name(s: ModelStatus) -> &'static str {
     }
 }
 
-fn vec2(a: &PyArrayLike1<'_, f64, AllowTypeChange>, what: &str) -> PyResult<Vector2<f64>> {
-    let v = a.as_array();
-    if v.len() != 2 {
-        return Err(InputError::new_err(format!(
-            "{what}: expected shape (2,), got ({},)",
-            v.len()
-        )));
-    }
-    Ok(Vector2::new(v[0], v[1]))
+fn vec2(a: &Arr1<'_>, what: &str) -> PyResult<Vector2<f64>> {
+    Ok(Vector2::from_column_slice(&finite_vec(a, what, 2)?))
 }
 
 /// D'Alembert trajectory correction (Paksoy et al., Fig. 2): per tick `F_D = -mass * a`
@@ -116,8 +110,8 @@ impl DalembertCorrector {
     fn step<'py>(
         &self,
         py: Python<'py>,
-        position: PyArrayLike1<'py, f64, AllowTypeChange>,
-        acceleration: PyArrayLike1<'py, f64, AllowTypeChange>,
+        position: Arr1<'py>,
+        acceleration: Arr1<'py>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let x = vec2(&position, "position")?;
         let a = vec2(&acceleration, "acceleration")?;

@@ -9,33 +9,16 @@ use deflect_core::drivetrain_io;
 use deflect_core::vjm::{Data, Model};
 use nalgebra::{Matrix2, Vector2, Vector3, Vector6};
 use numpy::ndarray::Array2;
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, ToPyArray};
+use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{iso_to_py, tick_err};
+use crate::convert::{Arr1, Arr2, finite_vec, iso_to_py, tick_err};
 use crate::vjm::SerialRobot;
 use crate::{InputError, LoadError, SingularError};
 
-type Arr1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
-type Arr2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
-
-fn vecn(a: &Arr1<'_>, what: &str, n: usize) -> PyResult<Vec<f64>> {
-    let v = a.as_array();
-    if v.len() != n {
-        return Err(InputError::new_err(format!(
-            "{what}: expected shape ({n},), got ({},)",
-            v.len()
-        )));
-    }
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(InputError::new_err(format!("{what}[{i}] is not finite")));
-    }
-    Ok(v.to_vec())
-}
-
 fn v2(a: &Arr1<'_>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&vecn(a, what, 2)?))
+    Ok(Vector2::from_column_slice(&finite_vec(a, what, 2)?))
 }
 
 fn m2(a: &Arr2<'_>, what: &str) -> PyResult<Matrix2<f64>> {
@@ -82,10 +65,10 @@ pub struct DriveTrain {
 
 impl DriveTrain {
     fn q(&self, q: &Arr1<'_>) -> PyResult<Vec<f64>> {
-        vecn(q, "q", self.model.dof())
+        finite_vec(q, "q", self.model.dof())
     }
     fn wrench(w: &Arr1<'_>) -> PyResult<Vector6<f64>> {
-        Ok(Vector6::from_column_slice(&vecn(w, "wrench", 6)?))
+        Ok(Vector6::from_column_slice(&finite_vec(w, "wrench", 6)?))
     }
     fn out<'py>(&self, py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
         v.get(..self.model.dof()).unwrap_or(&[]).to_pyarray(py)
@@ -112,9 +95,9 @@ impl DriveTrain {
     ) -> PyResult<Self> {
         let model = robot.inner.model.clone();
         let n = model.dof();
-        let k = vecn(&stiffness, "stiffness", n)?;
+        let k = finite_vec(&stiffness, "stiffness", n)?;
         let b = match backlash {
-            Some(b) => vecn(&b, "backlash", n)?,
+            Some(b) => finite_vec(&b, "backlash", n)?,
             None => vec![0.0; n],
         };
         let mut table = LinkMasses::new();
