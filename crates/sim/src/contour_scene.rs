@@ -316,6 +316,8 @@ pub struct TraceOptions {
     pub c_contact: f64,
     /// Tracer steps after which a trace is stopped.
     pub max_steps: usize,
+    /// Readings averaged for the sensor bias before the approach.
+    pub bias_samples: usize,
 }
 
 impl Default for TraceOptions {
@@ -336,6 +338,7 @@ impl Default for TraceOptions {
             k_contact: 5.0e5,
             c_contact: 150.0,
             max_steps: 4000,
+            bias_samples: 10,
         }
     }
 }
@@ -401,6 +404,7 @@ impl ArmSim {
         let (mut angle, mut at, mut parent_len) = (0.0, Vector::ZERO, 0.0);
         let mut joints = Vec::new();
         let mut bodies = Vec::new();
+        #[allow(clippy::needless_range_loop)] // i indexes q, params and the chain order
         for i in 0..2 {
             angle += q[i];
             let (l, m) = (params.lengths[i], params.masses[i]);
@@ -646,6 +650,7 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
     cfg.approach_step = opts.approach_step;
     cfg.direction = TraceDirection::CounterClockwise;
     cfg.max_steps = opts.max_steps;
+    cfg.bias_samples = opts.bias_samples.max(1);
     let start = v2(&object.start);
     let mut q_cmd = arm.ik(&start);
     let k0 = cartesian_stiffness_xy(&model, &mut data, &drive, &q_cmd).map_err(err)?;

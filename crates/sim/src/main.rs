@@ -656,10 +656,13 @@ fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
     };
     opts.approach_step = opts.approach_step.min(opts.step);
     let ok = |v: f64| v.is_finite() && v > 0.0;
-    if !(ok(opts.step) && opts.step <= 0.02)
-        || !(opts.target_force > opts.contact_force && opts.target_force < opts.jam_force)
-        || !(opts.noise.is_finite() && opts.noise >= 0.0)
-    {
+    let valid = ok(opts.step)
+        && opts.step <= 0.02
+        && opts.target_force > opts.contact_force
+        && opts.target_force < opts.jam_force
+        && opts.noise.is_finite()
+        && opts.noise >= 0.0;
+    if !valid {
         return Err(SimError::new(
             "contour: 0 < step <= 20 mm, 1.5 N < target force < 30 N, noise >= 0",
         ));
