@@ -2,9 +2,6 @@
 //! global allocator watches many calls. One test function only, so no other test thread
 //! allocates meanwhile.
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicUsize, Ordering};
-
 use deflect_core::contour::{self, ContourTracer, TracerConfig};
 use deflect_core::drivetrain::{
     DriveTrain, LinkMasses, cartesian_stiffness, cartesian_stiffness_xy, compensated_forward,
@@ -14,27 +11,10 @@ use deflect_core::vjm::Data;
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
 
-struct Counting;
-static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
-
-// SAFETY: forwards to the system allocator; only counts.
-#[allow(unsafe_code)] // reason: a global allocator is an unsafe trait by definition
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+mod common;
 
 #[global_allocator]
-static GLOBAL: Counting = Counting;
+static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn drive_train_and_tracer_do_not_allocate() {
@@ -86,7 +66,7 @@ fn drive_train_and_tracer_do_not_allocate() {
     let mut p = Vector2::new(0.4, 0.0);
     let mut sink = 0.0;
 
-    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let before = common::allocations();
     for i in 0..3_000 {
         q[0] = 1e-4 * i as f64;
         sink += gravity_torques(&model, &drive, &q).unwrap()[1];
@@ -111,7 +91,7 @@ fn drive_train_and_tracer_do_not_allocate() {
         assert!(matches!(bad, Err(TickError::WrongLength { .. })));
         assert!(tracer.step(&Vector2::new(f64::NAN, 0.0), &f).is_err());
     }
-    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    let after = common::allocations();
     assert!(sink.is_finite());
     assert!(tracer.stats().contacts > 100, "the tracer did trace");
     assert_eq!(after - before, 0, "allocations on the per-call path");
