@@ -2,20 +2,19 @@
 //! per object (true outline vs raw and compensated recovered contours, and the distance of
 //! each recorded point to the outline).
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
-use mcap::records::MessageHeader;
 use nalgebra::Vector2;
 use plotters::prelude::*;
 use serde_json::json;
 
 use crate::SimError;
 use crate::contour_scene::{ContourRun, Sample};
-use crate::output::{perr, register_font};
+use crate::output::{
+    ChartStyle, McapLog, canvas, labelled_line, legend, new_chart, perr, stamp, stamp_schema,
+    write_summary,
+};
 use crate::report::reduction;
 
 /// The summary table: shape errors raw vs compensated, forces, contact losses.
@@ -110,14 +109,9 @@ pub fn summary_csv(runs: &[ContourRun]) -> String {
     s
 }
 
-fn stamp(t: f64) -> serde_json::Value {
-    let ns = (t * 1e9).round() as u64;
-    json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
-}
-
 fn point_schema(title: &str, unit: &str) -> serde_json::Value {
     json!({"title": title, "type": "object", "properties": {
-        "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+        "timestamp": stamp_schema(),
         "shape": {"type": "string"},
         "state": {"type": "string"},
         "x": {"type": "number", "description": unit},
@@ -155,8 +149,7 @@ fn messages(shape: &str, s: &Sample, t: f64) -> [Option<serde_json::Value>; 6] {
 /// Writes every run into one MCAP file, topics `/contour/<shape>/<topic>`; shapes follow each
 /// other in log time. Returns the number of messages.
 pub fn write_mcap(path: &Path, runs: &[ContourRun]) -> Result<usize, SimError> {
-    let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
-    let stamp_schema = json!({"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}});
+    let mut log = McapLog::create(path)?;
     let schemas = [
         (
             "deflect.ContourCommand",
@@ -177,7 +170,7 @@ pub fn write_mcap(path: &Path, runs: &[ContourRun]) -> Result<usize, SimError> {
         (
             "deflect.ContourForce",
             json!({"title": "force the tool exerts on the object [N]", "type": "object", "properties": {
-                "timestamp": stamp_schema, "shape": {"type": "string"}, "state": {"type": "string"},
+                "timestamp": stamp_schema(), "shape": {"type": "string"}, "state": {"type": "string"},
                 "x": {"type": "number", "description": "bias removed, N"}, "y": {"type": "number", "description": "bias removed, N"},
                 "sensed_x": {"type": "number"}, "sensed_y": {"type": "number"},
                 "true_x": {"type": "number"}, "true_y": {"type": "number"}}}),
@@ -185,57 +178,44 @@ pub fn write_mcap(path: &Path, runs: &[ContourRun]) -> Result<usize, SimError> {
         (
             "deflect.ContourJoints",
             json!({"title": "joint angles [rad]", "type": "object", "properties": {
-                "timestamp": stamp_schema, "shape": {"type": "string"},
+                "timestamp": stamp_schema(), "shape": {"type": "string"},
                 "motor": {"type": "array", "items": {"type": "number"}},
                 "link": {"type": "array", "items": {"type": "number"}}}}),
         ),
     ];
     let mut ids = Vec::new();
     for (name, s) in &schemas {
-        ids.push(w.add_schema(name, "jsonschema", serde_json::to_string(s)?.as_bytes())?);
+        ids.push(log.add_schema(name, s)?);
     }
-    let (mut offset, mut count) = (0.0, 0);
+    let mut offset = 0.0;
     for r in runs {
         let mut channels = Vec::new();
         for (topic, id) in TOPICS.iter().zip(&ids) {
-            let mut meta = BTreeMap::new();
-            meta.insert("shape".to_string(), r.name.clone());
-            channels.push(w.add_channel(
+            channels.push(log.add_channel(
                 *id,
                 &format!("/contour/{}/{topic}", r.name),
-                "json",
-                &meta,
+                "shape",
+                &r.name,
             )?);
         }
         let mut last = 0.0;
         for (seq, s) in (0u32..).zip(&r.samples) {
             let t = offset + s.t;
-            let ns = (t * 1e9).round() as u64;
             for (ch, msg) in channels.iter().zip(messages(&r.name, s, t)) {
                 let Some(msg) = msg else { continue };
-                let header = MessageHeader {
-                    channel_id: *ch,
-                    sequence: seq,
-                    log_time: ns,
-                    publish_time: ns,
-                };
-                w.write_to_known_channel(&header, serde_json::to_string(&msg)?.as_bytes())?;
-                count += 1;
+                log.write(*ch, seq, t, &msg)?;
             }
             last = s.t;
         }
         offset += last + 1.0;
     }
-    w.finish()?;
-    Ok(count)
+    log.finish()
 }
 
 /// One PNG per run: left the true outline (black), the raw (red) and compensated (blue)
 /// recovered contours in mm, right the signed distance of each recorded point to the outline.
 pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, (1500, 700)).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
+    let root = canvas(path, (1500, 700))?;
     let (left, right) = root.split_horizontally(700);
     let mm = |p: &Vector2<f64>| (p.x * 1e3, p.y * 1e3);
     let outline: Vec<(f64, f64)> = r.outline.polyline().iter().map(mm).collect();
@@ -266,40 +246,28 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     // Equal scales on both axes.
     let half = 0.5 * (x1 - x0).max(y1 - y0) + 8.0;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-    let mut chart = ChartBuilder::on(&left)
-        .caption(format!("{}: recovered contour", r.name), ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(55)
-        .build_cartesian_2d(cx - half..cx + half, cy - half..cy + half)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("x [mm]")
-        .y_desc("y [mm]")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(perr)?;
+    let style = ChartStyle {
+        caption: 22,
+        label_areas: (40, 55),
+        labels: 14,
+    };
+    let mut chart = new_chart(
+        &left,
+        style,
+        &format!("{}: recovered contour", r.name),
+        cx - half..cx + half,
+        cy - half..cy + half,
+        ("x [mm]", "y [mm]"),
+    )?;
     let series = [
         (outline.clone(), BLACK, "true outline"),
         (raw.clone(), RED, "raw (motor readings)"),
         (comp.clone(), BLUE, "compensated (Eq. 10)"),
     ];
     for (pts, c, label) in series {
-        chart
-            .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-            .map_err(perr)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        labelled_line(&mut chart, pts, c, 2, label)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.85, 14)?;
 
     let dist = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
         pts.iter()
@@ -320,41 +288,26 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
         .fold(0.05, f64::max)
         * 1.1;
     let n = raw.len().max(2) as f64;
-    let mut chart = ChartBuilder::on(&right)
-        .caption(
-            format!(
-                "distance to the outline: raw RMS {:.3} mm, compensated RMS {:.4} mm",
-                r.raw.rms_mm, r.compensated.rms_mm
-            ),
-            ("sans-serif", 20),
-        )
-        .margin(12)
-        .x_label_area_size(40)
-        .y_label_area_size(60)
-        .build_cartesian_2d(0.0..n, -lim..lim)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("contact sample")
-        .y_desc("signed distance (+ outside) [mm]")
-        .label_style(("sans-serif", 14))
-        .draw()
-        .map_err(perr)?;
+    let style = ChartStyle {
+        caption: 20,
+        label_areas: (40, 60),
+        labels: 14,
+    };
+    let mut chart = new_chart(
+        &right,
+        style,
+        &format!(
+            "distance to the outline: raw RMS {:.3} mm, compensated RMS {:.4} mm",
+            r.raw.rms_mm, r.compensated.rms_mm
+        ),
+        0.0..n,
+        -lim..lim,
+        ("contact sample", "signed distance (+ outside) [mm]"),
+    )?;
     for (pts, c, label) in [(draw, RED, "raw"), (dcomp, BLUE, "compensated")] {
-        chart
-            .draw_series(LineSeries::new(pts, c.stroke_width(2)))
-            .map_err(perr)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        labelled_line(&mut chart, pts, c, 2, label)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.85, 14)?;
     root.present().map_err(perr)?;
     Ok(())
 }
@@ -362,12 +315,7 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
 /// Writes `contour_summary.{txt,csv,json}`, `contour.mcap` and `contour_<shape>.png` into
 /// `out`; returns the number of MCAP messages.
 pub fn write_all(out: &Path, runs: &[ContourRun], table: &str) -> Result<usize, SimError> {
-    std::fs::write(out.join("contour_summary.txt"), table)?;
-    std::fs::write(out.join("contour_summary.csv"), summary_csv(runs))?;
-    std::fs::write(
-        out.join("contour_summary.json"),
-        serde_json::to_string_pretty(runs)?,
-    )?;
+    write_summary(out, "contour_summary", table, &summary_csv(runs), runs)?;
     let n = write_mcap(&out.join("contour.mcap"), runs)?;
     for r in runs {
         plot_run(&out.join(format!("contour_{}.png", r.name)), r)?;

@@ -31,6 +31,7 @@ use rapier3d_f64::prelude::*;
 use serde::Serialize;
 
 use crate::SimError;
+use crate::serial::insert_planar_chain;
 
 fn err<E: core::fmt::Display>(e: E) -> SimError {
     SimError::new(format!("contour: {e}"))
@@ -399,14 +400,7 @@ impl ArmSim {
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::ZERO; // horizontal plane: gravity loads no joint
         world.integration_parameters.dt = DT;
-        let mut parent = world.insert_body(RigidBodyBuilder::fixed());
-        let locked = JointAxesMask::LIN_AXES | JointAxesMask::ANG_X | JointAxesMask::ANG_Y;
-        let (mut angle, mut at, mut parent_len) = (0.0, Vector::ZERO, 0.0);
-        let mut joints = Vec::new();
-        let mut bodies = Vec::new();
-        #[allow(clippy::needless_range_loop)] // i indexes q, params and the chain order
-        for i in 0..2 {
-            angle += q[i];
+        let links = [0, 1].map(|i| {
             let (l, m) = (params.lengths[i], params.masses[i]);
             // Rod plus (on the last link) the tool mass at the tip.
             let (mt, com, i_zz) = if i == 1 {
@@ -419,32 +413,20 @@ impl ArmSim {
             } else {
                 (m, 0.5 * l, m * l * l / 12.0)
             };
-            let body = world.insert_body(
-                RigidBodyBuilder::dynamic()
-                    .pose(Pose::from_parts(at, Rotation::from_rotation_z(angle)))
-                    .additional_mass_properties(MassProperties::new(
-                        Vector::new(com, 0.0, 0.0),
-                        mt,
-                        Vector::new(1e-4 * mt, i_zz, i_zz),
-                    ))
-                    .can_sleep(false),
+            let props = MassProperties::new(
+                Vector::new(com, 0.0, 0.0),
+                mt,
+                Vector::new(1e-4 * mt, i_zz, i_zz),
             );
-            let joint = GenericJointBuilder::new(locked)
-                .local_frame1(Pose::from_parts(
-                    Vector::new(parent_len, 0.0, 0.0),
-                    Rotation::from_rotation_z(q[i]),
-                ))
-                .contacts_enabled(false)
-                .build();
-            let h = world
-                .insert_multibody_joint(parent, body, joint)
-                .ok_or_else(|| SimError::new("contour arm joint rejected"))?;
-            joints.push(h);
-            bodies.push(body);
-            at += Rotation::from_rotation_z(angle) * Vector::new(l, 0.0, 0.0);
-            parent = body;
-            parent_len = l;
-        }
+            (l, props)
+        });
+        let (joints, bodies) = insert_planar_chain(
+            &mut world,
+            &links,
+            q,
+            "contour arm joint rejected",
+            |_, _, _| {},
+        )?;
         let (Ok(joints), Ok(bodies)) = (joints.try_into(), bodies.try_into()) else {
             return Err(SimError::new("contour arm: two joints expected"));
         };

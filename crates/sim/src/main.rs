@@ -452,12 +452,7 @@ fn mass_sweep(maps: &[(Constraint, ComplianceMap)], out: &Path) -> Result<(), Si
 }
 
 fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimError> {
-    std::fs::write(out.join("summary.csv"), output::summary_csv(runs))?;
-    std::fs::write(
-        out.join("summary.json"),
-        serde_json::to_string_pretty(runs)?,
-    )?;
-    std::fs::write(out.join("summary.txt"), table)?;
+    output::write_summary(out, "summary", table, &output::summary_csv(runs), runs)?;
     let gmax = runs.iter().map(|r| r.g).max().unwrap_or(5);
     let top: Vec<&RunResult> = runs.iter().filter(|r| r.g == gmax).collect();
     output::write_mcap(&out.join("reproduce.mcap"), &top, true)?;

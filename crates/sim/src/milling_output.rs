@@ -1,18 +1,17 @@
 //! Outputs of the milling scenario: summary table (text, CSV, JSON), MCAP log and PNG plots.
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::fs::File;
-use std::io::BufWriter;
 use std::path::Path;
 
-use mcap::records::MessageHeader;
 use plotters::prelude::*;
 use serde_json::json;
 
 use crate::SimError;
 use crate::milling::{MillingResult, Sample};
-use crate::output::{perr, register_font};
+use crate::output::{
+    CHART, McapLog, canvas, labelled_line, legend, new_chart, perr, stamp, stamp_schema,
+    write_summary,
+};
 
 /// Topics written per run, as `/milling/<run>/<topic>`.
 pub const TOPICS: [&str; 7] = [
@@ -179,14 +178,9 @@ pub fn json(r: &MillingResult) -> serde_json::Value {
     })
 }
 
-fn stamp(t: f64) -> serde_json::Value {
-    let ns = (t * 1e9).round() as u64;
-    json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
-}
-
 fn schema(title: &str, fields: &[(&str, &str)]) -> serde_json::Value {
     let mut props = json!({
-        "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+        "timestamp": stamp_schema(),
         "run": {"type": "string"},
     });
     for (f, unit) in fields {
@@ -249,54 +243,35 @@ fn message(topic: &str, run: &str, s: &Sample) -> serde_json::Value {
 /// Writes the runs to `path`, topics `/milling/<run>/<topic>`; all runs share the
 /// scenario's time axis. Returns the number of messages.
 pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
-    let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
+    let mut log = McapLog::create(path)?;
     let mut schema_ids = Vec::new();
     for topic in TOPICS {
         let s = schema(&format!("milling {topic}"), &fields(topic));
-        schema_ids.push(w.add_schema(
-            &format!("deflect.milling.{topic}"),
-            "jsonschema",
-            serde_json::to_string(&s)?.as_bytes(),
-        )?);
+        schema_ids.push(log.add_schema(&format!("deflect.milling.{topic}"), &s)?);
     }
-    let mut count = 0;
     for run in &r.runs {
         let name = run.mode.label();
-        let mut meta = BTreeMap::new();
-        meta.insert("run".to_string(), name.to_string());
         let mut channels = Vec::new();
         for (topic, schema) in TOPICS.iter().zip(&schema_ids) {
-            channels.push(w.add_channel(
+            channels.push(log.add_channel(
                 *schema,
                 &format!("/milling/{name}/{topic}"),
-                "json",
-                &meta,
+                "run",
+                name,
             )?);
         }
         for (seq, s) in (0u32..).zip(&run.samples) {
-            let ns = (s.t * 1e9).round() as u64;
             for (topic, ch) in TOPICS.iter().zip(&channels) {
-                let header = MessageHeader {
-                    channel_id: *ch,
-                    sequence: seq,
-                    log_time: ns,
-                    publish_time: ns,
-                };
-                let msg = message(topic, name, s);
-                w.write_to_known_channel(&header, serde_json::to_string(&msg)?.as_bytes())?;
-                count += 1;
+                log.write(*ch, seq, s.t, &message(topic, name, s))?;
             }
         }
     }
-    w.finish()?;
-    Ok(count)
+    log.finish()
 }
 
 /// Path error against time for the runs, with the cutter entry and exit marked.
 pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, (1100, 620)).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
+    let root = canvas(path, (1100, 620))?;
     let t_end = r.options.t_end();
     let ymax = r
         .runs
@@ -304,23 +279,14 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
         .flat_map(|x| x.samples.iter().map(|s| s.error_mm))
         .fold(0.1, f64::max)
         * 1.1;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            "milling: tool-point deviation across the feed",
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.0..t_end, 0.0..ymax)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("time [s]")
-        .y_desc("path error [mm]")
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    let mut chart = new_chart(
+        &root,
+        CHART,
+        "milling: tool-point deviation across the feed",
+        0.0..t_end,
+        0.0..ymax,
+        ("time [s]", "path error [mm]"),
+    )?;
     for t in [r.options.t_entry(), r.options.t_exit()] {
         chart
             .draw_series(LineSeries::new(
@@ -338,32 +304,22 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             m.max_mm,
             m.rms_mm
         );
-        chart
-            .draw_series(LineSeries::new(
-                run.samples.iter().map(|s| (s.t, s.error_mm)),
-                c.stroke_width(2),
-            ))
-            .map_err(perr)?
-            .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+        labelled_line(
+            &mut chart,
+            run.samples.iter().map(|s| (s.t, s.error_mm)),
+            c,
+            2,
+            label,
+        )?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.8, 15)?;
     root.present().map_err(perr)?;
     Ok(())
 }
 
 /// Identified vs true stiffness per joint (frames and TCP, with +- 2 se bars).
 pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, (900, 560)).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
+    let root = canvas(path, (900, 560))?;
     let kmax = r
         .stiffness
         .iter()
@@ -371,20 +327,14 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
         .filter(|k| k.is_finite())
         .fold(1.0, f64::max)
         * 1.2e-3;
-    let mut chart = ChartBuilder::on(&root)
-        .caption("joint stiffness: identified vs true", ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(-0.5f64..3.5f64, 0.0..kmax)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("joint (0 = yaw, 1-3 = pitch)")
-        .y_desc("stiffness [kN m/rad]")
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    let mut chart = new_chart(
+        &root,
+        CHART,
+        "joint stiffness: identified vs true",
+        -0.5f64..3.5f64,
+        0.0..kmax,
+        ("joint (0 = yaw, 1-3 = pitch)", "stiffness [kN m/rad]"),
+    )?;
     let true_pts: Vec<(f64, f64)> = r
         .stiffness
         .iter()
@@ -431,14 +381,7 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             }))
             .map_err(perr)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.8, 15)?;
     root.present().map_err(perr)?;
     Ok(())
 }
@@ -447,12 +390,7 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
 /// `milling_stiffness.png` into `out`.
 pub fn write_all(out: &Path, r: &MillingResult) -> Result<(), SimError> {
     std::fs::create_dir_all(out)?;
-    std::fs::write(out.join("milling_summary.txt"), table(r))?;
-    std::fs::write(out.join("milling_summary.csv"), csv(r))?;
-    std::fs::write(
-        out.join("milling_summary.json"),
-        serde_json::to_string_pretty(&json(r))?,
-    )?;
+    write_summary(out, "milling_summary", &table(r), &csv(r), &json(r))?;
     write_mcap(&out.join("milling.mcap"), r)?;
     plot_error(&out.join("milling_error.png"), r)?;
     plot_stiffness(&out.join("milling_stiffness.png"), r)?;

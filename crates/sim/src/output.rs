@@ -5,9 +5,12 @@ use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::fs::File;
 use std::io::BufWriter;
+use std::ops::Range;
 use std::path::Path;
 
 use mcap::records::MessageHeader;
+use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use serde_json::json;
 
@@ -25,7 +28,7 @@ pub const TOPICS: [&str; 5] = [
 
 fn point_schema(title: &str, unit: &str, z: bool) -> serde_json::Value {
     let mut props = json!({
-        "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+        "timestamp": stamp_schema(),
         "run": {"type": "string"},
         "x": {"type": "number", "description": unit},
         "y": {"type": "number", "description": unit},
@@ -57,7 +60,7 @@ fn schemas() -> [(String, serde_json::Value); 5] {
         (
             "deflect.Joints".into(),
             json!({"title": "joint angles", "type": "object", "properties": {
-                "timestamp": {"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}},
+                "timestamp": stamp_schema(),
                 "run": {"type": "string"},
                 "command": {"type": "array", "items": {"type": "number"}, "description": "rad"},
                 "motor": {"type": "array", "items": {"type": "number"}, "description": "rad"},
@@ -67,9 +70,89 @@ fn schemas() -> [(String, serde_json::Value); 5] {
     ]
 }
 
-fn stamp(t: f64) -> serde_json::Value {
-    let ns = (t * 1e9).round() as u64;
+/// Log time `t` [s] in nanoseconds.
+fn nanos(t: f64) -> u64 {
+    (t * 1e9).round() as u64
+}
+
+/// A message timestamp `{"sec", "nsec"}` for time `t` [s].
+pub(crate) fn stamp(t: f64) -> serde_json::Value {
+    let ns = nanos(t);
     json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
+}
+
+/// The JSON schema of a [`stamp`].
+pub(crate) fn stamp_schema() -> serde_json::Value {
+    json!({"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}})
+}
+
+/// An MCAP file of JSON messages with JSON schemas (zstd chunks), shared by the scenarios.
+pub(crate) struct McapLog {
+    w: mcap::Writer<BufWriter<File>>,
+    count: usize,
+}
+
+impl McapLog {
+    /// Creates the file at `path`.
+    pub(crate) fn create(path: &Path) -> Result<Self, SimError> {
+        Ok(Self {
+            w: mcap::Writer::new(BufWriter::new(File::create(path)?))?,
+            count: 0,
+        })
+    }
+
+    /// Adds a JSON schema named `name`; returns its id.
+    pub(crate) fn add_schema(
+        &mut self,
+        name: &str,
+        schema: &serde_json::Value,
+    ) -> Result<u16, SimError> {
+        Ok(self.w.add_schema(
+            name,
+            "jsonschema",
+            serde_json::to_string(schema)?.as_bytes(),
+        )?)
+    }
+
+    /// Adds a JSON channel on `topic` with one metadata entry `key: value`; returns its id.
+    pub(crate) fn add_channel(
+        &mut self,
+        schema: u16,
+        topic: &str,
+        key: &str,
+        value: &str,
+    ) -> Result<u16, SimError> {
+        let mut meta = BTreeMap::new();
+        meta.insert(key.to_string(), value.to_string());
+        Ok(self.w.add_channel(schema, topic, "json", &meta)?)
+    }
+
+    /// Writes `msg` on `channel` with sequence number `seq`, logged and published at `t` [s].
+    pub(crate) fn write(
+        &mut self,
+        channel: u16,
+        seq: u32,
+        t: f64,
+        msg: &serde_json::Value,
+    ) -> Result<(), SimError> {
+        let ns = nanos(t);
+        let header = MessageHeader {
+            channel_id: channel,
+            sequence: seq,
+            log_time: ns,
+            publish_time: ns,
+        };
+        self.w
+            .write_to_known_channel(&header, serde_json::to_string(msg)?.as_bytes())?;
+        self.count += 1;
+        Ok(())
+    }
+
+    /// Finishes the file; returns the number of messages written.
+    pub(crate) fn finish(mut self) -> Result<usize, SimError> {
+        self.w.finish()?;
+        Ok(self.count)
+    }
 }
 
 fn messages(run: &str, s: &Sample, t: f64) -> [serde_json::Value; 5] {
@@ -102,17 +185,12 @@ pub fn write_mcap(
     runs: &[&RunResult],
     prefix_topics: bool,
 ) -> Result<usize, SimError> {
-    let mut w = mcap::Writer::new(BufWriter::new(File::create(path)?))?;
+    let mut log = McapLog::create(path)?;
     let mut schema_ids = Vec::new();
     for (name, s) in schemas() {
-        schema_ids.push(w.add_schema(
-            &name,
-            "jsonschema",
-            serde_json::to_string(&s)?.as_bytes(),
-        )?);
+        schema_ids.push(log.add_schema(&name, &s)?);
     }
     let mut offset = 0.0;
-    let mut count = 0;
     for r in runs {
         let name = run_name(r);
         let mut channels = Vec::new();
@@ -122,30 +200,19 @@ pub fn write_mcap(
             } else {
                 format!("/{topic}")
             };
-            let mut meta = BTreeMap::new();
-            meta.insert("run".to_string(), name.clone());
-            channels.push(w.add_channel(*schema, &full, "json", &meta)?);
+            channels.push(log.add_channel(*schema, &full, "run", &name)?);
         }
         let mut last = 0.0;
         for (seq, s) in (0u32..).zip(&r.samples) {
             let t = offset + s.t;
-            let ns = (t * 1e9).round() as u64;
             for (ch, msg) in channels.iter().zip(messages(&name, s, t)) {
-                let header = MessageHeader {
-                    channel_id: *ch,
-                    sequence: seq,
-                    log_time: ns,
-                    publish_time: ns,
-                };
-                w.write_to_known_channel(&header, serde_json::to_string(&msg)?.as_bytes())?;
-                count += 1;
+                log.write(*ch, seq, t, &msg)?;
             }
             last = s.t;
         }
         offset += last + 0.1;
     }
-    w.finish()?;
-    Ok(count)
+    log.finish()
 }
 
 /// CSV of all runs' metrics.
@@ -190,12 +257,119 @@ pub(crate) fn perr<E: std::fmt::Display>(e: E) -> SimError {
     SimError::new(format!("plot: {e}"))
 }
 
+/// A PNG canvas of `size` pixels at `path`, filled white (font registered).
+pub(crate) fn canvas(
+    path: &Path,
+    size: (u32, u32),
+) -> Result<DrawingArea<BitMapBackend<'_>, Shift>, SimError> {
+    register_font();
+    let root = BitMapBackend::new(path, size).into_drawing_area();
+    root.fill(&WHITE).map_err(perr)?;
+    Ok(root)
+}
+
+/// A 2-D chart of `f64` axes as the scenarios draw them.
+pub(crate) type Chart<'a, 'b> =
+    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Font sizes and label areas of a chart.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ChartStyle {
+    /// Caption font size.
+    pub caption: u32,
+    /// X and y label area sizes.
+    pub label_areas: (u32, u32),
+    /// Axis label font size.
+    pub labels: u32,
+}
+
+/// The usual style: caption 22, label areas 45 x 70, labels 15.
+pub(crate) const CHART: ChartStyle = ChartStyle {
+    caption: 22,
+    label_areas: (45, 70),
+    labels: 15,
+};
+
+/// A chart on `area` with a caption, axis ranges `x`, `y` and axis descriptions `desc`
+/// (mesh drawn).
+pub(crate) fn new_chart<'a, 'b>(
+    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
+    style: ChartStyle,
+    caption: &str,
+    x: Range<f64>,
+    y: Range<f64>,
+    desc: (&str, &str),
+) -> Result<Chart<'a, 'b>, SimError> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(caption, ("sans-serif", style.caption))
+        .margin(12)
+        .x_label_area_size(style.label_areas.0)
+        .y_label_area_size(style.label_areas.1)
+        .build_cartesian_2d(x, y)
+        .map_err(perr)?;
+    chart
+        .configure_mesh()
+        .x_desc(desc.0)
+        .y_desc(desc.1)
+        .label_style(("sans-serif", style.labels))
+        .draw()
+        .map_err(perr)?;
+    Ok(chart)
+}
+
+/// Draws a line of `width` in color `c` with a legend entry `label`.
+pub(crate) fn labelled_line(
+    chart: &mut Chart<'_, '_>,
+    pts: impl IntoIterator<Item = (f64, f64)>,
+    c: RGBColor,
+    width: u32,
+    label: impl Into<String>,
+) -> Result<(), SimError> {
+    chart
+        .draw_series(LineSeries::new(pts, c.stroke_width(width)))
+        .map_err(perr)?
+        .label(label)
+        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width)));
+    Ok(())
+}
+
+/// Draws the legend box (upper right, white at `opacity`, font size `font`).
+pub(crate) fn legend<'a, 'b: 'a>(
+    chart: &mut Chart<'a, 'b>,
+    opacity: f64,
+    font: u32,
+) -> Result<(), SimError> {
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .background_style(WHITE.mix(opacity))
+        .border_style(BLACK)
+        .label_font(("sans-serif", font))
+        .draw()
+        .map_err(perr)
+}
+
+/// Writes `<stem>.txt`, `<stem>.csv` and `<stem>.json` (pretty JSON of `json`) into `out`.
+pub fn write_summary<T: serde::Serialize + ?Sized>(
+    out: &Path,
+    stem: &str,
+    txt: &str,
+    csv: &str,
+    json: &T,
+) -> Result<(), SimError> {
+    std::fs::write(out.join(format!("{stem}.txt")), txt)?;
+    std::fs::write(out.join(format!("{stem}.csv")), csv)?;
+    std::fs::write(
+        out.join(format!("{stem}.json")),
+        serde_json::to_string_pretty(json)?,
+    )?;
+    Ok(())
+}
+
 /// Path plot of runs of one motion: deviation across the path (mm, magnified) against the
 /// position along it, one curve per run.
 pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, (1000, 620)).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
+    let root = canvas(path, (1000, 620))?;
     let Some(first) = runs.first() else {
         return Ok(());
     };
@@ -218,20 +392,14 @@ pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), S
             umax = umax.max(u);
         }
     }
-    let mut chart = ChartBuilder::on(&root)
-        .caption(title, ("sans-serif", 22))
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(umin - 2.0..umax + 2.0, -vmax * 1.1..vmax * 1.1)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("along the first segment [mm]")
-        .y_desc("across [mm]")
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    let mut chart = new_chart(
+        &root,
+        CHART,
+        title,
+        umin - 2.0..umax + 2.0,
+        -vmax * 1.1..vmax * 1.1,
+        ("along the first segment [mm]", "across [mm]"),
+    )?;
     let colors = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
     let mut configs: Vec<&str> = Vec::new();
     for r in runs {
@@ -254,22 +422,9 @@ pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), S
                 "uncorrected"
             }
         );
-        chart
-            .draw_series(LineSeries::new(series, c.stroke_width(width)))
-            .map_err(perr)?
-            .label(label)
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width))
-            });
+        labelled_line(&mut chart, series, c, width, label)?;
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.8, 15)?;
     root.present().map_err(perr)?;
     Ok(())
 }
@@ -277,29 +432,18 @@ pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), S
 /// Max path deviation (or tracking error for the x-line) against acceleration, per
 /// configuration, uncorrected (dashed-looking thin) and corrected (thick).
 pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Result<(), SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, (1000, 620)).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
+    let root = canvas(path, (1000, 620))?;
     let sel: Vec<&RunResult> = runs.iter().filter(|r| r.motion == motion).collect();
     let metric = |r: &RunResult| r.metrics.max_dev_mm;
     let ymax = sel.iter().map(|r| metric(r)).fold(0.01, f64::max) * 1.1;
-    let mut chart = ChartBuilder::on(&root)
-        .caption(
-            format!("{}: max path deviation vs acceleration", motion.label()),
-            ("sans-serif", 22),
-        )
-        .margin(12)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(0.8f64..5.2f64, 0.0..ymax)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc("peak acceleration [g]")
-        .y_desc("max deviation [mm]")
-        .label_style(("sans-serif", 15))
-        .draw()
-        .map_err(perr)?;
+    let mut chart = new_chart(
+        &root,
+        CHART,
+        &format!("{}: max path deviation vs acceleration", motion.label()),
+        0.8f64..5.2f64,
+        0.0..ymax,
+        ("peak acceleration [g]", "max deviation [mm]"),
+    )?;
     let mut configs: Vec<String> = sel.iter().map(|r| r.config.clone()).collect();
     configs.dedup();
     configs.sort();
@@ -323,26 +467,13 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
                     "uncorrected"
                 }
             );
-            chart
-                .draw_series(LineSeries::new(pts.clone(), c.stroke_width(width)))
-                .map_err(perr)?
-                .label(label)
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width))
-                });
+            labelled_line(&mut chart, pts.clone(), c, width, label)?;
             chart
                 .draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))
                 .map_err(perr)?;
         }
     }
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(0.8))
-        .border_style(BLACK)
-        .label_font(("sans-serif", 14))
-        .draw()
-        .map_err(perr)?;
+    legend(&mut chart, 0.8, 14)?;
     root.present().map_err(perr)?;
     Ok(())
 }

@@ -8,6 +8,51 @@ use rapier3d_f64::prelude::*;
 use crate::SimError;
 use crate::robot::DT;
 
+/// Inserts a planar chain of links on revolute-z multibody joints into `world`, on a fixed base
+/// at the origin: link `i` has length `links[i].0` and mass properties `links[i].1` (its frame
+/// at the joint, x along the link) and is built at relative joint angle `q[i]` [rad].
+/// `on_joint(world, joint, i)` runs right after joint `i` is inserted (drive spring, damping).
+/// Returns the joints and the link bodies, base to tip; `rejected` is the error if rapier
+/// refuses a joint.
+pub(crate) fn insert_planar_chain(
+    world: &mut PhysicsWorld,
+    links: &[(f64, MassProperties)],
+    q: &[f64],
+    rejected: &str,
+    mut on_joint: impl FnMut(&mut PhysicsWorld, MultibodyJointHandle, usize),
+) -> Result<(Vec<MultibodyJointHandle>, Vec<RigidBodyHandle>), SimError> {
+    let mut parent = world.insert_body(RigidBodyBuilder::fixed());
+    let locked = JointAxesMask::LIN_AXES | JointAxesMask::ANG_X | JointAxesMask::ANG_Y;
+    let (mut angle, mut at, mut parent_len) = (0.0, Vector::ZERO, 0.0);
+    let (mut joints, mut bodies) = (Vec::new(), Vec::new());
+    for (i, (&(l, props), &qi)) in links.iter().zip(q).enumerate() {
+        angle += qi;
+        let body = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .pose(Pose::from_parts(at, Rotation::from_rotation_z(angle)))
+                .additional_mass_properties(props)
+                .can_sleep(false),
+        );
+        let joint = GenericJointBuilder::new(locked)
+            .local_frame1(Pose::from_parts(
+                Vector::new(parent_len, 0.0, 0.0),
+                Rotation::from_rotation_z(qi),
+            ))
+            .contacts_enabled(false)
+            .build();
+        let h = world
+            .insert_multibody_joint(parent, body, joint)
+            .ok_or_else(|| SimError::new(rejected))?;
+        on_joint(world, h, i);
+        joints.push(h);
+        bodies.push(body);
+        at += Rotation::from_rotation_z(angle) * Vector::new(l, 0.0, 0.0);
+        parent = body;
+        parent_len = l;
+    }
+    Ok((joints, bodies))
+}
+
 /// A planar serial arm with compliant joints in rapier.
 pub struct SerialArmSim {
     world: PhysicsWorld,
@@ -43,55 +88,44 @@ impl SerialArmSim {
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::ZERO;
         world.integration_parameters.dt = DT;
-        let mut parent = world.insert_body(RigidBodyBuilder::fixed());
-        let mut parent_len = 0.0;
-        let mut joints = Vec::new();
-        let mut angle = 0.0;
-        let mut at = Vector::ZERO;
-        let locked = JointAxesMask::LIN_AXES | JointAxesMask::ANG_X | JointAxesMask::ANG_Y;
-        for i in 0..n {
-            angle += q[i];
-            let (l, m) = (lengths[i], masses[i]);
-            let body = world.insert_body(
-                RigidBodyBuilder::dynamic()
-                    .pose(Pose::from_parts(at, Rotation::from_rotation_z(angle)))
-                    .additional_mass_properties(MassProperties::new(
-                        Vector::new(0.5 * l, 0.0, 0.0),
-                        m,
-                        Vector::new(1e-5, m * l * l / 12.0, m * l * l / 12.0),
-                    ))
-                    .can_sleep(false),
-            );
-            let joint = GenericJointBuilder::new(locked)
-                .local_frame1(Pose::from_parts(
-                    Vector::new(parent_len, 0.0, 0.0),
-                    Rotation::from_rotation_z(q[i]),
-                ))
-                .contacts_enabled(false)
-                .build();
-            let h = world
-                .insert_multibody_joint(parent, body, joint)
-                .ok_or_else(|| SimError::new("serial joint rejected"))?;
-            if let Some((mb, id)) = world.multibody_joints.get_mut(h) {
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint.set_spring(5, stiffness[i], 0.0);
+        let links: Vec<(f64, MassProperties)> = lengths
+            .iter()
+            .zip(masses)
+            .map(|(&l, &m)| {
+                let props = MassProperties::new(
+                    Vector::new(0.5 * l, 0.0, 0.0),
+                    m,
+                    Vector::new(1e-5, m * l * l / 12.0, m * l * l / 12.0),
+                );
+                (l, props)
+            })
+            .collect();
+        let (joints, bodies) = insert_planar_chain(
+            &mut world,
+            &links,
+            q,
+            "serial joint rejected",
+            |world, h, i| {
+                if let Some((mb, id)) = world.multibody_joints.get_mut(h) {
+                    if let Some(link) = mb.link_mut(id) {
+                        link.joint.set_spring(5, stiffness[i], 0.0);
+                    }
+                    if let Some(d) = mb.damping_mut().iter_mut().last() {
+                        *d = 20.0; // structural damping [N m s/rad]: 10-40 % of critical for the default test arm
+                    }
                 }
-                if let Some(d) = mb.damping_mut().iter_mut().last() {
-                    *d = 20.0; // structural damping [N m s/rad]: 10-40 % of critical for the default test arm
-                }
-            }
-            joints.push(h);
-            at += Rotation::from_rotation_z(angle) * Vector::new(l, 0.0, 0.0);
-            parent = body;
-            parent_len = l;
-        }
+            },
+        )?;
+        let tip_body = *bodies
+            .last()
+            .ok_or_else(|| SimError::new("serial arm: no links"))?;
         Ok(Self {
             world,
             lengths: lengths.to_vec(),
             stiffness: stiffness.to_vec(),
             q_ref: q.to_vec(),
             joints,
-            tip_body: parent,
+            tip_body,
         })
     }
 
