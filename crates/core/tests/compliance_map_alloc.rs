@@ -14,6 +14,8 @@ static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn displacement_allocates_nothing() {
+    common::watch_this_thread();
+    common::assert_counter_works();
     let text = include_str!("../../../data/paksoy2025_compliance_oc.csv");
     let oc =
         ComplianceMap::from_paper_csv(text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap();

@@ -14,6 +14,8 @@ static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn corrector_ticks_do_not_allocate() {
+    common::watch_this_thread();
+    common::assert_counter_works();
     let text = std::fs::read_to_string(format!(
         "{}/../../data/paksoy2025_compliance_oc.csv",
         env!("CARGO_MANIFEST_DIR")

@@ -18,6 +18,8 @@ static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn drive_train_and_tracer_do_not_allocate() {
+    common::watch_this_thread();
+    common::assert_counter_works();
     let mut b = ModelBuilder::new();
     let mut masses = LinkMasses::new();
     for (i, axis) in [

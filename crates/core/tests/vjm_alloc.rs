@@ -12,6 +12,8 @@ static GLOBAL: common::Counting = common::Counting;
 
 #[test]
 fn vjm_calls_do_not_allocate() {
+    common::watch_this_thread();
+    common::assert_counter_works();
     let mut b = ModelBuilder::new();
     for (i, axis) in [
         Vector3::z(),
