@@ -55,5 +55,8 @@ pub fn assert_counter_works() {
     let before = allocations();
     let v: Vec<u8> = std::hint::black_box(Vec::with_capacity(64));
     drop(v);
-    assert!(allocations() > before, "the counting allocator missed an allocation");
+    assert!(
+        allocations() > before,
+        "the counting allocator missed an allocation"
+    );
 }
