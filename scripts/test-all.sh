@@ -9,6 +9,9 @@ PY="${PYTHON:-python3}"
 echo "== Rust: format, lints, tests =="
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
+# The C/C++ example tests link target/debug/libdeflect.a: build the static library first
+# (a workspace-wide test build may only produce the rlib).
+cargo build -p deflect-ffi --quiet
 cargo test --workspace --quiet
 # The real-time core must build without std (no_std, no alloc) ...
 cargo build -p deflect-core --no-default-features --quiet

@@ -21,7 +21,7 @@ fn lib_dir() -> PathBuf {
     let dir = exe.parent().unwrap().parent().unwrap().to_path_buf();
     assert!(
         dir.join("libdeflect.a").exists(),
-        "no libdeflect.a in {}",
+        "no libdeflect.a in {}: run `cargo build -p deflect-ffi` first (scripts/test-all.sh does)",
         dir.display()
     );
     dir
