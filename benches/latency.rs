@@ -21,6 +21,12 @@ pub fn report(name: &str, n: usize, budget_ns: f64, mut tick: impl FnMut(usize))
         tick(i); // warm-up
     }
     for i in 0..n {
+        // A servo thread sleeps between ticks; a SCHED_FIFO thread that never sleeps is
+        // throttled by the kernel (50 ms per second by default), which is not what a
+        // controller sees. Pause briefly every 256 ticks, outside the timed region.
+        if i % 256 == 255 {
+            std::thread::sleep(std::time::Duration::from_micros(200));
+        }
         let t0 = Instant::now();
         tick(i);
         ns.push(t0.elapsed().as_nanos() as u64);
