@@ -7,7 +7,6 @@
 
 use std::hint::black_box;
 use std::ptr;
-use std::time::Instant;
 
 use deflect::*;
 use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
@@ -18,28 +17,6 @@ use deflect_core::vjm::{self, Data, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
 use nalgebra::Vector2;
 
-/// Runs `tick(i)` `n` times (after up to 10 000 warm-up ticks) and prints median / p99.9 /
-/// max in ns.
-fn report(name: &str, n: usize, mut tick: impl FnMut(usize)) {
-    let mut ns = Vec::with_capacity(n);
-    for i in 0..n.min(10_000) {
-        tick(i);
-    }
-    for i in 0..n {
-        let t0 = Instant::now();
-        tick(i);
-        ns.push(t0.elapsed().as_nanos() as u64);
-    }
-    ns.sort_unstable();
-    let q = |p: f64| ns[((ns.len() - 1) as f64 * p).round() as usize];
-    println!(
-        "{name:<36} ticks {n:>8}  median {:>6} ns  p99.9 {:>7} ns  max {:>8} ns",
-        q(0.5),
-        q(0.999),
-        ns[ns.len() - 1]
-    );
-}
-
 fn c_path(rel: &str) -> std::ffi::CString {
     std::ffi::CString::new(repo_path(rel)).expect("no NUL in paths")
 }
@@ -49,7 +26,8 @@ fn main() {
         .skip(1)
         .find_map(|a| a.parse().ok())
         .unwrap_or(1_000_000);
-    println!("deflect C-API latency harness (C API = extern \"C\" functions of deflect-ffi)");
+    let rt = deflect_tests::realtime_setup();
+    println!("deflect C-API latency harness ({rt}; C API = extern \"C\" functions of deflect-ffi)");
 
     // --- The 2 kHz D'Alembert tick: sample the 5 g y-line, corrector step, one-shot. ---
     let text = std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv"))
@@ -71,7 +49,7 @@ fn main() {
     let period = traj.duration();
     let corr = DalembertCorrector::new(5.0).expect("mass");
     let mut q2 = Vector2::zeros();
-    report("rust: dalembert tick (sample+step)", n, |i| {
+    deflect_tests::latency_report("rust: dalembert tick (sample+step)", n, None, |i| {
         let t = (i as f64 / 2000.0) % period;
         let s = traj.sample(black_box(t)).expect("in range");
         if let Ok(tick) = corr.step(&robot2, &view, &s.position, &s.acceleration, &q2) {
@@ -109,7 +87,7 @@ fn main() {
     let mut q = [0.0; 2];
     let mut st = DeflectState2::default();
     let mut tick = DeflectCorrectedTick2::default();
-    report("C API: dalembert tick (sample+step)", n, |i| {
+    deflect_tests::latency_report("C API: dalembert tick (sample+step)", n, None, |i| {
         let t = (i as f64 / 2000.0) % period;
         // SAFETY: live handles from above, outputs are locals, arrays of 2 doubles.
         let ok = unsafe {
@@ -134,7 +112,7 @@ fn main() {
     let mut data = Data::new(&robot.model);
     let w = Vector6::from_row_slice(&MILLING_WRENCH);
     let mut qk = KR300_MILLING_POSE;
-    report("rust: vjm::deflection (KR 300)", n, |i| {
+    deflect_tests::latency_report("rust: vjm::deflection (KR 300)", n, None, |i| {
         qk[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::deflection(&robot.model, &mut data, black_box(&qk), &w).ok());
     });
@@ -158,7 +136,7 @@ fn main() {
         );
     }
     let mut d = [0.0; 6];
-    report("C API: deflect_serial_robot_deflection", n, |i| {
+    deflect_tests::latency_report("C API: deflect_serial_robot_deflection", n, None, |i| {
         qk[0] = 1e-6 * (i % 1000) as f64;
         // SAFETY: live handle, 6 joints, 6-wrench, 6 writable doubles.
         let s = unsafe {

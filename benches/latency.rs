@@ -3,7 +3,6 @@
 //! `cargo bench --bench latency` (optionally `-- N` ticks).
 
 use std::hint::black_box;
-use std::time::Instant;
 
 use deflect_core::compensation::{CompensatorConfig, OnlineCompensator, SensorCalibration};
 use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
@@ -11,58 +10,11 @@ use deflect_core::dalembert::DalembertCorrector;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
+use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, latency_report, repo_path};
 use nalgebra::{Vector2, Vector3};
 
-/// Runs `tick(i)` `n` times and prints median / p99.9 / max in ns.
-pub fn report(name: &str, n: usize, budget_ns: f64, mut tick: impl FnMut(usize)) {
-    let mut ns = Vec::with_capacity(n);
-    for i in 0..n.min(10_000) {
-        tick(i); // warm-up
-    }
-    for i in 0..n {
-        // A servo thread sleeps between ticks; a SCHED_FIFO thread that never sleeps is
-        // throttled by the kernel (50 ms per second by default), which is not what a
-        // controller sees. Pause briefly every 256 ticks, outside the timed region.
-        if i % 256 == 255 {
-            std::thread::sleep(std::time::Duration::from_micros(200));
-        }
-        let t0 = Instant::now();
-        tick(i);
-        ns.push(t0.elapsed().as_nanos() as u64);
-    }
-    ns.sort_unstable();
-    let q = |p: f64| ns[((ns.len() - 1) as f64 * p).round() as usize];
-    println!(
-        "{name:<28} ticks {n:>8}  median {:>7} ns  p99.9 {:>7} ns  max {:>8} ns  (budget {budget_ns:.0} ns)",
-        q(0.5),
-        q(0.999),
-        ns[ns.len() - 1]
-    );
-}
-
-/// Asks for what a servo thread gets on a real-time controller: SCHED_FIFO priority 80 and
-/// locked memory. Returns a description of what was granted (a container may refuse).
-fn realtime_setup() -> &'static str {
-    #[allow(unsafe_code)] // reason: plain libc calls with valid arguments
-    // SAFETY: `sched_param` is fully initialised; both calls only read their arguments.
-    let (fifo, locked) = unsafe {
-        let param = libc::sched_param { sched_priority: 80 };
-        (
-            libc::sched_setscheduler(0, libc::SCHED_FIFO, &param) == 0,
-            libc::mlockall(libc::MCL_CURRENT | libc::MCL_FUTURE) == 0,
-        )
-    };
-    match (fifo, locked) {
-        (true, true) => "SCHED_FIFO 80, memory locked",
-        (true, false) => "SCHED_FIFO 80, memory not locked",
-        (false, true) => "normal scheduling (SCHED_FIFO refused), memory locked",
-        (false, false) => "normal scheduling (SCHED_FIFO and mlockall refused)",
-    }
-}
-
 fn main() {
-    let rt = realtime_setup();
+    let rt = deflect_tests::realtime_setup();
     let n: usize = std::env::args()
         .skip(1)
         .find_map(|a| a.parse().ok())
@@ -75,15 +27,15 @@ fn main() {
     let w = Vector6::from_row_slice(&MILLING_WRENCH);
     let mut q = KR300_MILLING_POSE;
     println!("deflect latency harness ({rt}); KR 300 model (6 joints, 11 virtual joints)");
-    report("vjm::deflection", n, budget, |i| {
+    latency_report("vjm::deflection", n, Some(budget), |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::deflection(model, &mut data, black_box(&q), &w).ok());
     });
-    report("vjm::compliance", n, budget, |i| {
+    latency_report("vjm::compliance", n, Some(budget), |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::compliance(model, &mut data, black_box(&q)).ok());
     });
-    report("vjm::joint_correction(1)", n / 10, budget, |i| {
+    latency_report("vjm::joint_correction(1)", n / 10, Some(budget), |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
         black_box(vjm::joint_correction(model, &mut data, black_box(&q), &w, 1, 0.0).ok());
     });
@@ -120,7 +72,7 @@ fn main() {
         ),
     ] {
         let mut q2 = Vector2::zeros();
-        report(name, n, budget, |i| {
+        latency_report(name, n, Some(budget), |i| {
             // Tick-by-tick sampling at 2 kHz, wrapping around the 375 ms motion.
             let t = (i as f64 / 2000.0) % period;
             let s = traj.sample(black_box(t)).expect("in range");
@@ -142,7 +94,7 @@ fn main() {
         let mut comp = OnlineCompensator::new(model, cfg).expect("valid config");
         let feed = Vector3::new(0.0, 0.025, 0.0);
         let estimated = Vector6::from_row_slice(&MILLING_WRENCH);
-        report(name, n, budget, |i| {
+        latency_report(name, n, Some(budget), |i| {
             // A cutter exit every 250 cycles: the reading drops to zero.
             let reading = if (i / 250) % 2 == 0 {
                 w
