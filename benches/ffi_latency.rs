@@ -9,10 +9,8 @@ use std::hint::black_box;
 use std::ptr;
 
 use deflect::*;
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
 use deflect_core::dalembert::DalembertCorrector;
 use deflect_core::mechanism::ParallelRobot2;
-use deflect_core::motion::{Trajectory, paper_limits};
 use deflect_core::vjm::{self, Data, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
 use nalgebra::Vector2;
@@ -30,22 +28,10 @@ fn main() {
     println!("deflect C-API latency harness ({rt}; C API = extern \"C\" functions of deflect-ffi)");
 
     // --- The 2 kHz D'Alembert tick: sample the 5 g y-line, corrector step, one-shot. ---
-    let text = std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv"))
-        .expect("shipped table");
-    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)
-        .expect("valid table")
-        .with_options(QueryOptions {
-            out_of_grid: OutOfGrid::Clamp,
-            ..QueryOptions::default()
-        });
+    let map = deflect_tests::paper_oc_map_clamped();
     let view = map.view();
     let robot2 = ParallelRobot2::paper();
-    let traj = Trajectory::line(
-        Vector2::new(0.222132, -0.075),
-        Vector2::new(0.222132, 0.075),
-        &paper_limits(5).expect("paper limits"),
-    )
-    .expect("valid line");
+    let traj = deflect_tests::paper_y_line_5g();
     let period = traj.duration();
     let corr = DalembertCorrector::new(5.0).expect("mass");
     let mut q2 = Vector2::zeros();

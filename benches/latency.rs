@@ -5,12 +5,10 @@
 use std::hint::black_box;
 
 use deflect_core::compensation::{CompensatorConfig, OnlineCompensator, SensorCalibration};
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
 use deflect_core::dalembert::DalembertCorrector;
 use deflect_core::mechanism::ParallelRobot2;
-use deflect_core::motion::{Trajectory, paper_limits};
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, latency_report, repo_path};
+use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, latency_report};
 use nalgebra::{Vector2, Vector3};
 
 fn main() {
@@ -42,22 +40,10 @@ fn main() {
 
     // The 2 kHz D'Alembert loop of the parallel robot: plan (sample the jerk-limited profile)
     // -> F_D = -m* a -> compliance map -> corrected point -> closed-form IK.
-    let text = std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv"))
-        .expect("shipped table");
-    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)
-        .expect("valid table")
-        .with_options(QueryOptions {
-            out_of_grid: OutOfGrid::Clamp,
-            ..QueryOptions::default()
-        });
+    let map = deflect_tests::paper_oc_map_clamped();
     let view = map.view();
     let robot2 = ParallelRobot2::paper();
-    let traj = Trajectory::line(
-        Vector2::new(0.222132, -0.075),
-        Vector2::new(0.222132, 0.075),
-        &paper_limits(5).expect("paper limits"),
-    )
-    .expect("valid line");
+    let traj = deflect_tests::paper_y_line_5g();
     let period = traj.duration();
     for (name, corr) in [
         (

@@ -75,3 +75,39 @@ pub fn realtime_setup() -> &'static str {
         (false, false) => "normal scheduling (SCHED_FIFO and mlockall refused)",
     }
 }
+
+/// The shipped OC compliance map of Paksoy et al. (force unit N, lengths mm), clamped at the
+/// grid boundary: the map the 2 kHz benchmarks and examples drive.
+pub fn paper_oc_map_clamped() -> deflect_core::compliance_map::ComplianceMap {
+    use deflect_core::compliance_map::{
+        ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions,
+    };
+    let text = match std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv")) {
+        Ok(t) => t,
+        Err(e) => panic!("the shipped OC table must be readable: {e}"),
+    };
+    match ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre) {
+        Ok(m) => m.with_options(QueryOptions {
+            out_of_grid: OutOfGrid::Clamp,
+            ..QueryOptions::default()
+        }),
+        Err(e) => panic!("the shipped OC table must load: {e}"),
+    }
+}
+
+/// The paper's 150 mm y-line (x = 222.132 mm) planned at 5 g.
+pub fn paper_y_line_5g() -> deflect_core::motion::Trajectory<2> {
+    use nalgebra::Vector2;
+    let limits = match deflect_core::motion::paper_limits(5) {
+        Ok(l) => l,
+        Err(e) => panic!("paper limits: {e}"),
+    };
+    match deflect_core::motion::Trajectory::line(
+        Vector2::new(0.222132, -0.075),
+        Vector2::new(0.222132, 0.075),
+        &limits,
+    ) {
+        Ok(t) => t,
+        Err(e) => panic!("the y-line must plan: {e}"),
+    }
+}
