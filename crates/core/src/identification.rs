@@ -21,68 +21,13 @@ use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::compensation::SensorCalibration;
 use crate::compensation::sensor::{POLY_TERMS, orientation_quaternion, poly_terms};
-use crate::error::TickError;
+use crate::error::{BuildError, TickError};
 use crate::vjm::{Data, Element, Model, Vector6, forward};
 
 /// Singular values below `RANK_TOLERANCE * sigma_max` count as zero.
 pub const RANK_TOLERANCE: f64 = 1.0e-9;
 /// A parameter whose squared weight in the null space exceeds this is unobservable.
 const NULL_WEIGHT: f64 = 1.0e-6;
-
-/// Why identification failed.
-#[derive(Debug, Clone, PartialEq)]
-#[non_exhaustive]
-pub enum IdentificationError {
-    /// Fewer equations than needed, or none.
-    TooFewMeasurements {
-        /// Measurements given.
-        got: usize,
-        /// Least number needed.
-        needed: usize,
-    },
-    /// A measurement refers to a virtual joint that does not exist.
-    UnknownSpring {
-        /// Measurement index.
-        measurement: usize,
-        /// Spring index given.
-        spring: usize,
-        /// Springs in the model.
-        springs: usize,
-    },
-    /// A measurement holds NaN or an infinity, or has the wrong size.
-    BadMeasurement {
-        /// Measurement index.
-        measurement: usize,
-        /// What is wrong.
-        error: TickError,
-    },
-    /// The SVD did not converge.
-    Numerical,
-}
-
-impl core::fmt::Display for IdentificationError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            Self::TooFewMeasurements { got, needed } => {
-                write!(f, "{got} measurements; at least {needed} are needed")
-            }
-            Self::UnknownSpring {
-                measurement,
-                spring,
-                springs,
-            } => write!(
-                f,
-                "measurement {measurement}: virtual joint {spring} does not exist (model has {springs})"
-            ),
-            Self::BadMeasurement { measurement, error } => {
-                write!(f, "measurement {measurement}: {error}")
-            }
-            Self::Numerical => write!(f, "the least-squares SVD did not converge"),
-        }
-    }
-}
-
-impl std::error::Error for IdentificationError {}
 
 /// A linear least-squares solution with its statistics.
 #[derive(Debug, Clone, PartialEq)]
@@ -101,70 +46,180 @@ pub struct LeastSquares {
     pub residual_rms: f64,
 }
 
-/// Solves `A x = b` (rows of `a`, each of `n` entries) in the least-squares sense via an SVD,
-/// with rank, standard errors and identifiability.
-pub fn least_squares(
-    rows: &[Vec<f64>],
-    b: &[f64],
+/// Most measurements one identification accepts: 100 000 (a calibration campaign has tens to
+/// thousands; the VJM paper's had a few dozen). Past it the call refuses with
+/// [`BuildError::Budget`] before any work, which bounds its time (about 10 us per TCP
+/// measurement) ; memory does not grow with the count at all ([`LeastSquaresAccumulator`]).
+pub const MAX_MEASUREMENTS: usize = 100_000;
+
+/// Rows folded into the accumulated factor at a time.
+const BLOCK: usize = 256;
+
+/// Linear least squares `A x = b` accumulated row by row in O(n^2) memory, whatever the number
+/// of rows: the rows are buffered `BLOCK` at a time and folded into the triangular factor of a
+/// Householder QR of the augmented matrix `[A | b]` (faer). [`Self::finish`] then solves with
+/// an SVD of the n x n factor, which has the singular values of `A` itself (the normal
+/// equations would square the condition number; this does not).
+#[derive(Debug, Clone)]
+pub struct LeastSquaresAccumulator {
     n: usize,
-) -> Result<LeastSquares, IdentificationError> {
-    let m = rows.len();
-    if m == 0 || n == 0 {
-        return Err(IdentificationError::TooFewMeasurements { got: m, needed: 1 });
-    }
-    let a = Mat::<f64>::from_fn(m, n, |i, j| {
-        rows.get(i).and_then(|r| r.get(j)).copied().unwrap_or(0.0)
-    });
-    let svd = a.svd().map_err(|_| IdentificationError::Numerical)?;
-    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
-    let k = m.min(n);
-    let sigma: Vec<f64> = (0..k).map(|i| s[i]).collect();
-    let sigma_max = sigma.iter().copied().fold(0.0, f64::max);
-    let tol = sigma_max * RANK_TOLERANCE;
-    let rank = sigma.iter().filter(|&&x| x > tol).count();
-    let mut x = vec![0.0; n];
-    for (i, &si) in sigma.iter().enumerate() {
-        if si <= tol {
-            continue;
-        }
-        let ub: f64 = (0..m)
-            .map(|r| u[(r, i)] * b.get(r).copied().unwrap_or(0.0))
-            .sum();
-        for (j, xj) in x.iter_mut().enumerate() {
-            *xj += v[(j, i)] * ub / si;
+    // (n + 1) x (n + 1) upper triangular factor of [A | b] so far.
+    r: Mat<f64>,
+    // Buffered rows, each n + 1 values (the row and its b).
+    pending: Vec<f64>,
+    rows: usize,
+}
+
+impl LeastSquaresAccumulator {
+    /// An empty problem with `n` unknowns.
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            r: Mat::zeros(n + 1, n + 1),
+            pending: Vec::with_capacity(BLOCK * (n + 1)),
+            rows: 0,
         }
     }
-    let residual: Vec<f64> = rows
-        .iter()
-        .zip(b)
-        .map(|(row, bi)| bi - row.iter().zip(&x).map(|(a, x)| a * x).sum::<f64>())
-        .collect();
-    let rss: f64 = residual.iter().map(|r| r * r).sum();
-    let dof = m.saturating_sub(rank);
-    let s2 = if dof > 0 { rss / dof as f64 } else { f64::NAN };
-    let mut std_error = vec![0.0; n];
-    let mut identifiable = vec![true; n];
-    for j in 0..n {
-        let mut var = 0.0;
-        let mut null = 0.0;
-        for i in 0..n {
-            let vji = v[(j, i)];
-            match sigma.get(i) {
-                Some(&si) if si > tol => var += vji * vji / (si * si),
-                _ => null += vji * vji,
+
+    /// Rows pushed so far.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Adds the equation `row . x = b` (`row` of `n` entries, all finite).
+    pub fn push(&mut self, row: &[f64], b: f64) -> Result<(), BuildError> {
+        if row.len() != self.n {
+            return Err(BuildError::WrongLength {
+                what: "least-squares row",
+                expected: self.n,
+                got: row.len(),
+            });
+        }
+        if let Some(index) = row.iter().chain([&b]).position(|v| !v.is_finite()) {
+            return Err(BuildError::NonFinite {
+                what: "least-squares row (then b)",
+                index,
+            });
+        }
+        self.pending.extend_from_slice(row);
+        self.pending.push(b);
+        self.rows += 1;
+        if self.pending.len() >= BLOCK * (self.n + 1) {
+            self.fold();
+        }
+        Ok(())
+    }
+
+    /// QR of the factor stacked over the buffered rows; keeps the new factor.
+    fn fold(&mut self) {
+        let w = self.n + 1;
+        let k = self.pending.len() / w;
+        if k == 0 {
+            return;
+        }
+        let stacked = Mat::<f64>::from_fn(w + k, w, |i, j| {
+            if i < w {
+                self.r[(i, j)]
+            } else {
+                self.pending.get((i - w) * w + j).copied().unwrap_or(0.0)
+            }
+        });
+        let qr = stacked.qr();
+        let r = qr.thin_R();
+        self.r = Mat::from_fn(w, w, |i, j| if j >= i { r[(i, j)] } else { 0.0 });
+        self.pending.clear();
+    }
+
+    /// The minimum-norm solution with rank, standard errors and identifiability.
+    pub fn finish(mut self) -> Result<LeastSquares, BuildError> {
+        self.fold();
+        let (m, n) = (self.rows, self.n);
+        if m == 0 || n == 0 {
+            return Err(BuildError::TooFew {
+                what: "measurements",
+                needed: 1,
+                got: m,
+            });
+        }
+        let r = Mat::<f64>::from_fn(n, n, |i, j| self.r[(i, j)]);
+        let qtb: Vec<f64> = (0..n).map(|i| self.r[(i, n)]).collect();
+        let rho = self.r[(n, n)];
+        let svd = r.svd().map_err(|_| BuildError::Numerical {
+            what: "least-squares SVD",
+        })?;
+        let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+        let k = m.min(n);
+        let sigma: Vec<f64> = (0..k).map(|i| s[i]).collect();
+        let sigma_max = sigma.iter().copied().fold(0.0, f64::max);
+        let tol = sigma_max * RANK_TOLERANCE;
+        let rank = sigma.iter().filter(|&&x| x > tol).count();
+        let mut x = vec![0.0; n];
+        for (i, &si) in sigma.iter().enumerate() {
+            if si <= tol {
+                continue;
+            }
+            let ub: f64 = (0..n).map(|r| u[(r, i)] * qtb[r]).sum();
+            for (j, xj) in x.iter_mut().enumerate() {
+                *xj += v[(j, i)] * ub / si;
             }
         }
-        std_error[j] = (s2 * var).sqrt();
-        identifiable[j] = null < NULL_WEIGHT;
+        // |b - A x|^2 = |Q^T b - R x|^2 over the first n rows plus what lies outside A's
+        // range (rho^2).
+        let rss: f64 = (0..n)
+            .map(|i| {
+                let e = qtb[i] - (0..n).map(|j| r[(i, j)] * x[j]).sum::<f64>();
+                e * e
+            })
+            .sum::<f64>()
+            + rho * rho;
+        let dof = m.saturating_sub(rank);
+        let s2 = if dof > 0 { rss / dof as f64 } else { f64::NAN };
+        let mut std_error = vec![0.0; n];
+        let mut identifiable = vec![true; n];
+        for j in 0..n {
+            let mut var = 0.0;
+            let mut null = 0.0;
+            for i in 0..n {
+                let vji = v[(j, i)];
+                match sigma.get(i) {
+                    Some(&si) if si > tol => var += vji * vji / (si * si),
+                    _ => null += vji * vji,
+                }
+            }
+            std_error[j] = (s2 * var).sqrt();
+            identifiable[j] = null < NULL_WEIGHT;
+        }
+        Ok(LeastSquares {
+            x,
+            std_error,
+            identifiable,
+            rank,
+            singular_values: sigma,
+            residual_rms: (rss / m as f64).sqrt(),
+        })
     }
-    Ok(LeastSquares {
-        x,
-        std_error,
-        identifiable,
-        rank,
-        singular_values: sigma,
-        residual_rms: (rss / m as f64).sqrt(),
-    })
+}
+
+/// Solves `A x = b` (rows of `a`, each of `n` entries) in the least-squares sense with rank,
+/// standard errors and identifiability ([`LeastSquaresAccumulator`] over the rows).
+pub fn least_squares(rows: &[Vec<f64>], b: &[f64], n: usize) -> Result<LeastSquares, BuildError> {
+    let mut acc = LeastSquaresAccumulator::new(n);
+    for (row, &bi) in rows.iter().zip(b) {
+        acc.push(row, bi)?;
+    }
+    acc.finish()
+}
+
+/// Refuses more than [`MAX_MEASUREMENTS`].
+fn check_count(count: usize) -> Result<(), BuildError> {
+    if count > MAX_MEASUREMENTS {
+        return Err(BuildError::Budget {
+            what: "measurements",
+            limit: MAX_MEASUREMENTS,
+            requested: count,
+        });
+    }
+    Ok(())
 }
 
 /// Identified stiffness of one virtual-joint axis.
@@ -174,14 +229,14 @@ pub struct AxisEstimate {
     pub spring: usize,
     /// 0, 1, 2 for the spring frame's x, y, z (k_C, k_B, k_A).
     pub axis: usize,
-    /// Compliance `1/k` [rad / (N m)], or `None` when the data cannot see this axis.
+    /// Compliance `1/k` \[rad / (N m)\], or `None` when the data cannot see this axis.
     pub compliance: Option<f64>,
-    /// Standard error of the compliance [rad / (N m)].
+    /// Standard error of the compliance \[rad / (N m)\].
     pub std_error: f64,
 }
 
 impl AxisEstimate {
-    /// Stiffness `k = 1/c` [N m / rad] (`inf` for a zero compliance), `None` if unobservable
+    /// Stiffness `k = 1/c` \[N m / rad\] (`inf` for a zero compliance), `None` if unobservable
     /// or the estimate is not positive.
     pub fn stiffness(&self) -> Option<f64> {
         match self.compliance {
@@ -225,7 +280,10 @@ fn spring_frames(
                 let a = qi.next().copied().unwrap_or(0.0);
                 t *= nalgebra::Translation3::from(axis.into_inner() * a);
             }
-            Element::Spring { compliance, .. } => frames.push((t, compliance)),
+            Element::Spring {
+                compliance, offset, ..
+            } => frames.push((t * offset, compliance)),
+            Element::Mass { .. } => {}
         }
     }
     Ok((frames, tcp))
@@ -255,7 +313,9 @@ fn parameter_axes(model: &Model, all_axes: bool) -> Vec<(usize, usize)> {
         .elements()
         .iter()
         .filter_map(|e| match e {
-            Element::Spring { compliance, index } => Some((*index, *compliance)),
+            Element::Spring {
+                compliance, index, ..
+            } => Some((*index, *compliance)),
             _ => None,
         })
         .flat_map(|(s, c)| {
@@ -287,7 +347,7 @@ fn finish(params: Vec<(usize, usize)>, fit: LeastSquares) -> StiffnessIdentifica
 
 /// A frame-pair measurement (section 2.5): the robot at `q` under the TCP `wrench` (base
 /// frame, moment about the TCP); the frames on either side of virtual joint `spring` turned
-/// against each other by `rotation` [rad] (rotation vector in the spring frame, loaded minus
+/// against each other by `rotation` \[rad\] (rotation vector in the spring frame, loaded minus
 /// unloaded; to first order the Eq. 7 angles `[alpha, beta, gamma]`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FrameMeasurement<'q> {
@@ -308,17 +368,18 @@ pub fn identify_from_frames(
     model: &Model,
     measurements: &[FrameMeasurement<'_>],
     all_axes: bool,
-) -> Result<StiffnessIdentification, IdentificationError> {
+) -> Result<StiffnessIdentification, BuildError> {
+    check_count(measurements.len())?;
     let params = parameter_axes(model, all_axes);
-    let mut rows = Vec::new();
-    let mut b = Vec::new();
+    let mut acc = LeastSquaresAccumulator::new(params.len());
+    let mut row = vec![0.0; params.len()];
     for (i, meas) in measurements.iter().enumerate() {
-        let bad = |error| IdentificationError::BadMeasurement {
+        let bad = |error| BuildError::BadMeasurement {
             measurement: i,
             error,
         };
         if meas.spring >= model.spring_count() {
-            return Err(IdentificationError::UnknownSpring {
+            return Err(BuildError::UnknownSpring {
                 measurement: i,
                 spring: meas.spring,
                 springs: model.spring_count(),
@@ -333,26 +394,21 @@ pub fn identify_from_frames(
             .copied()
             .unwrap_or_else(Vector3::zeros);
         for a in 0..3 {
-            let row: Vec<f64> = params
-                .iter()
-                .map(|&(s, pa)| {
-                    if s == meas.spring && pa == a {
-                        m[a]
-                    } else {
-                        0.0
-                    }
-                })
-                .collect();
-            rows.push(row);
-            b.push(meas.rotation[a]);
+            for (r, &(s, pa)) in row.iter_mut().zip(&params) {
+                *r = if s == meas.spring && pa == a {
+                    m[a]
+                } else {
+                    0.0
+                };
+            }
+            acc.push(&row, meas.rotation[a])?;
         }
     }
-    let fit = least_squares(&rows, &b, params.len())?;
-    Ok(finish(params, fit))
+    Ok(finish(params, acc.finish()?))
 }
 
 /// A TCP measurement: the robot at `q` under `wrench` deflects by `deflection`
-/// `[dp; dr]` [m, rad] (base frame). With `translation_only` only `dp` was measured.
+/// `[dp; dr]` \[m, rad\] (base frame). With `translation_only` only `dp` was measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TcpMeasurement<'q> {
     /// Joint values.
@@ -372,12 +428,13 @@ pub fn identify_from_tcp(
     model: &Model,
     measurements: &[TcpMeasurement<'_>],
     all_axes: bool,
-) -> Result<StiffnessIdentification, IdentificationError> {
+) -> Result<StiffnessIdentification, BuildError> {
+    check_count(measurements.len())?;
     let params = parameter_axes(model, all_axes);
-    let mut rows = Vec::new();
-    let mut b = Vec::new();
+    let mut acc = LeastSquaresAccumulator::new(params.len());
+    let mut row = vec![0.0; params.len()];
     for (i, meas) in measurements.iter().enumerate() {
-        let bad = |error| IdentificationError::BadMeasurement {
+        let bad = |error| BuildError::BadMeasurement {
             measurement: i,
             error,
         };
@@ -399,12 +456,18 @@ pub fn identify_from_tcp(
             .collect();
         let n_rows = if meas.translation_only { 3 } else { 6 };
         for r in 0..n_rows {
-            rows.push(cols.iter().map(|c| c[r] * c.dot(&meas.wrench)).collect());
-            b.push(meas.deflection[r]);
+            for (x, c) in row.iter_mut().zip(&cols) {
+                *x = c[r] * c.dot(&meas.wrench);
+            }
+            acc.push(&row, meas.deflection[r]).map_err(|_| {
+                bad(TickError::NonFiniteOutput {
+                    what: "design row",
+                    index: r,
+                })
+            })?;
         }
     }
-    let fit = least_squares(&rows, &b, params.len())?;
-    Ok(finish(params, fit))
+    Ok(finish(params, acc.finish()?))
 }
 
 /// Result of the sensor identification.
@@ -417,11 +480,11 @@ pub struct SensorIdentification {
     pub force_rank: usize,
     /// Rank of the moment fit (6 = offsets and centre of gravity determined).
     pub moment_rank: usize,
-    /// RMS of the force residuals after the physical model [N].
+    /// RMS of the force residuals after the physical model \[N\].
     pub force_rms: f64,
-    /// RMS of the moment residuals after the physical model [N m].
+    /// RMS of the moment residuals after the physical model \[N m\].
     pub moment_rms: f64,
-    /// RMS left after the residual polynomial [N or N m], if fitted.
+    /// RMS left after the residual polynomial \[N or N m\], if fitted.
     pub polynomial_rms: Option<f64>,
 }
 
@@ -437,15 +500,20 @@ pub fn identify_sensor(
     readings: &[Vector6],
     fit_polynomial: bool,
     sensor_to_tcp: Isometry3<f64>,
-) -> Result<SensorIdentification, IdentificationError> {
+) -> Result<SensorIdentification, BuildError> {
+    check_count(orientations.len().max(readings.len()))?;
     let n = orientations.len().min(readings.len());
     let needed = if fit_polynomial { POLY_TERMS } else { 3 };
     if n < needed || orientations.len() != readings.len() {
-        return Err(IdentificationError::TooFewMeasurements { got: n, needed });
+        return Err(BuildError::TooFew {
+            what: "measurements",
+            needed,
+            got: n,
+        });
     }
     for (i, r) in readings.iter().enumerate() {
         crate::error::check_finite("reading", r.as_slice()).map_err(|error| {
-            IdentificationError::BadMeasurement {
+            BuildError::BadMeasurement {
                 measurement: i,
                 error,
             }

@@ -1,16 +1,51 @@
 //! # deflect-core
 //!
 //! Compliant-deflection models of robots and the real-time pieces that cancel that
-//! deflection. Everything here is `#![no_std]`; the `alloc` and `std` features add the
-//! conveniences that need a heap (loaders, fitting), and `urdf` loads serial robots from a
-//! URDF plus a stiffness TOML file.
+//! deflection: the virtual-joint model of a serial robot (Hähn and Weigold), compliance maps
+//! from static tests and the D'Alembert trajectory corrector (Paksoy, Dede and Kiper 2025),
+//! online force-based compensation, drive-train errors and force-feedback contour tracing.
+//! Everything here is `#![no_std]`; the `alloc` and `std` features add what needs a heap
+//! (fitting, identification, loaders in [`io`]), and `urdf` loads serial robots from a URDF
+//! plus a stiffness TOML file.
 //!
-//! Units are SI throughout: m, N, N m, rad, s, kg. Loaders of files in other units convert
-//! explicitly and say so.
+//! Units are SI throughout: m, N, N m, rad, s, kg ([`units`]). Loaders of files in other
+//! units convert explicitly and say so.
 //!
-//! Per-tick functions follow pinocchio's layout: an immutable model built once, a [`vjm::Data`]
-//! that owns every buffer, and functions of `(&Model, &mut Data, inputs)` that allocate nothing,
-//! never panic and return a typed [`error::TickError`] for wrong-sized or non-finite input.
+//! ## One tick shape
+//!
+//! Every per-tick concept follows pinocchio's layout: an immutable `Model` built and
+//! validated once, a `Data::new(&model)` that owns every buffer the tick needs and can
+//! `check(&model)`, and per-tick functions `fn(&Model, &mut Data, inputs) -> Result<_,
+//! TickError>` that allocate nothing and never panic. Errors come in three tiers
+//! ([`error`]): [`BuildError`] / [`LoadError`] when a model is assembled or loaded,
+//! [`TickError`] per tick, numerical failure inside a solver as an `Option`.
+//!
+//! | concept | model | per tick |
+//! |---|---|---|
+//! | virtual-joint deflection | [`vjm::Model`] | [`vjm::deflection`], [`vjm::compliance`], [`vjm::joint_correction`] |
+//! | compliance-map query | [`ComplianceMapView`] | [`compliance_map::query`] |
+//! | D'Alembert correction | [`dalembert::Model`] | [`dalembert::step`] |
+//! | mechanism (IK/FK) | [`mechanism::Mechanism`] | `inverse`, `forward` |
+//! | online compensation | [`compensation::Model`] | [`compensation::step`] |
+//! | drive-train errors | [`drivetrain::Model`] | [`drivetrain::correct_joints`] |
+//! | contour tracing | [`contour::Model`] | [`contour::step`] |
+//!
+//! ```
+//! use deflect_core::vjm::{self, Data, Vector6};
+//! use deflect_core::ModelBuilder;
+//! use nalgebra::{Isometry3, Vector3};
+//! // A 1 m arm about z with a spring at its joint: 1e4 N m/rad about z.
+//! let model = ModelBuilder::new()
+//!     .revolute(Vector3::z())?
+//!     .spring([f64::INFINITY, f64::INFINITY, 1.0e4])?
+//!     .fixed(Isometry3::translation(1.0, 0.0, 0.0))?
+//!     .build()?;
+//! let mut data = Data::new(&model);
+//! // 100 N along +y at the tip: moment 100 N m, angle 0.01 rad, tip moves ~10 mm along y.
+//! let d = vjm::deflection(&model, &mut data, &[0.0], &Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0))?;
+//! assert!((d.y - 0.01f64.sin()).abs() < 1e-12);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![no_std]
 // The real-time core must never panic: these are hard errors here (tests may unwrap).
 #![cfg_attr(
@@ -22,7 +57,7 @@
         clippy::indexing_slicing
     )
 )]
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 #[cfg(feature = "alloc")]
 extern crate alloc;
@@ -37,23 +72,21 @@ pub mod drivetrain;
 pub mod error;
 #[cfg(feature = "std")]
 pub mod identification;
+#[cfg(feature = "std")]
+pub mod io;
 pub mod mechanism;
 pub mod motion;
-pub mod vjm;
-
-#[cfg(feature = "urdf")]
-pub mod drivetrain_io;
-#[cfg(feature = "urdf")]
+#[cfg(feature = "std")]
 pub mod robot;
+pub mod units;
+pub mod vjm;
 
 #[cfg(feature = "alloc")]
 pub use compliance_map::ComplianceMap;
-pub use compliance_map::{
-    ComplianceMapError, ComplianceMapView, Interpolation, OutOfGrid, QueryError, QueryOptions,
-    QueryStatus,
-};
-pub use error::{BuildError, TickError};
+pub use compliance_map::{ComplianceMapView, Interpolation, OutOfGrid, QueryOptions};
+#[cfg(feature = "std")]
+pub use error::LoadError;
+pub use error::{BuildError, Placement, TickError};
+#[cfg(feature = "std")]
+pub use robot::SerialRobot;
 pub use vjm::{Data, Model, ModelBuilder};
-
-#[cfg(feature = "urdf")]
-pub use robot::{LoadError, SerialRobot};

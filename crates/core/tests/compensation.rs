@@ -3,7 +3,7 @@
 use approx::assert_relative_eq;
 use deflect_core::compensation::sensor::{POLY_TERMS, orientation_quaternion, poly_terms};
 use deflect_core::compensation::{
-    CompensatorConfig, CorrectionOutput, LowPass, MovingAverage, OnlineCompensator, PilotControl,
+    self, CompensatorConfig, CorrectionOutput, LowPass, MovingAverage, PilotControl,
     SensorCalibration, project_normal_to_feed,
 };
 use deflect_core::vjm::{self, Data, Vector6};
@@ -35,8 +35,8 @@ fn lowpass_step_response_and_delay() {
         y = lp.step(&Vector6::repeat(k as f64));
     }
     assert_relative_eq!(1999.0 - y[0], lp.delay_samples(), epsilon = 1e-9);
-    assert!(LowPass::new(0.0, 0.004).is_none());
-    assert!(LowPass::new(10.0, f64::NAN).is_none());
+    assert!(LowPass::new(0.0, 0.004).is_err());
+    assert!(LowPass::new(10.0, f64::NAN).is_err());
 }
 
 #[test]
@@ -56,8 +56,8 @@ fn moving_average_step_response_and_delay() {
         y = ma.step(&Vector6::repeat(k as f64))[0];
     }
     assert_eq!(19.0 - y, 2.0);
-    assert!(MovingAverage::<8>::new(9, 0.004).is_none());
-    assert!(MovingAverage::<8>::new(0, 0.004).is_none());
+    assert!(MovingAverage::<8>::new(9, 0.004).is_err());
+    assert!(MovingAverage::<8>::new(0, 0.004).is_err());
 }
 
 #[test]
@@ -86,7 +86,7 @@ fn pilot_switches_exactly_above_threshold_and_ramps_over_the_set_time() {
         p.step(&measured, &measured);
         assert_relative_eq!(p.weight(), 1.0 - 0.05 * k as f64, epsilon = 1e-9);
     }
-    assert!(PilotControl::new(-1.0, 0.08, dt).is_none());
+    assert!(PilotControl::new(-1.0, 0.08, dt).is_err());
 }
 
 #[test]
@@ -191,7 +191,8 @@ fn compensator_steady_state_cancels_the_model_deflection() {
     let mut cfg = CompensatorConfig::paper(dt, cal);
     cfg.project_on_feed = false;
     cfg.max_rate = 1.0;
-    let mut comp = OnlineCompensator::new(&model, cfg).unwrap();
+    let comp = compensation::Model::new(model.clone(), cfg).unwrap();
+    let mut cdata = compensation::Data::new(&comp);
     // Delay of the paper chain: low-pass tau/dt + (5 - 1)/2.
     let tau = 1.0 / (2.0 * std::f64::consts::PI * 10.0);
     assert_relative_eq!(comp.delay_samples(), tau / dt + 2.0, epsilon = 1e-9);
@@ -207,8 +208,7 @@ fn compensator_steady_state_cancels_the_model_deflection() {
     let mut out = None;
     for _ in 0..400 {
         out = Some(
-            comp.step(&model, &q, &reading, None, &Vector3::zeros())
-                .unwrap(),
+            compensation::step(&comp, &mut cdata, &q, &reading, None, &Vector3::zeros()).unwrap(),
         );
     }
     let out = out.unwrap();
@@ -225,14 +225,12 @@ fn compensator_steady_state_cancels_the_model_deflection() {
     let mut cfg_j = cfg;
     cfg_j.output = CorrectionOutput::Joint;
     cfg_j.max_rate = 10.0;
-    let mut comp = OnlineCompensator::new(&model, cfg_j).unwrap();
-    let mut out = comp
-        .step(&model, &q, &reading, None, &Vector3::zeros())
-        .unwrap();
+    let comp = compensation::Model::new(model.clone(), cfg_j).unwrap();
+    let mut cdata = compensation::Data::new(&comp);
+    let mut out =
+        compensation::step(&comp, &mut cdata, &q, &reading, None, &Vector3::zeros()).unwrap();
     for _ in 0..400 {
-        out = comp
-            .step(&model, &q, &reading, None, &Vector3::zeros())
-            .unwrap();
+        out = compensation::step(&comp, &mut cdata, &q, &reading, None, &Vector3::zeros()).unwrap();
     }
     vjm::joint_jacobian(&model, &mut data, &q).unwrap();
     let j = data.jacobian.fixed_columns::<3>(0).into_owned();
@@ -249,11 +247,12 @@ fn compensator_limits_and_pilot_are_reported() {
     let mut cfg = CompensatorConfig::paper(dt, SensorCalibration::default());
     cfg.max_correction = 0.1e-3;
     cfg.max_rate = 0.01; // 40 um per cycle
-    let mut comp = OnlineCompensator::new(&model, cfg).unwrap();
+    let comp = compensation::Model::new(model.clone(), cfg).unwrap();
+    let mut cdata = compensation::Data::new(&comp);
     let q = [0.2, -0.3, 0.9];
     let reading = w([0.0, 0.0, -2000.0, 0.0, 0.0, 0.0]);
     let feed = Vector3::new(0.0, 0.025, 0.0);
-    let first = comp.step(&model, &q, &reading, None, &feed).unwrap();
+    let first = compensation::step(&comp, &mut cdata, &q, &reading, None, &feed).unwrap();
     assert!(first.rate_limited);
     assert_relative_eq!(
         first.correction.fixed_rows::<3>(0).norm(),
@@ -267,7 +266,7 @@ fn compensator_limits_and_pilot_are_reported() {
     );
     let mut last = first;
     for _ in 0..100 {
-        last = comp.step(&model, &q, &reading, None, &feed).unwrap();
+        last = compensation::step(&comp, &mut cdata, &q, &reading, None, &feed).unwrap();
     }
     assert!(last.size_limited && !last.rate_limited);
     assert_relative_eq!(
@@ -279,15 +278,15 @@ fn compensator_limits_and_pilot_are_reported() {
     let est = w([0.0, 0.0, -2500.0, 0.0, 0.0, 0.0]);
     let mut o = last;
     for _ in 0..20 {
-        o = comp.step(&model, &q, &reading, Some(&est), &feed).unwrap();
+        o = compensation::step(&comp, &mut cdata, &q, &reading, Some(&est), &feed).unwrap();
     }
     assert_eq!(o.pilot_weight, 1.0);
     assert!(o.wrench[2] < -2400.0);
     // Bad input is a typed error, not a panic.
     let nan = w([f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]);
-    assert!(comp.step(&model, &q, &nan, None, &feed).is_err());
-    assert!(comp.step(&model, &q[..2], &reading, None, &feed).is_err());
+    assert!(compensation::step(&comp, &mut cdata, &q, &nan, None, &feed).is_err());
+    assert!(compensation::step(&comp, &mut cdata, &q[..2], &reading, None, &feed).is_err());
     let mut bad = cfg;
     bad.moving_average_window = 0;
-    assert!(OnlineCompensator::new(&model, bad).is_err());
+    assert!(compensation::Model::new(model, bad).is_err());
 }

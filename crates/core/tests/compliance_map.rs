@@ -7,10 +7,12 @@
 )]
 
 use deflect_core::compliance_map::{
-    ComplianceMap, ComplianceMapError, ComplianceMapView, FitOptions, ForceUnit, HoldOutAxis,
-    Interpolation, LengthUnit, Measurement, OutOfGrid, QueryError, QueryOptions, QueryStatus, fit,
-    leave_one_node_out, two_point_displacement,
+    ComplianceMap, ComplianceMapView, FitOptions, HoldOutAxis, Interpolation, Measurement,
+    OutOfGrid, QueryOptions, fit, leave_one_node_out, two_point_displacement,
 };
+use deflect_core::io::{map_csv, map_json};
+use deflect_core::units::{ForceUnit, LengthUnit};
+use deflect_core::{BuildError, LoadError, Placement, TickError};
 use proptest::prelude::*;
 
 const OC: &str = include_str!("../../../data/paksoy2025_compliance_oc.csv");
@@ -30,7 +32,7 @@ fn rows(text: &str) -> Vec<[f64; 10]> {
 }
 
 fn paper(text: &str) -> ComplianceMap {
-    ComplianceMap::from_paper_csv(text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap()
+    map_csv::from_str(text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap()
 }
 
 fn query(map: &ComplianceMap, p: [f64; 2], f: [f64; 2], o: QueryOptions) -> [f64; 2] {
@@ -118,13 +120,12 @@ fn between_nodes_is_eq14_by_hand() {
 #[test]
 fn force_unit_and_length_unit_are_explicit() {
     let n = paper(OC);
-    let kgf = ComplianceMap::from_paper_csv(OC, ForceUnit::KilogramForce, LengthUnit::Millimetre)
-        .unwrap();
+    let kgf = map_csv::from_str(OC, ForceUnit::KilogramForce, LengthUnit::Millimetre).unwrap();
     // Table II, node (1,1): m = 1.344e-3 mm per unit force.
     assert!(close(n.slope(0, 0, 0, 0).unwrap(), 1.344e-6, 1e-12));
     assert!(close(kgf.slope(0, 0, 0, 0).unwrap(), 1.344e-6 / KGF, 1e-12));
     assert!(close(n.offset(0, 0, 1, 1).unwrap(), 13.977e-6, 1e-12));
-    let m = ComplianceMap::from_paper_csv(OC, ForceUnit::Newton, LengthUnit::Metre).unwrap();
+    let m = map_csv::from_str(OC, ForceUnit::Newton, LengthUnit::Metre).unwrap();
     assert!(close(m.slope(0, 0, 0, 0).unwrap(), 1.344e-3, 1e-12));
     assert!(
         close(m.x()[0], 172.132e-3, 1e-12),
@@ -251,7 +252,7 @@ fn base_measurements() -> Vec<Measurement> {
     synthetic(&paper(OC), 0.0, 3)
 }
 
-fn fit_err(ms: &[Measurement]) -> ComplianceMapError {
+fn fit_err(ms: &[Measurement]) -> BuildError {
     fit(ms, &FitOptions::default()).unwrap_err()
 }
 
@@ -267,7 +268,7 @@ fn fit_rejections() {
         .collect();
     assert_eq!(
         fit_err(&few),
-        ComplianceMapError::TooFewForceLevels {
+        BuildError::TooFewForceLevels {
             node_x: x0,
             node_y: y0,
             force_axis: 1,
@@ -280,16 +281,13 @@ fn fit_rejections() {
         .copied()
         .filter(|m| !(m.x == x0 && m.y == y0))
         .collect();
-    assert_eq!(
-        fit_err(&missing),
-        ComplianceMapError::MissingNode { x: x0, y: y0 }
-    );
+    assert_eq!(fit_err(&missing), BuildError::MissingNode { x: x0, y: y0 });
     // Duplicate (node, axis, force).
     let mut dup = base.clone();
     dup.push(base[7]);
     assert_eq!(
         fit_err(&dup),
-        ComplianceMapError::DuplicateMeasurement {
+        BuildError::DuplicateMeasurement {
             row: base.len(),
             previous_row: 7
         }
@@ -299,7 +297,7 @@ fn fit_rejections() {
     nan[4].displacement[1] = f64::NAN;
     assert_eq!(
         fit_err(&nan),
-        ComplianceMapError::NonFinite {
+        BuildError::NonFiniteMeasurement {
             row: 4,
             column: "d1"
         }
@@ -307,7 +305,7 @@ fn fit_rejections() {
     nan[2].force = f64::INFINITY;
     assert_eq!(
         fit_err(&nan),
-        ComplianceMapError::NonFinite {
+        BuildError::NonFiniteMeasurement {
             row: 2,
             column: "force"
         }
@@ -317,7 +315,7 @@ fn fit_rejections() {
     axis[3].force_axis = 2;
     assert_eq!(
         fit_err(&axis),
-        ComplianceMapError::ForceAxisOutOfRange {
+        BuildError::ForceAxisOutOfRange {
             row: 3,
             force_axis: 2,
             n_force: 2
@@ -335,7 +333,7 @@ fn fit_rejections() {
         .collect();
     assert_eq!(
         fit_err(&scattered),
-        ComplianceMapError::NotRectilinear {
+        BuildError::NotRectilinear {
             nodes: 6,
             distinct_x: 6,
             distinct_y: 6
@@ -347,15 +345,16 @@ fn fit_rejections() {
     chain[1].x += 1.8e-6;
     assert!(matches!(
         fit_err(&chain),
-        ComplianceMapError::AmbiguousCoordinate { axis: "x", .. }
+        BuildError::AmbiguousCoordinate { axis: "x", .. }
     ));
     // A single grid line.
     let line: Vec<_> = base.iter().copied().filter(|m| m.x == x0).collect();
     assert_eq!(
         fit_err(&line),
-        ComplianceMapError::TooFewNodes {
-            axis: "x",
-            count: 1
+        BuildError::TooFew {
+            what: "x nodes",
+            needed: 2,
+            got: 1
         }
     );
     // Bad dimensions.
@@ -368,9 +367,10 @@ fn fit_rejections() {
             }
         )
         .unwrap_err(),
-        ComplianceMapError::BadAxisCount {
+        BuildError::InvalidParameter {
             what: "n_force",
-            count: 7
+            value: 7.0,
+            expected: "in 1..=6"
         }
     );
     // Errors print what and where.
@@ -384,24 +384,23 @@ fn loader_and_view_rejections() {
     let dup_row = lines[3];
     lines.push(dup_row);
     let text = lines.join("\n");
-    let load =
-        |t: &str| ComplianceMap::from_paper_csv(t, ForceUnit::Newton, LengthUnit::Millimetre);
+    let load = |t: &str| map_csv::from_str(t, ForceUnit::Newton, LengthUnit::Millimetre);
     assert_eq!(
         load(&text).unwrap_err(),
-        ComplianceMapError::DuplicateNode {
+        LoadError::Build(BuildError::DuplicateNode {
             row: 15,
             previous_row: 2
-        }
+        })
     );
     let short: String = OC.lines().take(15).collect::<Vec<_>>().join("\n");
     assert!(matches!(
         load(&short).unwrap_err(),
-        ComplianceMapError::MissingNode { .. }
+        LoadError::Build(BuildError::MissingNode { .. })
     ));
     let bad = OC.replacen("1.344e-3", "abc", 1);
     assert_eq!(
         load(&bad).unwrap_err(),
-        ComplianceMapError::BadNumber {
+        LoadError::BadNumber {
             row: 0,
             column: "m"
         }
@@ -409,20 +408,36 @@ fn loader_and_view_rejections() {
     let inf = OC.replacen("1.344e-3", "inf", 1);
     assert_eq!(
         load(&inf).unwrap_err(),
-        ComplianceMapError::NonFinite {
+        LoadError::NonFiniteCell {
             row: 0,
             column: "m"
         }
     );
-    let nocol = OC.replacen(",w\n", ",ww\n", 1);
+    // A misspelt column is named as unknown (it used to be dropped silently and reported
+    // only as the missing column it should have been).
+    let misspelt = OC.replacen(",w\n", ",ww\n", 1);
+    assert_eq!(
+        load(&misspelt).unwrap_err(),
+        LoadError::UnknownColumn {
+            column: "ww".to_string()
+        }
+    );
+    // Without the last column (`w`) in the header and in every row.
+    let nocol: String = OC
+        .lines()
+        .map(|l| match l.rsplit_once(',') {
+            Some((head, _)) if !l.starts_with('#') => format!("{head}\n"),
+            _ => format!("{l}\n"),
+        })
+        .collect();
     assert_eq!(
         load(&nocol).unwrap_err(),
-        ComplianceMapError::MissingColumn { column: "w" }
+        LoadError::MissingColumn { column: "w" }
     );
     let ragged = format!("{OC}1,1,2\n");
     assert!(matches!(
         load(&ragged).unwrap_err(),
-        ComplianceMapError::Csv { line: Some(17), .. }
+        LoadError::Csv { line: Some(17), .. }
     ));
 
     let x = [0.0, 1.0, 1.0];
@@ -430,14 +445,14 @@ fn loader_and_view_rejections() {
     let c = [0.0; 6];
     assert_eq!(
         ComplianceMapView::new(&x, &y, 1, 1, &c, &c).unwrap_err(),
-        ComplianceMapError::NotIncreasing {
-            axis: "x",
+        BuildError::NotIncreasing {
+            what: "x",
             index: 2
         }
     );
     assert_eq!(
         ComplianceMapView::new(&[0.0, 1.0], &y, 1, 1, &c, &c).unwrap_err(),
-        ComplianceMapError::WrongLength {
+        BuildError::WrongLength {
             what: "slopes",
             expected: 4,
             got: 6
@@ -445,9 +460,10 @@ fn loader_and_view_rejections() {
     );
     assert_eq!(
         ComplianceMapView::new(&[0.0], &y, 1, 1, &c, &c).unwrap_err(),
-        ComplianceMapError::TooFewNodes {
-            axis: "x",
-            count: 1
+        BuildError::TooFew {
+            what: "x nodes",
+            needed: 2,
+            got: 1
         }
     );
 
@@ -456,21 +472,21 @@ fn loader_and_view_rejections() {
     let p = [0.2, 0.0];
     assert_eq!(
         map.displacement([f64::NAN, 0.0], &[1.0, 1.0], &mut out),
-        Err(QueryError::NonFinite {
+        Err(TickError::NonFinite {
             what: "position",
             index: 0
         })
     );
     assert_eq!(
         map.displacement(p, &[1.0, f64::INFINITY], &mut out),
-        Err(QueryError::NonFinite {
+        Err(TickError::NonFinite {
             what: "force",
             index: 1
         })
     );
     assert_eq!(
         map.displacement(p, &[1.0], &mut out),
-        Err(QueryError::WrongLength {
+        Err(TickError::WrongLength {
             what: "force",
             expected: 2,
             got: 1
@@ -478,30 +494,30 @@ fn loader_and_view_rejections() {
     );
     assert_eq!(
         map.displacement(p, &[1.0, 1.0], &mut [0.0; 3]),
-        Err(QueryError::WrongLength {
+        Err(TickError::WrongLength {
             what: "out",
             expected: 2,
             got: 3
         })
     );
 
-    let json = map.to_json().unwrap();
+    let json = map_json::to_string(&map).unwrap();
     let v2 = json.replacen("\"format_version\": 1", "\"format_version\": 2", 1);
     assert_eq!(
-        ComplianceMap::from_json(&v2).unwrap_err(),
-        ComplianceMapError::UnsupportedVersion { found: 2 }
+        map_json::from_str(&v2).unwrap_err(),
+        LoadError::UnsupportedVersion { found: 2 }
     );
     let mm = json.replacen("\"position\": \"m\"", "\"position\": \"mm\"", 1);
     assert!(matches!(
-        ComplianceMap::from_json(&mm).unwrap_err(),
-        ComplianceMapError::UnexpectedUnits {
+        map_json::from_str(&mm).unwrap_err(),
+        LoadError::UnexpectedUnits {
             quantity: "position",
             ..
         }
     ));
     assert!(matches!(
-        ComplianceMap::from_json("{\"format_version\": 1}").unwrap_err(),
-        ComplianceMapError::Json { .. }
+        map_json::from_str("{\"format_version\": 1}").unwrap_err(),
+        LoadError::Json { .. }
     ));
 }
 
@@ -518,7 +534,7 @@ fn out_of_grid_policies() {
         &mut out,
         opts(Interpolation::Bilinear, OutOfGrid::Error),
     ) {
-        Err(QueryError::OutOfGrid {
+        Err(TickError::OutOfGrid {
             axis: 0,
             value,
             min,
@@ -530,14 +546,14 @@ fn out_of_grid_policies() {
     }
     for method in [Interpolation::Bilinear, Interpolation::Bicubic] {
         let st = map.displacement_with(outside, &f, &mut out, opts(method, OutOfGrid::Clamp));
-        assert_eq!(st, Ok(QueryStatus::Clamped));
+        assert_eq!(st, Ok(Placement::Clamped));
         assert_eq!(
             out,
             query(&map, [x[2], y[1]], f, opts(method, OutOfGrid::Error))
         );
         let inside =
             map.displacement_with([x[1], y[1]], &f, &mut out, opts(method, OutOfGrid::Clamp));
-        assert_eq!(inside, Ok(QueryStatus::Inside));
+        assert_eq!(inside, Ok(Placement::Inside));
     }
     // Bilinear extrapolation continues the boundary cell's line: along y = y_1 the values
     // at x_1, x_2 extend linearly by 0.01 / 0.05 of their difference.
@@ -559,7 +575,7 @@ fn out_of_grid_policies() {
         &mut out,
         opts(Interpolation::Bilinear, OutOfGrid::Extrapolate),
     );
-    assert_eq!(st, Ok(QueryStatus::Extrapolated));
+    assert_eq!(st, Ok(Placement::Extrapolated));
     for k in 0..2 {
         assert!(
             close(out[k], b[k] + 0.2 * (b[k] - a[k]), 1e-9),
@@ -584,7 +600,7 @@ fn out_of_grid_policies() {
     }
     // Below and left of the grid at once.
     let st = map.displacement_with([0.0, -1.0], &f, &mut out, o);
-    assert_eq!(st, Ok(QueryStatus::Extrapolated));
+    assert_eq!(st, Ok(Placement::Extrapolated));
     assert!(out.iter().all(|v| v.is_finite()));
 }
 
@@ -717,7 +733,7 @@ fn two_point_extrapolation_is_rigid_body() {
     assert!((m.displacement[1] - w[1]).abs() < 1e-18 && m.displacement[2] == 0.0);
     assert_eq!(
         two_point_displacement(&u, &l, 0.0, 0.0025, &mut out),
-        Err(ComplianceMapError::BadTwoPoint { spacing: 0.0 })
+        Err(BuildError::BadTwoPoint { spacing: 0.0 })
     );
 }
 
@@ -727,9 +743,9 @@ fn json_round_trip_is_exact() {
     let mut fitted = fit(&synthetic(&table, 1.7e-6, 42), &FitOptions::default()).unwrap();
     fitted.set_options(opts(Interpolation::Bicubic, OutOfGrid::Clamp));
     for map in [table, fitted] {
-        let json = map.to_json().unwrap();
+        let json = map_json::to_string(&map).unwrap();
         assert!(json.contains("\"format_version\": 1"));
-        let back = ComplianceMap::from_json(&json).unwrap();
+        let back = map_json::from_str(&json).unwrap();
         assert_eq!(back, map);
         for (a, b) in back.slopes().iter().zip(map.slopes()) {
             assert_eq!(a.to_bits(), b.to_bits());
@@ -754,7 +770,7 @@ fn static_test_csv_fit() {
             m.displacement[1] * 1e3
         );
     }
-    let fitted = ComplianceMap::fit_static_csv(
+    let fitted = map_csv::fit_static_str(
         &text,
         ForceUnit::KilogramForce,
         LengthUnit::Millimetre,
@@ -768,9 +784,9 @@ fn static_test_csv_fit() {
     }
     let bad = text.replacen(",x,", ",q,", 1);
     assert_eq!(
-        ComplianceMap::fit_static_csv(&bad, ForceUnit::Newton, LengthUnit::Metre, None, 1e-6)
+        map_csv::fit_static_str(&bad, ForceUnit::Newton, LengthUnit::Metre, None, 1e-6)
             .unwrap_err(),
-        ComplianceMapError::BadNumber {
+        LoadError::BadNumber {
             row: 0,
             column: "force_axis"
         }
@@ -959,7 +975,7 @@ fn batch_equals_single_bit_for_bit() {
                 })
                 .unwrap();
             assert_eq!(err.row, first_out);
-            assert!(matches!(err.error, QueryError::OutOfGrid { .. }));
+            assert!(matches!(err.error, TickError::OutOfGrid { .. }));
         }
         let mut out = vec![0.0; 4];
         let mut bad = pos[..6].to_vec();
@@ -971,7 +987,7 @@ fn batch_equals_single_bit_for_bit() {
             (err.row, err.error),
             (
                 1,
-                QueryError::NonFinite {
+                TickError::NonFinite {
                     what: "position",
                     index: 1
                 }

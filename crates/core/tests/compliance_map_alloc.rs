@@ -1,11 +1,14 @@
-//! `displacement` allocates nothing: a counting global allocator over 1e4 queries. Its own
-//! test binary with a single test, so nothing else allocates while it counts.
+//! `displacement` and the tick-shape `compliance_map::query` allocate nothing: a counting
+//! global allocator over 1e4 queries of each. Its own test binary with a single test, so
+//! nothing else allocates while it counts.
 #![allow(unsafe_code)] // reason: a GlobalAlloc impl is unsafe by definition; it only forwards to System
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 use deflect_core::compliance_map::{
-    ComplianceMap, ForceUnit, Interpolation, LengthUnit, OutOfGrid, QueryOptions,
+    self, ComplianceMap, ComplianceMapView, Interpolation, OutOfGrid, QueryOptions,
 };
+use deflect_core::io::map_csv;
+use deflect_core::units::{ForceUnit, LengthUnit};
 
 mod common;
 
@@ -17,8 +20,7 @@ fn displacement_allocates_nothing() {
     common::watch_this_thread();
     common::assert_counter_works();
     let text = include_str!("../../../data/paksoy2025_compliance_oc.csv");
-    let oc =
-        ComplianceMap::from_paper_csv(text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap();
+    let oc = map_csv::from_str(text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap();
     // An unevenly spaced copy exercises the binary-search lookup.
     let uneven = ComplianceMap::new(
         vec![0.17, 0.2, 0.27],
@@ -47,8 +49,18 @@ fn displacement_allocates_nothing() {
         (0..2000).map(|k| (k % 7) as f64 * 30.0).collect(),
         vec![0.0; 2000],
     );
+    // The tick shape: one view per (map, options) and a `Data::new(&view)` for each, made
+    // before counting starts.
+    let views: Vec<ComplianceMapView<'_>> = (0..8)
+        .map(|v| maps[v % 2].view().with_options(options[v / 2]))
+        .collect();
+    let mut datas: Vec<compliance_map::Data> =
+        views.iter().map(compliance_map::Data::new).collect();
+    assert!(views.iter().zip(&datas).all(|(v, d)| d.check(v)));
     let mut out = [0.0; 2];
+    let mut direct = [0.0; 2];
     let (mut ok, mut refused, mut checksum) = (0usize, 0usize, 0.0);
+    let (mut query_ok, mut query_refused) = (0usize, 0usize);
     let before = common::allocations();
     for k in 0..10_000 {
         let t = k as f64 * 0.618_033_988_749_895;
@@ -66,6 +78,25 @@ fn displacement_allocates_nothing() {
             }
             Err(_) => refused += 1,
         }
+        // `query` on a view with the same options gives what `view.displacement` gives,
+        // bit for bit, placement and errors included.
+        let v = (k % 2) + 2 * (k % 4);
+        let (view, data) = (&views[v], &mut datas[v]);
+        let queried = compliance_map::query(view, data, p, &f);
+        let displaced = view.displacement(p, &f, &mut direct);
+        assert_eq!(queried, displaced);
+        match queried {
+            Ok(placement) => {
+                query_ok += 1;
+                assert_eq!(data.placement, placement);
+                assert_eq!(data.displacement().len(), 2);
+                assert_eq!(data.displacement()[0].to_bits(), direct[0].to_bits());
+                assert_eq!(data.displacement()[1].to_bits(), direct[1].to_bits());
+                assert_eq!(data.displacement()[0].to_bits(), out[0].to_bits());
+                assert_eq!(data.displacement()[1].to_bits(), out[1].to_bits());
+            }
+            Err(_) => query_refused += 1,
+        }
     }
     // The batch path, into buffers allocated before counting started.
     let (pos, force, mut batch_out) = prepared;
@@ -79,6 +110,7 @@ fn displacement_allocates_nothing() {
         after - before
     );
     assert_eq!(ok + refused, 10_000);
+    assert_eq!((query_ok, query_refused), (ok, refused));
     assert!(ok > 7_000 && refused > 100, "ok {ok}, refused {refused}");
     assert!(checksum.is_finite() && checksum != 0.0);
 }

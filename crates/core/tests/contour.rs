@@ -4,12 +4,9 @@
 //! shape recovery from raw joint readings vs readings compensated by Eq. 10.
 
 use deflect_core::contour::shape::{self, ShapeError};
-use deflect_core::contour::{
-    self, ContourError, ContourTracer, TraceDirection, TracerConfig, TracerState,
-};
-use deflect_core::drivetrain::{DriveTrain, cartesian_stiffness_xy, correct_joints};
-use deflect_core::vjm::Data;
-use deflect_core::{Model, ModelBuilder};
+use deflect_core::contour::{self, TraceDirection, TracerConfig, TracerState};
+use deflect_core::drivetrain::{self, Data, cartesian_stiffness_xy, correct_joints};
+use deflect_core::{BuildError, ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
 
 /// xorshift64*: deterministic test randomness.
@@ -47,7 +44,7 @@ fn eq21_recovers_the_edge_angle_for_random_stiffness_and_edges() {
         }
         let r = rng.uniform(1e-4, 5e-3);
         let step = Vector2::new(r * theta1.cos(), r * theta1.sin());
-        let f = contour::edge_contact_force(&k, &step, edge);
+        let f = contour::edge_contact_force(&k, &step, edge).unwrap();
         // Eq. 11 says the same: the tool stopped at the projected point.
         let f11 = contour::contact_force(&k, &step, &contour::edge_motion(&step, edge));
         assert!((f - f11).norm() <= 1e-12 * f.norm().max(1.0));
@@ -70,34 +67,43 @@ fn eq21_errors() {
     let k = Matrix2::new(1e4, 0.0, 0.0, 2e4);
     let step = Vector2::new(1e-3, 0.0);
     // Straight into a vertical edge: the tool does not move.
-    let f = contour::edge_contact_force(&k, &step, std::f64::consts::FRAC_PI_2);
+    let f = contour::edge_contact_force(&k, &step, std::f64::consts::FRAC_PI_2).unwrap();
     assert_eq!(
         contour::edge_direction(&k, &step, &f),
-        Err(ContourError::NoEdgeMotion)
+        Err(TickError::NoEdgeMotion)
     );
     let singular = Matrix2::new(1e4, 1e4, 1e4, 1e4);
     assert!(matches!(
         contour::edge_direction(&singular, &step, &f),
-        Err(ContourError::SingularStiffness { .. })
+        Err(TickError::Singular { .. })
     ));
     assert!(matches!(
         contour::edge_direction(&k, &Vector2::new(f64::NAN, 0.0), &f),
-        Err(ContourError::NonFinite { .. })
+        Err(TickError::NonFinite { .. })
     ));
     // Bad configurations.
     let mut cfg = TracerConfig::new(1e-3, 5.0, 2.0);
     assert!(matches!(
-        ContourTracer::new(cfg, &k),
-        Err(ContourError::InvalidConfig { .. })
+        contour::Model::new(cfg, &k),
+        Err(BuildError::InvalidParameter {
+            what: "jam_force",
+            ..
+        })
     ));
     cfg = TracerConfig::new(1e-3, 2.0, 20.0);
     cfg.approach_direction = Vector2::zeros();
-    assert!(ContourTracer::new(cfg, &k).is_err());
-    let mut t = ContourTracer::new(TracerConfig::new(1e-3, 2.0, 20.0), &k).unwrap();
+    assert!(contour::Model::new(cfg, &k).is_err());
+    let tm = contour::Model::new(TracerConfig::new(1e-3, 2.0, 20.0), &k).unwrap();
+    let mut t = contour::Data::new(&tm);
     assert!(t.set_stiffness(&singular).is_err());
     assert!(
-        t.step(&Vector2::new(0.0, f64::INFINITY), &Vector2::zeros())
-            .is_err()
+        contour::step(
+            &tm,
+            &mut t,
+            &Vector2::new(0.0, f64::INFINITY),
+            &Vector2::zeros()
+        )
+        .is_err()
     );
     assert_eq!(t.state(), TracerState::Init);
 }
@@ -108,8 +114,7 @@ struct Arm {
     l: [f64; 2],
     k: [f64; 2],
     backlash: [f64; 2],
-    model: Model,
-    drive: DriveTrain,
+    drive: drivetrain::Model,
 }
 
 impl Arm {
@@ -128,12 +133,11 @@ impl Arm {
             .unwrap()
             .build()
             .unwrap();
-        let drive = DriveTrain::new(&model, &k, &backlash).unwrap();
+        let drive = drivetrain::Model::new(model, &k, &backlash).unwrap();
         Self {
             l,
             k,
             backlash,
-            model,
             drive,
         }
     }
@@ -308,7 +312,7 @@ struct TraceResult {
 
 fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
     let arm = Arm::new();
-    let mut data = Data::new(&arm.model);
+    let mut data = Data::new(&arm.drive);
     let bias = Vector2::new(0.7, -0.4);
     let mut rng = Rng(12345);
     // The arm is up to ~4 times stiffer along x than along y here: a tool that wraps round
@@ -319,8 +323,9 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
     cfg.approach_step = 1.0e-3;
     cfg.direction = TraceDirection::CounterClockwise;
     let q0 = arm.ik(&start);
-    let k0 = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q0).unwrap();
-    let mut tracer = ContourTracer::new(cfg, &k0).unwrap();
+    let k0 = cartesian_stiffness_xy(&arm.drive, &mut data, &q0).unwrap();
+    let tracer_model = contour::Model::new(cfg, &k0).unwrap();
+    let mut tracer = contour::Data::new(&tracer_model);
     let mut cmd = start;
     let mut q_prev = q0;
     let (mut raw, mut comp, mut truth) = (Vec::new(), Vec::new(), Vec::new());
@@ -334,14 +339,14 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
         max_true_force = max_true_force.max(f.norm());
         let sensed =
             f + bias + Vector2::new(rng.uniform(-noise, noise), rng.uniform(-noise, noise));
-        let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q_cmd).unwrap();
+        let k = cartesian_stiffness_xy(&arm.drive, &mut data, &q_cmd).unwrap();
         tracer.set_stiffness(&k).unwrap();
-        let out = tracer.step(&cmd, &sensed).unwrap();
+        let out = contour::step(&tracer_model, &mut tracer, &cmd, &sensed).unwrap();
         if out.contact {
             // The motor readings are the commanded angles.
             raw.push(arm.fk(&q_cmd));
             let w = Vector6::new(out.force.x, out.force.y, 0.0, 0.0, 0.0, 0.0);
-            let c = correct_joints(&arm.model, &mut data, &arm.drive, &q_cmd, &w).unwrap();
+            let c = correct_joints(&arm.drive, &mut data, &q_cmd, &w).unwrap();
             comp.push(arm.fk(&[c.q[0], c.q[1]]));
             truth.push(arm.fk(&q_true));
         }
@@ -473,22 +478,23 @@ fn traces_clockwise_and_reports_failures() {
     // Clockwise round the circle closes as well.
     let arm = Arm::new();
     let shape = Shape::Circle(Vector2::new(0.6, 0.05), 0.08);
-    let mut data = Data::new(&arm.model);
+    let mut data = Data::new(&arm.drive);
     let mut cfg = TracerConfig::new(1.5e-3, 2.0, 30.0);
     cfg.direction = TraceDirection::Clockwise;
     cfg.bias_samples = 1;
     let mut cmd = Vector2::new(0.45, 0.05);
-    let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &arm.ik(&cmd)).unwrap();
-    let mut tracer = ContourTracer::new(cfg, &k).unwrap();
+    let k = cartesian_stiffness_xy(&arm.drive, &mut data, &arm.ik(&cmd)).unwrap();
+    let tracer_model = contour::Model::new(cfg, &k).unwrap();
+    let mut tracer = contour::Data::new(&tracer_model);
     let mut state = tracer.state();
     let mut q_prev = arm.ik(&cmd);
     for _ in 0..5000 {
         let q = arm.ik(&cmd);
         let (q_true, f) = equilibrium(&arm, &shape, &q, &q_prev);
         q_prev = q_true;
-        let k = cartesian_stiffness_xy(&arm.model, &mut data, &arm.drive, &q).unwrap();
+        let k = cartesian_stiffness_xy(&arm.drive, &mut data, &q).unwrap();
         tracer.set_stiffness(&k).unwrap();
-        let out = tracer.step(&cmd, &f).unwrap();
+        let out = contour::step(&tracer_model, &mut tracer, &cmd, &f).unwrap();
         state = out.state;
         if state.is_finished() {
             break;
@@ -498,37 +504,44 @@ fn traces_clockwise_and_reports_failures() {
     assert_eq!(state, TracerState::Done);
     assert_eq!(state.name(), "done");
     // Finished tracers hold the position.
-    let out = tracer.step(&cmd, &Vector2::zeros()).unwrap();
+    let out = contour::step(&tracer_model, &mut tracer, &cmd, &Vector2::zeros()).unwrap();
     assert_eq!(out.command, cmd);
 
     // Nothing to touch: the approach gives up.
     let mut cfg = TracerConfig::new(1e-3, 2.0, 30.0);
     cfg.bias_samples = 1;
     cfg.max_approach_steps = 50;
-    let mut t = ContourTracer::new(cfg, &k).unwrap();
+    let tm = contour::Model::new(cfg, &k).unwrap();
+    let mut t = contour::Data::new(&tm);
     let mut p = Vector2::zeros();
     for _ in 0..60 {
-        p = t.step(&p, &Vector2::zeros()).unwrap().command;
+        p = contour::step(&tm, &mut t, &p, &Vector2::zeros())
+            .unwrap()
+            .command;
     }
     assert_eq!(t.state().name(), "failed_no_contact");
 
     // The object vanishes after contact: bisections run out.
-    let mut t = ContourTracer::new(cfg, &k).unwrap();
-    t.step(&p, &Vector2::zeros()).unwrap(); // bias
-    let out = t.step(&p, &Vector2::new(10.0, 0.0)).unwrap();
+    let mut t = contour::Data::new(&tm);
+    contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap(); // bias
+    let out = contour::step(&tm, &mut t, &p, &Vector2::new(10.0, 0.0)).unwrap();
     assert!(out.contact);
     let mut state = out.state;
     for _ in 0..20 {
-        state = t.step(&out.command, &Vector2::zeros()).unwrap().state;
+        state = contour::step(&tm, &mut t, &out.command, &Vector2::zeros())
+            .unwrap()
+            .state;
     }
     assert_eq!(state.name(), "failed_contact_lost");
 
     // A force that stays above the jam force.
-    let mut t = ContourTracer::new(cfg, &k).unwrap();
-    t.step(&p, &Vector2::zeros()).unwrap();
+    let mut t = contour::Data::new(&tm);
+    contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap();
     let mut state = t.state();
     for _ in 0..20 {
-        state = t.step(&p, &Vector2::new(100.0, 0.0)).unwrap().state;
+        state = contour::step(&tm, &mut t, &p, &Vector2::new(100.0, 0.0))
+            .unwrap()
+            .state;
     }
     assert_eq!(state.name(), "failed_jammed");
 }

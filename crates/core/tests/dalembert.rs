@@ -1,11 +1,13 @@
 //! The D'Alembert trajectory corrector (Paksoy et al., sec. 3.3, Eq. 5, 9-14).
 
 use approx::assert_relative_eq;
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{CorrectorError, DalembertCorrector, ModelStatus, VjmDisplacement};
+use deflect_core::compliance_map::{ComplianceMap, OutOfGrid, QueryOptions};
+use deflect_core::dalembert::{self, Data, Model, VjmDisplacement};
+use deflect_core::io::map_csv;
 use deflect_core::mechanism::{IkOptions, Mechanism, ParallelRobot2, SerialArm};
 use deflect_core::motion::{Limits, Trajectory, paper_limits};
-use deflect_core::{ModelBuilder, vjm};
+use deflect_core::units::{ForceUnit, LengthUnit};
+use deflect_core::{ModelBuilder, Placement, TickError, vjm};
 use nalgebra::{Isometry3, SVector, Vector2, Vector3};
 
 /// The paper's 3 x 5 grid [m] with the same slopes at every node.
@@ -29,7 +31,7 @@ fn constant_map(c: [[f64; 2]; 2], offsets: [f64; 2]) -> ComplianceMap {
 fn paper_map(file: &str) -> ComplianceMap {
     let text = std::fs::read_to_string(format!("{}/../../data/{file}", env!("CARGO_MANIFEST_DIR")))
         .unwrap();
-    ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap()
+    map_csv::from_str(&text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap()
 }
 
 fn x_line(g: u8) -> Trajectory<2> {
@@ -45,23 +47,19 @@ fn x_line(g: u8) -> Trajectory<2> {
 fn zero_map_leaves_the_path_unchanged() {
     let map = constant_map([[0.0; 2]; 2], [0.0; 2]);
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(5.0)
+    let corr = Model::new(robot, map.view(), 5.0)
         .unwrap()
-        .with_fixed_point(3, 0.0);
+        .with_fixed_point(3, 0.0)
+        .unwrap();
+    let mut data = Data::new(&corr);
+    data.set_seed(Vector2::zeros());
     let traj = x_line(5);
     let mut n = 0;
-    corr.correct_each(
-        &robot,
-        &map.view(),
-        &traj,
-        2000.0,
-        &Vector2::zeros(),
-        |_, t| {
-            assert_eq!(t.commanded, t.desired);
-            assert_eq!(t.joints, robot.ik(&t.desired).unwrap());
-            n += 1;
-        },
-    )
+    dalembert::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
+        assert_eq!(t.commanded, t.desired);
+        assert_eq!(t.joints, robot.ik(&t.desired).unwrap());
+        n += 1;
+    })
     .unwrap();
     assert_eq!(n, (traj.duration() * 2000.0).ceil() as usize + 1);
 }
@@ -71,12 +69,12 @@ fn constant_map_gives_exactly_c_m_a() {
     let c = [[2.0e-6, -0.5e-6], [0.3e-6, 4.0e-6]]; // m/N
     let map = constant_map(c, [0.0; 2]);
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(5.0).unwrap();
+    let corr = Model::new(robot, map.view(), 5.0).unwrap();
+    let mut data = Data::new(&corr);
     let a = Vector2::new(3.0 * 9.81, -2.0 * 9.81);
     let x = Vector2::new(0.2, 0.01);
-    let t = corr
-        .step(&robot, &map.view(), &x, &a, &Vector2::zeros())
-        .unwrap();
+    data.set_seed(Vector2::zeros());
+    let t = dalembert::step(&corr, &mut data, &x, &a).unwrap();
     // F_D = -m* a; displacement C F_D; command x - C F_D = x + C m* a.
     assert_eq!(t.force, Vector2::new(-5.0 * 3.0 * 9.81, 5.0 * 2.0 * 9.81));
     let cma = Vector2::new(
@@ -86,11 +84,13 @@ fn constant_map_gives_exactly_c_m_a() {
     assert_relative_eq!(t.commanded, x + cma, epsilon = 1e-17);
     assert_eq!(t.iterations, 0);
     // A constant map has a constant displacement: one fixed-point iteration changes nothing.
-    let t2 = DalembertCorrector::new(5.0)
+    let corr2 = Model::new(robot, map.view(), 5.0)
         .unwrap()
         .with_fixed_point(5, 1e-15)
-        .step(&robot, &map.view(), &x, &a, &Vector2::zeros())
         .unwrap();
+    let mut data2 = Data::new(&corr2);
+    data2.set_seed(Vector2::zeros());
+    let t2 = dalembert::step(&corr2, &mut data2, &x, &a).unwrap();
     assert_eq!(t2.iterations, 1);
     assert_relative_eq!(t2.commanded, t.commanded, epsilon = 1e-18);
 }
@@ -101,9 +101,12 @@ fn fixed_point_reproduces_the_desired_path() {
     let map = paper_map("paksoy2025_compliance_oc.csv");
     let view = map.view();
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(DalembertCorrector::PAPER_MASS)
+    let corr = Model::new(robot, view, dalembert::PAPER_MASS)
         .unwrap()
-        .with_fixed_point(20, 1e-13);
+        .with_fixed_point(20, 1e-13)
+        .unwrap();
+    let mut data = Data::new(&corr);
+    data.set_seed(Vector2::zeros());
     let traj = Trajectory::polyline(
         &[
             Vector2::new(0.19, -0.05),
@@ -116,7 +119,7 @@ fn fixed_point_reproduces_the_desired_path() {
     .unwrap();
     let mut worst: f64 = 0.0;
     let mut largest_correction: f64 = 0.0;
-    corr.correct_each(&robot, &view, &traj, 2000.0, &Vector2::zeros(), |_, t| {
+    dalembert::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
         let mut d = [0.0; 2];
         view.displacement_with(
             [t.commanded.x, t.commanded.y],
@@ -128,7 +131,7 @@ fn fixed_point_reproduces_the_desired_path() {
         let reached = t.commanded + Vector2::new(d[0], d[1]);
         worst = worst.max((reached - t.desired).norm());
         largest_correction = largest_correction.max((t.commanded - t.desired).norm());
-        assert_eq!(t.model_status, ModelStatus::Inside);
+        assert_eq!(t.placement, Placement::Inside);
         assert_relative_eq!(robot.fk(&t.joints).unwrap(), t.commanded, epsilon = 1e-14);
     })
     .unwrap();
@@ -144,9 +147,6 @@ fn fixed_point_reproduces_the_desired_path() {
 fn streaming_and_offline_agree_exactly() {
     let map = paper_map("paksoy2025_compliance_nc.csv");
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(5.0)
-        .unwrap()
-        .with_fixed_point(2, 0.0);
     let traj = x_line(3);
     // The paper's x line spans the grid edge to edge: the corrected command leaves it by a
     // few micrometres at the ends, so clamp there (and see it flagged).
@@ -154,21 +154,20 @@ fn streaming_and_offline_agree_exactly() {
         out_of_grid: OutOfGrid::Clamp,
         ..QueryOptions::default()
     });
-    let offline = corr
-        .correct(&robot, &view, &traj, 2000.0, &Vector2::zeros())
+    let corr = Model::new(robot, view, 5.0)
+        .unwrap()
+        .with_fixed_point(2, 0.0)
         .unwrap();
-    assert!(
-        offline
-            .iter()
-            .any(|t| t.model_status == ModelStatus::Clamped)
-    );
+    let mut data = Data::new(&corr);
+    data.set_seed(Vector2::zeros());
+    let offline = dalembert::correct(&corr, &mut data, &traj, 2000.0).unwrap();
+    assert!(offline.iter().any(|t| t.placement == Placement::Clamped));
     let mut q = Vector2::zeros();
     let mut cursor = traj.ticks(2000.0).unwrap();
     let mut i = 0;
     while let Some(s) = cursor.step() {
-        let t = corr
-            .step(&robot, &view, &s.position, &s.acceleration, &q)
-            .unwrap();
+        data.set_seed(q);
+        let t = dalembert::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
         assert_eq!(t, offline[i]);
         q = t.joints;
         i += 1;
@@ -180,51 +179,41 @@ fn streaming_and_offline_agree_exactly() {
 fn out_of_map_points_are_statuses_not_panics() {
     let map = paper_map("paksoy2025_compliance_oc.csv");
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(5.0).unwrap();
+    let corr = Model::new(robot, map.view(), 5.0).unwrap();
+    let mut data = Data::new(&corr);
     let outside = Vector2::new(0.15, 0.0); // x below the grid's 0.172 m
     let a = Vector2::new(9.81, 0.0);
-    let e = corr
-        .step(&robot, &map.view(), &outside, &a, &Vector2::zeros())
-        .unwrap_err();
-    assert!(matches!(e, CorrectorError::Map(_)), "{e:?}");
+    data.set_seed(Vector2::zeros());
+    let e = dalembert::step(&corr, &mut data, &outside, &a).unwrap_err();
+    // The map refuses the point (its default is to refuse out-of-grid queries).
+    assert!(matches!(e, TickError::OutOfGrid { .. }), "{e:?}");
     let clamp = map.view().with_options(QueryOptions {
         out_of_grid: OutOfGrid::Clamp,
         ..QueryOptions::default()
     });
-    let t = corr
-        .step(&robot, &clamp, &outside, &a, &Vector2::zeros())
-        .unwrap();
-    assert_eq!(t.model_status, ModelStatus::Clamped);
+    let corr_clamp = Model::new(robot, clamp, 5.0).unwrap();
+    let mut data = Data::new(&corr_clamp);
+    data.set_seed(Vector2::zeros());
+    let t = dalembert::step(&corr_clamp, &mut data, &outside, &a).unwrap();
+    assert_eq!(t.placement, Placement::Clamped);
     // Out of the robot's reach (2 L = 0.3 m): a mechanism error.
-    let far = clamp;
-    let e = corr
-        .step(
-            &robot,
-            &far,
-            &Vector2::new(0.35, 0.0),
-            &a,
-            &Vector2::zeros(),
-        )
-        .unwrap_err();
-    assert!(matches!(e, CorrectorError::Mechanism(_)), "{e:?}");
-    let e = corr
-        .step(
-            &robot,
-            &clamp,
-            &Vector2::new(f64::NAN, 0.0),
-            &a,
-            &Vector2::zeros(),
-        )
-        .unwrap_err();
+    let far = Model::new(robot, clamp, 5.0).unwrap();
+    let mut data = Data::new(&far);
+    data.set_seed(Vector2::zeros());
+    let e = dalembert::step(&far, &mut data, &Vector2::new(0.35, 0.0), &a).unwrap_err();
+    assert!(matches!(e, TickError::OutOfWorkspace { .. }), "{e:?}");
+    let mut data = Data::new(&corr_clamp);
+    data.set_seed(Vector2::zeros());
+    let e = dalembert::step(&corr_clamp, &mut data, &Vector2::new(f64::NAN, 0.0), &a).unwrap_err();
     assert_eq!(
         e,
-        CorrectorError::NonFinite {
+        TickError::NonFinite {
             what: "position",
             index: 0
         }
     );
-    assert!(DalembertCorrector::new(-1.0).is_err());
-    assert!(DalembertCorrector::new(f64::NAN).is_err());
+    assert!(Model::new(robot, map.view(), -1.0).is_err());
+    assert!(Model::new(robot, map.view(), f64::NAN).is_err());
 }
 
 #[test]
@@ -251,19 +240,22 @@ fn serial_arm_corrected_with_its_virtual_joint_model() {
         .unwrap()
         .build()
         .unwrap();
-    let arm = SerialArm::<3>::new(&model, IkOptions::default()).unwrap();
-    let vjm_model = VjmDisplacement::new(&model);
+    let arm = SerialArm::<3>::new(model.clone(), IkOptions::default()).unwrap();
+    let vjm_model = VjmDisplacement::new(model.clone());
     let q0 = SVector::<f64, 3>::new(0.2, -0.5, 1.2);
-    let start = arm.forward(&q0).unwrap();
+    let start = arm.forward(&mut arm.new_data(), &q0).unwrap();
     let end = start + Vector3::new(0.0, 0.1, -0.05);
     let traj =
         Trajectory::line(start, end, &Limits::new(0.5, 3.0 * 9.81, 2000.0).unwrap()).unwrap();
-    let corr = DalembertCorrector::new(2.0)
+    let corr = Model::new(arm, vjm_model, 2.0)
         .unwrap()
-        .with_fixed_point(10, 1e-12);
+        .with_fixed_point(10, 1e-12)
+        .unwrap();
+    let mut corr_data = Data::new(&corr);
+    corr_data.set_seed(q0);
     let mut worst: f64 = 0.0;
     let mut largest: f64 = 0.0;
-    corr.correct_each(&arm, &vjm_model, &traj, 2000.0, &q0, |_, t| {
+    dalembert::correct_each(&corr, &mut corr_data, &traj, 2000.0, |_, t| {
         // The loaded arm commanded to `joints` puts its TCP on the desired point.
         let mut data = vjm::Data::new(&model);
         let w = vjm::Vector6::new(t.force.x, t.force.y, t.force.z, 0.0, 0.0, 0.0);

@@ -1,10 +1,12 @@
 //! 1e4 consecutive 2 kHz ticks of planner + compliance map + corrector + IK allocate nothing:
 //! a counting global allocator watches them. One test function only.
 
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
-use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
+use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::io::map_csv;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
+use deflect_core::units::{ForceUnit, LengthUnit};
 use nalgebra::Vector2;
 
 mod common;
@@ -21,16 +23,13 @@ fn corrector_ticks_do_not_allocate() {
         env!("CARGO_MANIFEST_DIR")
     ))
     .unwrap();
-    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)
+    let map = map_csv::from_str(&text, ForceUnit::Newton, LengthUnit::Millimetre)
         .unwrap()
         .with_options(QueryOptions {
             out_of_grid: OutOfGrid::Clamp,
             ..QueryOptions::default()
         });
     let robot = ParallelRobot2::paper();
-    let corr = DalembertCorrector::new(5.0)
-        .unwrap()
-        .with_fixed_point(3, 1e-12);
     // y line of the paper, 150 mm at 5 g, back and forth until 1e4 ticks have run.
     let up = Trajectory::line(
         Vector2::new(0.222132, -0.075),
@@ -39,6 +38,11 @@ fn corrector_ticks_do_not_allocate() {
     )
     .unwrap();
     let view = map.view();
+    let corr = Model::new(robot, view, 5.0)
+        .unwrap()
+        .with_fixed_point(3, 1e-12)
+        .unwrap();
+    let mut data = Data::new(&corr);
     let mut q = Vector2::zeros();
     let mut ticks = 0usize;
     let mut sink = 0.0;
@@ -47,9 +51,8 @@ fn corrector_ticks_do_not_allocate() {
     while ticks < 10_000 {
         let mut cursor = up.ticks(2000.0).unwrap();
         while let Some(s) = cursor.step() {
-            let t = corr
-                .step(&robot, &view, &s.position, &s.acceleration, &q)
-                .unwrap();
+            data.set_seed(q);
+            let t = dalembert::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
             q = t.joints;
             sink += t.commanded.x;
             ticks += 1;

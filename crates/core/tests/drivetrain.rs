@@ -4,12 +4,13 @@
 
 use approx::assert_relative_eq;
 use deflect_core::drivetrain::{
-    self, DriveTrain, DriveTrainError, LinkMasses, cartesian_stiffness, cartesian_stiffness_planar,
-    cartesian_stiffness_xy, correct_joints, gravity_torques,
+    self, LinkMasses, cartesian_stiffness, cartesian_stiffness_planar, cartesian_stiffness_xy,
+    correct_joints, gravity_torques,
 };
-use deflect_core::drivetrain_io::{drive_train_from_strs, parse_joint_drives};
+use deflect_core::io;
+use deflect_core::units::STANDARD_GRAVITY;
 use deflect_core::vjm::{self, Data};
-use deflect_core::{Model, ModelBuilder, SerialRobot, TickError};
+use deflect_core::{BuildError, Model, ModelBuilder, SerialRobot, TickError};
 use nalgebra::{Isometry3, Matrix2, Matrix6, Vector3, Vector6};
 
 /// The joints of a 6-axis arm with a prismatic track: (axis, revolute?, link offset).
@@ -89,18 +90,19 @@ fn gravity_torques_are_the_gradient_of_the_potential_energy() {
         masses.push(j, m, c).unwrap();
     }
     for g in [Vector3::new(0.0, 0.0, -9.81), Vector3::new(1.2, -3.0, -9.0)] {
-        let drive = DriveTrain::new(&model, &[1e5; 6], &[0.0; 6])
+        let drive = drivetrain::Model::new(model.clone(), &[1e5; 6], &[0.0; 6])
             .unwrap()
             .with_masses(masses.clone())
             .unwrap()
             .with_gravity(g)
             .unwrap();
+        let mut data = drivetrain::Data::new(&drive);
         for q in [
             [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
             [0.3, -0.7, 0.12, 1.1, -0.4, 0.9],
             [-1.2, 0.5, -0.05, -0.8, 2.0, -1.5],
         ] {
-            let tau = gravity_torques(&model, &drive, &q).unwrap();
+            let tau = gravity_torques(&drive, &mut data, &q).unwrap();
             let h = 1e-6;
             for j in 0..6 {
                 let (mut qp, mut qm) = (q, q);
@@ -132,28 +134,33 @@ fn eq10_gravity_hand_example() {
         .unwrap()
         .with(1, 1.0, Vector3::new(0.25, 0.0, 0.0))
         .unwrap();
-    let drive = DriveTrain::new(&model, &[1.0e4, 5.0e3], &[1.0e-3, 5.0e-4])
+    let drive = drivetrain::Model::new(model, &[1.0e4, 5.0e3], &[1.0e-3, 5.0e-4])
         .unwrap()
         .with_masses(masses)
         .unwrap();
     // Gravity pulls both links down (-z); about +y that is +x m g on the links, so the
-    // drives hold u = -(x m g): u1 = -(0.5*2 + 1.25*1)*9.81 = -22.0725,
-    // u2 = -(0.25*1)*9.81 = -2.4525 N m.
+    // drives hold u = -(x m g): u1 = -(0.5*2 + 1.25*1)*g, u2 = -(0.25*1)*g N m with the
+    // default standard gravity g (-22.0725 and -2.4525 N m with g = 9.81).
+    let g = STANDARD_GRAVITY;
     let c = correct_joints(
-        &model,
-        &mut Data::new(&model),
         &drive,
+        &mut drivetrain::Data::new(&drive),
         &[0.0, 0.0],
         &Vector6::zeros(),
     )
     .unwrap();
-    assert_relative_eq!(c.torque[0], -22.0725, epsilon = 1e-12);
-    assert_relative_eq!(c.torque[1], -2.4525, epsilon = 1e-12);
+    assert_relative_eq!(c.torque[0], -(0.5 * 2.0 + 1.25 * 1.0) * g, epsilon = 1e-12);
+    assert_relative_eq!(c.torque[1], -(0.25 * 1.0) * g, epsilon = 1e-12);
     assert_eq!(&c.backlash_sign[..2], &[-1.0, -1.0]);
     // theta := theta - sgn(u) theta_b - u / K:
-    // 0 + 1e-3 + 22.0725/1e4 = 3.20725e-3; 0 + 5e-4 + 2.4525/5e3 = 9.905e-4 rad.
-    assert_relative_eq!(c.q[0], 3.20725e-3, epsilon = 1e-15);
-    assert_relative_eq!(c.q[1], 9.905e-4, epsilon = 1e-15);
+    // 0 + 1e-3 + (2.25 g)/1e4; 0 + 5e-4 + (0.25 g)/5e3 rad (3.20725e-3 and 9.905e-4 with
+    // g = 9.81).
+    assert_relative_eq!(
+        c.q[0],
+        1.0e-3 + (0.5 * 2.0 + 1.25 * 1.0) * g / 1.0e4,
+        epsilon = 1e-15
+    );
+    assert_relative_eq!(c.q[1], 5.0e-4 + (0.25 * 1.0) * g / 5.0e3, epsilon = 1e-15);
 }
 
 /// Planar arm, joints about z (no gravity torque), pushing along +x: contact torques only.
@@ -177,7 +184,7 @@ fn eq10_contact_hand_example() {
     let masses = LinkMasses::new()
         .with(1, 3.0, Vector3::new(0.2, 0.0, 0.0))
         .unwrap();
-    let drive = DriveTrain::new(&model, &[1000.0, 500.0, 200.0], &[1e-3, 2e-3, 0.0])
+    let drive = drivetrain::Model::new(model, &[1000.0, 500.0, 200.0], &[1e-3, 2e-3, 0.0])
         .unwrap()
         .with_masses(masses)
         .unwrap();
@@ -190,7 +197,7 @@ fn eq10_contact_hand_example() {
     // (-0.5, 1.2), (-0.5, 0.2), (0, 0.2). F = (10, 4): J^T F = [-5 + 4.8, -5 + 0.8, 0.8]
     // = [-0.2, -4.2, 0.8] N m.
     let w = Vector6::new(10.0, 4.0, 0.0, 0.0, 0.0, 0.0);
-    let c = correct_joints(&model, &mut Data::new(&model), &drive, &q, &w).unwrap();
+    let c = correct_joints(&drive, &mut drivetrain::Data::new(&drive), &q, &w).unwrap();
     for (u, e) in c.torque.iter().zip([-0.2, -4.2, 0.8]) {
         assert_relative_eq!(*u, e, epsilon = 1e-12);
     }
@@ -201,9 +208,8 @@ fn eq10_contact_hand_example() {
     assert_relative_eq!(c.q[2], q[2] - 4.0e-3, epsilon = 1e-15);
     // sgn(0) = 0: no force, no gravity about z -> the readings come back unchanged.
     let c0 = correct_joints(
-        &model,
-        &mut Data::new(&model),
         &drive,
+        &mut drivetrain::Data::new(&drive),
         &q,
         &Vector6::zeros(),
     )
@@ -212,7 +218,7 @@ fn eq10_contact_hand_example() {
     assert_eq!(&c0.backlash_sign[..3], &[0.0, 0.0, 0.0]);
     // A deadband keeps small torques from taking up backlash.
     let dead = drive.clone().with_torque_deadband(0.5).unwrap();
-    let cd = correct_joints(&model, &mut Data::new(&model), &dead, &q, &w).unwrap();
+    let cd = correct_joints(&dead, &mut drivetrain::Data::new(&dead), &q, &w).unwrap();
     assert_eq!(&cd.backlash_sign[..3], &[0.0, -1.0, 1.0]);
 }
 
@@ -253,14 +259,14 @@ fn spring_arm(k: &[f64; 6]) -> Model {
 fn cartesian_stiffness_inverts_the_joint_axis_compliance() {
     let k = [2.0e6, 1.5e6, 1.0e6, 4.0e5, 3.0e5, 2.0e5];
     let model = spring_arm(&k);
-    let drive = DriveTrain::new(&model, &k, &[0.0; 6]).unwrap();
-    let mut data = Data::new(&model);
+    let drive = drivetrain::Model::new(model.clone(), &k, &[0.0; 6]).unwrap();
+    let mut data = drivetrain::Data::new(&drive);
     for q in [
         [0.1, -0.5, 0.9, 0.3, 0.7, -0.2],
         [-0.8, 0.2, 1.4, -1.0, -0.6, 0.5],
     ] {
-        let kc = cartesian_stiffness(&model, &mut data, &drive, &q).unwrap();
-        let c = vjm::compliance(&model, &mut data, &q).unwrap();
+        let kc = cartesian_stiffness(&drive, &mut data, &q).unwrap();
+        let c = vjm::compliance(&model, &mut data.vjm, &q).unwrap();
         let kc_ref: Matrix6<f64> = c.try_inverse().unwrap();
         let err = (kc - kc_ref).norm() / kc_ref.norm();
         assert!(err < 1e-9, "relative error {err:e}");
@@ -269,7 +275,7 @@ fn cartesian_stiffness_inverts_the_joint_axis_compliance() {
     }
     // Wrist singularity: joints 4 and 6 (both about x) collinear when joint 5 is at 0.
     let q = [0.1, -0.5, 0.9, 0.3, 0.0, -0.2];
-    let e = cartesian_stiffness(&model, &mut data, &drive, &q).unwrap_err();
+    let e = cartesian_stiffness(&drive, &mut data, &q).unwrap_err();
     assert!(matches!(e, TickError::Singular { .. }), "{e:?}");
 }
 
@@ -291,24 +297,24 @@ fn planar(lengths: &[f64], k: &[f64]) -> Model {
 fn planar_stiffness_matches_the_xy_compliance() {
     let k = [2000.0, 1000.0];
     let model = planar(&[0.5, 0.4], &k);
-    let drive = DriveTrain::new(&model, &k, &[0.0; 2]).unwrap();
-    let mut data = Data::new(&model);
+    let drive = drivetrain::Model::new(model.clone(), &k, &[0.0; 2]).unwrap();
+    let mut data = drivetrain::Data::new(&drive);
     let q = [0.4, 1.3];
-    let kxy = cartesian_stiffness_xy(&model, &mut data, &drive, &q).unwrap();
-    let c = vjm::compliance(&model, &mut data, &q).unwrap();
+    let kxy = cartesian_stiffness_xy(&drive, &mut data, &q).unwrap();
+    let c = vjm::compliance(&model, &mut data.vjm, &q).unwrap();
     let cxy = Matrix2::new(c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(1, 1)]);
     assert!((kxy * cxy - Matrix2::identity()).norm() < 1e-10);
     // Stretched arm: singular.
-    let e = cartesian_stiffness_xy(&model, &mut data, &drive, &[0.4, 0.0]).unwrap_err();
+    let e = cartesian_stiffness_xy(&drive, &mut data, &[0.4, 0.0]).unwrap_err();
     assert!(matches!(e, TickError::Singular { .. }));
     // Nearly stretched: refused by the condition limit, accepted with a looser one.
     let near = [0.4, 1e-7];
-    assert!(cartesian_stiffness_xy(&model, &mut data, &drive, &near).is_err());
+    assert!(cartesian_stiffness_xy(&drive, &mut data, &near).is_err());
     let loose = drive.clone().with_max_condition(1e9).unwrap();
-    assert!(cartesian_stiffness_xy(&model, &mut data, &loose, &near).is_ok());
+    assert!(cartesian_stiffness_xy(&loose, &mut data, &near).is_ok());
     // Wrong joint count for the 6x6 and 3x3 forms.
     assert!(matches!(
-        cartesian_stiffness(&model, &mut data, &drive, &q),
+        cartesian_stiffness(&drive, &mut data, &q),
         Err(TickError::WrongLength { .. })
     ));
 
@@ -316,10 +322,11 @@ fn planar_stiffness_matches_the_xy_compliance() {
     // free its xy part is the inverse of the xy compliance.
     let k3 = [3000.0, 1500.0, 400.0];
     let m3 = planar(&[0.5, 0.4, 0.15], &k3);
-    let d3 = DriveTrain::new(&m3, &k3, &[0.0; 3]).unwrap();
+    let d3 = drivetrain::Model::new(m3.clone(), &k3, &[0.0; 3]).unwrap();
+    let mut data3 = drivetrain::Data::new(&d3);
     let q3 = [0.3, 1.1, -0.7];
-    let kp = cartesian_stiffness_planar(&m3, &mut data, &d3, &q3).unwrap();
-    let c = vjm::compliance(&m3, &mut data, &q3).unwrap();
+    let kp = cartesian_stiffness_planar(&d3, &mut data3, &q3).unwrap();
+    let c = vjm::compliance(&m3, &mut data3.vjm, &q3).unwrap();
     let idx = [0usize, 1, 5];
     let cp = nalgebra::Matrix3::from_fn(|r, s| c[(idx[r], idx[s])]);
     assert!((kp * cp - nalgebra::Matrix3::identity()).norm() < 1e-9);
@@ -332,69 +339,90 @@ fn planar_stiffness_matches_the_xy_compliance() {
 fn bad_inputs_are_statuses() {
     let model = planar(&[0.5, 0.4], &[1.0, 1.0]);
     assert!(matches!(
-        DriveTrain::new(&model, &[1.0], &[0.0, 0.0]),
-        Err(DriveTrainError::WrongLength { .. })
+        drivetrain::Model::new(model.clone(), &[1.0], &[0.0, 0.0]),
+        Err(BuildError::WrongLength { .. })
     ));
     assert!(matches!(
-        DriveTrain::new(&model, &[1.0, 0.0], &[0.0, 0.0]),
-        Err(DriveTrainError::NonPositiveStiffness { joint: 1, .. })
+        drivetrain::Model::new(model.clone(), &[1.0, 0.0], &[0.0, 0.0]),
+        Err(BuildError::InvalidEntry {
+            what: "stiffness",
+            index: 1,
+            ..
+        })
     ));
     assert!(matches!(
-        DriveTrain::new(&model, &[1.0, f64::INFINITY], &[0.0, 0.0]),
-        Err(DriveTrainError::NonPositiveStiffness { joint: 1, .. })
+        drivetrain::Model::new(model.clone(), &[1.0, f64::INFINITY], &[0.0, 0.0]),
+        Err(BuildError::InvalidEntry {
+            what: "stiffness",
+            index: 1,
+            ..
+        })
     ));
     assert!(matches!(
-        DriveTrain::new(&model, &[1.0, 1.0], &[-1.0, 0.0]),
-        Err(DriveTrainError::InvalidBacklash { joint: 0, .. })
+        drivetrain::Model::new(model.clone(), &[1.0, 1.0], &[-1.0, 0.0]),
+        Err(BuildError::InvalidEntry {
+            what: "backlash",
+            index: 0,
+            ..
+        })
     ));
     let mut m = LinkMasses::new();
     assert!(matches!(
         m.push(0, -1.0, Vector3::zeros()),
-        Err(DriveTrainError::InvalidMass { .. })
+        Err(BuildError::InvalidEntry { what: "masses", .. })
     ));
     assert!(matches!(
         m.push(0, 1.0, Vector3::new(f64::NAN, 0.0, 0.0)),
-        Err(DriveTrainError::NonFiniteCom { .. })
+        Err(BuildError::NonFinite {
+            what: "centre of mass",
+            ..
+        })
     ));
     for _ in 0..drivetrain::MAX_MASSES {
         m.push(0, 1.0, Vector3::zeros()).unwrap();
     }
     assert!(matches!(
         m.push(0, 1.0, Vector3::zeros()),
-        Err(DriveTrainError::CapacityExceeded { .. })
+        Err(BuildError::Capacity { what: "masses", .. })
     ));
     let far = LinkMasses::new().with(2, 1.0, Vector3::zeros()).unwrap();
-    let drive = DriveTrain::new(&model, &[1.0, 1.0], &[0.0, 0.0]).unwrap();
+    let drive = drivetrain::Model::new(model.clone(), &[1.0, 1.0], &[0.0, 0.0]).unwrap();
+    // The mass hangs after joint 2, which the 2-joint chain does not have.
     assert!(matches!(
         drive.clone().with_masses(far),
-        Err(DriveTrainError::JointOutOfRange { joint: 2, .. })
+        Err(BuildError::InvalidEntry {
+            what: "masses (after_joint)",
+            index: 0,
+            value,
+            ..
+        }) if value == 2.0
     ));
-    let mut data = Data::new(&model);
+    let mut data = drivetrain::Data::new(&drive);
     assert!(matches!(
-        correct_joints(&model, &mut data, &drive, &[0.0], &Vector6::zeros()),
+        correct_joints(&drive, &mut data, &[0.0], &Vector6::zeros()),
         Err(TickError::WrongLength { .. })
     ));
     assert!(matches!(
-        correct_joints(
-            &model,
-            &mut data,
-            &drive,
-            &[0.0, f64::NAN],
-            &Vector6::zeros()
-        ),
+        correct_joints(&drive, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
         Err(TickError::NonFinite { .. })
     ));
     let mut w = Vector6::zeros();
     w[3] = f64::INFINITY;
     assert!(matches!(
-        correct_joints(&model, &mut data, &drive, &[0.0, 0.1], &w),
+        correct_joints(&drive, &mut data, &[0.0, 0.1], &w),
         Err(TickError::NonFinite { .. })
     ));
-    // A drive train of another model.
+    // A drive train of another model: the drive-train model now owns its chain, so the
+    // mismatch left to catch is a workspace made for another model.
     let other = planar(&[0.5, 0.4, 0.1], &[1.0; 3]);
+    let other_drive = drivetrain::Model::new(other, &[1.0; 3], &[0.0; 3]).unwrap();
     assert!(matches!(
-        gravity_torques(&other, &drive, &[0.0; 3]),
-        Err(TickError::WrongLength { .. })
+        gravity_torques(&drive, &mut drivetrain::Data::new(&other_drive), &[0.0; 3]),
+        Err(TickError::ModelMismatch {
+            what: "dof",
+            expected: 2,
+            got: 3
+        })
     ));
 }
 
@@ -434,9 +462,9 @@ stiffness = 1.0e5   # N m/rad
 
 #[test]
 fn loads_stiffness_backlash_and_urdf_masses() {
-    let robot = SerialRobot::from_strs(URDF, STIFFNESS, None, "tool").unwrap();
+    let robot = SerialRobot::from_str(URDF, STIFFNESS, None, "tool").unwrap();
     assert_eq!(robot.joint_names, ["a1", "a2"]);
-    let drive = drive_train_from_strs(&robot, URDF, STIFFNESS).unwrap();
+    let drive = io::drive::from_str(&robot, URDF, STIFFNESS).unwrap();
     assert_eq!(drive.stiffness(), &[1.0e5, 8.0e4]);
     assert_eq!(drive.backlash(), &[0.0, 2.0e-4]);
     // The base (before a1) loads nothing; upper + bracket hang after a1 (bracket's CoM at
@@ -459,32 +487,35 @@ fn loads_stiffness_backlash_and_urdf_masses() {
         .unwrap()
         .with(1, 6.0, Vector3::new(0.3, 0.0, 0.01))
         .unwrap();
-    let hand = DriveTrain::new(&robot.model, &[1.0e5, 8.0e4], &[0.0, 2.0e-4])
+    let hand = drivetrain::Model::new(robot.model.clone(), &[1.0e5, 8.0e4], &[0.0, 2.0e-4])
         .unwrap()
         .with_masses(by_hand)
         .unwrap();
+    let mut data = drivetrain::Data::new(&drive);
+    let mut hand_data = drivetrain::Data::new(&hand);
     for q in [[0.0, 0.0], [0.4, -1.1]] {
-        let a = gravity_torques(&robot.model, &drive, &q).unwrap();
-        let b = gravity_torques(&robot.model, &hand, &q).unwrap();
+        let a = gravity_torques(&drive, &mut data, &q).unwrap();
+        let b = gravity_torques(&hand, &mut hand_data, &q).unwrap();
         for j in 0..2 {
             assert_relative_eq!(a[j], b[j], epsilon = 1e-9);
         }
     }
     // At q = 0 the CoMs sit at x = 0.4 (upper), 0.8 (bracket) and 0.8 + 0.3 (fore) from a1:
-    // the drive holds -(sum x m) g = -(4.8 + 1.6 + 6.6) * 9.81 N m.
-    let a = gravity_torques(&robot.model, &drive, &[0.0, 0.0]).unwrap();
-    assert_relative_eq!(a[0], -(4.8 + 1.6 + 6.6) * 9.81, epsilon = 1e-9);
-    assert_relative_eq!(a[1], -(0.3 * 6.0) * 9.81, epsilon = 1e-9);
+    // the drive holds -(sum x m) g = -(4.8 + 1.6 + 6.6) * g N m (default standard gravity).
+    let a = gravity_torques(&drive, &mut data, &[0.0, 0.0]).unwrap();
+    assert_relative_eq!(a[0], -(4.8 + 1.6 + 6.6) * STANDARD_GRAVITY, epsilon = 1e-9);
+    assert_relative_eq!(a[1], -(0.3 * 6.0) * STANDARD_GRAVITY, epsilon = 1e-9);
 }
 
 #[test]
 fn drive_file_errors_name_the_entry() {
-    let robot = SerialRobot::from_strs(URDF, STIFFNESS, None, "tool").unwrap();
+    let robot = SerialRobot::from_str(URDF, STIFFNESS, None, "tool").unwrap();
     let cases = [
         ("[[joint]]\nname = \"a1\"\nstiffness = 1.0\n", "a2"),
         (
             "[[joint]]\nname = \"a1\"\nstiffness = 1.0\n[[joint]]\nname = \"a1\"\nstiffness = 2.0\n",
-            "twice",
+            // The duplicate entry is a `LoadError::DuplicateName` ("duplicate ... 'a1'").
+            "duplicate",
         ),
         ("[[joint]]\nname = \"mount\"\nstiffness = 1.0\n", "mount"),
         ("[[joint]]\nname = \"a1\"\nstiffness = -1.0\n", "a1"),
@@ -495,10 +526,10 @@ fn drive_file_errors_name_the_entry() {
         ("[[joint]]\nname = \"a1\"\nstifness = 1.0\n", "stifness"),
     ];
     for (text, needle) in cases {
-        let e = drive_train_from_strs(&robot, URDF, text)
+        let e = io::drive::from_str(&robot, URDF, text)
             .unwrap_err()
             .to_string();
         assert!(e.contains(needle), "{e} should mention {needle}");
     }
-    assert_eq!(parse_joint_drives(STIFFNESS).unwrap().len(), 2);
+    assert_eq!(io::drive::parse(STIFFNESS).unwrap().len(), 2);
 }

@@ -2,12 +2,11 @@
 //! global allocator watches many calls. One test function only, so no other test thread
 //! allocates meanwhile.
 
-use deflect_core::contour::{self, ContourTracer, TracerConfig};
+use deflect_core::contour::{self, TracerConfig};
 use deflect_core::drivetrain::{
-    DriveTrain, LinkMasses, cartesian_stiffness, cartesian_stiffness_xy, compensated_forward,
+    self, Data, LinkMasses, cartesian_stiffness, cartesian_stiffness_xy, compensated_forward,
     correct_joints, gravity_torques,
 };
-use deflect_core::vjm::Data;
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
 
@@ -43,7 +42,7 @@ fn drive_train_and_tracer_do_not_allocate() {
             .unwrap();
     }
     let model = b.build().unwrap();
-    let drive = DriveTrain::new(&model, &[1e5; 6], &[1e-4; 6])
+    let drive = drivetrain::Model::new(model, &[1e5; 6], &[1e-4; 6])
         .unwrap()
         .with_masses(masses)
         .unwrap();
@@ -58,43 +57,44 @@ fn drive_train_and_tracer_do_not_allocate() {
         .unwrap()
         .build()
         .unwrap();
-    let pdrive = DriveTrain::new(&planar, &[2000.0, 1000.0], &[0.0; 2]).unwrap();
-    let mut data = Data::new(&model);
-    let mut pdata = Data::new(&planar);
+    let pdrive = drivetrain::Model::new(planar, &[2000.0, 1000.0], &[0.0; 2]).unwrap();
+    let mut data = Data::new(&drive);
+    let mut pdata = Data::new(&pdrive);
     let wrench = Vector6::new(30.0, -20.0, -50.0, 1.0, 0.0, -0.5);
     let mut q = [0.1, -0.4, 0.9, 0.2, 0.6, -0.3];
     let k = Matrix2::new(8000.0, 500.0, 500.0, 3000.0);
-    let mut tracer = ContourTracer::new(TracerConfig::new(1e-3, 2.0, 30.0), &k).unwrap();
+    let tracer = contour::Model::new(TracerConfig::new(1e-3, 2.0, 30.0), &k).unwrap();
+    let mut tracer_data = contour::Data::new(&tracer);
     let mut p = Vector2::new(0.4, 0.0);
     let mut sink = 0.0;
 
     let before = common::allocations();
     for i in 0..3_000 {
         q[0] = 1e-4 * i as f64;
-        sink += gravity_torques(&model, &drive, &q).unwrap()[1];
-        sink += correct_joints(&model, &mut data, &drive, &q, &wrench)
-            .unwrap()
-            .q[2];
-        sink += compensated_forward(&model, &mut data, &drive, &q, &wrench)
+        sink += gravity_torques(&drive, &mut data, &q).unwrap()[1];
+        sink += correct_joints(&drive, &mut data, &q, &wrench).unwrap().q[2];
+        sink += compensated_forward(&drive, &mut data, &q, &wrench)
             .unwrap()
             .translation
             .x;
-        sink += cartesian_stiffness(&model, &mut data, &drive, &q).unwrap()[(0, 0)];
-        sink += cartesian_stiffness_xy(&planar, &mut pdata, &pdrive, &[q[0], 1.2]).unwrap()[(0, 0)];
+        sink += cartesian_stiffness(&drive, &mut data, &q).unwrap()[(0, 0)];
+        sink += cartesian_stiffness_xy(&pdrive, &mut pdata, &[q[0], 1.2]).unwrap()[(0, 0)];
         sink += contour::edge_direction(&k, &Vector2::new(1e-3, 2e-4), &Vector2::new(0.0, 1.0))
             .unwrap();
         // A wall at x = 0.45: the tracer approaches, then slides along it.
         let f = Vector2::new(f64::max(p.x - 0.45, 0.0) * 8000.0, 0.0);
-        let out = tracer.step(&p, &f).unwrap();
+        let out = contour::step(&tracer, &mut tracer_data, &p, &f).unwrap();
         p = out.command;
-        tracer.set_stiffness(&k).unwrap();
+        tracer_data.set_stiffness(&k).unwrap();
         // Error paths allocate nothing either.
-        let bad = correct_joints(&model, &mut data, &drive, &q[..5], &wrench);
+        let bad = correct_joints(&drive, &mut data, &q[..5], &wrench);
         assert!(matches!(bad, Err(TickError::WrongLength { .. })));
-        assert!(tracer.step(&Vector2::new(f64::NAN, 0.0), &f).is_err());
+        assert!(
+            contour::step(&tracer, &mut tracer_data, &Vector2::new(f64::NAN, 0.0), &f).is_err()
+        );
     }
     let after = common::allocations();
     assert!(sink.is_finite());
-    assert!(tracer.stats().contacts > 100, "the tracer did trace");
+    assert!(tracer_data.stats().contacts > 100, "the tracer did trace");
     assert_eq!(after - before, 0, "allocations on the per-call path");
 }

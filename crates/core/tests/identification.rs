@@ -4,11 +4,10 @@ use approx::assert_relative_eq;
 use deflect_core::compensation::SensorCalibration;
 use deflect_core::compensation::sensor::POLY_TERMS;
 use deflect_core::identification::{
-    FrameMeasurement, IdentificationError, TcpMeasurement, identify_from_frames, identify_from_tcp,
-    identify_sensor,
+    FrameMeasurement, TcpMeasurement, identify_from_frames, identify_from_tcp, identify_sensor,
 };
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_core::{Model, ModelBuilder};
+use deflect_core::{BuildError, Model, ModelBuilder};
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 /// A 4R arm with 4 springs: 3 compliant axes each except the last (z only).
@@ -239,7 +238,7 @@ fn unobservable_axes_are_flagged_not_set() {
     }];
     assert!(matches!(
         identify_from_frames(&model, &bad, false),
-        Err(IdentificationError::UnknownSpring { spring: 9, .. })
+        Err(BuildError::UnknownSpring { spring: 9, .. })
     ));
 }
 
@@ -284,7 +283,11 @@ fn sensor_offsets_weight_and_cog_from_three_orientations() {
             false,
             Isometry3::identity()
         ),
-        Err(IdentificationError::TooFewMeasurements { got: 2, needed: 3 })
+        Err(BuildError::TooFew {
+            what: "measurements",
+            got: 2,
+            needed: 3
+        })
     ));
 }
 

@@ -8,12 +8,12 @@
 )]
 
 use approx::assert_relative_eq;
-use deflect_core::ModelBuilder;
 use deflect_core::mechanism::{
-    DEFAULT_MIN_SIGMA, IkOptions, Mechanism, MechanismError, PAPER_LINK, ParallelRobot2, SerialArm,
+    DEFAULT_MIN_SIGMA, IkOptions, Mechanism, PAPER_LINK, ParallelRobot2, SerialArm,
 };
 use deflect_core::motion::{self, Trajectory};
 use deflect_core::vjm::Model;
+use deflect_core::{BuildError, ModelBuilder, TickError};
 use nalgebra::{Isometry3, SMatrix, SVector, Vector2, Vector3};
 use proptest::prelude::*;
 
@@ -31,11 +31,12 @@ fn grid() -> Vec<Vector2<f64>> {
     g
 }
 
-/// Central finite differences of any mechanism's FK.
+/// Central finite differences of any mechanism's FK (in a workspace of its own).
 fn fd_jacobian<M: Mechanism<T, J>, const T: usize, const J: usize>(
     m: &M,
     q: &SVector<f64, J>,
 ) -> SMatrix<f64, T, J> {
+    let mut data = m.new_data();
     let h = 1e-6;
     let mut jac = SMatrix::<f64, T, J>::zeros();
     for c in 0..J {
@@ -43,7 +44,8 @@ fn fd_jacobian<M: Mechanism<T, J>, const T: usize, const J: usize>(
         let mut qm = *q;
         qp[c] += h;
         qm[c] -= h;
-        let col = (m.forward(&qp).unwrap() - m.forward(&qm).unwrap()) / (2.0 * h);
+        let col =
+            (m.forward(&mut data, &qp).unwrap() - m.forward(&mut data, &qm).unwrap()) / (2.0 * h);
         jac.set_column(c, &col);
     }
     jac
@@ -57,13 +59,17 @@ fn grid_nodes_round_trip() {
         assert_relative_eq!(r.fk(&q).unwrap(), p, epsilon = 1e-15);
         assert_relative_eq!(r.ik(&r.fk(&q).unwrap()).unwrap(), q, epsilon = 1e-12);
         // Through the trait, too.
-        assert_eq!(r.inverse(&p, &Vector2::zeros()).unwrap(), q);
+        assert_eq!(r.inverse(&mut (), &p, &Vector2::zeros()).unwrap(), q);
         // Working mode: elbow A on the +y side of the line O-C.
         let d = q.x - q.y;
         assert!(d > 0.0 && d < core::f64::consts::PI);
-        let sd = r.singularity_distance(&q).unwrap();
+        let sd = r.singularity_distance(&mut (), &q).unwrap();
         assert!(sd >= 0.07, "sigma_min {sd} at {p}");
-        assert_relative_eq!(r.jacobian(&q).unwrap(), fd_jacobian(&r, &q), epsilon = 1e-9);
+        assert_relative_eq!(
+            r.jacobian(&mut (), &q).unwrap(),
+            fd_jacobian(&r, &q),
+            epsilon = 1e-9
+        );
     }
 }
 
@@ -93,10 +99,14 @@ fn geometry_of_the_linkage() {
         epsilon = 1e-15
     );
     // Singular values sqrt(2) L cos(Delta/2), sqrt(2) L sin(Delta/2).
-    let sv = r.jacobian(&q).unwrap().singular_values();
+    let sv = r.jacobian(&mut (), &q).unwrap().singular_values();
     let expect = 2f64.sqrt() * l * (del / 2.0).cos().min((del / 2.0).sin());
     assert_relative_eq!(sv.min(), expect, epsilon = 1e-14);
-    assert_relative_eq!(r.singularity_distance(&q).unwrap(), expect, epsilon = 1e-14);
+    assert_relative_eq!(
+        r.singularity_distance(&mut (), &q).unwrap(),
+        expect,
+        epsilon = 1e-14
+    );
 }
 
 #[test]
@@ -138,15 +148,14 @@ fn out_of_workspace_and_singular_points_are_errors() {
     let r = ParallelRobot2::paper();
     assert_eq!(
         r.ik(&Vector2::new(0.31, 0.0)),
-        Err(MechanismError::OutOfWorkspace {
-            x: 0.31,
-            y: 0.0,
+        Err(TickError::OutOfWorkspace {
+            distance: 0.31,
             reach: 0.3
         })
     );
     assert!(matches!(
         r.ik(&Vector2::new(0.0, -0.4)),
-        Err(MechanismError::OutOfWorkspace { .. })
+        Err(TickError::OutOfWorkspace { .. })
     ));
     // Full stretch and the base centre.
     for p in [
@@ -156,34 +165,37 @@ fn out_of_workspace_and_singular_points_are_errors() {
         Vector2::new(0.001, 0.0),
     ] {
         match r.ik(&p) {
-            Err(MechanismError::Singular { distance }) => assert!(distance < DEFAULT_MIN_SIGMA),
+            Err(TickError::Singular { sigma_min, .. }) => assert!(sigma_min < DEFAULT_MIN_SIGMA),
             other => panic!("{p}: {other:?}"),
         }
     }
     assert_eq!(
         r.ik(&Vector2::new(0.0, 0.0)),
-        Err(MechanismError::Singular { distance: 0.0 })
+        Err(TickError::Singular {
+            what: "task Jacobian",
+            sigma_min: 0.0
+        })
     );
     // At a stretched pose the Jacobian is rank deficient.
     let stretched = Vector2::new(0.4, 0.4);
-    assert!(r.singularity_distance(&stretched).unwrap() < 1e-12);
+    assert!(r.singularity_distance(&mut (), &stretched).unwrap() < 1e-12);
     assert!(matches!(
         r.ik(&Vector2::new(f64::NAN, 0.0)),
-        Err(MechanismError::NonFinite {
+        Err(TickError::NonFinite {
             what: "x",
             index: 0
         })
     ));
     assert!(matches!(
         r.fk(&Vector2::new(0.0, f64::INFINITY)),
-        Err(MechanismError::NonFinite {
+        Err(TickError::NonFinite {
             what: "q",
             index: 1
         })
     ));
     assert!(matches!(
         ParallelRobot2::new(0.15, 0.09, 0.0),
-        Err(MechanismError::InvalidParameter {
+        Err(BuildError::InvalidParameter {
             what: "min_sigma",
             ..
         })
@@ -202,7 +214,7 @@ proptest! {
         prop_assert!((qi - q).norm() < 1e-10, "{q} -> {p} -> {qi}");
         prop_assert!((r.fk(&qi).unwrap() - p).norm() < 1e-15);
         let jfd = fd_jacobian(&r, &q);
-        prop_assert!((r.jacobian(&q).unwrap() - jfd).norm() < 1e-9);
+        prop_assert!((r.jacobian(&mut (), &q).unwrap() - jfd).norm() < 1e-9);
     }
 
     #[test]
@@ -212,10 +224,10 @@ proptest! {
         match r.ik(&p) {
             Ok(q) => {
                 prop_assert!((r.fk(&q).unwrap() - p).norm() < 1e-15);
-                prop_assert!(r.singularity_distance(&q).unwrap() >= DEFAULT_MIN_SIGMA * (1.0 - 1e-12));
+                prop_assert!(r.singularity_distance(&mut (), &q).unwrap() >= DEFAULT_MIN_SIGMA * (1.0 - 1e-12));
             }
-            Err(MechanismError::OutOfWorkspace { reach, .. }) => prop_assert!(p.norm() > reach),
-            Err(MechanismError::Singular { distance }) => prop_assert!(distance < DEFAULT_MIN_SIGMA),
+            Err(TickError::OutOfWorkspace { reach, .. }) => prop_assert!(p.norm() > reach),
+            Err(TickError::Singular { sigma_min, .. }) => prop_assert!(sigma_min < DEFAULT_MIN_SIGMA),
             Err(e) => prop_assert!(false, "{e}"),
         }
     }
@@ -272,19 +284,20 @@ fn arm6() -> Model {
 #[test]
 fn serial_3r_ik_recovers_joints() {
     let model = arm3();
-    let arm = SerialArm::<3>::new(&model, IkOptions::default()).unwrap();
+    let arm = SerialArm::<3>::new(model.clone(), IkOptions::default()).unwrap();
+    let mut data = arm.new_data();
     let q = SVector::<f64, 3>::new(0.3, -0.4, 0.8);
-    let x = arm.forward(&q).unwrap();
+    let x = arm.forward(&mut data, &q).unwrap();
     let seed = q + SVector::<f64, 3>::new(0.1, -0.15, 0.2);
-    let qi = arm.inverse(&x, &seed).unwrap();
+    let qi = arm.inverse(&mut data, &x, &seed).unwrap();
     assert_relative_eq!(qi, q, epsilon = 1e-8);
-    assert!((arm.forward(&qi).unwrap() - x).norm() <= 1e-9);
+    assert!((arm.forward(&mut data, &qi).unwrap() - x).norm() <= 1e-9);
     assert_relative_eq!(
-        arm.jacobian(&q).unwrap(),
+        arm.jacobian(&mut data, &q).unwrap(),
         fd_jacobian(&arm, &q),
         epsilon = 1e-8
     );
-    assert!(arm.singularity_distance(&q).unwrap() > 0.01);
+    assert!(arm.singularity_distance(&mut data, &q).unwrap() > 0.01);
     // Tick-by-tick along a line: seeded with the previous solution, it tracks.
     let tr = Trajectory::line(
         x,
@@ -294,41 +307,42 @@ fn serial_3r_ik_recovers_joints() {
     .unwrap();
     let mut qk = q;
     for s in tr.ticks(2000.0).unwrap() {
-        qk = arm.inverse(&s.position, &qk).unwrap();
-        assert!((arm.forward(&qk).unwrap() - s.position).norm() <= 1e-9);
+        qk = arm.inverse(&mut data, &s.position, &qk).unwrap();
+        assert!((arm.forward(&mut data, &qk).unwrap() - s.position).norm() <= 1e-9);
     }
 }
 
 #[test]
 fn serial_6r_ik_converges_and_reports_failures() {
     let model = arm6();
-    let arm = SerialArm::<6>::new(&model, IkOptions::default()).unwrap();
+    let arm = SerialArm::<6>::new(model.clone(), IkOptions::default()).unwrap();
+    let mut data = arm.new_data();
     let q = SVector::<f64, 6>::from_column_slice(&[0.2, -0.3, 0.9, 0.4, -0.6, 0.3]);
-    let x = arm.forward(&q).unwrap();
+    let x = arm.forward(&mut data, &q).unwrap();
     let seed = q.add_scalar(0.1);
-    let qi = arm.inverse(&x, &seed).unwrap();
-    assert!((arm.forward(&qi).unwrap() - x).norm() <= 1e-9);
+    let qi = arm.inverse(&mut data, &x, &seed).unwrap();
+    assert!((arm.forward(&mut data, &qi).unwrap() - x).norm() <= 1e-9);
     assert_relative_eq!(
-        arm.jacobian(&q).unwrap(),
+        arm.jacobian(&mut data, &q).unwrap(),
         fd_jacobian(&arm, &q),
         epsilon = 1e-8
     );
     // Far out of reach: the arm stretches, then fails with a typed error.
     let far = Vector3::new(3.0, 0.0, 0.4);
-    match arm.inverse(&far, &q) {
-        Err(MechanismError::NotConverged {
+    match arm.inverse(&mut data, &far, &q) {
+        Err(TickError::NotConverged {
             iterations,
             residual,
         }) => {
             assert_eq!(iterations, IkOptions::default().max_iterations);
             assert!(residual > 1.0);
         }
-        Err(MechanismError::Singular { distance }) => assert!(distance < 1e-4),
+        Err(TickError::Singular { sigma_min, .. }) => assert!(sigma_min < 1e-4),
         other => panic!("{other:?}"),
     }
     // Too few iterations: NotConverged.
     let short = SerialArm::<6>::new(
-        &model,
+        model.clone(),
         IkOptions {
             max_iterations: 1,
             ..IkOptions::default()
@@ -336,18 +350,19 @@ fn serial_6r_ik_converges_and_reports_failures() {
     )
     .unwrap();
     assert!(matches!(
-        short.inverse(&(x + Vector3::new(0.05, 0.05, 0.0)), &q),
-        Err(MechanismError::NotConverged { iterations: 1, .. })
+        short.inverse(&mut data, &(x + Vector3::new(0.05, 0.05, 0.0)), &q),
+        Err(TickError::NotConverged { iterations: 1, .. })
     ));
     assert!(matches!(
-        arm.inverse(&Vector3::new(f64::NAN, 0.0, 0.0), &q),
-        Err(MechanismError::NonFinite { what: "x", .. })
+        arm.inverse(&mut data, &Vector3::new(f64::NAN, 0.0, 0.0), &q),
+        Err(TickError::NonFinite { what: "x", .. })
     ));
     assert_eq!(
-        SerialArm::<3>::new(&model, IkOptions::default()).err(),
-        Some(MechanismError::WrongDof {
-            expected: 3,
-            got: 6
+        SerialArm::<3>::new(model, IkOptions::default()).err(),
+        Some(BuildError::DofMismatch {
+            what: "SerialArm<J>",
+            expected: 6,
+            got: 3
         })
     );
 }

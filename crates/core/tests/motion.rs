@@ -9,9 +9,10 @@
 
 use approx::assert_relative_eq;
 use deflect_core::motion::{
-    self, Limits, MAX_POINTS, MotionError, PAPER_ACCEL_TIMES, PAPER_G, PAPER_X_DURATIONS,
-    PAPER_Y_DURATIONS, Profile, Trajectory,
+    self, Limits, MAX_POINTS, PAPER_ACCEL_TIMES, PAPER_G, PAPER_X_DURATIONS, PAPER_Y_DURATIONS,
+    Profile, Trajectory,
 };
+use deflect_core::{BuildError, TickError};
 use nalgebra::{SVector, Vector2, Vector3};
 use proptest::prelude::*;
 
@@ -192,11 +193,11 @@ fn paper_durations_are_reproduced() {
     }
     assert_eq!(
         motion::paper_limits(0),
-        Err(MotionError::UnknownGLevel { g_level: 0 })
+        Err(BuildError::UnknownGLevel { g_level: 0 })
     );
     assert_eq!(
         motion::paper_limits(6),
-        Err(MotionError::UnknownGLevel { g_level: 6 })
+        Err(BuildError::UnknownGLevel { g_level: 6 })
     );
 }
 
@@ -280,7 +281,11 @@ fn validation_errors() {
     ] {
         assert_eq!(
             Limits::new(v, a, j),
-            Err(MotionError::InvalidLimit { what, value: bad })
+            Err(BuildError::InvalidParameter {
+                what,
+                value: bad,
+                expected: "finite and > 0 (not sub-normal)"
+            })
         );
         let raw = Limits {
             v_max: v,
@@ -289,30 +294,43 @@ fn validation_errors() {
         };
         assert!(matches!(
             Trajectory::line(p0, p1, &raw),
-            Err(MotionError::InvalidLimit { .. })
+            Err(BuildError::InvalidParameter { .. })
         ));
     }
     assert!(matches!(
         Limits::new(1.0, f64::NAN, 1.0),
-        Err(MotionError::InvalidLimit { what: "a_max", .. })
+        Err(BuildError::InvalidParameter { what: "a_max", .. })
     ));
     let l = lim(1.0, 10.0, 100.0);
     assert_eq!(
         Trajectory::line(p0, Vector2::new(0.1, f64::NAN), &l),
-        Err(MotionError::NonFinitePoint { index: 1, axis: 1 })
+        Err(BuildError::NonFinite {
+            what: "points (flattened, N per point)",
+            // Point 1, axis 1, N = 2 coordinates per point.
+            index: 3
+        })
     );
     assert_eq!(
         Trajectory::<2>::polyline(&[p0], &l),
-        Err(MotionError::TooFewPoints { got: 1 })
+        Err(BuildError::TooFew {
+            what: "points",
+            needed: 2,
+            got: 1
+        })
     );
     assert_eq!(
         Trajectory::<2>::polyline(&[], &l),
-        Err(MotionError::TooFewPoints { got: 0 })
+        Err(BuildError::TooFew {
+            what: "points",
+            needed: 2,
+            got: 0
+        })
     );
     let many = vec![p1; MAX_POINTS + 1];
     assert_eq!(
         Trajectory::polyline(&many, &l),
-        Err(MotionError::CapacityExceeded {
+        Err(BuildError::Capacity {
+            what: "points",
             capacity: MAX_POINTS,
             got: MAX_POINTS + 1
         })
@@ -326,15 +344,28 @@ fn validation_errors() {
     );
     assert_eq!(
         Profile::new(-1.0, &l),
-        Err(MotionError::InvalidLength { length: -1.0 })
+        Err(BuildError::InvalidParameter {
+            what: "profile length",
+            value: -1.0,
+            expected: "finite and >= 0 (m)"
+        })
     );
     let tr = Trajectory::line(p0, p1, &l).unwrap();
     assert!(matches!(
         tr.sample(f64::NAN),
-        Err(MotionError::NonFiniteTime { .. })
+        Err(TickError::NonFinite {
+            what: "t",
+            index: 0
+        })
     ));
     for r in [0.0, -1.0, f64::NAN, f64::INFINITY] {
-        assert!(matches!(tr.ticks(r), Err(MotionError::InvalidRate { .. })));
+        assert!(matches!(
+            tr.ticks(r),
+            Err(TickError::InvalidArgument {
+                what: "rate_hz",
+                ..
+            })
+        ));
     }
     // Before the start and after the end: at rest.
     assert_eq!(tr.sample(-1.0).unwrap().position, p0);

@@ -38,7 +38,7 @@ k = [inf, inf, 2.0e3]
 
 #[test]
 fn loads_and_matches_hand_computation() {
-    let r = SerialRobot::from_strs(&good_urdf(), STIFF, None, "tip").unwrap();
+    let r = SerialRobot::from_str(&good_urdf(), STIFF, None, "tip").unwrap();
     assert_eq!(r.joint_names, ["j1", "j2"]);
     assert_eq!(r.spring_names, ["l1", "l2"]);
     assert_eq!(r.base_link, "base");
@@ -77,7 +77,7 @@ xyz = [0.3, 0.0, 0.0]
 rpy = [0.0, 0.0, 0.0]
 k = [inf, inf, 4.0e3]
 "#;
-    let r = SerialRobot::from_strs(&good_urdf(), two, None, "tip").unwrap();
+    let r = SerialRobot::from_str(&good_urdf(), two, None, "tip").unwrap();
     assert_eq!(r.spring_names, ["l2", "l2#1"]);
     let mut data = Data::new(&r.model);
     let c = vjm::compliance(&r.model, &mut data, &[0.0, 0.0]).unwrap();
@@ -87,7 +87,7 @@ k = [inf, inf, 4.0e3]
 }
 
 fn err(urdf: &str, stiff: &str, tip: &str) -> LoadError {
-    SerialRobot::from_strs(urdf, stiff, None, tip).unwrap_err()
+    SerialRobot::from_str(urdf, stiff, None, tip).unwrap_err()
 }
 
 #[test]
@@ -124,7 +124,7 @@ fn every_malformed_input_is_a_named_error() {
   <joint name="k" type="fixed"><parent link="other_root"/><child link="island"/></joint>"#,
     );
     assert_eq!(
-        SerialRobot::from_strs(&island, STIFF, Some("base"), "island").unwrap_err(),
+        SerialRobot::from_str(&island, STIFF, Some("base"), "island").unwrap_err(),
         LoadError::TipNotReachable {
             tip: "island".into(),
             base: "base".into()
@@ -200,7 +200,7 @@ fn stiffness_file_errors_name_the_entry() {
         err(&u, unknown, "tip"),
         LoadError::UnknownLink {
             link: "elbow".into(),
-            referenced_by: "stiffness file".into()
+            referenced_by: "virtual_joint #0 of the stiffness file".into()
         }
     );
     let off_chain = "[[virtual_joint]]\nlink = \"tip\"\nk = [1.0, 1.0, 1.0]\n";
@@ -214,8 +214,7 @@ fn stiffness_file_errors_name_the_entry() {
     assert_eq!(
         e,
         LoadError::NonPositiveStiffness {
-            link: "l2".into(),
-            entry: 1,
+            element: "virtual_joint #1 on link 'l2'".into(),
             axis: 1,
             value: 0.0
         }
@@ -246,6 +245,78 @@ fn stiffness_file_errors_name_the_entry() {
         }
     }
     let missing =
-        SerialRobot::from_files("/nonexistent.urdf", "/nonexistent.toml", "tip").unwrap_err();
+        SerialRobot::from_path("/nonexistent.urdf", "/nonexistent.toml", "tip").unwrap_err();
     assert!(matches!(missing, LoadError::Io { ref path, .. } if path == "/nonexistent.urdf"));
+}
+
+#[test]
+fn a_spring_at_a_joint_has_its_first_axis_along_the_joint_axis() {
+    // Joint j2 about z: `joint = "j2"` puts the spring in l2's frame with x along z, i.e.
+    // the same spring as `link = "l2"` with the torsional stiffness about z written last.
+    // Check it through the compliance: both files give identical models.
+    let u = good_urdf();
+    let by_joint = "[[virtual_joint]]\njoint = \"j2\"\nk = [2.0e3, 5.0e4, 7.0e4]\n";
+    let by_link = "[[virtual_joint]]\nlink = \"l2\"\nrpy = [0.0, -1.5707963267948966, 0.0]\n\
+                   k = [2.0e3, 5.0e4, 7.0e4]\n";
+    let a = SerialRobot::from_str(&u, by_joint, None, "tip").unwrap();
+    let b = SerialRobot::from_str(&u, by_link, None, "tip").unwrap();
+    assert_eq!(a.spring_names, ["j2"]);
+    let q = [0.3, -0.7];
+    let (mut da, mut db) = (Data::new(&a.model), Data::new(&b.model));
+    let ca = vjm::compliance(&a.model, &mut da, &q).unwrap();
+    let cb = vjm::compliance(&b.model, &mut db, &q).unwrap();
+    // 1/k_torsion about z: a 100 N force normal to the last 0.3 m turns it by 30/2000 rad.
+    let w = Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0);
+    let d = vjm::deflection(&a.model, &mut da, &[0.0, 0.0], &w).unwrap();
+    assert_relative_eq!(d[5], 100.0 * 0.3 / 2.0e3, max_relative = 1e-4);
+    for (x, y) in ca.iter().zip(cb.iter()) {
+        assert_relative_eq!(*x, *y, epsilon = 1e-18, max_relative = 1e-12);
+    }
+    // A joint about -x gets a half turn about z (x -> -x), still x along the axis.
+    let neg = urdf(r#"xyz="0.5 0 0" rpy="0 0 0""#, "-1 0 0", "");
+    assert!(SerialRobot::from_str(&neg, by_joint, None, "tip").is_ok());
+}
+
+#[test]
+fn spring_placement_errors_are_named() {
+    let u = good_urdf();
+    let cases = [
+        ("[[virtual_joint]]\nk = [1.0, 1.0, 1.0]\n", "exactly one of"),
+        (
+            "[[virtual_joint]]\nlink = \"l1\"\njoint = \"j1\"\nk = [1.0, 1.0, 1.0]\n",
+            "not both",
+        ),
+        (
+            "[[virtual_joint]]\njoint = \"j1\"\nxyz = [0.0, 0.0, 0.1]\nk = [1.0, 1.0, 1.0]\n",
+            "only with `link`",
+        ),
+        (
+            "[[virtual_joint]]\njoint = \"nope\"\nk = [1.0, 1.0, 1.0]\n",
+            "unknown joint 'nope'",
+        ),
+        (
+            "[[virtual_joint]]\njoint = \"fix\"\nk = [1.0, 1.0, 1.0]\n",
+            "fixed",
+        ),
+        (
+            "[[virtual_joint]]\njoint = \"j2\"\nk = [1.0, 0.0, 1.0]\n",
+            "virtual_joint #0 at joint 'j2': stiffness about y",
+        ),
+        (
+            "[[virtual_joint]]\njoint = \"j2\"\nk = [1.0, 1.0]\n",
+            "expected 3 values",
+        ),
+    ];
+    for (toml, needle) in cases {
+        let e = err(&u, toml, "tip").to_string();
+        assert!(e.contains(needle), "{toml:?}: {e}");
+    }
+    // A joint off the chain (tip = l1 leaves j2 out).
+    let e = err(
+        &u,
+        "[[virtual_joint]]\njoint = \"j2\"\nk = [1.0, 1.0, 1.0]\n",
+        "l1",
+    )
+    .to_string();
+    assert!(e.contains("not on the base-to-tip chain"), "{e}");
 }

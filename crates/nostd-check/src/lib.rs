@@ -1,11 +1,12 @@
 //! Compile-time check that deflect-core's real-time paths need neither `std` nor `alloc`.
 //!
 //! This crate is `#![no_std]`, has no `extern crate alloc`, and depends on deflect-core with
-//! `default-features = false`. It calls the per-tick functions a controller runs: VJM
-//! deflection and compliance, a compliance-map view lookup, trajectory sampling and the
-//! D'Alembert corrector step. Build it alone (`cargo build -p deflect-nostd-check`): built
-//! together with the rest of the workspace, cargo unifies deflect-core's features and the
-//! check proves nothing.
+//! `default-features = false`. It builds every per-tick concept in its tick shape (`Model`,
+//! `Data::new(&model)`, `fn(&Model, &mut Data, inputs)`) and calls what a controller runs:
+//! VJM deflection and compliance, a compliance-map query, trajectory sampling, the D'Alembert
+//! corrector, online compensation, drive-train correction and the contour tracer. Build it
+//! alone (`cargo build -p deflect-nostd-check`): built together with the rest of the
+//! workspace, cargo unifies deflect-core's features and the check proves nothing.
 #![no_std]
 #![deny(
     clippy::unwrap_used,
@@ -13,15 +14,18 @@
     clippy::panic,
     clippy::indexing_slicing
 )]
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
-use deflect_core::compliance_map::{ComplianceMapView, OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{CorrectedTick, DalembertCorrector};
+use deflect_core::compensation::{self, CompensatorConfig, CycleOutput, SensorCalibration};
+use deflect_core::compliance_map::{self, ComplianceMapView, OutOfGrid, QueryOptions};
+use deflect_core::contour::{self, TracerConfig, TracerStep};
+use deflect_core::dalembert::{self, CorrectedTick};
+use deflect_core::drivetrain::{self, JointErrors};
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Limits, Trajectory};
 use deflect_core::vjm::{self, Data, Model, ModelBuilder, Vector6};
-use deflect_core::{BuildError, ComplianceMapError};
-use nalgebra::{Isometry3, Matrix6, Vector2, Vector3};
+use deflect_core::{BuildError, TickError};
+use nalgebra::{Isometry3, Matrix2, Matrix6, Vector2, Vector3};
 
 /// Why a check call failed (a `no_std` error type: no strings, no heap).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,9 +33,7 @@ pub enum CheckError {
     /// Model building failed.
     Build(BuildError),
     /// A per-tick call refused its input.
-    Tick,
-    /// The map tables are invalid.
-    Map,
+    Tick(TickError),
 }
 
 impl From<BuildError> for CheckError {
@@ -40,9 +42,9 @@ impl From<BuildError> for CheckError {
     }
 }
 
-impl From<ComplianceMapError> for CheckError {
-    fn from(_: ComplianceMapError) -> Self {
-        Self::Map
+impl From<TickError> for CheckError {
+    fn from(e: TickError) -> Self {
+        Self::Tick(e)
     }
 }
 
@@ -65,14 +67,14 @@ pub fn vjm_tick(
     q: &[f64; 2],
     wrench: &Vector6,
 ) -> Result<(Vector6, Matrix6<f64>), CheckError> {
-    let d = vjm::deflection(model, data, q, wrench).map_err(|_| CheckError::Tick)?;
-    let c = vjm::compliance(model, data, q).map_err(|_| CheckError::Tick)?;
+    let d = vjm::deflection(model, data, q, wrench)?;
+    let c = vjm::compliance(model, data, q)?;
     Ok((d, c))
 }
 
-/// The paper's 3 x 5 grid [m].
+/// The paper's 3 x 5 grid \[m\].
 pub const GRID_X: [f64; 3] = [0.172132, 0.222132, 0.272132];
-/// The paper's 3 x 5 grid [m].
+/// The paper's 3 x 5 grid \[m\].
 pub const GRID_Y: [f64; 5] = [-0.075, -0.0375, 0.0, 0.0375, 0.075];
 
 /// A borrowed, allocation-free compliance map over static tables (2 force, 2 displacement
@@ -91,45 +93,100 @@ pub fn map_view<'a>(
     )
 }
 
-/// A map-view lookup: displacement [m] at `position` under `force` [N].
+/// A map query in the tick shape: displacement \[m\] at `position` under `force` \[N\].
 pub fn map_lookup(
     view: &ComplianceMapView<'_>,
+    data: &mut compliance_map::Data,
     position: [f64; 2],
     force: [f64; 2],
 ) -> Result<[f64; 2], CheckError> {
-    let mut out = [0.0; 2];
-    view.displacement(position, &force, &mut out)
-        .map_err(|_| CheckError::Tick)?;
-    Ok(out)
+    compliance_map::query(view, data, position, &force)?;
+    Ok([data.displacement[0], data.displacement[1]])
+}
+
+/// The D'Alembert corrector of the paper's robot over a borrowed map.
+pub type Corrector<'a> = dalembert::Model<ParallelRobot2, ComplianceMapView<'a>>;
+
+/// The corrector with the paper's mass parameter.
+pub fn corrector<'a>(view: ComplianceMapView<'a>) -> Result<Corrector<'a>, CheckError> {
+    Ok(dalembert::Model::new(
+        ParallelRobot2::paper(),
+        view,
+        dalembert::PAPER_MASS,
+    )?)
 }
 
 /// One 2 kHz D'Alembert tick of the paper's robot at time `t` of `trajectory`.
 pub fn dalembert_tick(
-    view: &ComplianceMapView<'_>,
+    model: &Corrector<'_>,
+    data: &mut dalembert::Data<(), (), 2>,
     trajectory: &Trajectory<2>,
     t: f64,
-    seed: &Vector2<f64>,
 ) -> Result<CorrectedTick<2, 2>, CheckError> {
-    let corrector =
-        DalembertCorrector::new(DalembertCorrector::PAPER_MASS).map_err(|_| CheckError::Tick)?;
-    let s = trajectory.sample(t).map_err(|_| CheckError::Tick)?;
-    corrector
-        .step(
-            &ParallelRobot2::paper(),
-            view,
-            &s.position,
-            &s.acceleration,
-            seed,
-        )
-        .map_err(|_| CheckError::Tick)
+    let s = trajectory.sample(t)?;
+    Ok(dalembert::step(model, data, &s.position, &s.acceleration)?)
 }
 
 /// The paper's 150 mm y-line, planned without a heap.
 pub fn y_line(limits: &Limits) -> Result<Trajectory<2>, CheckError> {
-    Trajectory::line(
+    Ok(Trajectory::line(
         Vector2::new(0.222132, -0.075),
         Vector2::new(0.222132, 0.075),
         limits,
-    )
-    .map_err(|_| CheckError::Tick)
+    )?)
+}
+
+/// The online compensation chain of `chain` at 2 kHz with the paper's settings.
+pub fn compensator(chain: Model) -> Result<compensation::Model, CheckError> {
+    let config = CompensatorConfig::paper(0.0005, SensorCalibration::default());
+    Ok(compensation::Model::new(chain, config)?)
+}
+
+/// One compensation cycle.
+pub fn compensation_tick(
+    model: &compensation::Model,
+    data: &mut compensation::Data,
+    q: &[f64; 2],
+    reading: &Vector6,
+) -> Result<CycleOutput, CheckError> {
+    let feed = Vector3::new(0.05, 0.0, 0.0);
+    Ok(compensation::step(model, data, q, reading, None, &feed)?)
+}
+
+/// The drive train of `chain`: joint stiffnesses and backlashes, standard gravity.
+pub fn drive_train(chain: Model) -> Result<drivetrain::Model, CheckError> {
+    Ok(drivetrain::Model::new(
+        chain,
+        &[2.0e4, 1.0e4],
+        &[1.0e-4, 1.0e-4],
+    )?)
+}
+
+/// Eq. 10 of the contour-tracking paper at readings `q` under the tool wrench `wrench`.
+pub fn drive_tick(
+    model: &drivetrain::Model,
+    data: &mut drivetrain::Data,
+    q: &[f64; 2],
+    wrench: &Vector6,
+) -> Result<JointErrors, CheckError> {
+    Ok(drivetrain::correct_joints(model, data, q, wrench)?)
+}
+
+/// A contour tracer with a 1 mm step, a 2..20 N window and a diagonal 1e5 N/m stiffness.
+pub fn tracer() -> Result<contour::Model, CheckError> {
+    let k = Matrix2::new(1.0e5, 0.0, 0.0, 1.0e5);
+    Ok(contour::Model::new(
+        TracerConfig::new(1.0e-3, 2.0, 20.0),
+        &k,
+    )?)
+}
+
+/// One tracer step.
+pub fn tracer_tick(
+    model: &contour::Model,
+    data: &mut contour::Data,
+    position: &Vector2<f64>,
+    force: &Vector2<f64>,
+) -> Result<TracerStep, CheckError> {
+    Ok(contour::step(model, data, position, force)?)
 }

@@ -1,6 +1,7 @@
 //! The quasi-static part of the force signal (VJM paper, section 2.2): a first-order low-pass
 //! and a moving average, each with the delay it costs stated in samples and seconds.
 
+use crate::error::{BuildError, param};
 use crate::vjm::Vector6;
 
 /// First-order IIR low-pass on a wrench, `y += alpha (x - y)`, `alpha = dt / (tau + dt)`,
@@ -15,13 +16,12 @@ pub struct LowPass {
 }
 
 impl LowPass {
-    /// Cut-off `cutoff_hz` [Hz] at sample time `dt` [s]; `None` unless both are finite and > 0.
-    pub fn new(cutoff_hz: f64, dt: f64) -> Option<Self> {
-        if !(cutoff_hz.is_finite() && cutoff_hz > 0.0 && dt.is_finite() && dt > 0.0) {
-            return None;
-        }
+    /// Cut-off `cutoff_hz` \[Hz\] at sample time `dt` \[s\], both finite and > 0.
+    pub fn new(cutoff_hz: f64, dt: f64) -> Result<Self, BuildError> {
+        param("lowpass_cutoff_hz", cutoff_hz, cutoff_hz > 0.0, "> 0 (Hz)")?;
+        param("dt", dt, dt > 0.0, "> 0 (s)")?;
         let tau = 1.0 / (2.0 * core::f64::consts::PI * cutoff_hz);
-        Some(Self {
+        Ok(Self {
             alpha: dt / (tau + dt),
             dt,
             state: Vector6::zeros(),
@@ -34,12 +34,12 @@ impl LowPass {
         self.alpha
     }
 
-    /// Low-frequency delay [samples].
+    /// Low-frequency delay \[samples\].
     pub fn delay_samples(&self) -> f64 {
         (1.0 - self.alpha) / self.alpha
     }
 
-    /// Low-frequency delay [s].
+    /// Low-frequency delay \[s\].
     pub fn delay_seconds(&self) -> f64 {
         self.delay_samples() * self.dt
     }
@@ -74,13 +74,18 @@ pub struct MovingAverage<const N: usize> {
 }
 
 impl<const N: usize> MovingAverage<N> {
-    /// A `window`-sample average at sample time `dt` [s]; `None` unless `1 <= window <= N` and
-    /// `dt` is finite and > 0.
-    pub fn new(window: usize, dt: f64) -> Option<Self> {
-        if window == 0 || window > N || !(dt.is_finite() && dt > 0.0) {
-            return None;
+    /// A `window`-sample average at sample time `dt` \[s\]: `1 <= window <= N`, `dt` finite
+    /// and > 0.
+    pub fn new(window: usize, dt: f64) -> Result<Self, BuildError> {
+        if window == 0 || window > N {
+            return Err(BuildError::InvalidParameter {
+                what: "moving_average_window",
+                value: window as f64,
+                expected: "in 1..=MAX_AVERAGE_WINDOW (64) samples",
+            });
         }
-        Some(Self {
+        param("dt", dt, dt > 0.0, "> 0 (s)")?;
+        Ok(Self {
             buffer: [Vector6::zeros(); N],
             window,
             len: 0,
@@ -89,17 +94,17 @@ impl<const N: usize> MovingAverage<N> {
         })
     }
 
-    /// Window length [samples].
+    /// Window length \[samples\].
     pub fn window(&self) -> usize {
         self.window
     }
 
-    /// Delay [samples] of a full window.
+    /// Delay \[samples\] of a full window.
     pub fn delay_samples(&self) -> f64 {
         (self.window as f64 - 1.0) / 2.0
     }
 
-    /// Delay [s] of a full window.
+    /// Delay \[s\] of a full window.
     pub fn delay_seconds(&self) -> f64 {
         self.delay_samples() * self.dt
     }

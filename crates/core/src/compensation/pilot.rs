@@ -4,11 +4,12 @@
 //! and back to the measurement once they agree again. This removes the 100-150 ms reaction
 //! time of the filtered measurement at cutter entry and exit.
 
+use crate::error::{BuildError, param};
 use crate::vjm::Vector6;
 
-/// The paper's switching threshold [N].
+/// The paper's switching threshold \[N\].
 pub const PAPER_THRESHOLD: f64 = 150.0;
-/// The paper's blending time [s].
+/// The paper's blending time \[s\].
 pub const PAPER_RAMP: f64 = 0.080;
 
 /// Pilot-control state: the weight `w` of the estimate in `(1 - w) measured + w estimated`.
@@ -21,17 +22,14 @@ pub struct PilotControl {
 }
 
 impl PilotControl {
-    /// Switch when `|F_measured - F_estimated| > threshold` [N] (force part of the wrench),
-    /// blend over `ramp` [s] at cycle time `dt` [s]. `ramp = 0` switches in one cycle.
-    /// `None` unless threshold >= 0, ramp >= 0 and dt > 0, all finite.
-    pub fn new(threshold: f64, ramp: f64, dt: f64) -> Option<Self> {
-        let ok = threshold.is_finite()
-            && threshold >= 0.0
-            && ramp.is_finite()
-            && ramp >= 0.0
-            && dt.is_finite()
-            && dt > 0.0;
-        ok.then_some(Self {
+    /// Switch when `|F_measured - F_estimated| > threshold` \[N\] (force part of the wrench),
+    /// blend over `ramp` \[s\] at cycle time `dt` \[s\]. `ramp = 0` switches in one cycle.
+    /// Threshold >= 0, ramp >= 0 and dt > 0, all finite.
+    pub fn new(threshold: f64, ramp: f64, dt: f64) -> Result<Self, BuildError> {
+        param("pilot threshold", threshold, threshold >= 0.0, ">= 0 (N)")?;
+        param("pilot ramp", ramp, ramp >= 0.0, ">= 0 (s)")?;
+        param("dt", dt, dt > 0.0, "> 0 (s)")?;
+        Ok(Self {
             threshold,
             ramp,
             dt,
@@ -39,8 +37,8 @@ impl PilotControl {
         })
     }
 
-    /// The paper's 150 N / 80 ms at cycle time `dt` [s].
-    pub fn paper(dt: f64) -> Option<Self> {
+    /// The paper's 150 N / 80 ms at cycle time `dt` \[s\].
+    pub fn paper(dt: f64) -> Result<Self, BuildError> {
         Self::new(PAPER_THRESHOLD, PAPER_RAMP, dt)
     }
 
@@ -49,17 +47,17 @@ impl PilotControl {
         self.weight
     }
 
-    /// Threshold [N].
+    /// Threshold \[N\].
     pub fn threshold(&self) -> f64 {
         self.threshold
     }
 
-    /// Ramp time [s].
+    /// Ramp time \[s\].
     pub fn ramp(&self) -> f64 {
         self.ramp
     }
 
-    /// One cycle: blends `measured` and `estimated` wrenches [N, N m] and returns the blend.
+    /// One cycle: blends `measured` and `estimated` wrenches \[N, N m\] and returns the blend.
     /// The weight moves by `dt / ramp` per cycle towards 1 while the forces differ by more than
     /// the threshold, towards 0 otherwise.
     pub fn step(&mut self, measured: &Vector6, estimated: &Vector6) -> Vector6 {

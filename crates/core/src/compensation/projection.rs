@@ -3,7 +3,7 @@
 
 use nalgebra::Vector3;
 
-/// Feed speeds below this [m/s] count as standing still: no feed direction is defined.
+/// Feed speeds below this \[m/s\] count as standing still: no feed direction is defined.
 pub const MIN_FEED_SPEED: f64 = 1.0e-9;
 
 /// `r_v = r - (r . v_n) v_n` with `v_n = v / |v|` (Eq. 10-11). When the feed speed is below

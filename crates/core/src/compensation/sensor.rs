@@ -4,7 +4,7 @@
 //! compensated wrench to the TCP.
 //!
 //! Model of a reading in the sensor frame S with the sensor at orientation `R_BS` (base from
-//! sensor) and gravity `g = (0, 0, -G)` in the base frame (G the end effector's weight [N]):
+//! sensor) and gravity `g = (0, 0, -G)` in the base frame (G the end effector's weight \[N\]):
 //!
 //! ```text
 //! F_M = F_SI + R_BS^T g + F_app(q_S) + F_ext
@@ -21,6 +21,7 @@
 
 use nalgebra::{Isometry3, Rotation3, UnitQuaternion, Vector3};
 
+use crate::error::{BuildError, param};
 use crate::vjm::Vector6;
 
 /// Number of terms of the residual polynomial of Eq. 17.
@@ -60,13 +61,13 @@ pub fn poly_terms(q: &[f64; 4]) -> [f64; POLY_TERMS] {
 /// Identified sensor parameters and the fixed sensor-to-TCP transform.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SensorCalibration {
-    /// Internal force offset `F_SI` [N], sensor frame.
+    /// Internal force offset `F_SI` \[N\], sensor frame.
     pub force_offset: Vector3<f64>,
-    /// Internal moment offset `M_SI` [N m], sensor frame.
+    /// Internal moment offset `M_SI` \[N m\], sensor frame.
     pub moment_offset: Vector3<f64>,
-    /// Weight of everything beyond the sensor, `G` [N] (> 0; gravity is `-z` of the base).
+    /// Weight of everything beyond the sensor, `G` \[N\] (> 0; gravity is `-z` of the base).
     pub weight: f64,
-    /// Centre of gravity `r_G` [m], sensor frame.
+    /// Centre of gravity `r_G` \[m\], sensor frame.
     pub center_of_gravity: Vector3<f64>,
     /// Residual-offset polynomial coefficients `a_1..a_15` (Eq. 17) per wrench component
     /// `[Fx, Fy, Fz, Mx, My, Mz]` of the sensor frame; zeros disable it.
@@ -89,6 +90,50 @@ impl Default for SensorCalibration {
 }
 
 impl SensorCalibration {
+    /// Checks that every value is finite, the weight non-negative and the sensor-to-TCP
+    /// rotation a unit quaternion.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        let vectors: [(&'static str, &[f64]); 3] = [
+            ("force_offset", self.force_offset.as_slice()),
+            ("moment_offset", self.moment_offset.as_slice()),
+            ("center_of_gravity", self.center_of_gravity.as_slice()),
+        ];
+        for (what, v) in vectors {
+            if let Some(index) = v.iter().position(|x| !x.is_finite()) {
+                return Err(BuildError::NonFinite { what, index });
+            }
+        }
+        param("weight", self.weight, self.weight >= 0.0, ">= 0 (N)")?;
+        if let Some(index) = self.residual.iter().flatten().position(|x| !x.is_finite()) {
+            return Err(BuildError::NonFinite {
+                what: "residual",
+                index,
+            });
+        }
+        let t = &self.sensor_to_tcp;
+        if let Some(index) = t
+            .translation
+            .vector
+            .iter()
+            .chain(t.rotation.coords.iter())
+            .position(|x| !x.is_finite())
+        {
+            return Err(BuildError::NonFinite {
+                what: "sensor_to_tcp",
+                index,
+            });
+        }
+        let norm = t.rotation.coords.norm();
+        if (norm - 1.0).abs() > 1e-9 {
+            return Err(BuildError::InvalidParameter {
+                what: "sensor_to_tcp rotation (quaternion norm)",
+                value: norm,
+                expected: "1 (a rotation)",
+            });
+        }
+        Ok(())
+    }
+
     /// The residual offset `F_app` (Eq. 16-17) at sensor orientation `r_bs`, sensor frame.
     pub fn residual_at(&self, r_bs: &UnitQuaternion<f64>) -> Vector6 {
         let t = poly_terms(&orientation_quaternion(r_bs));

@@ -5,25 +5,27 @@
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::{ComplianceMap, ComplianceMapError, MAX_AXES, check_counts, sqrt};
+use super::view::check_counts;
+use super::{ComplianceMap, MAX_AXES, sqrt};
+use crate::error::BuildError;
 
 /// Column names used in errors for the displacement entries of a [`Measurement`].
 pub(crate) const DISPLACEMENT_COLUMNS: [&str; MAX_AXES] = ["d0", "d1", "d2", "d3", "d4", "d5"];
 
-/// One static-test reading: at node position `(x, y)` [m] a force `force` [N] (or moment
-/// [N m]) is applied along force axis `force_axis` only, and the displacement of the working
-/// point is measured (`displacement[..n_displacement]`, [m] or [rad]; later entries unused).
+/// One static-test reading: at node position `(x, y)` \[m\] a force `force` \[N\] (or moment
+/// \[N m\]) is applied along force axis `force_axis` only, and the displacement of the working
+/// point is measured (`displacement[..n_displacement]`, \[m\] or \[rad\]; later entries unused).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Measurement {
-    /// Node x [m].
+    /// Node x \[m\].
     pub x: f64,
-    /// Node y [m].
+    /// Node y \[m\].
     pub y: f64,
     /// Loaded force axis, `0..n_force`.
     pub force_axis: usize,
-    /// Force level [N] (moment [N m]).
+    /// Force level \[N\] (moment \[N m\]).
     pub force: f64,
-    /// Measured displacement [m] / [rad]; the first `n_displacement` entries are used.
+    /// Measured displacement \[m\] / \[rad\]; the first `n_displacement` entries are used.
     pub displacement: [f64; MAX_AXES],
 }
 
@@ -55,7 +57,7 @@ impl Measurement {
         lower: &[f64],
         spacing: f64,
         extension: f64,
-    ) -> Result<Self, ComplianceMapError> {
+    ) -> Result<Self, BuildError> {
         let n = upper.len().min(lower.len()).min(MAX_AXES);
         let mut d = [0.0; MAX_AXES];
         two_point_displacement(
@@ -86,10 +88,10 @@ impl Measurement {
 /// delta_W = delta_l + (e / L) * (delta_l - delta_u)
 /// ```
 ///
-/// where `L = |P_u P_l| > 0` is the spacing of the two points [m] and `e` the signed distance
-/// from P_l to W along the axis pointing from P_u to P_l [m] (`e > 0` beyond P_l, the paper's
+/// where `L = |P_u P_l| > 0` is the spacing of the two points \[m\] and `e` the signed distance
+/// from P_l to W along the axis pointing from P_u to P_l \[m\] (`e > 0` beyond P_l, the paper's
 /// `e = 2.5 mm`; `e = 0` gives P_l, `e = -L` gives P_u). `(delta_l - delta_u) / L` is the
-/// small tilt of the tool axis [rad] for the transverse components. Component-wise on equal
+/// small tilt of the tool axis \[rad\] for the transverse components. Component-wise on equal
 /// length slices; `out` gets `min(len)` entries.
 pub fn two_point_displacement(
     upper: &[f64],
@@ -97,9 +99,9 @@ pub fn two_point_displacement(
     spacing: f64,
     extension: f64,
     out: &mut [f64],
-) -> Result<(), ComplianceMapError> {
+) -> Result<(), BuildError> {
     if !(spacing.is_finite() && spacing > 0.0) {
-        return Err(ComplianceMapError::BadTwoPoint { spacing });
+        return Err(BuildError::BadTwoPoint { spacing });
     }
     let k = extension / spacing;
     for ((o, u), l) in out.iter_mut().zip(upper).zip(lower) {
@@ -115,7 +117,7 @@ pub struct FitOptions {
     pub n_force: usize,
     /// Number of displacement axes (1..=6).
     pub n_displacement: usize,
-    /// Coordinates closer than this are the same grid line [m]. Default 1e-6 m.
+    /// Coordinates closer than this are the same grid line \[m\]. Default 1e-6 m.
     pub position_tolerance: f64,
 }
 
@@ -134,11 +136,11 @@ impl Default for FitOptions {
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "std", derive(serde::Serialize, serde::Deserialize))]
 pub struct LineStats {
-    /// Fitted slope [m/N].
+    /// Fitted slope \[m/N\].
     pub slope: f64,
-    /// Fitted offset [m].
+    /// Fitted offset \[m\].
     pub offset: f64,
-    /// Root mean square of the residuals, `sqrt(sum r^2 / k)` over the `k` readings [m].
+    /// Root mean square of the residuals, `sqrt(sum r^2 / k)` over the `k` readings \[m\].
     pub rms: f64,
     /// Coefficient of determination `1 - SS_res / SS_tot` (1 when the displacement does not
     /// vary at all).
@@ -153,9 +155,9 @@ pub struct NodeFit {
     pub i: usize,
     /// Node index along y.
     pub j: usize,
-    /// Node x [m] (mean of its readings' x).
+    /// Node x \[m\] (mean of its readings' x).
     pub x: f64,
-    /// Node y [m].
+    /// Node y \[m\].
     pub y: f64,
     /// Line statistics, index `d * n_force + f`.
     pub lines: Vec<LineStats>,
@@ -172,7 +174,7 @@ fn cluster(
     values: &[f64],
     axis: &'static str,
     tolerance: f64,
-) -> Result<(Vec<f64>, Vec<usize>), ComplianceMapError> {
+) -> Result<(Vec<f64>, Vec<usize>), BuildError> {
     let mut order: Vec<usize> = (0..values.len()).collect();
     let val = |k: usize| values.get(k).copied().unwrap_or(0.0);
     order.sort_by(|a, b| val(*a).total_cmp(&val(*b)));
@@ -188,7 +190,7 @@ fn cluster(
         if count == 0 {
             start = v;
         } else if v - start > tolerance {
-            return Err(ComplianceMapError::AmbiguousCoordinate {
+            return Err(BuildError::AmbiguousCoordinate {
                 axis,
                 low: start,
                 high: v,
@@ -208,27 +210,29 @@ fn cluster(
     Ok((centres, line_of))
 }
 
-/// Grid lines along x and y [m] and each reading's node index.
+/// Grid lines along x and y \[m\] and each reading's node index.
 pub(crate) type Grid = (Vec<f64>, Vec<f64>, Vec<usize>);
 
 /// Grid lines of the readings' positions and each reading's node `i * ny + j`; checks that
 /// the nodes form a full rectilinear grid of at least 2 x 2.
-pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, ComplianceMapError> {
+pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, BuildError> {
     let xs: Vec<f64> = measurements.iter().map(|m| m.x).collect();
     let ys: Vec<f64> = measurements.iter().map(|m| m.y).collect();
     let (cx, line_x) = cluster(&xs, "x", tol)?;
     let (cy, line_y) = cluster(&ys, "y", tol)?;
     let (nx, ny) = (cx.len(), cy.len());
     if nx < 2 {
-        return Err(ComplianceMapError::TooFewNodes {
-            axis: "x",
-            count: nx,
+        return Err(BuildError::TooFew {
+            what: "x nodes",
+            needed: 2,
+            got: nx,
         });
     }
     if ny < 2 {
-        return Err(ComplianceMapError::TooFewNodes {
-            axis: "y",
-            count: ny,
+        return Err(BuildError::TooFew {
+            what: "y nodes",
+            needed: 2,
+            got: ny,
         });
     }
     let nodes: Vec<usize> = line_x
@@ -244,14 +248,14 @@ pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, Co
     }
     let measured = present.iter().filter(|p| **p).count();
     if 2 * measured < nx * ny {
-        return Err(ComplianceMapError::NotRectilinear {
+        return Err(BuildError::NotRectilinear {
             nodes: measured,
             distinct_x: nx,
             distinct_y: ny,
         });
     }
     if let Some(k) = present.iter().position(|p| !*p) {
-        return Err(ComplianceMapError::MissingNode {
+        return Err(BuildError::MissingNode {
             x: cx.get(k / ny).copied().unwrap_or(f64::NAN),
             y: cy.get(k % ny).copied().unwrap_or(f64::NAN),
         });
@@ -268,20 +272,20 @@ pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, Co
 /// paper (Eq. 10), each force axis keeps its own intercept as its offset, so the model's
 /// zero-force displacement is the sum of the offsets over the force axes.
 ///
-/// Errors: non-finite values ([`ComplianceMapError::NonFinite`] with row and column `x`, `y`,
+/// Errors: non-finite values ([`BuildError::NonFinite`] with row and column `x`, `y`,
 /// `force` or `d<k>`), a force axis `>= n_force`, ambiguous or non-rectilinear positions, a
 /// missing node, a repeated (node, axis, force), fewer than 2 force levels for a line.
 pub fn fit(
     measurements: &[Measurement],
     options: &FitOptions,
-) -> Result<ComplianceMap, ComplianceMapError> {
+) -> Result<ComplianceMap, BuildError> {
     let (nf, nd) = (options.n_force, options.n_displacement);
     check_counts(nf, nd)?;
     let tol = options.position_tolerance;
     for (row, m) in measurements.iter().enumerate() {
         for (column, v) in [("x", m.x), ("y", m.y), ("force", m.force)] {
             if !v.is_finite() {
-                return Err(ComplianceMapError::NonFinite { row, column });
+                return Err(BuildError::NonFiniteMeasurement { row, column });
             }
         }
         for (column, v) in DISPLACEMENT_COLUMNS
@@ -290,11 +294,11 @@ pub fn fit(
             .take(nd)
         {
             if !v.is_finite() {
-                return Err(ComplianceMapError::NonFinite { row, column });
+                return Err(BuildError::NonFiniteMeasurement { row, column });
             }
         }
         if m.force_axis >= nf {
-            return Err(ComplianceMapError::ForceAxisOutOfRange {
+            return Err(BuildError::ForceAxisOutOfRange {
                 row,
                 force_axis: m.force_axis,
                 n_force: nf,
@@ -324,7 +328,7 @@ pub fn fit(
     for w in order.windows(2) {
         if let [a, b] = w {
             if key(*a) == key(*b) {
-                return Err(ComplianceMapError::DuplicateMeasurement {
+                return Err(BuildError::DuplicateMeasurement {
                     row: *b,
                     previous_row: *a,
                 });
@@ -368,7 +372,7 @@ pub fn fit(
             }
             let rows = order.get(begin..pos).unwrap_or(&[]);
             if rows.len() < 2 {
-                return Err(ComplianceMapError::TooFewForceLevels {
+                return Err(BuildError::TooFewForceLevels {
                     node_x,
                     node_y,
                     force_axis: f,
@@ -389,7 +393,8 @@ pub fn fit(
                 group.iter().map(|m| m.force).sum::<f64>(),
                 k,
             );
-            let lmax = 0.5 * (a + c + sqrt((a - c) * (a - c) + 4.0 * b * b));
+            // hypot, not sqrt of the squares: (a - c)^2 overflows for forces above ~1e77 N.
+            let lmax = 0.5 * (a + c + nalgebra::ComplexField::hypot(a - c, 2.0 * b));
             // det(A^T A) = k * sum (F - mean)^2, computed without cancellation.
             let lmin = k * sxx / lmax;
             if let Some(slot) = nfit.condition.get_mut(f) {
@@ -438,6 +443,20 @@ pub fn fit(
                     };
                 }
             }
+        }
+        // Sums of squares of huge (finite) forces or displacements overflow: refuse such a fit
+        // rather than return statistics of NaN or inf (JSON cannot hold them).
+        let mut values = nfit.condition.iter().copied().chain(
+            nfit.lines
+                .iter()
+                .flat_map(|l| [l.slope, l.offset, l.rms, l.r_squared]),
+        );
+        if let Some(index) = values.position(|v| !v.is_finite()) {
+            return Err(BuildError::NonFinite {
+                what: "fit statistics (condition, then slope, offset, rms, r_squared per \
+                       line) of a node: forces or displacements too large",
+                index,
+            });
         }
         stats.push(nfit);
     }

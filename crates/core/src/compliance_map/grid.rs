@@ -3,20 +3,13 @@
 //!
 //! Everything here is allocation-free and panic-free: indices are reached through `.get()`.
 
-use super::{ComplianceMapError, Interpolation, OutOfGrid, QueryError};
+use super::{Interpolation, OutOfGrid};
+use crate::error::{BuildError, Placement, TickError};
 
 /// Relative tolerance under which an axis counts as evenly spaced (O(1) cell lookup).
 const UNIFORM_RTOL: f64 = 1e-12;
 
-/// Where a coordinate fell relative to its axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Placement {
-    Inside,
-    Clamped,
-    Extrapolated,
-}
-
-/// One grid axis: strictly increasing finite node coordinates [m].
+/// One grid axis: strictly increasing finite node coordinates \[m\].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Axis<'a> {
     pub nodes: &'a [f64],
@@ -26,23 +19,24 @@ pub(crate) struct Axis<'a> {
 
 /// Checks an axis (at least 2 nodes, finite, strictly increasing) and returns `1/step` when
 /// it is evenly spaced, else `0.0`.
-pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, ComplianceMapError> {
+pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, BuildError> {
     if nodes.len() < 2 {
-        return Err(ComplianceMapError::TooFewNodes {
-            axis,
-            count: nodes.len(),
+        return Err(BuildError::TooFew {
+            what: if axis == "x" { "x nodes" } else { "y nodes" },
+            needed: 2,
+            got: nodes.len(),
         });
     }
     for (index, v) in nodes.iter().enumerate() {
         if !v.is_finite() {
-            return Err(ComplianceMapError::NonFiniteValue { what: axis, index });
+            return Err(BuildError::NonFinite { what: axis, index });
         }
     }
     for (index, w) in nodes.windows(2).enumerate() {
         if let [a, b] = w {
             if b <= a {
-                return Err(ComplianceMapError::NotIncreasing {
-                    axis,
+                return Err(BuildError::NotIncreasing {
+                    what: axis,
                     index: index + 1,
                 });
             }
@@ -107,14 +101,14 @@ impl Axis<'_> {
         axis: usize,
         v: f64,
         policy: OutOfGrid,
-    ) -> Result<(usize, f64, Placement), QueryError> {
+    ) -> Result<(usize, f64, Placement), TickError> {
         let lo = self.node(0);
         let hi = self.node(self.nodes.len().saturating_sub(1));
         if v >= lo && v <= hi {
             return Ok((self.cell(v), v, Placement::Inside));
         }
         match policy {
-            OutOfGrid::Error => Err(QueryError::OutOfGrid {
+            OutOfGrid::Error => Err(TickError::OutOfGrid {
                 axis,
                 value: v,
                 min: lo,
@@ -167,7 +161,7 @@ impl Axis<'_> {
         axis: usize,
         v: f64,
         policy: OutOfGrid,
-    ) -> Result<(usize, f64, Placement), QueryError> {
+    ) -> Result<(usize, f64, Placement), TickError> {
         let (i, v, place) = self.locate(axis, v, policy)?;
         let (x0, x1) = (self.node(i), self.node(i + 1));
         let t = if v == x1 {
@@ -215,7 +209,7 @@ impl Axis<'_> {
         v: f64,
         method: Interpolation,
         policy: OutOfGrid,
-    ) -> Result<(Stencil, Placement), QueryError> {
+    ) -> Result<(Stencil, Placement), TickError> {
         let (i, t, place) = self.cell_t(axis, v, policy)?;
         // The coordinate actually evaluated (clamped if so asked).
         let v = self.node(i) + t * (self.node(i + 1) - self.node(i));

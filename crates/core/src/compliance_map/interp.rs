@@ -1,13 +1,12 @@
 //! Evaluation of the map: the node lines (Eq. 9-10) combined with the 2-D weights of Eq. 14
-//! (bilinear) or of the cubic Hermite option; and, with `alloc`, a leave-one-node-out
-//! cross-validation of the two interpolations.
+//! (bilinear) or of the cubic Hermite option.
 
-use super::grid::Placement;
-use super::{ComplianceMapView, Interpolation, QueryError, QueryOptions, QueryStatus};
+use super::{ComplianceMapView, Interpolation, QueryOptions};
+use crate::error::{Placement, TickError};
 
 impl ComplianceMapView<'_> {
-    /// Displacement at `position` `[x, y]` [m] under `force` (`n_force` entries, [N] or
-    /// [N m]) written into `out` (`n_displacement` entries, [m] or [rad]), with explicit
+    /// Displacement at `position` `[x, y]` \[m\] under `force` (`n_force` entries, \[N\] or
+    /// \[N m\]) written into `out` (`n_displacement` entries, \[m\] or \[rad\]), with explicit
     /// query options. Allocation-free, never panics.
     ///
     /// At a node this is Eq. 9-10: `out[d] = sum_f (slope[d][f] * force[f] + offset[d][f])`.
@@ -21,13 +20,13 @@ impl ComplianceMapView<'_> {
         force: &[f64],
         out: &mut [f64],
         options: QueryOptions,
-    ) -> Result<QueryStatus, QueryError> {
+    ) -> Result<Placement, TickError> {
         self.eval(position, force, out, options)
     }
 
     /// Many queries in one call, allocation-free: row `r` reads `positions[r * stride..]`
-    /// (x, y [m]; entries past the first two, e.g. z, are ignored), `forces[r * n_force..]`
-    /// [N] and writes `out[r * n_displacement..]` [m]. Stops at the first refused row.
+    /// (x, y \[m\]; entries past the first two, e.g. z, are ignored), `forces[r * n_force..]`
+    /// \[N\] and writes `out[r * n_displacement..]` \[m\]. Stops at the first refused row.
     pub fn displacement_batch(
         &self,
         positions: &[f64],
@@ -40,7 +39,7 @@ impl ComplianceMapView<'_> {
         let rows = forces.len() / nf;
         let shape_err = |what, expected, got| BatchError {
             row: 0,
-            error: QueryError::WrongLength {
+            error: TickError::WrongLength {
                 what,
                 expected,
                 got,
@@ -73,9 +72,9 @@ impl ComplianceMapView<'_> {
                 continue;
             };
             match self.eval([x, y], f, o, options) {
-                Ok(QueryStatus::Inside) => summary.inside += 1,
-                Ok(QueryStatus::Clamped) => summary.clamped += 1,
-                Ok(QueryStatus::Extrapolated) => summary.extrapolated += 1,
+                Ok(Placement::Inside) => summary.inside += 1,
+                Ok(Placement::Clamped) => summary.clamped += 1,
+                Ok(Placement::Extrapolated) => summary.extrapolated += 1,
                 Err(error) => return Err(BatchError { row, error }),
             }
         }
@@ -124,9 +123,9 @@ impl ComplianceMapView<'_> {
             let inside = px >= x_lo && px <= x_hi && py >= y_lo && py <= y_hi;
             if probe != 0.0 || !inside {
                 match self.eval([px, py], f, o, options) {
-                    Ok(QueryStatus::Inside) => summary.inside += 1,
-                    Ok(QueryStatus::Clamped) => summary.clamped += 1,
-                    Ok(QueryStatus::Extrapolated) => summary.extrapolated += 1,
+                    Ok(Placement::Inside) => summary.inside += 1,
+                    Ok(Placement::Clamped) => summary.clamped += 1,
+                    Ok(Placement::Extrapolated) => summary.extrapolated += 1,
                     Err(error) => return Err(BatchError { row, error }),
                 }
                 continue;
@@ -168,6 +167,16 @@ impl ComplianceMapView<'_> {
                 *acc_d += w[2] * ((sa2 * f0 + ca2) + (sb2 * f1 + cb2));
                 *acc_d += w[3] * ((sa3 * f0 + ca3) + (sb3 * f1 + cb3));
             }
+            if !(acc[0].is_finite() && acc[1].is_finite()) {
+                let index = usize::from(acc[0].is_finite());
+                return Err(BatchError {
+                    row,
+                    error: TickError::NonFiniteOutput {
+                        what: "displacement",
+                        index,
+                    },
+                });
+            }
             *o = acc;
             summary.inside += 1;
         }
@@ -181,30 +190,30 @@ impl ComplianceMapView<'_> {
         force: &[f64],
         out: &mut [f64],
         options: QueryOptions,
-    ) -> Result<QueryStatus, QueryError> {
+    ) -> Result<Placement, TickError> {
         let (nf, nd) = (self.n_force, self.n_disp);
         if force.len() != nf {
-            return Err(QueryError::WrongLength {
+            return Err(TickError::WrongLength {
                 what: "force",
                 expected: nf,
                 got: force.len(),
             });
         }
         if out.len() != nd {
-            return Err(QueryError::WrongLength {
+            return Err(TickError::WrongLength {
                 what: "out",
                 expected: nd,
                 got: out.len(),
             });
         }
         if let Some(index) = position.iter().position(|v| !v.is_finite()) {
-            return Err(QueryError::NonFinite {
+            return Err(TickError::NonFinite {
                 what: "position",
                 index,
             });
         }
         if let Some(index) = force.iter().position(|v| !v.is_finite()) {
-            return Err(QueryError::NonFinite {
+            return Err(TickError::NonFinite {
                 what: "force",
                 index,
             });
@@ -250,10 +259,14 @@ impl ComplianceMapView<'_> {
             );
             (plx, ply)
         };
+        // Extrapolating far out (or forces near f64::MAX) overflows: refuse, never NaN.
+        crate::error::check_output("displacement", out)?;
+        // A clamped axis wins over an extrapolated one: the position actually evaluated
+        // was moved.
         Ok(match (plx, ply) {
-            (Placement::Inside, Placement::Inside) => QueryStatus::Inside,
-            (Placement::Clamped, _) | (_, Placement::Clamped) => QueryStatus::Clamped,
-            _ => QueryStatus::Extrapolated,
+            (Placement::Inside, Placement::Inside) => Placement::Inside,
+            (Placement::Clamped, _) | (_, Placement::Clamped) => Placement::Clamped,
+            _ => Placement::Extrapolated,
         })
     }
 
@@ -344,7 +357,7 @@ impl ComplianceMapView<'_> {
         position: [f64; 2],
         force: &[f64],
         out: &mut [f64],
-    ) -> Result<QueryStatus, QueryError> {
+    ) -> Result<Placement, TickError> {
         self.displacement_with(position, force, out, self.options)
     }
 }
@@ -366,7 +379,7 @@ pub struct BatchError {
     /// Row index (0 for a shape error).
     pub row: usize,
     /// The reason.
-    pub error: QueryError,
+    pub error: TickError,
 }
 
 impl core::fmt::Display for BatchError {
@@ -376,154 +389,3 @@ impl core::fmt::Display for BatchError {
 }
 
 impl core::error::Error for BatchError {}
-
-#[cfg(feature = "alloc")]
-pub use cv::{CrossValidation, HeldOutNode, HoldOutAxis, leave_one_node_out};
-
-#[cfg(feature = "alloc")]
-mod cv {
-    use alloc::vec::Vec;
-
-    use super::super::{ComplianceMap, ComplianceMapError, Interpolation, OutOfGrid, QueryOptions};
-
-    /// Which grid line is removed to hold a node out (see [`leave_one_node_out`]).
-    #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-    pub enum HoldOutAxis {
-        /// Remove the line `x = x_i` through the node; the node is predicted along its row.
-        X,
-        /// Remove the line `y = y_j` through the node; the node is predicted along its column.
-        Y,
-    }
-
-    /// Prediction errors at one held-out node.
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct HeldOutNode {
-        /// Node index along x.
-        pub i: usize,
-        /// Node index along y.
-        pub j: usize,
-        /// RMS over the test forces of the Euclidean displacement error [m], bilinear.
-        pub rms_bilinear: f64,
-        /// Same for the cubic Hermite interpolation [m].
-        pub rms_bicubic: f64,
-    }
-
-    /// Result of [`leave_one_node_out`].
-    #[derive(Debug, Clone, PartialEq)]
-    pub struct CrossValidation {
-        /// The axis along which nodes were held out.
-        pub axis: HoldOutAxis,
-        /// Per held-out node errors.
-        pub nodes: Vec<HeldOutNode>,
-        /// RMS over all held-out nodes and test forces of `|predicted - node model|` [m].
-        pub rms_bilinear: f64,
-        /// Same for the cubic Hermite interpolation [m].
-        pub rms_bicubic: f64,
-    }
-
-    impl CrossValidation {
-        /// The interpolation with the smaller RMS error (bilinear on a tie).
-        pub fn better(&self) -> Interpolation {
-            if self.rms_bicubic < self.rms_bilinear {
-                Interpolation::Bicubic
-            } else {
-                Interpolation::Bilinear
-            }
-        }
-    }
-
-    /// Leave-one-node-out cross-validation of bilinear vs cubic Hermite interpolation.
-    ///
-    /// A rectilinear grid with one node removed is no longer rectilinear, so node `(i, j)` is
-    /// held out by removing its whole grid line along `axis` (for `HoldOutAxis::Y` the line
-    /// `y = y_j`, leaving an unevenly spaced grid) and predicting the node from the rest.
-    /// Because the node still lies on the grid line `x = x_i`, whose 1-D weight is 1, the
-    /// prediction uses column `i` only: it is exactly the leave-one-node-out prediction
-    /// along that column. Nodes held out are those interior along `axis`
-    /// (`0 < j < ny - 1` for `Y`), all indices across it; the axis must keep >= 2 nodes.
-    ///
-    /// `forces` holds the test forces back to back, `n_force` entries each [N]. The error at a
-    /// node for one force is the Euclidean norm of predicted minus the node's own lines
-    /// (Eq. 10) [m]; reported as RMS per node and over everything.
-    pub fn leave_one_node_out(
-        map: &ComplianceMap,
-        forces: &[f64],
-        axis: HoldOutAxis,
-    ) -> Result<CrossValidation, ComplianceMapError> {
-        let (nx, ny) = (map.x().len(), map.y().len());
-        let (nf, nd) = (map.n_force(), map.n_displacement());
-        if forces.is_empty() || forces.len() % nf != 0 {
-            return Err(ComplianceMapError::WrongLength {
-                what: "forces",
-                expected: nf,
-                got: forces.len(),
-            });
-        }
-        let along = if axis == HoldOutAxis::X { nx } else { ny };
-        if along < 3 {
-            return Err(ComplianceMapError::TooFewNodes {
-                axis: if axis == HoldOutAxis::X { "x" } else { "y" },
-                count: along,
-            });
-        }
-        let mut nodes = Vec::new();
-        let (mut sum_lin, mut sum_cub, mut count) = (0.0, 0.0, 0usize);
-        let mut truth = [0.0; super::super::MAX_AXES];
-        let mut pred = [0.0; super::super::MAX_AXES];
-        for k in 1..along - 1 {
-            let reduced = map.without_line(axis == HoldOutAxis::X, k)?;
-            let across = if axis == HoldOutAxis::X { ny } else { nx };
-            for l in 0..across {
-                let (i, j) = if axis == HoldOutAxis::X {
-                    (k, l)
-                } else {
-                    (l, k)
-                };
-                let pos = [
-                    map.x().get(i).copied().unwrap_or(f64::NAN),
-                    map.y().get(j).copied().unwrap_or(f64::NAN),
-                ];
-                let (mut s_lin, mut s_cub) = (0.0, 0.0);
-                for f in forces.chunks_exact(nf) {
-                    let t = truth.get_mut(..nd).unwrap_or(&mut []);
-                    map.node_displacement(i, j, f, t)?;
-                    for (method, acc) in [
-                        (Interpolation::Bilinear, &mut s_lin),
-                        (Interpolation::Bicubic, &mut s_cub),
-                    ] {
-                        let p = pred.get_mut(..nd).unwrap_or(&mut []);
-                        let opts = QueryOptions {
-                            interpolation: method,
-                            out_of_grid: OutOfGrid::Error,
-                        };
-                        reduced
-                            .displacement_with(pos, f, p, opts)
-                            .map_err(ComplianceMapError::Query)?;
-                        *acc += p
-                            .iter()
-                            .zip(truth.iter())
-                            .map(|(a, b)| (a - b) * (a - b))
-                            .sum::<f64>();
-                    }
-                }
-                let nforce = (forces.len() / nf) as f64;
-                sum_lin += s_lin;
-                sum_cub += s_cub;
-                count += forces.len() / nf;
-                nodes.push(HeldOutNode {
-                    i,
-                    j,
-                    rms_bilinear: super::super::sqrt(s_lin / nforce),
-                    rms_bicubic: super::super::sqrt(s_cub / nforce),
-                });
-            }
-        }
-        let c = count.max(1) as f64;
-        Ok(CrossValidation {
-            axis,
-            nodes,
-            rms_bilinear: super::super::sqrt(sum_lin / c),
-            rms_bicubic: super::super::sqrt(sum_cub / c),
-        })
-    }
-}

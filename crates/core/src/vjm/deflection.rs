@@ -2,13 +2,36 @@
 //! Cartesian compliance. Every function here is allocation-free, bounded by the chain length
 //! and panic-free.
 
-use nalgebra::{Isometry3, Matrix6, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix6, UnitQuaternion, Vector3};
 
-use super::{Data, Element, MAX_DOF, Model, Vector6};
-use crate::error::{TickError, check_finite};
+use super::model::Op;
+use super::{Data, Model, Vector6};
+use crate::error::{TickError, check_finite, check_output};
 
-/// Validates a joint vector against the model.
-pub(crate) fn check_q(model: &Model, q: &[f64]) -> Result<(), TickError> {
+impl Data {
+    /// [`Self::check`] as the status every per-tick function returns.
+    pub(crate) fn check_model(&self, model: &Model) -> Result<(), TickError> {
+        if self.dof != model.dof {
+            return Err(TickError::ModelMismatch {
+                what: "dof",
+                expected: model.dof,
+                got: self.dof,
+            });
+        }
+        if self.springs != model.springs {
+            return Err(TickError::ModelMismatch {
+                what: "springs",
+                expected: model.springs,
+                got: self.springs,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Validates the workspace and a joint vector against the model.
+pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickError> {
+    data.check_model(model)?;
     if q.len() != model.dof {
         return Err(TickError::WrongLength {
             what: "q",
@@ -19,17 +42,41 @@ pub(crate) fn check_q(model: &Model, q: &[f64]) -> Result<(), TickError> {
     check_finite("q", q)
 }
 
-/// `(sin x, cos x)`. Elastic angles are tiny (1e-6..1e-3 rad): below 0.01 rad the Taylor
-/// series to x^9 / x^10 is exact to rounding (the next terms are below 1e-22 relative) and
-/// several times cheaper than the library call.
+/// Largest elastic angle of a virtual joint the deflection accepts \[rad\]: 0.5 rad (29 deg). Real
+/// robots turn their springs by milliradians; a load that turns one by more is far outside
+/// the small-deflection model of Eq. 5-7 (which takes the moments in the undeformed pose), and
+/// its "deflection" would be garbage (or NaN for loads near `f64::MAX`), so it is refused.
+pub const MAX_SPRING_ANGLE: f64 = 0.5;
+
+/// `(sin x, cos x)`. Elastic angles are tiny (1e-6..1e-3 rad): below 0.01 rad a Taylor series
+/// is exact to rounding and several times cheaper than the library call. Below 1e-3 the
+/// terms past x^5 (sine) and x^4 (cosine) are below 1e-21 relative and are left out; up to
+/// 0.01 the series runs to x^9 / x^10 (next terms below 1e-22 relative). Multiplications by
+/// the reciprocal factorial ratios, not divisions: a chain of divisions would dominate the
+/// deflection's latency. Zero (a rigid axis) costs nothing.
 #[inline]
 fn sin_cos_small(x: f64) -> (f64, f64) {
-    if x.abs() < 1.0e-2 {
+    const R6: f64 = 1.0 / 6.0;
+    const R20: f64 = 1.0 / 20.0;
+    const R42: f64 = 1.0 / 42.0;
+    const R72: f64 = 1.0 / 72.0;
+    const R12: f64 = 1.0 / 12.0;
+    const R30: f64 = 1.0 / 30.0;
+    const R56: f64 = 1.0 / 56.0;
+    const R90: f64 = 1.0 / 90.0;
+    let ax = x.abs();
+    if ax == 0.0 {
+        (x, 1.0)
+    } else if ax < 1.0e-3 {
         let x2 = x * x;
-        let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+        let s = x * (1.0 - x2 * R6 * (1.0 - x2 * R20));
+        let c = 1.0 - x2 * 0.5 * (1.0 - x2 * R12);
+        (s, c)
+    } else if ax < 1.0e-2 {
+        let x2 = x * x;
+        let s = x * (1.0 - x2 * R6 * (1.0 - x2 * R20 * (1.0 - x2 * R42 * (1.0 - x2 * R72))));
         let c = 1.0
-            - x2 / 2.0
-                * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0 * (1.0 - x2 / 90.0))));
+            - x2 * 0.5 * (1.0 - x2 * R12 * (1.0 - x2 * R30 * (1.0 - x2 * R56 * (1.0 - x2 * R90))));
         (s, c)
     } else {
         (
@@ -39,7 +86,26 @@ fn sin_cos_small(x: f64) -> (f64, f64) {
     }
 }
 
-/// `Rz(gamma) Ry(beta) Rx(alpha)` as a unit quaternion (the same as nalgebra's
+/// The rotation vector (axis times angle, in [0, pi]) of the unit quaternion `q`, as
+/// nalgebra's `scaled_axis`, with a series for small rotations instead of an arctangent: with
+/// `t = |v| / w` below 1e-4, `2 atan(t) / |v| = (2 / w) (1 - t^2/3 + t^4/5)` to rounding. The
+/// kernels compare nearly equal rotations (deflected against rigid TCP, loaded pose against
+/// target) every tick.
+#[inline]
+pub(crate) fn rotation_vector(q: &UnitQuaternion<f64>) -> Vector3<f64> {
+    let (w, v) = (q.scalar(), q.imag());
+    // q and -q are the same rotation: take the one with w >= 0 (angle <= pi).
+    let (w, v) = if w < 0.0 { (-w, -v) } else { (w, v) };
+    let n2 = v.norm_squared();
+    if w > 0.0 && n2 < 1.0e-8 * w * w {
+        let t2 = n2 / (w * w);
+        v * (2.0 / w * (1.0 - t2 * (1.0 / 3.0) + t2 * t2 * 0.2))
+    } else {
+        q.scaled_axis()
+    }
+}
+
+/// `Rz(gamma) Ry(beta) Rx(alpha)` as a unit quaternion (Eq. 4; nalgebra's
 /// `from_euler_angles(alpha, beta, gamma)`), from half-angle sines and cosines.
 #[inline]
 fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64> {
@@ -54,68 +120,143 @@ fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64> {
     ))
 }
 
-/// The motions of the actuated joints at `q`, computed once per call (each costs a sin/cos).
-fn joint_motions(model: &Model, q: &[f64]) -> [Isometry3<f64>; MAX_DOF] {
-    let mut out = [Isometry3::identity(); MAX_DOF];
-    for e in model.elements.iter() {
-        let (m, index) = match *e {
-            Element::Revolute { axis, index } => (
-                Isometry3::from_parts(
-                    Translation3::identity(),
-                    UnitQuaternion::from_axis_angle(&axis, q.get(index).copied().unwrap_or(0.0)),
-                ),
+/// One pass over the chain at `q` (validated by the caller): the rigid TCP pose, and in
+/// `data` the world frames of the springs and the world axes and origins of the joints
+/// (before their own motion), which every kernel below reads.
+fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
+    let mut frame = Isometry3::identity();
+    for op in model.ops.iter() {
+        match op {
+            Op::Fixed(f) => frame *= f,
+            Op::Joint {
+                pre,
+                axis,
+                revolute,
                 index,
-            ),
-            Element::Prismatic { axis, index } => (
-                Isometry3::from_parts(
-                    Translation3::from(axis.into_inner() * q.get(index).copied().unwrap_or(0.0)),
-                    UnitQuaternion::identity(),
-                ),
-                index,
-            ),
-            _ => continue,
-        };
-        if let Some(slot) = out.get_mut(index) {
-            *slot = m;
+            } => {
+                let i = *index;
+                frame *= pre;
+                if let (Some(a), Some(o)) =
+                    (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
+                {
+                    *a = frame.rotation * axis.into_inner();
+                    *o = frame.translation.vector;
+                }
+                let qi = q.get(i).copied().unwrap_or(0.0);
+                if *revolute {
+                    frame.rotation *= UnitQuaternion::from_axis_angle(axis, qi);
+                } else {
+                    frame.translation.vector += frame.rotation * (axis.into_inner() * qi);
+                }
+            }
+            Op::Spring { offset, index, .. } => {
+                if let Some(slot) = data.spring_frames.get_mut(*index) {
+                    *slot = match offset {
+                        Some(o) => frame * o,
+                        None => frame,
+                    };
+                }
+            }
+            Op::Mass { .. } => {}
         }
     }
-    out
+    frame
 }
 
-/// The transform an element applies (`None` for a spring), given the joint motions.
-#[inline]
-fn motion(e: &Element, motions: &[Isometry3<f64>; MAX_DOF]) -> Option<Isometry3<f64>> {
-    match *e {
-        Element::Fixed(t) => Some(t),
-        Element::Revolute { index, .. } | Element::Prismatic { index, .. } => Some(
-            motions
-                .get(index)
-                .copied()
-                .unwrap_or_else(Isometry3::identity),
-        ),
-        Element::Spring { .. } => None,
-    }
-}
-
-/// Rigid forward kinematics without checks (callers have validated `q`).
-fn rigid_tcp(model: &Model, motions: &[Isometry3<f64>; MAX_DOF]) -> Isometry3<f64> {
-    model
-        .elements
-        .iter()
-        .filter_map(|e| motion(e, motions))
-        .fold(Isometry3::identity(), |t, m| t * m)
-}
-
-/// Rigid TCP pose in the base frame (Eq. 2 with i = 0). `q` [rad or m], length
+/// Rigid TCP pose in the base frame (Eq. 2 with i = 0). `q` \[rad or m\], length
 /// [`Model::dof`]. Also stored in `data.tcp`.
 pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f64>, TickError> {
-    check_q(model, q)?;
-    data.tcp = rigid_tcp(model, &joint_motions(model, q));
-    Ok(data.tcp)
+    check_q(model, data, q)?;
+    let tcp = rigid_pass(model, data, q);
+    check_output("tcp translation", tcp.translation.vector.as_slice())?;
+    data.tcp = tcp;
+    Ok(tcp)
 }
 
-/// TCP deflection `[dx, dy, dz, rx, ry, rz]` [m, rad] in the base frame under the TCP wrench
-/// `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m] (base frame, moment about the TCP): the paper's exact
+/// The spring angles `M / k` (Eq. 5-7) of every spring under the TCP wrench, from the rigid
+/// frames of the last pass, into `data.spring_angles`; refuses angles past
+/// [`MAX_SPRING_ANGLE`].
+fn spring_angles(
+    model: &Model,
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    wrench: &Vector6,
+) -> Result<(), TickError> {
+    let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
+    let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
+    let p_tcp = tcp.translation.vector;
+    for op in model.ops.iter() {
+        let Op::Spring {
+            compliance, index, ..
+        } = op
+        else {
+            continue;
+        };
+        let Some(f) = data.spring_frames.get(*index).copied() else {
+            continue;
+        };
+        // Eq. 5-6: load moved to the spring origin, expressed in the spring frame.
+        let m_local = f
+            .rotation
+            .inverse_transform_vector(&(moment + (p_tcp - f.translation.vector).cross(&force)));
+        // Eq. 7: alpha = M_C / k_C, beta = M_B / k_B, gamma = M_A / k_A.
+        let angles = compliance.component_mul(&m_local);
+        let largest = angles.amax();
+        if largest.is_nan() || largest > MAX_SPRING_ANGLE {
+            return Err(TickError::InvalidArgument {
+                what: "wrench (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
+                       small-deflection model)",
+                value: largest,
+            });
+        }
+        if let Some(slot) = data.spring_angles.get_mut(*index) {
+            *slot = angles;
+        }
+    }
+    Ok(())
+}
+
+/// The deflected TCP (Eq. 8) from the spring angles: with `F_k` the rigid world frame of
+/// spring `k` and `R*_k` its rotation (Eq. 4), the deflected chain is
+/// `T = (F_1 R*_1 F_1^-1) ... (F_n R*_n F_n^-1) T_tcp` (each factor turns the rest of the
+/// chain about the spring's origin), applied from the last spring back: one rotation per
+/// spring instead of a second walk along the chain.
+pub(super) fn deflected_tcp(model: &Model, data: &Data, tcp: &Isometry3<f64>) -> Isometry3<f64> {
+    let (mut r, mut p) = (tcp.rotation, tcp.translation.vector);
+    for k in (0..model.springs).rev() {
+        let (Some(f), Some(a)) = (data.spring_frames.get(k), data.spring_angles.get(k)) else {
+            continue;
+        };
+        let e = euler_zyx(a.x, a.y, a.z);
+        // F e F^-1: conjugating a quaternion by a rotation turns its vector part (one
+        // vector rotation instead of two quaternion products).
+        let v = f.rotation * e.imag();
+        let q = UnitQuaternion::new_unchecked(nalgebra::Quaternion::from_parts(e.scalar(), v));
+        let origin = f.translation.vector;
+        r = q * r;
+        p = q * (p - origin) + origin;
+    }
+    Isometry3::from_parts(p.into(), r)
+}
+
+/// `[dp; dr]` of the deflected TCP against the rigid one, and both poses into `data`.
+pub(super) fn finish_deflection(
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    deflected: &Isometry3<f64>,
+) -> Result<Vector6, TickError> {
+    let dp = deflected.translation.vector - tcp.translation.vector;
+    let dr = rotation_vector(&(deflected.rotation * tcp.rotation.inverse()));
+    let d = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z);
+    // A wrench of 1e308 N overflows the spring moments: refuse rather than return NaN.
+    check_output("deflection", d.as_slice())?;
+    data.tcp = *tcp;
+    data.tcp_deflected = *deflected;
+    Ok(d)
+}
+
+/// TCP deflection `[dx, dy, dz, rx, ry, rz]` \[m, rad\] in the base frame under the TCP wrench
+/// `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] (base frame, moment about the TCP): the paper's exact
 /// model. Torques on each spring are taken in the undeformed pose (Eq. 5-6, plus the applied
 /// moment), turned into angles `M / k` (Eq. 7) and inserted as z-y'-x'' rotations (Eq. 3-4);
 /// the result is the deflected FK (Eq. 8) minus the rigid one (Eq. 9): the translation, then
@@ -128,76 +269,92 @@ pub fn deflection(
     q: &[f64],
     wrench: &Vector6,
 ) -> Result<Vector6, TickError> {
-    check_q(model, q)?;
+    check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
-    let motions = joint_motions(model, q);
-    let tcp = rigid_tcp(model, &motions);
-    let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
-    let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
+    let tcp = rigid_pass(model, data, q);
+    spring_angles(model, data, &tcp, wrench)?;
+    let deflected = deflected_tcp(model, data, &tcp);
+    finish_deflection(data, &tcp, &deflected)
+}
 
-    let mut rigid = Isometry3::identity();
-    let mut deflected = Isometry3::identity();
-    for e in model.elements.iter() {
-        match (motion(e, &motions), e) {
-            (Some(m), _) => {
-                rigid *= m;
-                deflected *= m;
-            }
-            (None, Element::Spring { compliance, index }) => {
-                // Eq. 5-6: load moved to the spring origin, expressed in the spring frame.
-                let r = tcp.translation.vector - rigid.translation.vector;
-                let m_local = rigid.rotation.inverse() * (moment + r.cross(&force));
-                // Eq. 7: alpha = M_C / k_C, beta = M_B / k_B, gamma = M_A / k_A.
-                let angles = compliance.component_mul(&m_local);
-                if let Some(slot) = data.spring_angles.get_mut(*index) {
-                    *slot = angles;
-                }
-                // Eq. 4: R* = Rz(gamma) Ry(beta) Rx(alpha), nalgebra's roll-pitch-yaw.
-                let r_star = euler_zyx(angles.x, angles.y, angles.z);
-                deflected *= r_star;
-            }
-            (None, _) => {}
+/// Fills `data.jacobian` from the joint axes and origins of the last pass.
+pub(super) fn fill_jacobian(model: &Model, data: &mut Data, tcp: &Isometry3<f64>) {
+    data.jacobian.fill(0.0);
+    for op in model.ops.iter() {
+        let Op::Joint {
+            revolute, index, ..
+        } = op
+        else {
+            continue;
+        };
+        let (Some(u), Some(o)) = (data.joint_axes.get(*index), data.joint_origins.get(*index))
+        else {
+            continue;
+        };
+        let col = if *revolute {
+            let lin = u.cross(&(tcp.translation.vector - o));
+            Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z)
+        } else {
+            Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0)
+        };
+        if *index < data.jacobian.ncols() {
+            data.jacobian.set_column(*index, &col);
         }
     }
-    data.tcp = tcp;
-    data.tcp_deflected = deflected;
-    let dp = deflected.translation.vector - tcp.translation.vector;
-    let dr = (deflected.rotation * tcp.rotation.inverse()).scaled_axis();
-    Ok(Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z))
+}
+
+/// [`deflection`] and [`joint_jacobian`] at the same `q` in one pass over the chain (the
+/// rigid frames serve both): fills `data.tcp`, `data.tcp_deflected`, `data.spring_angles`
+/// and `data.jacobian`, and returns the deflection. What a loaded pose IK needs each step.
+pub fn deflection_and_jacobian(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    wrench: &Vector6,
+) -> Result<Vector6, TickError> {
+    check_q(model, data, q)?;
+    check_finite("wrench", wrench.as_slice())?;
+    let tcp = rigid_pass(model, data, q);
+    spring_angles(model, data, &tcp, wrench)?;
+    fill_jacobian(model, data, &tcp);
+    let deflected = deflected_tcp(model, data, &tcp);
+    finish_deflection(data, &tcp, &deflected)
 }
 
 /// The 6x6 Cartesian compliance of the linearized model, `C = sum_s J_s K_s^-1 J_s^T`
-/// [m/N, m/(N m), rad/N, rad/(N m)] in the base frame, ordered as the wrench
+/// \[m/N, m/(N m), rad/N, rad/(N m)\] in the base frame, ordered as the wrench
 /// `[F; M]` and the deflection `[dp; dr]`: `deflection(q, w) = C w + O(|w|^2)`.
 /// `J_s` maps the three spring angles to the TCP's translation and rotation.
 /// Also stored in `data.compliance`.
 pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f64>, TickError> {
-    check_q(model, q)?;
-    let motions = joint_motions(model, q);
-    let tcp = rigid_tcp(model, &motions);
+    check_q(model, data, q)?;
+    let tcp = rigid_pass(model, data, q);
     let mut c = Matrix6::zeros();
-    let mut frame = Isometry3::identity();
-    for e in model.elements.iter() {
-        match (motion(e, &motions), e) {
-            (Some(m), _) => frame *= m,
-            (None, Element::Spring { compliance, .. }) => {
-                let r = tcp.translation.vector - frame.translation.vector;
-                let rot = frame.rotation.to_rotation_matrix();
-                for (a, &ca) in compliance.iter().enumerate() {
-                    if ca == 0.0 {
-                        continue;
-                    }
-                    let u: Vector3<f64> = rot.matrix().column(a).into_owned();
-                    let lin = u.cross(&r);
-                    let col = Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z);
-                    c += (col * col.transpose()) * ca;
-                }
+    for op in model.ops.iter() {
+        let Op::Spring {
+            compliance, index, ..
+        } = op
+        else {
+            continue;
+        };
+        let Some(f) = data.spring_frames.get(*index) else {
+            continue;
+        };
+        let r = tcp.translation.vector - f.translation.vector;
+        let rot = f.rotation.to_rotation_matrix();
+        for (a, &ca) in compliance.iter().enumerate() {
+            if ca == 0.0 {
+                continue;
             }
-            (None, _) => {}
+            let u: Vector3<f64> = rot.matrix().column(a).into_owned();
+            let lin = u.cross(&r);
+            let col = Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z);
+            c += (col * col.transpose()) * ca;
         }
     }
     data.tcp = tcp;
     data.compliance = c;
+    check_output("compliance", c.as_slice())?;
     Ok(c)
 }
 
@@ -205,35 +362,9 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
 /// `[v; w]` in the base frame, and `data.tcp` with the rigid pose. Columns past the model's
 /// dof are zero.
 pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), TickError> {
-    check_q(model, q)?;
-    let motions = joint_motions(model, q);
-    let tcp = rigid_tcp(model, &motions);
-    data.jacobian.fill(0.0);
-    let mut frame = Isometry3::identity();
-    for e in model.elements.iter() {
-        // The joint's axis is expressed in the frame *before* its own motion (the same axis
-        // after it, since a joint moves along/about its own axis).
-        let column = match *e {
-            Element::Revolute { axis, index } => {
-                let u = frame.rotation * axis.into_inner();
-                let lin = u.cross(&(tcp.translation.vector - frame.translation.vector));
-                Some((index, Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z)))
-            }
-            Element::Prismatic { axis, index } => {
-                let u = frame.rotation * axis.into_inner();
-                Some((index, Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0)))
-            }
-            _ => None,
-        };
-        if let Some((index, col)) = column {
-            if index < data.jacobian.ncols() {
-                data.jacobian.set_column(index, &col);
-            }
-        }
-        if let Some(m) = motion(e, &motions) {
-            frame *= m;
-        }
-    }
+    check_q(model, data, q)?;
+    let tcp = rigid_pass(model, data, q);
+    fill_jacobian(model, data, &tcp);
     data.tcp = tcp;
     Ok(())
 }
@@ -254,16 +385,39 @@ mod tests {
             let ours = euler_zyx(a, b, g);
             let theirs = UnitQuaternion::from_euler_angles(a, b, g);
             assert!(ours.angle_to(&theirs) < 1e-15, "{a} {b} {g}");
+            assert!((ours.coords - theirs.coords).amax() < 2e-16, "{a} {b} {g}");
             assert!((ours.quaternion().norm() - 1.0).abs() < 1e-15);
         }
-        for i in -100..=100 {
-            let x = i as f64 * 1.0e-4; // up to 0.01
+        for i in -1000..=1000 {
+            let x = i as f64 * 1.0e-5; // up to 0.01, both branches
             let (s, c) = sin_cos_small(x);
             assert!(
                 (s - x.sin()).abs() <= 1e-18 + 2.0 * f64::EPSILON * x.abs(),
                 "{x}"
             );
             assert!((c - x.cos()).abs() <= 2.0 * f64::EPSILON, "{x}");
+        }
+    }
+
+    #[test]
+    fn rotation_vector_equals_nalgebra() {
+        for v in [
+            Vector3::new(1e-9, -2e-9, 3e-10),
+            Vector3::new(1e-5, 2e-5, -3e-5),
+            Vector3::new(3e-3, 0.0, 0.0),
+            Vector3::new(0.1, -0.2, 0.3),
+            Vector3::new(0.0, 3.1, 0.0),
+            Vector3::zeros(),
+        ] {
+            let q = UnitQuaternion::from_scaled_axis(v);
+            for q in [q, UnitQuaternion::new_unchecked(-q.into_inner())] {
+                let ours = rotation_vector(&q);
+                let theirs = q.scaled_axis();
+                assert!(
+                    (ours - theirs).amax() <= 4.0 * f64::EPSILON * v.amax().max(1e-300),
+                    "{v:?}: {ours:?} vs {theirs:?}"
+                );
+            }
         }
     }
 }

@@ -1,6 +1,6 @@
 //! Virtual-joint model (VJM) of a serial robot: forward compliance after Hähn & Weigold,
 //! "Hybrid compliance compensation for path accuracy enhancement in robot machining",
-//! section 2.1, Eq. 1-9 (`shared/papers/001_bf9bba303970c33c.txt`).
+//! Production Engineering (2020), section 2.1, Eq. 1-9.
 //!
 //! A [`Model`] is a chain of fixed transforms, actuated revolute/prismatic joints and virtual
 //! joints ("springs"): frames with three rotational stiffnesses about their own x, y, z axes
@@ -10,12 +10,30 @@
 
 mod correction;
 mod deflection;
+#[cfg(feature = "alloc")]
+mod equilibrium;
+mod loads;
 mod model;
 
-pub use correction::{JointCorrection, commanded_pose, joint_correction, joint_delta};
-pub use deflection::{compliance, deflection, forward, joint_jacobian};
-pub use model::{Data, Element, MAX_DOF, MAX_ELEMENTS, MAX_SPRINGS, Model, ModelBuilder};
+pub use correction::{
+    JointCorrection, MAX_CORRECTION_ITERATIONS, POSE_TOLERANCE, commanded_pose, joint_correction,
+    joint_delta, pose_from_matrix, rotation_from_matrix,
+};
+pub(crate) use deflection::rotation_vector;
+pub use deflection::{
+    MAX_SPRING_ANGLE, compliance, deflection, deflection_and_jacobian, forward, joint_jacobian,
+};
+#[cfg(feature = "alloc")]
+pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
+pub use loads::{
+    ArmMotion, deflection_and_jacobian_under, deflection_under, linearized_deflection_under,
+    tcp_acceleration_bias,
+};
+pub use model::{
+    Data, Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder,
+    valid_stiffness,
+};
 
-/// A 6-vector `[x, y, z, rx, ry, rz]`: a wrench `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m] or a small
-/// pose change `[dx, dy, dz, rx, ry, rz]` [m, rad] (rotation vector), always in the base frame.
+/// A 6-vector `[x, y, z, rx, ry, rz]`: a wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] or a small
+/// pose change `[dx, dy, dz, rx, ry, rz]` \[m, rad\] (rotation vector), always in the base frame.
 pub type Vector6 = nalgebra::Vector6<f64>;

@@ -1,6 +1,6 @@
 //! The immutable chain model, its builder and the per-call workspace.
 
-use nalgebra::{Isometry3, Matrix6, SMatrix, Unit, Vector3};
+use nalgebra::{Isometry3, Matrix3, Matrix6, SMatrix, Unit, Vector3};
 
 use crate::error::BuildError;
 
@@ -10,6 +10,9 @@ pub const MAX_DOF: usize = 8;
 /// Most virtual joints: the paper's KR 300 model has 11 (Table 1); 32 leaves room for a
 /// spring per joint and per link of an 8-axis cell with a multi-part end effector.
 pub const MAX_SPRINGS: usize = 32;
+/// Most link masses (the arm's own inertia, for loads under motion): one per link of the
+/// largest chain.
+pub const MAX_MASSES: usize = 32;
 /// Most chain elements after merging consecutive fixed transforms. A spring placed inside a
 /// link costs up to three elements (offset, spring, inverse offset), a joint two; 4 * 32
 /// covers [`MAX_SPRINGS`] springs and [`MAX_DOF`] joints with their fixed origins.
@@ -20,26 +23,70 @@ pub const MAX_ELEMENTS: usize = 128;
 pub enum Element {
     /// A constant transform (URDF joint origins, fixed joints, tool offsets).
     Fixed(Isometry3<f64>),
-    /// A revolute joint about `axis` of the current frame; angle `q[index]` [rad].
+    /// A revolute joint about `axis` of the current frame; angle `q[index]` \[rad\].
     Revolute {
         /// Unit axis in the current frame.
         axis: Unit<Vector3<f64>>,
         /// Index into the joint vector.
         index: usize,
     },
-    /// A prismatic joint along `axis` of the current frame; travel `q[index]` [m].
+    /// A prismatic joint along `axis` of the current frame; travel `q[index]` \[m\].
     Prismatic {
         /// Unit axis in the current frame.
         axis: Unit<Vector3<f64>>,
         /// Index into the joint vector.
         index: usize,
     },
-    /// A virtual joint at the current frame: compliances `1/k` [rad / (N m)] about the frame's
-    /// x, y, z axes (k_C, k_B, k_A of Table 1). A compliance of 0 is a rigid axis.
+    /// A virtual joint whose frame sits at `offset` from the current frame (identity: at the
+    /// current frame): compliances `1/k` \[rad / (N m)\] about the spring frame's x, y, z axes
+    /// (k_C, k_B, k_A of Table 1). A compliance of 0 is a rigid axis. The chain continues
+    /// from the current frame (the offset only places the spring).
     Spring {
-        /// `[1/k_C, 1/k_B, 1/k_A]` [rad / (N m)].
+        /// `[1/k_C, 1/k_B, 1/k_A]` \[rad / (N m)\].
         compliance: Vector3<f64>,
         /// Index of the spring in chain order.
+        index: usize,
+        /// Spring frame relative to the current frame.
+        offset: Isometry3<f64>,
+    },
+    /// A rigid body attached to the current frame: mass \[kg\], centre of mass \[m\] and
+    /// inertia about the centre of mass \[kg m^2\], both in the current frame. It changes no
+    /// kinematics; under joint motion its inertial wrench loads every spring before it
+    /// ([`crate::vjm::deflection_under`]).
+    Mass {
+        /// Mass \[kg\].
+        mass: f64,
+        /// Centre of mass in the current frame \[m\].
+        com: Vector3<f64>,
+        /// Inertia about the centre of mass, current-frame axes \[kg m^2\].
+        inertia: Matrix3<f64>,
+        /// Index of the mass in chain order.
+        index: usize,
+    },
+}
+
+/// The chain compiled for the kernels at build time: each joint carries the fixed transform
+/// before it (one composition instead of two per joint), spring offsets are kept aside (the
+/// chain does not pass through them), and only a trailing fixed transform stays alone.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Op {
+    Fixed(Isometry3<f64>),
+    Joint {
+        pre: Isometry3<f64>,
+        axis: Unit<Vector3<f64>>,
+        revolute: bool,
+        index: usize,
+    },
+    Spring {
+        offset: Option<Isometry3<f64>>,
+        compliance: Vector3<f64>,
+        index: usize,
+    },
+    /// A mass in the frame of the op before (any pending fixed transform folded into it).
+    Mass {
+        mass: f64,
+        com: Vector3<f64>,
+        inertia: Matrix3<f64>,
         index: usize,
     },
 }
@@ -49,8 +96,10 @@ pub enum Element {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
     pub(crate) elements: heapless::Vec<Element, MAX_ELEMENTS>,
+    pub(crate) ops: heapless::Vec<Op, MAX_ELEMENTS>,
     pub(crate) dof: usize,
     pub(crate) springs: usize,
+    pub(crate) masses: usize,
 }
 
 impl Model {
@@ -61,6 +110,10 @@ impl Model {
     /// Number of virtual joints.
     pub fn spring_count(&self) -> usize {
         self.springs
+    }
+    /// Number of link masses ([`Element::Mass`]).
+    pub fn mass_count(&self) -> usize {
+        self.masses
     }
     /// The chain, base to TCP.
     pub fn elements(&self) -> &[Element] {
@@ -87,6 +140,7 @@ pub struct ModelBuilder {
     elements: heapless::Vec<Element, MAX_ELEMENTS>,
     dof: usize,
     springs: usize,
+    masses: usize,
     calls: usize,
 }
 
@@ -97,12 +151,11 @@ impl ModelBuilder {
     }
 
     fn push(&mut self, e: Element) -> Result<(), BuildError> {
-        self.elements
-            .push(e)
-            .map_err(|_| BuildError::CapacityExceeded {
-                what: "elements",
-                capacity: MAX_ELEMENTS,
-            })
+        self.elements.push(e).map_err(|_| BuildError::Capacity {
+            what: "elements",
+            capacity: MAX_ELEMENTS,
+            got: MAX_ELEMENTS + 1,
+        })
     }
 
     /// Appends a constant transform (merged with a preceding one).
@@ -110,7 +163,10 @@ impl ModelBuilder {
         let element = self.calls;
         self.calls += 1;
         if !iso_is_finite(&t) {
-            return Err(BuildError::NonFiniteTransform { element });
+            return Err(BuildError::NonFinite {
+                what: "transform",
+                index: element,
+            });
         }
         if let Some(Element::Fixed(prev)) = self.elements.last_mut() {
             *prev *= t;
@@ -128,9 +184,10 @@ impl ModelBuilder {
             return Err(BuildError::ZeroAxis { element });
         }
         if self.dof >= MAX_DOF {
-            return Err(BuildError::CapacityExceeded {
+            return Err(BuildError::Capacity {
                 what: "joints",
                 capacity: MAX_DOF,
+                got: MAX_DOF + 1,
             });
         }
         let axis = Unit::new_normalize(axis);
@@ -155,13 +212,16 @@ impl ModelBuilder {
     }
 
     /// Appends a virtual joint at the current frame with stiffnesses `k = [k_C, k_B, k_A]`
-    /// [N m / rad] about its x, y, z axes; `f64::INFINITY` makes an axis rigid.
+    /// \[N m / rad\] about its x, y, z axes; `f64::INFINITY` makes an axis rigid (see
+    /// [`valid_stiffness`]).
     pub fn spring(mut self, k: [f64; 3]) -> Result<Self, BuildError> {
         let element = self.calls;
         self.calls += 1;
         let mut compliance = Vector3::zeros();
         for (axis, (&ki, ci)) in k.iter().zip(compliance.iter_mut()).enumerate() {
-            if ki.is_nan() || ki <= 0.0 {
+            // Zero, negative, NaN and sub-normal values are refused: 1/k of a sub-normal
+            // overflows to infinity and turns every deflection into NaN.
+            if !valid_stiffness(ki) {
                 return Err(BuildError::NonPositiveStiffness {
                     element,
                     axis,
@@ -171,13 +231,18 @@ impl ModelBuilder {
             *ci = 1.0 / ki; // 0 for +inf: rigid
         }
         if self.springs >= MAX_SPRINGS {
-            return Err(BuildError::CapacityExceeded {
+            return Err(BuildError::Capacity {
                 what: "springs",
                 capacity: MAX_SPRINGS,
+                got: MAX_SPRINGS + 1,
             });
         }
         let index = self.springs;
-        self.push(Element::Spring { compliance, index })?;
+        self.push(Element::Spring {
+            compliance,
+            index,
+            offset: Isometry3::identity(),
+        })?;
         self.springs += 1;
         Ok(self)
     }
@@ -185,20 +250,146 @@ impl ModelBuilder {
     /// Appends a virtual joint whose frame sits at `frame` relative to the current frame
     /// (an offset and orientation inside a link); the chain continues from the current frame.
     pub fn spring_at(self, frame: Isometry3<f64>, k: [f64; 3]) -> Result<Self, BuildError> {
-        if frame == Isometry3::identity() {
-            return self.spring(k);
+        if !iso_is_finite(&frame) {
+            return Err(BuildError::NonFinite {
+                what: "spring frame",
+                index: self.calls,
+            });
         }
-        self.fixed(frame)?.spring(k)?.fixed(frame.inverse())
+        let mut b = self.spring(k)?;
+        if let Some(Element::Spring { offset, .. }) = b.elements.last_mut() {
+            *offset = frame;
+        }
+        Ok(b)
     }
 
-    /// Finishes the model.
+    /// Appends a rigid body at the current frame: `mass` \[kg\] (finite, >= 0), centre of mass
+    /// `com` \[m\] and `inertia` about it \[kg m^2\] (symmetric, positive semi-definite), both
+    /// in the current frame. Kinematics are unchanged; under joint motion its inertial wrench
+    /// loads the springs before it.
+    pub fn mass(
+        mut self,
+        mass: f64,
+        com: Vector3<f64>,
+        inertia: Matrix3<f64>,
+    ) -> Result<Self, BuildError> {
+        let element = self.calls;
+        self.calls += 1;
+        if !mass.is_finite() || com.iter().chain(inertia.iter()).any(|v| !v.is_finite()) {
+            return Err(BuildError::NonFinite {
+                what: "link mass properties",
+                index: element,
+            });
+        }
+        crate::error::param("link mass", mass, mass >= 0.0, ">= 0 (kg)")?;
+        let scale = inertia.amax().max(f64::MIN_POSITIVE);
+        let asym = (inertia - inertia.transpose()).amax();
+        if asym > 1e-9 * scale {
+            return Err(BuildError::InvalidParameter {
+                what: "link inertia (asymmetry)",
+                value: asym,
+                expected: "a symmetric tensor",
+            });
+        }
+        let min = inertia.symmetric_eigenvalues().min();
+        if min < -1e-9 * scale {
+            return Err(BuildError::Singular {
+                what: "link inertia (not positive semi-definite)",
+                measure: min,
+            });
+        }
+        if self.masses >= MAX_MASSES {
+            return Err(BuildError::Capacity {
+                what: "masses",
+                capacity: MAX_MASSES,
+                got: MAX_MASSES + 1,
+            });
+        }
+        let index = self.masses;
+        self.push(Element::Mass {
+            mass,
+            com,
+            inertia,
+            index,
+        })?;
+        self.masses += 1;
+        Ok(self)
+    }
+
+    /// Finishes the model (and compiles it for the kernels).
     pub fn build(self) -> Result<Model, BuildError> {
+        let mut ops: heapless::Vec<Op, MAX_ELEMENTS> = heapless::Vec::new();
+        let capacity = BuildError::Capacity {
+            what: "elements",
+            capacity: MAX_ELEMENTS,
+            got: MAX_ELEMENTS + 1,
+        };
+        // A fixed transform waiting to be folded into the next joint.
+        let mut pending: Option<Isometry3<f64>> = None;
+        for e in &self.elements {
+            let op = match *e {
+                Element::Fixed(t) => {
+                    pending = Some(pending.map_or(t, |p| p * t));
+                    continue;
+                }
+                Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
+                    Op::Joint {
+                        pre: pending.take().unwrap_or_else(Isometry3::identity),
+                        axis,
+                        revolute: matches!(e, Element::Revolute { .. }),
+                        index,
+                    }
+                }
+                Element::Spring {
+                    compliance,
+                    index,
+                    offset,
+                } => {
+                    if let Some(p) = pending.take() {
+                        ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
+                    }
+                    Op::Spring {
+                        offset: (offset != Isometry3::identity()).then_some(offset),
+                        compliance,
+                        index,
+                    }
+                }
+                Element::Mass {
+                    mass,
+                    com,
+                    inertia,
+                    index,
+                } => {
+                    // Expressed in the frame before a pending fixed transform, so that the
+                    // transform still folds into the next joint.
+                    let p = pending.unwrap_or_else(Isometry3::identity);
+                    let r = p.rotation.to_rotation_matrix();
+                    Op::Mass {
+                        mass,
+                        com: p.transform_point(&com.into()).coords,
+                        inertia: r.matrix() * inertia * r.matrix().transpose(),
+                        index,
+                    }
+                }
+            };
+            ops.push(op).map_err(|_| capacity)?;
+        }
+        if let Some(p) = pending {
+            ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
+        }
         Ok(Model {
             elements: self.elements,
+            ops,
             dof: self.dof,
             springs: self.springs,
+            masses: self.masses,
         })
     }
+}
+
+/// A virtual-joint stiffness \[N m / rad\]: a normal positive number, or `+inf` (rigid).
+pub fn valid_stiffness(k: f64) -> bool {
+    k == f64::INFINITY || (k.is_normal() && k > 0.0)
 }
 
 fn iso_is_finite(t: &Isometry3<f64>) -> bool {
@@ -207,33 +398,59 @@ fn iso_is_finite(t: &Isometry3<f64>) -> bool {
 }
 
 /// Per-call workspace and the last call's by-products, sized once for any model
-/// (fixed capacities, so creating one allocates nothing).
+/// (fixed capacities, so creating one allocates nothing). Records the dimensions of the model
+/// it was made for; every per-tick function refuses a model of other dimensions
+/// ([`crate::TickError::ModelMismatch`]).
 #[derive(Debug, Clone)]
 pub struct Data {
+    pub(super) dof: usize,
+    pub(super) springs: usize,
     /// Rigid TCP pose of the last call, base frame.
     pub tcp: Isometry3<f64>,
     /// Deflected TCP pose of the last [`crate::vjm::deflection`] call, base frame (Eq. 8).
     pub tcp_deflected: Isometry3<f64>,
-    /// Elastic angles `[alpha, beta, gamma]` [rad] of each spring from the last
+    /// Elastic angles `[alpha, beta, gamma]` \[rad\] of each spring from the last
     /// [`crate::vjm::deflection`] call (Eq. 7), in chain order; entries past
     /// [`Model::spring_count`] are zero.
     pub spring_angles: [Vector3<f64>; MAX_SPRINGS],
-    /// Actuated-joint Jacobian `[v; w]` of the TCP [m/rad or 1, rad/rad], base frame, from the
+    /// Actuated-joint Jacobian `[v; w]` of the TCP \[m/rad or 1, rad/rad\], base frame, from the
     /// last [`crate::vjm::joint_jacobian`] call; columns past [`Model::dof`] are zero.
     pub jacobian: SMatrix<f64, 6, MAX_DOF>,
     /// Cartesian compliance of the last [`crate::vjm::compliance`] call.
     pub compliance: Matrix6<f64>,
+    // Rigid world frames of the springs, and joint axes and origins (before their motion),
+    // of the last pass over the chain.
+    pub(crate) spring_frames: [Isometry3<f64>; MAX_SPRINGS],
+    pub(crate) joint_axes: [Vector3<f64>; MAX_DOF],
+    pub(crate) joint_origins: [Vector3<f64>; MAX_DOF],
+    /// Moment on each spring \[N m\] (world axes, about the spring's origin) of the last
+    /// loaded call ([`crate::vjm::deflection_under`]); entries past the spring count are zero.
+    pub spring_moments: [Vector3<f64>; MAX_SPRINGS],
+    // Inertial force and moment about the world origin of each mass, last loaded call.
+    pub(crate) mass_loads: [(Vector3<f64>, Vector3<f64>); MAX_MASSES],
 }
 
 impl Data {
-    /// A workspace for `model` (any model fits; the argument keeps the pinocchio shape).
-    pub fn new(_model: &Model) -> Self {
+    /// A workspace for `model`.
+    pub fn new(model: &Model) -> Self {
         Self {
+            dof: model.dof,
+            springs: model.springs,
             tcp: Isometry3::identity(),
             tcp_deflected: Isometry3::identity(),
             spring_angles: [Vector3::zeros(); MAX_SPRINGS],
             jacobian: SMatrix::zeros(),
             compliance: Matrix6::zeros(),
+            spring_frames: [Isometry3::identity(); MAX_SPRINGS],
+            joint_axes: [Vector3::zeros(); MAX_DOF],
+            joint_origins: [Vector3::zeros(); MAX_DOF],
+            spring_moments: [Vector3::zeros(); MAX_SPRINGS],
+            mass_loads: [(Vector3::zeros(), Vector3::zeros()); MAX_MASSES],
         }
+    }
+
+    /// Whether this workspace was made for a model of `model`'s dimensions.
+    pub fn check(&self, model: &Model) -> bool {
+        self.dof == model.dof && self.springs == model.springs
     }
 }

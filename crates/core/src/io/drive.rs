@@ -1,4 +1,4 @@
-//! Loading a [`DriveTrain`] for a [`SerialRobot`]: per-joint stiffness and backlash from a
+//! The drive-train [`Model`] of a [`SerialRobot`]: per-joint stiffness and backlash from a
 //! TOML file, link masses and centres of mass from the URDF `<inertial>` elements.
 //!
 //! The drive-train entries may sit in the robot's stiffness file next to its virtual joints
@@ -12,10 +12,10 @@
 //! ```
 //!
 //! Every actuated joint of the chain needs exactly one entry. Masses: each chain link's
-//! `<inertial>` mass [kg] at its `<origin xyz>` [m] (the centre of mass in the link frame)
+//! `<inertial>` mass \[kg\] at its `<origin xyz>` \[m\] (the centre of mass in the link frame)
 //! hangs after the last actuated joint before that link; links before the first actuated
 //! joint load no joint and are skipped, and so are links off the base-to-tip chain (branches
-//! such as grippers or sensors on other links: add them with [`LinkMasses::push`]). Masses
+//! such as grippers or sensors on other links: add them with [`crate::drivetrain::LinkMasses::push`]). Masses
 //! after the same joint are merged into one point mass (exact for gravity), so any URDF fits
 //! the fixed table.
 
@@ -25,12 +25,12 @@ use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Vector3};
 use serde::Deserialize;
 
-use crate::drivetrain::{DriveTrain, LinkMasses};
-use crate::error::BuildError;
-use crate::robot::{LoadError, SerialRobot};
+use crate::drivetrain::{LinkMasses, Model};
+use crate::error::LoadError;
+use crate::robot::SerialRobot;
 use crate::vjm::MAX_DOF;
 
 /// One `[[joint]]` entry of a drive-train file.
@@ -39,9 +39,9 @@ use crate::vjm::MAX_DOF;
 pub struct JointDriveSpec {
     /// URDF name of the actuated joint.
     pub name: String,
-    /// Joint stiffness `K_i` [N m/rad, or N/m for a prismatic joint].
+    /// Joint stiffness `K_i` \[N m/rad, or N/m for a prismatic joint\].
     pub stiffness: f64,
-    /// Backlash `theta_b_i` [rad, or m for a prismatic joint].
+    /// Backlash `theta_b_i` \[rad, or m for a prismatic joint\].
     #[serde(default)]
     pub backlash: f64,
 }
@@ -56,35 +56,19 @@ struct DriveFile {
     _virtual_joint: Option<toml::Value>,
 }
 
-fn bad(message: String) -> LoadError {
-    LoadError::StiffnessParse { message }
-}
-
 /// Parses the `[[joint]]` entries of a drive-train (or combined stiffness) TOML text.
-pub fn parse_joint_drives(text: &str) -> Result<Vec<JointDriveSpec>, LoadError> {
+pub fn parse(text: &str) -> Result<Vec<JointDriveSpec>, LoadError> {
+    super::check_size("drive-train file", text)?;
     toml::from_str::<DriveFile>(text)
         .map(|f| f.joint)
-        .map_err(|e| bad(e.to_string()))
-}
-
-fn pose(xyz: &[f64; 3], rpy: &[f64; 3], element: &str) -> Result<Isometry3<f64>, LoadError> {
-    if !xyz.iter().chain(rpy.iter()).all(|v| v.is_finite()) {
-        return Err(LoadError::NonFiniteOrigin {
-            element: element.to_string(),
-        });
-    }
-    Ok(Isometry3::from_parts(
-        Translation3::new(xyz[0], xyz[1], xyz[2]),
-        UnitQuaternion::from_euler_angles(rpy[0], rpy[1], rpy[2]),
-    ))
+        .map_err(|e| LoadError::StiffnessParse {
+            message: e.to_string(),
+        })
 }
 
 /// The link masses of `serial`'s base-to-tip chain from the parsed URDF it was loaded from
 /// (rules in the module docs).
-pub fn link_masses_from_urdf(
-    robot: &urdf_rs::Robot,
-    serial: &SerialRobot,
-) -> Result<LinkMasses, LoadError> {
+pub fn link_masses(robot: &urdf_rs::Robot, serial: &SerialRobot) -> Result<LinkMasses, LoadError> {
     let parent_joint: HashMap<&str, &urdf_rs::Joint> = robot
         .joints
         .iter()
@@ -124,16 +108,16 @@ pub fn link_masses_from_urdf(
         );
         if moving {
             if serial.joint_names.get(n_moving) != Some(&j.name) {
-                return Err(bad(format!(
-                    "URDF joint '{}' does not match the robot's joint list",
-                    j.name
-                )));
+                return Err(LoadError::UnknownJoint {
+                    joint: j.name.clone(),
+                    referenced_by: "the URDF chain (not the robot's joint list)".to_string(),
+                });
             }
             current = Some(n_moving);
             n_moving += 1;
             offset = Isometry3::identity();
         } else {
-            offset *= pose(
+            offset *= super::urdf::pose(
                 &j.origin.xyz.0,
                 &j.origin.rpy.0,
                 &format!("joint '{}'", j.name),
@@ -144,10 +128,12 @@ pub fn link_masses_from_urdf(
         };
         let m = l.inertial.mass.value;
         if !(m.is_finite() && m >= 0.0) {
-            return Err(bad(format!(
-                "link '{}': inertial mass {m} must be finite and >= 0 (kg)",
-                l.name
-            )));
+            return Err(LoadError::InvalidValue {
+                element: format!("link '{}' inertial", l.name),
+                field: "mass",
+                expected: "finite and >= 0 (kg)".to_string(),
+                got: m.to_string(),
+            });
         }
         let com_local = Vector3::from(l.inertial.origin.xyz.0);
         if !com_local.iter().all(|v| v.is_finite()) {
@@ -164,12 +150,7 @@ pub fn link_masses_from_urdf(
     let mut out = LinkMasses::new();
     for (index, (&m, s)) in mass.iter().zip(moment.iter()).enumerate().take(n_moving) {
         if m > 0.0 {
-            out.push(index, m, s / m).map_err(|_| {
-                LoadError::Build(BuildError::CapacityExceeded {
-                    what: "masses",
-                    capacity: crate::drivetrain::MAX_MASSES,
-                })
-            })?;
+            out.push(index, m, s / m).map_err(LoadError::Build)?;
         }
     }
     Ok(out)
@@ -177,41 +158,47 @@ pub fn link_masses_from_urdf(
 
 /// Builds the drive train of `serial` from its URDF text (masses) and the `[[joint]]`
 /// entries of `drive_toml` (stiffness, backlash).
-pub fn drive_train_from_strs(
-    serial: &SerialRobot,
-    urdf: &str,
-    drive_toml: &str,
-) -> Result<DriveTrain, LoadError> {
-    let robot = urdf_rs::read_from_string(urdf).map_err(|e| LoadError::UrdfParse {
-        message: e.to_string(),
-    })?;
-    let specs = parse_joint_drives(drive_toml)?;
+pub fn from_str(serial: &SerialRobot, urdf: &str, drive_toml: &str) -> Result<Model, LoadError> {
+    let robot = super::urdf::parse(urdf)?;
+    let specs = parse(drive_toml)?;
     let n = serial.joint_names.len();
     let mut stiffness: Vec<Option<f64>> = std::vec![None; n];
     let mut backlash = std::vec![0.0; n];
     for (entry, s) in specs.iter().enumerate() {
         let Some(i) = serial.joint_names.iter().position(|name| *name == s.name) else {
-            return Err(bad(format!(
-                "joint #{entry} '{}' is not an actuated joint of the chain (joints: {})",
-                s.name,
-                serial.joint_names.join(", ")
-            )));
+            return Err(LoadError::UnknownJoint {
+                joint: s.name.clone(),
+                referenced_by: format!(
+                    "[[joint]] #{entry} (actuated joints: {})",
+                    serial.joint_names.join(", ")
+                ),
+            });
         };
-        if !(s.stiffness.is_finite() && s.stiffness > 0.0) {
-            return Err(bad(format!(
-                "joint '{}': stiffness {} must be finite and > 0 (N m/rad)",
-                s.name, s.stiffness
-            )));
+        let element = || format!("[[joint]] '{}'", s.name);
+        if !(s.stiffness.is_normal() && s.stiffness > 0.0) {
+            return Err(LoadError::InvalidValue {
+                element: element(),
+                field: "stiffness",
+                expected: "a normal number > 0 (N m/rad)".to_string(),
+                got: s.stiffness.to_string(),
+            });
         }
         if !(s.backlash.is_finite() && s.backlash >= 0.0) {
-            return Err(bad(format!(
-                "joint '{}': backlash {} must be finite and >= 0 (rad)",
-                s.name, s.backlash
-            )));
+            return Err(LoadError::InvalidValue {
+                element: element(),
+                field: "backlash",
+                expected: "finite and >= 0 (rad)".to_string(),
+                got: s.backlash.to_string(),
+            });
         }
         match stiffness.get_mut(i) {
             Some(slot @ None) => *slot = Some(s.stiffness),
-            _ => return Err(bad(format!("joint '{}' is listed twice", s.name))),
+            _ => {
+                return Err(LoadError::DuplicateName {
+                    kind: "[[joint]] entry",
+                    name: s.name.clone(),
+                });
+            }
         }
         if let Some(b) = backlash.get_mut(i) {
             *b = s.backlash;
@@ -221,30 +208,29 @@ pub fn drive_train_from_strs(
     for (name, s) in serial.joint_names.iter().zip(stiffness.iter()) {
         match s {
             Some(v) => k.push(*v),
-            None => return Err(bad(format!("joint '{name}' has no [[joint]] entry"))),
+            None => {
+                return Err(LoadError::InvalidValue {
+                    element: format!("joint '{name}'"),
+                    field: "[[joint]] entry",
+                    expected: "one entry per actuated joint".to_string(),
+                    got: "none".to_string(),
+                });
+            }
         }
     }
-    let masses = link_masses_from_urdf(&robot, serial)?;
-    DriveTrain::new(&serial.model, &k, &backlash)
-        .and_then(|d| d.with_masses(masses))
-        .map_err(|e| bad(e.to_string()))
+    let masses = link_masses(&robot, serial)?;
+    Ok(Model::new(serial.model.clone(), &k, &backlash)?.with_masses(masses)?)
 }
 
-/// [`drive_train_from_strs`] from files.
-pub fn drive_train_from_files(
+/// [`from_str`] on the texts of the URDF file and the drive-train file.
+pub fn from_path(
     serial: &SerialRobot,
     urdf_path: impl AsRef<Path>,
     drive_path: impl AsRef<Path>,
-) -> Result<DriveTrain, LoadError> {
-    let read = |p: &Path| {
-        std::fs::read_to_string(p).map_err(|e| LoadError::Io {
-            path: p.display().to_string(),
-            message: e.to_string(),
-        })
-    };
-    drive_train_from_strs(
+) -> Result<Model, LoadError> {
+    from_str(
         serial,
-        &read(urdf_path.as_ref())?,
-        &read(drive_path.as_ref())?,
+        &super::read_text(urdf_path.as_ref())?,
+        &super::read_text(drive_path.as_ref())?,
     )
 }

@@ -1,0 +1,74 @@
+//! Loaders (`std`): every file format deflect reads, apart from the algorithms that use what
+//! they load. Each format has a `from_str` on the text and a `from_path` on a file; the
+//! bindings and the testbed call these and never read files themselves. Files in units other
+//! than SI say so (a parameter or a column name) and are converted here.
+//!
+//! | module | format | result |
+//! |---|---|---|
+//! | [`urdf`] (`urdf`) | URDF + stiffness TOML | [`crate::SerialRobot`] |
+//! | [`stiffness`] (`urdf`) | stiffness TOML `[[virtual_joint]]` | specs |
+//! | [`drive`] (`urdf`) | drive-train TOML `[[joint]]` + URDF masses | [`crate::drivetrain::Model`] |
+//! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
+//! | [`map_json`] | versioned JSON of a map | [`crate::ComplianceMap`] |
+
+#[cfg(feature = "urdf")]
+pub mod drive;
+pub mod map_csv;
+pub mod map_json;
+#[cfg(feature = "urdf")]
+pub mod stiffness;
+#[cfg(feature = "urdf")]
+pub mod urdf;
+#[cfg(feature = "urdf")]
+mod xml;
+
+use std::path::Path;
+use std::string::{String, ToString};
+
+use crate::error::LoadError;
+
+/// Largest text file (or text) a loader reads \[bytes\]: 16 MiB. A URDF with meshes
+/// referenced by name, a stiffness file or a map table are kilobytes; a larger input is
+/// refused before it is read or parsed ([`LoadError::TooLarge`]).
+pub const MAX_FILE_BYTES: usize = 16 << 20;
+
+/// Refuses a text over [`MAX_FILE_BYTES`].
+pub(crate) fn check_size(what: &str, text: &str) -> Result<(), LoadError> {
+    if text.len() > MAX_FILE_BYTES {
+        return Err(LoadError::TooLarge {
+            what: std::format!("{what} size (bytes)"),
+            limit: MAX_FILE_BYTES,
+            got: text.len(),
+        });
+    }
+    Ok(())
+}
+
+/// Reads a whole text file, naming it in the error; reads at most [`MAX_FILE_BYTES`] + 1
+/// bytes, so a huge file or an endless one (`/dev/zero`) is refused, not read.
+pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
+    use std::io::Read;
+    let io = |e: std::io::Error| LoadError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = std::vec::Vec::new();
+    file.take(MAX_FILE_BYTES as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(io)?;
+    if bytes.len() > MAX_FILE_BYTES {
+        return Err(LoadError::TooLarge {
+            what: std::format!(
+                "{} size (bytes, read up to one past the limit)",
+                path.display()
+            ),
+            limit: MAX_FILE_BYTES,
+            got: bytes.len(),
+        });
+    }
+    String::from_utf8(bytes).map_err(|e| LoadError::Io {
+        path: path.display().to_string(),
+        message: std::format!("not UTF-8 text: {e}"),
+    })
+}
