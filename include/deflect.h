@@ -18,6 +18,24 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+// Largest moving-average window of the online compensator [cycles].
+#define DEFLECT_MAX_AVERAGE_WINDOW 64
+
+// Number of terms of the sensor's residual-offset polynomial (Eq. 17).
+#define DEFLECT_RESIDUAL_TERMS 15
+
+// Compensator output: Cartesian correction values only.
+#define DEFLECT_OUTPUT_CARTESIAN 0
+
+// Compensator output: also axis-specific values `dq` through the joint Jacobian.
+#define DEFLECT_OUTPUT_JOINT 1
+
+// The online-compensation paper's control cycle [s] (KUKA RSI, 4 ms).
+#define DEFLECT_PAPER_CYCLE 0.004
+
+// The paper's tuned D'Alembert mass parameter m* [kg].
+#define DEFLECT_PAPER_MASS 5.0
+
 // File force unit: newton.
 #define DEFLECT_FORCE_UNIT_NEWTON 0
 
@@ -54,33 +72,22 @@
 // Query/model status: the position was outside and was extrapolated.
 #define DEFLECT_QUERY_EXTRAPOLATED 2
 
-// Most actuated joints of a serial robot (length of `DeflectJointCorrection.dq`).
-#define DEFLECT_MAX_DOF 8
-
-// The paper's tuned D'Alembert mass parameter m* [kg].
-#define DEFLECT_PAPER_MASS 5.0
-
 // The paper's correction rate [Hz].
 #define DEFLECT_PAPER_RATE_HZ 2000.0
 
-// Largest moving-average window of the online compensator [cycles].
-#define DEFLECT_MAX_AVERAGE_WINDOW 64
+// Most actuated joints of a serial robot (length of `DeflectJointCorrection.dq`).
+#define DEFLECT_MAX_DOF 8
 
-// Number of terms of the sensor's residual-offset polynomial (Eq. 17).
-#define DEFLECT_RESIDUAL_TERMS 15
+// Invert the paper's exact virtual-joint deflection (Eq. 2-9).
+#define DEFLECT_SERIAL_EXACT 0
 
-// Compensator output: Cartesian correction values only.
-#define DEFLECT_OUTPUT_CARTESIAN 0
+// Invert the linearized deflection `C(q) w`.
+#define DEFLECT_SERIAL_LINEARIZED 1
 
-// Compensator output: also axis-specific values `dq` through the joint Jacobian.
-#define DEFLECT_OUTPUT_JOINT 1
-
-// The online-compensation paper's control cycle [s] (KUKA RSI, 4 ms).
-#define DEFLECT_PAPER_CYCLE 0.004
-
-// The online force-compensation chain of one serial robot with its filter, pilot and
-// rate-limiter states and its own workspace. Opaque; create with `deflect_compensator_create`,
-// free with `deflect_compensator_destroy`. Not thread-safe: one thread at a time.
+// The online force-compensation chain of one serial robot: its model (the robot's chain and
+// the validated settings) and its state (filters, pilot control, rate limiter, workspace).
+// Opaque; create with `deflect_compensator_create`, free with `deflect_compensator_destroy`.
+// Not thread-safe: one thread at a time.
 typedef struct DeflectCompensator DeflectCompensator;
 
 // A compliance map (per-node force-displacement lines over an (x, y) grid). Opaque; create
@@ -89,9 +96,20 @@ typedef struct DeflectCompensator DeflectCompensator;
 typedef struct DeflectComplianceMap DeflectComplianceMap;
 
 // The D'Alembert trajectory corrector of the planar parallel robot (Paksoy et al.,
-// section 3.3): settings and robot geometry. Opaque; create with `deflect_dalembert_create`,
-// free with `deflect_dalembert_destroy`.
+// section 3.3): robot geometry, its own copy of the compliance map, settings, and the last
+// tick's joints. Opaque; create with `deflect_dalembert_create`, free with
+// `deflect_dalembert_destroy`. Not thread-safe: one thread at a time.
 typedef struct DeflectDalembert DeflectDalembert;
+
+// A planned pose motion. Opaque; create with `deflect_pose_motion_line`, free with
+// `deflect_pose_motion_destroy`. Read-only after creation.
+typedef struct DeflectPoseMotion DeflectPoseMotion;
+
+// The serial-arm D'Alembert corrector: the robot's chain and URDF joint limits, the payload,
+// the deflection model and the last ticks' joints (the warm start). Opaque; create with
+// `deflect_serial_dalembert_create`, free with `deflect_serial_dalembert_destroy`. Not
+// thread-safe: one thread at a time.
+typedef struct DeflectSerialDalembert DeflectSerialDalembert;
 
 // A serial robot (virtual-joint model) loaded from URDF + stiffness TOML, with its own
 // per-call workspace. Opaque; create with `deflect_serial_robot_load`, free with
@@ -106,85 +124,6 @@ typedef struct DeflectTrajectory2 DeflectTrajectory2;
 // Result of every fallible deflect function: `DEFLECT_OK` (0) on success, a negative
 // `DEFLECT_ERR_*` code otherwise (in the style of ruckig's `Result`).
 typedef int32_t DeflectStatus;
-
-// Result of `deflect_serial_robot_joint_correction`.
-typedef struct DeflectJointCorrection {
-  // Correction to add to the nominal joints [rad or m]; entries past the robot's dof are 0.
-  double dq[DEFLECT_MAX_DOF];
-  // Gauss-Newton steps taken.
-  uint32_t iterations;
-  // Remaining pose error |[dp; dr]| of the deflected TCP at q + dq [m, rad].
-  double residual;
-  // Smallest singular value of the joint Jacobian at the last step (NaN if no step).
-  double sigma_min;
-  // 1 if `residual <= tolerance`, else 0.
-  int32_t converged;
-} DeflectJointCorrection;
-
-// Path limits of a motion: speed [m/s], acceleration [m/s^2], jerk [m/s^3], each finite
-// and > 0.
-typedef struct DeflectLimits {
-  // Largest speed [m/s].
-  double v_max;
-  // Largest acceleration [m/s^2].
-  double a_max;
-  // Largest jerk [m/s^3].
-  double j_max;
-} DeflectLimits;
-
-// The state of a planar trajectory at one time.
-typedef struct DeflectState2 {
-  // Time since the start [s].
-  double t;
-  // Index of the segment being travelled.
-  size_t segment;
-  // Path length from the start of the polyline [m].
-  double path_s;
-  // Path speed along the current segment [m/s].
-  double path_v;
-  // Path acceleration along the current segment [m/s^2].
-  double path_a;
-  // Path jerk along the current segment [m/s^3].
-  double path_j;
-  // Position (x, y) [m].
-  double position[2];
-  // Velocity [m/s].
-  double velocity[2];
-  // Acceleration [m/s^2]: what the D'Alembert force -m* a needs.
-  double acceleration[2];
-  // Jerk [m/s^3].
-  double jerk[2];
-} DeflectState2;
-
-// Geometry of the paper's 2-DoF planar parallel robot (Paksoy et al., section 4.1).
-typedef struct DeflectParallelRobot2 {
-  // Length of every arm link [m] (paper: 0.150).
-  double link;
-  // Distance of the base pivots from the base centre [m] (paper: 0.090).
-  double half_width;
-  // Singularity threshold: smallest allowed Jacobian singular value [m/rad] (0.020).
-  double min_sigma;
-} DeflectParallelRobot2;
-
-// One corrected tick of the D'Alembert corrector of the planar robot.
-typedef struct DeflectCorrectedTick2 {
-  // Desired (planned) point [m].
-  double desired[2];
-  // Commanded point [m]: desired minus the predicted displacement.
-  double commanded[2];
-  // Joint command (theta_A, theta_B) [rad]: inverse kinematics of `commanded`.
-  double joints[2];
-  // D'Alembert force -m* a [N].
-  double force[2];
-  // Predicted displacement at the commanded point [m].
-  double displacement[2];
-  // Fixed-point iterations done (0 = the paper's one-shot update).
-  uint32_t iterations;
-  // |c_k - c_(k-1)| of the last fixed-point iteration [m] (0 without iterations).
-  double fixed_point_residual;
-  // Worst map status met: `DEFLECT_QUERY_INSIDE`, `_CLAMPED` or `_EXTRAPOLATED`.
-  int32_t model_status;
-} DeflectCorrectedTick2;
 
 // Sensor calibration and the fixed sensor-to-TCP transform of the online compensation
 // (Eq. 12-20), plain data. `deflect_sensor_calibration_default` fills the neutral one (no
@@ -267,6 +206,134 @@ typedef struct DeflectCycleOutput {
   uint8_t rate_limited;
 } DeflectCycleOutput;
 
+// Geometry of the paper's 2-DoF planar parallel robot (Paksoy et al., section 4.1).
+typedef struct DeflectParallelRobot2 {
+  // Length of every arm link [m] (paper: 0.150).
+  double link;
+  // Distance of the base pivots from the base centre [m] (paper: 0.090).
+  double half_width;
+  // Singularity threshold: smallest allowed Jacobian singular value [m/rad] (0.020).
+  double min_sigma;
+} DeflectParallelRobot2;
+
+// One corrected tick of the D'Alembert corrector of the planar robot.
+typedef struct DeflectCorrectedTick2 {
+  // Desired (planned) point [m].
+  double desired[2];
+  // Commanded point [m]: desired minus the predicted displacement.
+  double commanded[2];
+  // Joint command (theta_A, theta_B) [rad]: inverse kinematics of `commanded`.
+  double joints[2];
+  // D'Alembert force -m* a [N].
+  double force[2];
+  // Predicted displacement at the commanded point [m].
+  double displacement[2];
+  // Fixed-point iterations done (0 = the paper's one-shot update).
+  uint32_t iterations;
+  // |c_k - c_(k-1)| of the last fixed-point iteration [m] (0 without iterations).
+  double fixed_point_residual;
+  // Worst placement of the map queries: `DEFLECT_QUERY_INSIDE`, `_CLAMPED` or
+  // `_EXTRAPOLATED`.
+  int32_t placement;
+} DeflectCorrectedTick2;
+
+// Path limits of a motion: speed [m/s], acceleration [m/s^2], jerk [m/s^3], each finite
+// and > 0.
+typedef struct DeflectLimits {
+  // Largest speed [m/s].
+  double v_max;
+  // Largest acceleration [m/s^2].
+  double a_max;
+  // Largest jerk [m/s^3].
+  double j_max;
+} DeflectLimits;
+
+// The state of a planar trajectory at one time.
+typedef struct DeflectState2 {
+  // Time since the start [s].
+  double t;
+  // Index of the segment being travelled.
+  size_t segment;
+  // Path length from the start of the polyline [m].
+  double path_s;
+  // Path speed along the current segment [m/s].
+  double path_v;
+  // Path acceleration along the current segment [m/s^2].
+  double path_a;
+  // Path jerk along the current segment [m/s^3].
+  double path_j;
+  // Position (x, y) [m].
+  double position[2];
+  // Velocity [m/s].
+  double velocity[2];
+  // Acceleration [m/s^2]: what the D'Alembert force -m* a needs.
+  double acceleration[2];
+  // Jerk [m/s^3].
+  double jerk[2];
+} DeflectState2;
+
+// The state of a pose motion at one time, base frame.
+typedef struct DeflectPoseState {
+  // Time since the start [s].
+  double t;
+  // TCP pose, a 4 x 4 homogeneous matrix in row-major order (translation in elements 3,
+  // 7, 11) [m].
+  double pose[16];
+  // TCP velocity [m/s].
+  double velocity[3];
+  // TCP acceleration [m/s^2].
+  double acceleration[3];
+  // Angular velocity [rad/s].
+  double angular_velocity[3];
+  // Angular acceleration [rad/s^2].
+  double angular_acceleration[3];
+} DeflectPoseState;
+
+// Result of `deflect_serial_robot_joint_correction`.
+typedef struct DeflectJointCorrection {
+  // Correction to add to the nominal joints [rad or m]; entries past the robot's dof are 0.
+  double dq[DEFLECT_MAX_DOF];
+  // Gauss-Newton steps taken.
+  uint32_t iterations;
+  // Remaining pose error |[dp; dr]| of the deflected TCP at q + dq [m, rad].
+  double residual;
+  // Smallest singular value of the joint Jacobian at the last step (NaN if no step).
+  double sigma_min;
+  // 1 if `residual <= tolerance`, else 0.
+  int32_t converged;
+} DeflectJointCorrection;
+
+// Payload and tool beyond the TCP.
+typedef struct DeflectPayload {
+  // Mass [kg], finite and >= 0.
+  double mass;
+  // Centre of mass in the TCP frame [m].
+  double com[3];
+  // Inertia tensor about the centre of mass, TCP frame, row-major 3 x 3 [kg m^2]:
+  // symmetric, positive semi-definite (all zeros for a point mass).
+  double inertia[9];
+} DeflectPayload;
+
+// One corrected tick of a serial arm.
+typedef struct DeflectSerialTick {
+  // Commanded rigid TCP pose, row-major 4 x 4: where the joints put the unloaded TCP.
+  double commanded[16];
+  // Joint command [rad or m]; entries past the robot's dof are 0.
+  double joints[DEFLECT_MAX_DOF];
+  // Wrench cancelled, D'Alembert plus process `[F; M]` [N, N m], base frame at the TCP.
+  double wrench[6];
+  // Predicted TCP deflection at the command `[dp; dr]` [m, rad].
+  double deflection[6];
+  // Pose IK iterations done (0 when the warm start already met the tolerance).
+  uint32_t iterations;
+  // Position error left [m].
+  double position_error;
+  // Orientation error left [rad].
+  double orientation_error;
+  // Estimated smallest singular value of the joint Jacobian at the command.
+  double sigma_min;
+} DeflectSerialTick;
+
 // Success.
 #define DEFLECT_OK 0
 
@@ -307,6 +374,22 @@ typedef struct DeflectCycleOutput {
 // of the planar robot needs a 2-force, 2-displacement map).
 #define DEFLECT_ERR_MAP_DIMENSION -10
 
+// A per-tick result overflowed to NaN or an infinity although every input was finite
+// (inputs far outside the model's physical range, such as a wrench of 1e308 N).
+#define DEFLECT_ERR_NON_FINITE_OUTPUT -11
+
+// The contour tracer's tool did not move along the edge (Eq. 21 has no direction).
+#define DEFLECT_ERR_NO_EDGE_MOTION -12
+
+// A joint command falls outside the robot's joint limits.
+#define DEFLECT_ERR_JOINT_LIMIT -13
+
+// A call would exceed its documented memory or time budget (sample count, iterations).
+#define DEFLECT_ERR_BUDGET -14
+
+// A workspace was made for a model of other dimensions.
+#define DEFLECT_ERR_MODEL_MISMATCH -15
+
 // An error this version of the C API does not classify (a newer deflect-core error kind).
 #define DEFLECT_ERR_OTHER -98
 
@@ -329,90 +412,135 @@ const char *deflect_status_message(DeflectStatus status);
 // that panics are contained at the boundary. Prints nothing.
 DeflectStatus deflect_test_panic(void);
 
-// Loads a serial robot from a URDF file and a stiffness TOML file (see deflect-core's
-// `robot` module for the format); the chain runs from the URDF's root link to `tip_link`.
-// Init time: allocates. On success `*out` is a new handle; on failure `*out` is NULL and
-// `err` (if not NULL) receives the message, NUL-terminated, truncated to `err_len` bytes.
-//
-// Returns `DEFLECT_ERR_NULL` (a NULL string or `out`), `DEFLECT_ERR_INVALID_ARGUMENT`
-// (a string that is not UTF-8) or `DEFLECT_ERR_LOAD` (unreadable or invalid files).
+// Writes the neutral calibration to `*out`: no offsets, no weight, no residual, TCP at the
+// sensor (translation 0, rotation (1, 0, 0, 0)).
 //
 // # Safety
-// The strings are NULL or NUL-terminated; `out` is NULL or writable; `err` is NULL or
-// writable for `err_len` bytes.
-DeflectStatus deflect_serial_robot_load(const char *urdf_path,
-                                        const char *stiffness_path,
-                                        const char *tip_link,
-                                        struct DeflectSerialRobot **out,
-                                        char *err,
-                                        size_t err_len);
+// `out` is NULL or writable.
+DeflectStatus deflect_sensor_calibration_default(struct DeflectSensorCalibration *out);
 
-// Frees a robot handle. NULL is a no-op.
+// Writes the paper's chain at cycle time `dt` [s] to `*out`: the neutral calibration (set
+// `out->calibration` afterwards), 10 Hz low-pass, 5-cycle moving average, pilot control
+// 150 N / 80 ms, projection on, 3 mm and 50 mm/s limits, Cartesian output. `dt` is checked
+// by `deflect_compensator_create`, not here.
 //
 // # Safety
-// `robot` is NULL or a live handle from `deflect_serial_robot_load`, not used afterwards.
-void deflect_serial_robot_destroy(struct DeflectSerialRobot *robot);
+// `out` is NULL or writable.
+DeflectStatus deflect_compensator_config_paper(double dt, struct DeflectCompensatorConfig *out);
 
-// Writes the robot's number of actuated joints (the length of `q`) to `*dof` and its number
-// of virtual joints to `*springs` (either output may be NULL).
+// Creates the online compensation chain for `robot` with settings `*config`. The handle holds
+// the robot's chain with the settings and its own filter states and workspace; the robot
+// handle may be destroyed afterwards. Init time: allocates. On failure `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` (a non-finite setting or calibration
+// value) or `DEFLECT_ERR_INVALID_ARGUMENT` (dt or cut-off not > 0, window outside
+// 1..=`DEFLECT_MAX_AVERAGE_WINDOW`, negative threshold, ramp, limit or weight, a zero
+// quaternion, a flag other than 0/1, an unknown output code).
 //
 // # Safety
-// `robot` is NULL or a live handle; the outputs are NULL or writable.
-DeflectStatus deflect_serial_robot_dof(const struct DeflectSerialRobot *robot,
-                                       size_t *dof,
-                                       size_t *springs);
+// `robot` is NULL or a live handle; `config` is NULL or readable; `out` is NULL or writable.
+DeflectStatus deflect_compensator_create(const struct DeflectSerialRobot *robot,
+                                         const struct DeflectCompensatorConfig *config,
+                                         struct DeflectCompensator **out);
 
-// TCP deflection `out[6] = [dx, dy, dz, rx, ry, rz]` [m, rad] (base frame) at joints
-// `q[q_len]` [rad or m] under the TCP wrench `wrench[6] = [Fx, Fy, Fz, Mx, My, Mz]`
-// [N, N m] (base frame, moment about the TCP): the exact virtual-joint model (Hahn &
-// Weigold, Eq. 2-9). Per tick: no allocation.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (`q_len` is not the robot's dof)
-// or `DEFLECT_ERR_NON_FINITE`.
+// Frees a compensator handle. NULL is a no-op.
 //
 // # Safety
-// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
-// `wrench` 6 and `out` 6 writable doubles (or NULL).
-DeflectStatus deflect_serial_robot_deflection(struct DeflectSerialRobot *robot,
-                                              const double *q,
-                                              size_t q_len,
-                                              const double *wrench,
-                                              double *out);
+// `compensator` is NULL or a live handle, not used afterwards.
+void deflect_compensator_destroy(struct DeflectCompensator *compensator);
 
-// The 6x6 Cartesian compliance of the linearized model at joints `q[q_len]`, written
-// row-major to `out[36]`: `out[6 * i + j] = C[i][j]` with rows and columns ordered
-// `[dx, dy, dz, rx, ry, rz]` x `[Fx, Fy, Fz, Mx, My, Mz]` [m/N, m/(N m), rad/N, rad/(N m)],
-// so `deflection ~= C wrench`. Per tick: no allocation.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
+// Low-frequency delay of the filter chain (low-pass plus moving average): `*samples` in
+// cycles and `*seconds` in s (either output may be NULL).
 //
 // # Safety
-// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
-// `out` 36 writable doubles (or NULL).
-DeflectStatus deflect_serial_robot_compliance(struct DeflectSerialRobot *robot,
-                                              const double *q,
-                                              size_t q_len,
-                                              double *out);
+// `compensator` is NULL or a live handle; the outputs are NULL or writable.
+DeflectStatus deflect_compensator_delay(const struct DeflectCompensator *compensator,
+                                        double *samples,
+                                        double *seconds);
 
-// Axis-specific correction: the `dq` such that the robot commanded to `q + dq` and loaded by
-// `wrench[6]` puts its deflected TCP on the rigid TCP of `q[q_len]`. Gauss-Newton through an
-// SVD, at most `max_iterations` steps (1 = the paper's first-order `dq = -J^+ Delta`),
-// stopping at `residual <= tolerance`. Per tick: no allocation, bounded time.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH`, `DEFLECT_ERR_NON_FINITE`
-// (inputs or tolerance) or `DEFLECT_ERR_SINGULAR`. Not converging is not an error:
-// `out->converged` says it.
+// Clears the filter, pilot-control and rate-limiter states (as after create). No allocation.
 //
 // # Safety
-// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
-// `wrench` 6; `out` is NULL or writable.
-DeflectStatus deflect_serial_robot_joint_correction(struct DeflectSerialRobot *robot,
-                                                    const double *q,
-                                                    size_t q_len,
-                                                    const double *wrench,
-                                                    uint32_t max_iterations,
-                                                    double tolerance,
-                                                    struct DeflectJointCorrection *out);
+// `compensator` is NULL or a live handle not used by another thread.
+DeflectStatus deflect_compensator_reset(struct DeflectCompensator *compensator);
+
+// One control cycle of the online compensation: joints `q[q_len]` [rad or m], the raw sensor
+// reading `reading[6] = [Fx, Fy, Fz, Mx, My, Mz]` [N, N m] (sensor frame), the offline
+// estimate `estimated[6]` of the TCP wrench (base frame; NULL if the program provides none,
+// which also skips pilot control) and the feed velocity `feed_velocity[3]` [m/s] (base
+// frame). The sensor reading is compensated (Eq. 18) and carried to the TCP (Eq. 19-20),
+// low-pass filtered and averaged, piloted, turned into a deflection (Eq. 9), and the opposite
+// correction projected (Eq. 10-11), limited and written to `*out`. Per cycle: no allocation,
+// bounded time.
+//
+// Returns `DEFLECT_ERR_NULL` (handle, `q`, `reading`, `feed_velocity` or `out`; nothing is
+// changed then), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_WRONG_LENGTH` (`q_len` is not the
+// robot's dof) or `DEFLECT_ERR_SINGULAR` (joint output at a singular pose). Invalid inputs
+// are refused before any state changes, except a singular pose with joint output, which is
+// met after the filter states have advanced.
+//
+// # Safety
+// `compensator` is NULL or a live handle not used by another thread; `q` holds `q_len`
+// doubles, `reading` 6, `estimated` 6 (or is NULL), `feed_velocity` 3; `out` is NULL or
+// writable.
+DeflectStatus deflect_compensator_step(struct DeflectCompensator *compensator,
+                                       const double *q,
+                                       size_t q_len,
+                                       const double *reading,
+                                       const double *estimated,
+                                       const double *feed_velocity,
+                                       struct DeflectCycleOutput *out);
+
+// Writes the geometry of the paper's robot (L = 0.150 m, pivots 0.090 m from the centre,
+// singularity threshold 0.020 m/rad) to `*out`.
+//
+// # Safety
+// `out` is NULL or writable.
+DeflectStatus deflect_parallel_robot2_paper(struct DeflectParallelRobot2 *out);
+
+// Creates a D'Alembert corrector (Paksoy et al., section 3.3) for the planar parallel robot
+// `robot` (NULL = the paper's robot) with the compliance map `map` (copied into the
+// corrector; it must have 2 force and 2 displacement axes, and its options decide what
+// happens outside its grid) and mass parameter `mass` m* [kg] (finite, >= 0; the paper's is
+// `DEFLECT_PAPER_MASS`). With `fixed_point_iterations = 0` each step is the paper's one-shot
+// update; otherwise the command is iterated `c = x_d - d(c, F)` at most that often, stopping
+// once successive commands differ by at most `tolerance` [m] (finite, >= 0). Init time:
+// allocates the handle. On failure `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_MAP_DIMENSION` or
+// `DEFLECT_ERR_INVALID_ARGUMENT`.
+//
+// # Safety
+// `robot` is NULL or readable; `map` is NULL or a live handle; `out` is NULL or writable.
+DeflectStatus deflect_dalembert_create(const struct DeflectParallelRobot2 *robot,
+                                       const struct DeflectComplianceMap *map,
+                                       double mass,
+                                       uint32_t fixed_point_iterations,
+                                       double tolerance,
+                                       struct DeflectDalembert **out);
+
+// Frees a corrector handle. NULL is a no-op.
+//
+// # Safety
+// `corrector` is NULL or a live handle, not used afterwards.
+void deflect_dalembert_destroy(struct DeflectDalembert *corrector);
+
+// One corrector tick: desired point `desired[2]` [m] with planned acceleration
+// `acceleration[2]` [m/s^2] (from `deflect_trajectory2_sample`). The D'Alembert force
+// `-m* a` (Eq. 5), the map's displacement at the desired (or fixed-point) point, the command
+// `desired - displacement` and its inverse kinematics go to `*out`. Per tick: no
+// allocation, bounded time.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_OUT_OF_GRID`,
+// `DEFLECT_ERR_OUT_OF_WORKSPACE` or `DEFLECT_ERR_SINGULAR`.
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `desired` and
+// `acceleration` hold 2 doubles; `out` is NULL or writable.
+DeflectStatus deflect_dalembert_step(struct DeflectDalembert *corrector,
+                                     const double *desired,
+                                     const double *acceleration,
+                                     struct DeflectCorrectedTick2 *out);
 
 // Loads a compliance map from CSV text in the layout of the paper's coefficient tables
 // (Paksoy et al., Tables II/III: columns `x_mm, y_mm` (or `x_m, y_m`, or `x, y` in
@@ -590,139 +718,205 @@ DeflectStatus deflect_trajectory2_sample(const struct DeflectTrajectory2 *trajec
                                          double t,
                                          struct DeflectState2 *out);
 
-// Writes the geometry of the paper's robot (L = 0.150 m, pivots 0.090 m from the centre,
-// singularity threshold 0.020 m/rad) to `*out`.
+// Plans a time-optimal jerk-limited rest-to-rest pose motion from `start[16]` to `end[16]`
+// (row-major 4 x 4 rigid transforms, base frame): the position along the straight line under
+// `linear` ([m/s, m/s^2, m/s^3]), the orientation about one fixed axis under `angular`
+// ([rad/s, rad/s^2, rad/s^3]), on one profile. Init time: allocates the handle. On failure
+// `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` or `DEFLECT_ERR_INVALID_ARGUMENT` (a
+// limit not finite and > 0, or a matrix that is not a rigid transform).
 //
 // # Safety
-// `out` is NULL or writable.
-DeflectStatus deflect_parallel_robot2_paper(struct DeflectParallelRobot2 *out);
+// `start`, `end` hold 16 doubles; `linear`, `angular` are NULL or readable; `out` is NULL or
+// writable.
+DeflectStatus deflect_pose_motion_line(const double *start,
+                                       const double *end,
+                                       const struct DeflectLimits *linear,
+                                       const struct DeflectLimits *angular,
+                                       struct DeflectPoseMotion **out);
 
-// Creates a D'Alembert corrector (Paksoy et al., section 3.3) for the planar parallel robot
-// `robot` (NULL = the paper's robot) with mass parameter `mass` m* [kg] (finite, >= 0; the
-// paper's is `DEFLECT_PAPER_MASS`). With `fixed_point_iterations = 0` each step is the
-// paper's one-shot update; otherwise the command is iterated `c = x_d - d(c, F)` at most that
-// often, stopping once successive commands differ by at most `tolerance` [m] (finite, >= 0).
+// Frees a pose motion. NULL is a no-op.
+//
+// # Safety
+// `motion` is NULL or a live handle, not used afterwards.
+void deflect_pose_motion_destroy(struct DeflectPoseMotion *motion);
+
+// Writes the duration [s] to `*duration` and the number of ticks at `rate_hz` (tick `k` at
+// `k / rate_hz`, the last exactly at the duration) to `*ticks` (either may be NULL).
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT` (a rate not finite and > 0) or
+// `DEFLECT_ERR_BUDGET` (more than 2^40 ticks).
+//
+// # Safety
+// `motion` is NULL or a live handle; the outputs are NULL or writable.
+DeflectStatus deflect_pose_motion_info(const struct DeflectPoseMotion *motion,
+                                       double rate_hz,
+                                       double *duration,
+                                       size_t *ticks);
+
+// The exact state at `t` [s] (at rest before 0 and from the duration on) into `*out`.
+// Per tick: no allocation. Returns `DEFLECT_ERR_NULL` or `DEFLECT_ERR_NON_FINITE`.
+//
+// # Safety
+// `motion` is NULL or a live handle; `out` is NULL or writable.
+DeflectStatus deflect_pose_motion_sample(const struct DeflectPoseMotion *motion,
+                                         double t,
+                                         struct DeflectPoseState *out);
+
+// Loads a serial robot from a URDF file and a stiffness TOML file (see deflect-core's
+// `io::urdf` and `io::stiffness` modules for the formats); the chain runs from the URDF's root link to `tip_link`.
+// Init time: allocates. On success `*out` is a new handle; on failure `*out` is NULL and
+// `err` (if not NULL) receives the message, NUL-terminated, truncated to `err_len` bytes.
+//
+// Returns `DEFLECT_ERR_NULL` (a NULL string or `out`), `DEFLECT_ERR_INVALID_ARGUMENT`
+// (a string that is not UTF-8) or `DEFLECT_ERR_LOAD` (unreadable or invalid files).
+//
+// # Safety
+// The strings are NULL or NUL-terminated; `out` is NULL or writable; `err` is NULL or
+// writable for `err_len` bytes.
+DeflectStatus deflect_serial_robot_load(const char *urdf_path,
+                                        const char *stiffness_path,
+                                        const char *tip_link,
+                                        struct DeflectSerialRobot **out,
+                                        char *err,
+                                        size_t err_len);
+
+// Frees a robot handle. NULL is a no-op.
+//
+// # Safety
+// `robot` is NULL or a live handle from `deflect_serial_robot_load`, not used afterwards.
+void deflect_serial_robot_destroy(struct DeflectSerialRobot *robot);
+
+// Writes the robot's number of actuated joints (the length of `q`) to `*dof` and its number
+// of virtual joints to `*springs` (either output may be NULL).
+//
+// # Safety
+// `robot` is NULL or a live handle; the outputs are NULL or writable.
+DeflectStatus deflect_serial_robot_dof(const struct DeflectSerialRobot *robot,
+                                       size_t *dof,
+                                       size_t *springs);
+
+// Rigid TCP pose at joints `q[q_len]` [rad or m], written to `out[16]` as a row-major 4 x 4
+// homogeneous matrix (translation in elements 3, 7, 11) [m]. Per tick: no allocation.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
+//
+// # Safety
+// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+// `out` 16 writable doubles (or NULL).
+DeflectStatus deflect_serial_robot_forward(struct DeflectSerialRobot *robot,
+                                           const double *q,
+                                           size_t q_len,
+                                           double *out);
+
+// TCP deflection `out[6] = [dx, dy, dz, rx, ry, rz]` [m, rad] (base frame) at joints
+// `q[q_len]` [rad or m] under the TCP wrench `wrench[6] = [Fx, Fy, Fz, Mx, My, Mz]`
+// [N, N m] (base frame, moment about the TCP): the exact virtual-joint model (Hahn &
+// Weigold, Eq. 2-9). Per tick: no allocation.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (`q_len` is not the robot's dof)
+// or `DEFLECT_ERR_NON_FINITE`.
+//
+// # Safety
+// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+// `wrench` 6 and `out` 6 writable doubles (or NULL).
+DeflectStatus deflect_serial_robot_deflection(struct DeflectSerialRobot *robot,
+                                              const double *q,
+                                              size_t q_len,
+                                              const double *wrench,
+                                              double *out);
+
+// The 6x6 Cartesian compliance of the linearized model at joints `q[q_len]`, written
+// row-major to `out[36]`: `out[6 * i + j] = C[i][j]` with rows and columns ordered
+// `[dx, dy, dz, rx, ry, rz]` x `[Fx, Fy, Fz, Mx, My, Mz]` [m/N, m/(N m), rad/N, rad/(N m)],
+// so `deflection ~= C wrench`. Per tick: no allocation.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
+//
+// # Safety
+// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+// `out` 36 writable doubles (or NULL).
+DeflectStatus deflect_serial_robot_compliance(struct DeflectSerialRobot *robot,
+                                              const double *q,
+                                              size_t q_len,
+                                              double *out);
+
+// Axis-specific correction: the `dq` such that the robot commanded to `q + dq` and loaded by
+// `wrench[6]` puts its deflected TCP on the rigid TCP of `q[q_len]`. Gauss-Newton through an
+// SVD, at most `max_iterations` steps (1 = the paper's first-order `dq = -J^+ Delta`),
+// stopping at `residual <= tolerance`. Per tick: no allocation, bounded time.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH`, `DEFLECT_ERR_NON_FINITE`
+// (inputs or tolerance) or `DEFLECT_ERR_SINGULAR`. Not converging is not an error:
+// `out->converged` says it.
+//
+// # Safety
+// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+// `wrench` 6; `out` is NULL or writable.
+DeflectStatus deflect_serial_robot_joint_correction(struct DeflectSerialRobot *robot,
+                                                    const double *q,
+                                                    size_t q_len,
+                                                    const double *wrench,
+                                                    uint32_t max_iterations,
+                                                    double tolerance,
+                                                    struct DeflectJointCorrection *out);
+
+// Creates a corrector for `robot` (6..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
+// limits are copied in) carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
+// `DEFLECT_SERIAL_LINEARIZED`), warm-started from `seed[seed_len]` (the joints the motion
+// starts from; `seed_len` must be the dof). Pose IK: 20 iterations, 1e-8 m and 1e-8 rad.
 // Init time: allocates the handle. On failure `*out` is NULL.
 //
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` or `DEFLECT_ERR_INVALID_ARGUMENT`.
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 6
+// joints), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (negative mass,
+// asymmetric inertia, unknown model) or `DEFLECT_ERR_SINGULAR` (inertia not positive
+// semi-definite).
 //
 // # Safety
-// `robot` is NULL or readable; `out` is NULL or writable.
-DeflectStatus deflect_dalembert_create(const struct DeflectParallelRobot2 *robot,
-                                       double mass,
-                                       uint32_t fixed_point_iterations,
-                                       double tolerance,
-                                       struct DeflectDalembert **out);
+// `robot` is NULL or a live handle; `payload` NULL or readable; `seed` holds `seed_len`
+// doubles; `out` is NULL or writable.
+DeflectStatus deflect_serial_dalembert_create(const struct DeflectSerialRobot *robot,
+                                              const struct DeflectPayload *payload,
+                                              int32_t model,
+                                              const double *seed,
+                                              size_t seed_len,
+                                              struct DeflectSerialDalembert **out);
 
-// Frees a corrector handle. NULL is a no-op.
+// Frees a corrector. NULL is a no-op.
 //
 // # Safety
 // `corrector` is NULL or a live handle, not used afterwards.
-void deflect_dalembert_destroy(struct DeflectDalembert *corrector);
+void deflect_serial_dalembert_destroy(struct DeflectSerialDalembert *corrector);
 
-// One corrector tick: desired point `desired[2]` [m] with planned acceleration
-// `acceleration[2]` [m/s^2] (from `deflect_trajectory2_sample`), `seed[2]` the previous
-// tick's joints (ignored by the closed-form IK). The D'Alembert force `-m* a` (Eq. 5), the
-// map's displacement at the desired (or fixed-point) point, the command `desired -
-// displacement` and its inverse kinematics go to `*out`. The map must have 2 force and 2
-// displacement axes; its options decide what happens outside its grid. Per tick: no
-// allocation, bounded time.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_MAP_DIMENSION`,
-// `DEFLECT_ERR_OUT_OF_GRID`, `DEFLECT_ERR_OUT_OF_WORKSPACE` or `DEFLECT_ERR_SINGULAR`.
+// Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
+// that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
+// `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
 //
 // # Safety
-// `corrector` and `map` are NULL or live handles (the map not modified meanwhile);
-// `desired`, `acceleration`, `seed` hold 2 doubles; `out` is NULL or writable.
-DeflectStatus deflect_dalembert_step(const struct DeflectDalembert *corrector,
-                                     const struct DeflectComplianceMap *map,
-                                     const double *desired,
-                                     const double *acceleration,
-                                     const double *seed,
-                                     struct DeflectCorrectedTick2 *out);
+// `corrector` is NULL or a live handle not used by another thread; `q` holds `q_len`
+// doubles.
+DeflectStatus deflect_serial_dalembert_reset(struct DeflectSerialDalembert *corrector,
+                                             const double *q,
+                                             size_t q_len);
 
-// Writes the neutral calibration to `*out`: no offsets, no weight, no residual, TCP at the
-// sensor (translation 0, rotation (1, 0, 0, 0)).
+// One tick: the desired pose state `*desired` (from `deflect_pose_motion_sample`, or the
+// caller's own; base frame) and an optional process wrench `process[6]` [N, N m] at the TCP
+// (NULL: none). Writes the joint command and its diagnostics to `*out`. Per tick: no
+// allocation, bounded iterations.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (a
+// pose that is not a rigid transform, or a load outside the small-deflection model),
+// `DEFLECT_ERR_NOT_CONVERGED`, `DEFLECT_ERR_SINGULAR`, `DEFLECT_ERR_JOINT_LIMIT` or
+// `DEFLECT_ERR_NON_FINITE_OUTPUT`.
 //
 // # Safety
-// `out` is NULL or writable.
-DeflectStatus deflect_sensor_calibration_default(struct DeflectSensorCalibration *out);
-
-// Writes the paper's chain at cycle time `dt` [s] to `*out`: the neutral calibration (set
-// `out->calibration` afterwards), 10 Hz low-pass, 5-cycle moving average, pilot control
-// 150 N / 80 ms, projection on, 3 mm and 50 mm/s limits, Cartesian output. `dt` is checked
-// by `deflect_compensator_create`, not here.
-//
-// # Safety
-// `out` is NULL or writable.
-DeflectStatus deflect_compensator_config_paper(double dt, struct DeflectCompensatorConfig *out);
-
-// Creates the online compensation chain for `robot` with settings `*config`. The handle keeps
-// its own filter states and workspace (it only reads the robot's model); every
-// `deflect_compensator_step` must be given this same robot. Init time: allocates. On failure
-// `*out` is NULL.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` (a non-finite setting or calibration
-// value) or `DEFLECT_ERR_INVALID_ARGUMENT` (dt or cut-off not > 0, window outside
-// 1..=`DEFLECT_MAX_AVERAGE_WINDOW`, negative threshold, ramp, limit or weight, a zero
-// quaternion, a flag other than 0/1, an unknown output code).
-//
-// # Safety
-// `robot` is NULL or a live handle; `config` is NULL or readable; `out` is NULL or writable.
-DeflectStatus deflect_compensator_create(const struct DeflectSerialRobot *robot,
-                                         const struct DeflectCompensatorConfig *config,
-                                         struct DeflectCompensator **out);
-
-// Frees a compensator handle. NULL is a no-op.
-//
-// # Safety
-// `compensator` is NULL or a live handle, not used afterwards.
-void deflect_compensator_destroy(struct DeflectCompensator *compensator);
-
-// Low-frequency delay of the filter chain (low-pass plus moving average): `*samples` in
-// cycles and `*seconds` in s (either output may be NULL).
-//
-// # Safety
-// `compensator` is NULL or a live handle; the outputs are NULL or writable.
-DeflectStatus deflect_compensator_delay(const struct DeflectCompensator *compensator,
-                                        double *samples,
-                                        double *seconds);
-
-// Clears the filter, pilot-control and rate-limiter states (as after create). No allocation.
-//
-// # Safety
-// `compensator` is NULL or a live handle not used by another thread.
-DeflectStatus deflect_compensator_reset(struct DeflectCompensator *compensator);
-
-// One control cycle of the online compensation: joints `q[q_len]` [rad or m], the raw sensor
-// reading `reading[6] = [Fx, Fy, Fz, Mx, My, Mz]` [N, N m] (sensor frame), the offline
-// estimate `estimated[6]` of the TCP wrench (base frame; NULL if the program provides none,
-// which also skips pilot control) and the feed velocity `feed_velocity[3]` [m/s] (base
-// frame). The sensor reading is compensated (Eq. 18) and carried to the TCP (Eq. 19-20),
-// low-pass filtered and averaged, piloted, turned into a deflection (Eq. 9), and the opposite
-// correction projected (Eq. 10-11), limited and written to `*out`. Per cycle: no allocation,
-// bounded time.
-//
-// Returns `DEFLECT_ERR_NULL` (handles, `q`, `reading`, `feed_velocity` or `out`; nothing is
-// changed then), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_WRONG_LENGTH` (`q_len` is not the
-// robot's dof), `DEFLECT_ERR_INVALID_ARGUMENT` (`robot` has another dof or spring count than
-// the robot the compensator was created for) or `DEFLECT_ERR_SINGULAR` (joint output
-// at a singular pose). Invalid inputs are refused before any state changes, except a
-// singular pose with joint output, which is met after the filter states have advanced.
-//
-// # Safety
-// `compensator` is NULL or a live handle not used by another thread; `robot` is NULL or a
-// live handle (only read, not used by another thread meanwhile); `q` holds `q_len`
-// doubles, `reading` 6, `estimated` 6 (or is NULL), `feed_velocity` 3; `out` is NULL or
-// writable.
-DeflectStatus deflect_compensator_step(struct DeflectCompensator *compensator,
-                                       const struct DeflectSerialRobot *robot,
-                                       const double *q,
-                                       size_t q_len,
-                                       const double *reading,
-                                       const double *estimated,
-                                       const double *feed_velocity,
-                                       struct DeflectCycleOutput *out);
+// `corrector` is NULL or a live handle not used by another thread; `desired` is NULL or
+// readable; `process` is NULL or holds 6 doubles; `out` is NULL or writable.
+DeflectStatus deflect_serial_dalembert_step(struct DeflectSerialDalembert *corrector,
+                                            const struct DeflectPoseState *desired,
+                                            const double *process,
+                                            struct DeflectSerialTick *out);
 
 #ifdef __cplusplus
 }  // extern "C"

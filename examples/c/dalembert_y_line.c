@@ -64,15 +64,15 @@ int main(int argc, char **argv) {
     const double end[2] = {0.222132, 0.075};
     DeflectTrajectory2 *trajectory = NULL;
     CHECK(deflect_trajectory2_line(start, end, &limits, &trajectory));
+    /* The corrector copies the map, with its options (clamp at the grid boundary). */
     DeflectDalembert *corrector = NULL;
-    CHECK(deflect_dalembert_create(NULL, DEFLECT_PAPER_MASS, 0, 0.0, &corrector));
+    CHECK(deflect_dalembert_create(NULL, map, DEFLECT_PAPER_MASS, 0, 0.0, &corrector));
     size_t ticks = 0;
     CHECK(deflect_trajectory2_tick_count(trajectory, DEFLECT_PAPER_RATE_HZ, &ticks));
     double duration = 0.0;
     CHECK(deflect_trajectory2_duration(trajectory, &duration));
 
-    /* The servo loop: no allocation from here on. */
-    double q[2] = {0.0, 0.0};
+    /* The servo loop: no allocation from here on. The corrector keeps the last joints. */
     DeflectState2 state;
     DeflectCorrectedTick2 tick;
     if (latency_ticks <= 0) {
@@ -82,12 +82,10 @@ int main(int argc, char **argv) {
             double t = 0.0;
             CHECK(deflect_trajectory2_tick_time(trajectory, DEFLECT_PAPER_RATE_HZ, k, &t));
             CHECK(deflect_trajectory2_sample(trajectory, t, &state));
-            CHECK(deflect_dalembert_step(corrector, map, state.position, state.acceleration, q,
-                                         &tick));
-            q[0] = tick.joints[0];
-            q[1] = tick.joints[1];
+            CHECK(deflect_dalembert_step(corrector, state.position, state.acceleration, &tick));
             printf("%zu %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k, t, tick.desired[0],
-                   tick.desired[1], tick.commanded[0], tick.commanded[1], q[0], q[1]);
+                   tick.desired[1], tick.commanded[0], tick.commanded[1], tick.joints[0],
+                   tick.joints[1]);
         }
     } else {
         unsigned long long *ns = malloc((size_t)latency_ticks * sizeof *ns);
@@ -99,15 +97,13 @@ int main(int argc, char **argv) {
             t -= duration * (double)(long)(t / duration);
             unsigned long long t0 = now_ns();
             DeflectStatus s1 = deflect_trajectory2_sample(trajectory, t, &state);
-            DeflectStatus s2 = deflect_dalembert_step(corrector, map, state.position,
-                                                      state.acceleration, q, &tick);
+            DeflectStatus s2 =
+                deflect_dalembert_step(corrector, state.position, state.acceleration, &tick);
             unsigned long long t1 = now_ns();
             if (s1 != DEFLECT_OK || s2 != DEFLECT_OK) {
                 fprintf(stderr, "tick %ld failed: %d %d\n", i, (int)s1, (int)s2);
                 return 1;
             }
-            q[0] = tick.joints[0];
-            q[1] = tick.joints[1];
             if (i >= 0) {
                 ns[i] = t1 - t0;
             }

@@ -20,7 +20,8 @@ static void expect(const char *what, DeflectStatus got, DeflectStatus want) {
     }
 }
 
-/* A valid JSON map with one force and one displacement axis: the planar corrector refuses it. */
+/* A valid JSON map with one force and one displacement axis: the planar corrector refuses it
+ * at creation. */
 static const char *ONE_AXIS_JSON =
     "{\"format_version\": 1,"
     " \"units\": {\"position\": \"m\", \"force\": \"N (moments N m)\","
@@ -47,7 +48,8 @@ int main(int argc, char **argv) {
         deflect_trajectory2_line((const double[2]){0.222132, -0.075},
                                  (const double[2]){0.222132, 0.075}, &limits,
                                  &trajectory) != DEFLECT_OK ||
-        deflect_dalembert_create(NULL, DEFLECT_PAPER_MASS, 0, 0.0, &corrector) != DEFLECT_OK) {
+        deflect_dalembert_create(NULL, map, DEFLECT_PAPER_MASS, 0, 0.0, &corrector) !=
+            DEFLECT_OK) {
         fprintf(stderr, "setup failed\n");
         return 1;
     }
@@ -57,7 +59,7 @@ int main(int argc, char **argv) {
     DeflectState2 state;
     DeflectCorrectedTick2 tick;
 
-    expect("ok", deflect_dalembert_step(corrector, map, inside, zero, zero, &tick), DEFLECT_OK);
+    expect("ok", deflect_dalembert_step(corrector, inside, zero, &tick), DEFLECT_OK);
     expect("DEFLECT_ERR_NULL", deflect_paper_limits(5, NULL), DEFLECT_ERR_NULL);
     expect("DEFLECT_ERR_NON_FINITE", deflect_trajectory2_sample(trajectory, NAN, &state),
            DEFLECT_ERR_NON_FINITE);
@@ -82,15 +84,20 @@ int main(int argc, char **argv) {
     expect("DEFLECT_ERR_OUT_OF_GRID",
            deflect_compliance_map_displacement(map, zero, zero, 2, out, 2, NULL),
            DEFLECT_ERR_OUT_OF_GRID);
-    /* From here on clamp, so that the robot's own limits are reached. */
+    /* From here on clamp, so that the robot's own limits are reached. The corrector holds the
+     * copy of the map made at its creation: make one from the clamping map. */
     deflect_compliance_map_set_options(map, DEFLECT_INTERPOLATION_BILINEAR,
                                        DEFLECT_OUT_OF_GRID_CLAMP);
+    DeflectDalembert *clamped = NULL;
+    if (deflect_dalembert_create(NULL, map, DEFLECT_PAPER_MASS, 0, 0.0, &clamped) != DEFLECT_OK) {
+        fprintf(stderr, "clamped corrector setup failed\n");
+        return 1;
+    }
     const double far[2] = {1.0, 0.0};
-    expect("DEFLECT_ERR_OUT_OF_WORKSPACE",
-           deflect_dalembert_step(corrector, map, far, zero, zero, &tick),
+    expect("DEFLECT_ERR_OUT_OF_WORKSPACE", deflect_dalembert_step(clamped, far, zero, &tick),
            DEFLECT_ERR_OUT_OF_WORKSPACE);
     const double centre[2] = {0.001, 0.0};
-    expect("DEFLECT_ERR_SINGULAR", deflect_dalembert_step(corrector, map, centre, zero, zero, &tick),
+    expect("DEFLECT_ERR_SINGULAR", deflect_dalembert_step(clamped, centre, zero, &tick),
            DEFLECT_ERR_SINGULAR);
     expect("DEFLECT_ERR_INVALID_ARGUMENT", deflect_paper_limits(9, &limits),
            DEFLECT_ERR_INVALID_ARGUMENT);
@@ -100,15 +107,21 @@ int main(int argc, char **argv) {
         printf("one-axis JSON map did not load: %s\n", err);
         ++failures;
     } else {
+        DeflectDalembert *refused = clamped; /* not NULL: a failed create must set it to NULL */
         expect("DEFLECT_ERR_MAP_DIMENSION",
-               deflect_dalembert_step(corrector, one_axis, inside, zero, zero, &tick),
+               deflect_dalembert_create(NULL, one_axis, DEFLECT_PAPER_MASS, 0, 0.0, &refused),
                DEFLECT_ERR_MAP_DIMENSION);
+        if (refused != NULL) {
+            printf("  a refused create left its handle output non-NULL\n");
+            ++failures;
+        }
     }
     expect("DEFLECT_ERR_PANIC", deflect_test_panic(), DEFLECT_ERR_PANIC);
     /* NULL handles are no-ops for destroy. */
     deflect_compliance_map_destroy(NULL);
 
     deflect_compliance_map_destroy(one_axis);
+    deflect_dalembert_destroy(clamped);
     deflect_dalembert_destroy(corrector);
     deflect_trajectory2_destroy(trajectory);
     deflect_compliance_map_destroy(map);

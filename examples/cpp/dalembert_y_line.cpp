@@ -63,15 +63,16 @@ int main(int argc, char **argv) try {
     check(deflect_trajectory2_line(start, end, &limits, &raw_trajectory), "trajectory2_line");
     Trajectory trajectory(raw_trajectory);
     DeflectDalembert *raw_corrector = nullptr;
-    check(deflect_dalembert_create(nullptr, DEFLECT_PAPER_MASS, 0, 0.0, &raw_corrector),
+    // The corrector copies the map, with its options (clamp at the grid boundary).
+    check(deflect_dalembert_create(nullptr, map.get(), DEFLECT_PAPER_MASS, 0, 0.0,
+                                   &raw_corrector),
           "dalembert_create");
     Corrector corrector(raw_corrector);
     std::size_t ticks = 0;
     check(deflect_trajectory2_tick_count(trajectory.get(), DEFLECT_PAPER_RATE_HZ, &ticks),
           "tick_count");
 
-    // The servo loop: no allocation from here on.
-    double q[2] = {0.0, 0.0};
+    // The servo loop: no allocation from here on. The corrector keeps the last joints.
     std::printf("# k t desired_x desired_y commanded_x commanded_y theta_a theta_b (s, m, rad)\n");
     for (std::size_t k = 0; k < ticks; ++k) {
         double t = 0.0;
@@ -83,17 +84,16 @@ int main(int argc, char **argv) try {
             std::fprintf(stderr, "tick %zu: sampling failed\n", k);
             return 1;
         }
-        DeflectStatus s = deflect_dalembert_step(corrector.get(), map.get(), state.position,
-                                                 state.acceleration, q, &tick);
+        DeflectStatus s =
+            deflect_dalembert_step(corrector.get(), state.position, state.acceleration, &tick);
         if (s != DEFLECT_OK) {
             // A real controller would hold the last command and stop the motion here.
             std::fprintf(stderr, "tick %zu: %s\n", k, deflect_status_message(s));
             return 1;
         }
-        q[0] = tick.joints[0];
-        q[1] = tick.joints[1];
         std::printf("%zu %.17g %.17g %.17g %.17g %.17g %.17g %.17g\n", k, t, tick.desired[0],
-                    tick.desired[1], tick.commanded[0], tick.commanded[1], q[0], q[1]);
+                    tick.desired[1], tick.commanded[0], tick.commanded[1], tick.joints[0],
+                    tick.joints[1]);
     }
     return 0;
 } catch (const std::exception &e) {

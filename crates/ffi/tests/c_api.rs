@@ -8,7 +8,9 @@ use std::ptr;
 
 use deflect::*;
 use deflect_core::SerialRobot;
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit};
+use deflect_core::compliance_map::ComplianceMap;
+use deflect_core::io::{map_csv, map_json};
+use deflect_core::units::{ForceUnit, LengthUnit};
 use deflect_core::vjm::{self, Data, Vector6};
 
 const Q: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
@@ -50,7 +52,7 @@ fn kr300_c() -> *mut DeflectSerialRobot {
 }
 
 fn kr300_rust() -> SerialRobot {
-    SerialRobot::from_files(
+    SerialRobot::from_path(
         repo("robots/kr300/kr300_r2500.urdf"),
         repo("robots/kr300/kr300_r2500_stiffness.toml"),
         "tcp",
@@ -270,8 +272,7 @@ fn loaders_report_their_errors_in_the_callers_buffer() {
 fn compliance_map_through_the_c_api_equals_the_rust_api() {
     let m = oc_map_c();
     let text = std::fs::read_to_string(repo("data/paksoy2025_compliance_oc.csv")).unwrap();
-    let rust =
-        ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap();
+    let rust = map_csv::from_str(&text, ForceUnit::Newton, LengthUnit::Millimetre).unwrap();
     let (mut nf, mut nd) = (0, 0);
     assert_eq!(
         // SAFETY: live handles from this test, arrays of the documented lengths.
@@ -301,7 +302,7 @@ fn compliance_map_through_the_c_api_equals_the_rust_api() {
     assert_eq!(out, want);
 
     // JSON round trip through the C loader, then bicubic + extrapolation options.
-    let json = c(&rust.to_json().unwrap());
+    let json = c(&map_json::to_string(&rust).unwrap());
     let mut m2 = ptr::null_mut();
     assert_eq!(
         // SAFETY: live handles from this test, arrays of the documented lengths.
@@ -443,17 +444,19 @@ fn motion_and_corrector_errors() {
             DEFLECT_ERR_NULL
         );
 
+        // The corrector takes its map at creation (a copy, with the map's options).
+        let m = oc_map_c();
         let mut corr = ptr::null_mut();
         assert_eq!(
-            deflect_dalembert_create(ptr::null(), -1.0, 0, 0.0, &mut corr),
+            deflect_dalembert_create(ptr::null(), m, -1.0, 0, 0.0, &mut corr),
             DEFLECT_ERR_INVALID_ARGUMENT
         );
         assert_eq!(
-            deflect_dalembert_create(ptr::null(), f64::NAN, 0, 0.0, &mut corr),
+            deflect_dalembert_create(ptr::null(), m, f64::NAN, 0, 0.0, &mut corr),
             DEFLECT_ERR_NON_FINITE
         );
         assert_eq!(
-            deflect_dalembert_create(ptr::null(), 5.0, 3, -1.0, &mut corr),
+            deflect_dalembert_create(ptr::null(), m, 5.0, 3, -1.0, &mut corr),
             DEFLECT_ERR_INVALID_ARGUMENT
         );
         let mut geom = DeflectParallelRobot2 {
@@ -462,53 +465,82 @@ fn motion_and_corrector_errors() {
             min_sigma: 0.0,
         };
         assert_eq!(
-            deflect_dalembert_create(&geom, 5.0, 0, 0.0, &mut corr),
+            deflect_dalembert_create(&geom, m, 5.0, 0, 0.0, &mut corr),
             DEFLECT_ERR_INVALID_ARGUMENT
         );
         assert!(corr.is_null());
         assert_eq!(deflect_parallel_robot2_paper(&mut geom), DEFLECT_OK);
         assert_eq!(geom.link, 0.150);
+        // A NULL map is refused at creation (it used to be a step argument).
         assert_eq!(
-            deflect_dalembert_create(&geom, 5.0, 3, 1e-12, &mut corr),
+            deflect_dalembert_create(&geom, ptr::null(), 5.0, 3, 1e-12, &mut corr),
+            DEFLECT_ERR_NULL
+        );
+        assert!(corr.is_null());
+        // A map without 2 force and 2 displacement axes is refused at creation too.
+        let one_axis = ComplianceMap::new(
+            vec![0.1, 0.3],
+            vec![-0.1, 0.1],
+            1,
+            1,
+            vec![1e-6; 4],
+            vec![0.0; 4],
+        )
+        .unwrap();
+        let one_axis = c(&map_json::to_string(&one_axis).unwrap());
+        let mut m1 = ptr::null_mut();
+        assert_eq!(
+            deflect_compliance_map_from_json(one_axis.as_ptr(), &mut m1, ptr::null_mut(), 0),
             DEFLECT_OK
         );
-        let m = oc_map_c();
-        let (x, a, q) = ([0.222132, 0.0], [0.0, 5.0 * 9.81], [0.0, 0.0]);
+        let mut corr1 = ptr::NonNull::<DeflectDalembert>::dangling().as_ptr();
+        assert_eq!(
+            deflect_dalembert_create(&geom, m1, 5.0, 0, 0.0, &mut corr1),
+            DEFLECT_ERR_MAP_DIMENSION
+        );
+        assert!(corr1.is_null(), "a failed create sets *out to NULL");
+        deflect_compliance_map_destroy(m1);
+        assert_eq!(
+            deflect_dalembert_create(&geom, m, 5.0, 3, 1e-12, &mut corr),
+            DEFLECT_OK
+        );
+        let (x, a) = ([0.222132, 0.0], [0.0, 5.0 * 9.81]);
         let mut tick = DeflectCorrectedTick2::default();
         assert_eq!(
-            deflect_dalembert_step(corr, m, x.as_ptr(), a.as_ptr(), q.as_ptr(), &mut tick),
+            deflect_dalembert_step(corr, x.as_ptr(), a.as_ptr(), &mut tick),
             DEFLECT_OK
         );
         assert!(tick.iterations >= 1);
         assert_eq!(tick.force, [a[0] * -5.0, a[1] * -5.0]);
+        assert_eq!(tick.placement, DEFLECT_QUERY_INSIDE);
         let nan = [f64::NAN, 0.0];
         assert_eq!(
-            deflect_dalembert_step(corr, m, x.as_ptr(), nan.as_ptr(), q.as_ptr(), &mut tick),
+            deflect_dalembert_step(corr, x.as_ptr(), nan.as_ptr(), &mut tick),
             DEFLECT_ERR_NON_FINITE
         );
         assert_eq!(
-            deflect_dalembert_step(
-                corr,
-                ptr::null(),
-                x.as_ptr(),
-                a.as_ptr(),
-                q.as_ptr(),
-                &mut tick
-            ),
+            deflect_dalembert_step(ptr::null_mut(), x.as_ptr(), a.as_ptr(), &mut tick),
             DEFLECT_ERR_NULL
         );
         assert_eq!(
-            deflect_dalembert_step(corr, m, x.as_ptr(), a.as_ptr(), q.as_ptr(), ptr::null_mut()),
+            deflect_dalembert_step(corr, x.as_ptr(), a.as_ptr(), ptr::null_mut()),
             DEFLECT_ERR_NULL
         );
         // The default map policy refuses off-grid points.
         let off = [0.1, 0.0];
         assert_eq!(
-            deflect_dalembert_step(corr, m, off.as_ptr(), a.as_ptr(), q.as_ptr(), &mut tick),
+            deflect_dalembert_step(corr, off.as_ptr(), a.as_ptr(), &mut tick),
             DEFLECT_ERR_OUT_OF_GRID
         );
+        // The corrector owns its copy: destroying the map leaves it working.
         deflect_compliance_map_destroy(m);
+        assert_eq!(
+            deflect_dalembert_step(corr, x.as_ptr(), a.as_ptr(), &mut tick),
+            DEFLECT_OK
+        );
+        assert_eq!(tick.force, [a[0] * -5.0, a[1] * -5.0]);
         deflect_dalembert_destroy(corr);
+        deflect_dalembert_destroy(ptr::null_mut());
     }
 }
 
@@ -549,4 +581,41 @@ fn panics_are_contained_and_every_status_has_a_message() {
             .unwrap(),
         env!("CARGO_PKG_VERSION")
     );
+}
+
+#[test]
+fn the_new_status_codes_have_their_own_messages() {
+    let name = |s| {
+        // SAFETY: `deflect_status_message` returns a static NUL-terminated string.
+        unsafe { CStr::from_ptr(deflect_status_message(s)) }
+            .to_str()
+            .unwrap()
+    };
+    let new = [
+        (DEFLECT_ERR_NON_FINITE_OUTPUT, -11),
+        (DEFLECT_ERR_NO_EDGE_MOTION, -12),
+        (DEFLECT_ERR_JOINT_LIMIT, -13),
+        (DEFLECT_ERR_BUDGET, -14),
+        (DEFLECT_ERR_MODEL_MISMATCH, -15),
+    ];
+    let older: Vec<&str> = (-10..=0)
+        .chain([DEFLECT_ERR_OTHER, DEFLECT_ERR_PANIC])
+        .map(name)
+        .collect();
+    let mut names = Vec::new();
+    for (code, value) in new {
+        assert_eq!(code, value);
+        let msg = name(code);
+        assert_ne!(msg, "unknown status", "code {code}");
+        assert!(!msg.is_empty(), "code {code}");
+        assert!(
+            !older.contains(&msg),
+            "code {code} shares the message `{msg}`"
+        );
+        names.push(msg);
+    }
+    names.sort_unstable();
+    names.dedup();
+    assert_eq!(names.len(), new.len(), "distinct messages");
+    assert_eq!(name(-16), "unknown status");
 }

@@ -1,5 +1,5 @@
 //! The online force compensation through the C API: the same cycles as deflect-core's
-//! `OnlineCompensator::step` bit for bit (cutter exit, pilot control, both output forms,
+//! `compensation::step` bit for bit (cutter exit, pilot control, both output forms,
 //! reset), the paper's defaults, and every documented error code.
 #![allow(unsafe_code)] // reason: the tests call the extern "C" API, which is unsafe by nature.
 
@@ -11,7 +11,7 @@ use deflect::*;
 use deflect_core::SerialRobot;
 use deflect_core::compensation::sensor::POLY_TERMS;
 use deflect_core::compensation::{
-    CompensatorConfig, CorrectionOutput, CycleOutput, OnlineCompensator, SensorCalibration,
+    self, CompensatorConfig, CorrectionOutput, CycleOutput, SensorCalibration,
 };
 use deflect_core::vjm::Vector6;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
@@ -56,7 +56,7 @@ fn kr300_c() -> *mut DeflectSerialRobot {
 }
 
 fn kr300_rust() -> SerialRobot {
-    SerialRobot::from_files(
+    SerialRobot::from_path(
         repo("robots/kr300/kr300_r2500.urdf"),
         repo("robots/kr300/kr300_r2500_stiffness.toml"),
         "tcp",
@@ -222,14 +222,15 @@ fn run_against_rust(output: i32, with_estimate_from: usize) {
     } else {
         CorrectionOutput::Cartesian
     };
-    let mut rcomp = OnlineCompensator::new(&rust.model, rcfg).unwrap();
+    let rmodel = compensation::Model::new(rust.model.clone(), rcfg).unwrap();
+    let mut rdata = compensation::Data::new(&rmodel);
 
     let (mut samples, mut seconds) = (0.0, 0.0);
     // SAFETY: live handle, writable outputs.
     let s = unsafe { deflect_compensator_delay(comp, &mut samples, &mut seconds) };
     assert_eq!(s, DEFLECT_OK);
-    assert_eq!(samples.to_bits(), rcomp.delay_samples().to_bits());
-    assert_eq!(seconds.to_bits(), rcomp.delay_seconds().to_bits());
+    assert_eq!(samples.to_bits(), rmodel.delay_samples().to_bits());
+    assert_eq!(seconds.to_bits(), rmodel.delay_seconds().to_bits());
 
     let (mut max_weight, mut limited, mut projected) = (0.0f64, 0, 0);
     let mut out = DeflectCycleOutput::default();
@@ -237,7 +238,7 @@ fn run_against_rust(output: i32, with_estimate_from: usize) {
         if k == 350 {
             // SAFETY: live handle.
             assert_eq!(unsafe { deflect_compensator_reset(comp) }, DEFLECT_OK);
-            rcomp.reset();
+            rdata.reset();
         }
         let (q, reading, estimated, feed) = cycle(k);
         let est = (k >= with_estimate_from).then_some(estimated);
@@ -246,7 +247,6 @@ fn run_against_rust(output: i32, with_estimate_from: usize) {
         let s = unsafe {
             deflect_compensator_step(
                 comp,
-                robot,
                 q.as_ptr(),
                 q.len(),
                 reading.as_ptr(),
@@ -256,15 +256,15 @@ fn run_against_rust(output: i32, with_estimate_from: usize) {
             )
         };
         assert_eq!(s, DEFLECT_OK, "cycle {k}");
-        let want = rcomp
-            .step(
-                &rust.model,
-                &q,
-                &Vector6::from(reading),
-                est.map(Vector6::from).as_ref(),
-                &Vector3::from(feed),
-            )
-            .unwrap();
+        let want = compensation::step(
+            &rmodel,
+            &mut rdata,
+            &q,
+            &Vector6::from(reading),
+            est.map(Vector6::from).as_ref(),
+            &Vector3::from(feed),
+        )
+        .unwrap();
         assert_same(&out, &want, k);
         max_weight = max_weight.max(out.pilot_weight);
         limited += usize::from(out.rate_limited) + usize::from(out.size_limited);
@@ -352,7 +352,9 @@ fn a_non_unit_quaternion_is_normalised_like_from_quaternion() {
         ),
         ..SensorCalibration::default()
     };
-    let mut rcomp = OnlineCompensator::new(&rust.model, CompensatorConfig::paper(DT, cal)).unwrap();
+    let rmodel =
+        compensation::Model::new(rust.model.clone(), CompensatorConfig::paper(DT, cal)).unwrap();
+    let mut rdata = compensation::Data::new(&rmodel);
     let mut out = DeflectCycleOutput::default();
     for k in 0..50 {
         let (q, reading, _, feed) = cycle(k);
@@ -360,7 +362,6 @@ fn a_non_unit_quaternion_is_normalised_like_from_quaternion() {
         let s = unsafe {
             deflect_compensator_step(
                 comp,
-                robot,
                 q.as_ptr(),
                 6,
                 reading.as_ptr(),
@@ -370,15 +371,15 @@ fn a_non_unit_quaternion_is_normalised_like_from_quaternion() {
             )
         };
         assert_eq!(s, DEFLECT_OK);
-        let want = rcomp
-            .step(
-                &rust.model,
-                &q,
-                &Vector6::from(reading),
-                None,
-                &Vector3::from(feed),
-            )
-            .unwrap();
+        let want = compensation::step(
+            &rmodel,
+            &mut rdata,
+            &q,
+            &Vector6::from(reading),
+            None,
+            &Vector3::from(feed),
+        )
+        .unwrap();
         assert_same(&out, &want, k);
     }
     // SAFETY: live handles, destroyed once.
@@ -553,7 +554,8 @@ fn step_returns_the_documented_codes_and_leaves_the_state_alone() {
     let comp = create(robot, &cfg).unwrap();
     let mut rcfg = CompensatorConfig::paper(DT, SensorCalibration::default());
     rcfg.output = CorrectionOutput::Joint;
-    let mut rcomp = OnlineCompensator::new(&rust.model, rcfg).unwrap();
+    let rmodel = compensation::Model::new(rust.model.clone(), rcfg).unwrap();
+    let mut rdata = compensation::Data::new(&rmodel);
     let (q, reading, est, feed) = cycle(3);
     let nan6 = [0.0, 0.0, f64::NAN, 0.0, 0.0, 0.0];
     let nan3 = [0.0, f64::INFINITY, 0.0];
@@ -562,77 +564,71 @@ fn step_returns_the_documented_codes_and_leaves_the_state_alone() {
     let mut out = DeflectCycleOutput::default();
     // SAFETY: live handles or NULL, arrays of the documented lengths.
     let step = |comp: *mut DeflectCompensator,
-                robot: *const DeflectSerialRobot,
                 q: *const f64,
                 q_len: usize,
                 reading: *const f64,
                 est: *const f64,
                 feed: *const f64,
                 out: *mut DeflectCycleOutput| unsafe {
-        deflect_compensator_step(comp, robot, q, q_len, reading, est, feed, out)
+        deflect_compensator_step(comp, q, q_len, reading, est, feed, out)
     };
     let (qp, rp, ep, fp) = (q.as_ptr(), reading.as_ptr(), est.as_ptr(), feed.as_ptr());
     let o: *mut DeflectCycleOutput = &mut out;
-    let cases: [(&str, DeflectStatus, DeflectStatus); 12] = [
+    let cases: [(&str, DeflectStatus, DeflectStatus); 11] = [
         (
             "NULL compensator",
             DEFLECT_ERR_NULL,
-            step(ptr::null_mut(), robot, qp, 6, rp, ep, fp, o),
-        ),
-        (
-            "NULL robot",
-            DEFLECT_ERR_NULL,
-            step(comp, ptr::null(), qp, 6, rp, ep, fp, o),
+            step(ptr::null_mut(), qp, 6, rp, ep, fp, o),
         ),
         (
             "NULL q",
             DEFLECT_ERR_NULL,
-            step(comp, robot, ptr::null(), 6, rp, ep, fp, o),
+            step(comp, ptr::null(), 6, rp, ep, fp, o),
         ),
         (
             "NULL reading",
             DEFLECT_ERR_NULL,
-            step(comp, robot, qp, 6, ptr::null(), ep, fp, o),
+            step(comp, qp, 6, ptr::null(), ep, fp, o),
         ),
         (
             "NULL feed",
             DEFLECT_ERR_NULL,
-            step(comp, robot, qp, 6, rp, ep, ptr::null(), o),
+            step(comp, qp, 6, rp, ep, ptr::null(), o),
         ),
         (
             "NULL out",
             DEFLECT_ERR_NULL,
-            step(comp, robot, qp, 6, rp, ep, fp, ptr::null_mut()),
+            step(comp, qp, 6, rp, ep, fp, ptr::null_mut()),
         ),
         (
             "q_len 5",
             DEFLECT_ERR_WRONG_LENGTH,
-            step(comp, robot, qp, 5, rp, ep, fp, o),
+            step(comp, qp, 5, rp, ep, fp, o),
         ),
         (
             "q_len 7",
             DEFLECT_ERR_WRONG_LENGTH,
-            step(comp, robot, qp, 7, rp, ep, fp, o),
+            step(comp, qp, 7, rp, ep, fp, o),
         ),
         (
             "NaN q",
             DEFLECT_ERR_NON_FINITE,
-            step(comp, robot, q_nan.as_ptr(), 6, rp, ep, fp, o),
+            step(comp, q_nan.as_ptr(), 6, rp, ep, fp, o),
         ),
         (
             "NaN reading",
             DEFLECT_ERR_NON_FINITE,
-            step(comp, robot, qp, 6, nan6.as_ptr(), ep, fp, o),
+            step(comp, qp, 6, nan6.as_ptr(), ep, fp, o),
         ),
         (
             "NaN estimate",
             DEFLECT_ERR_NON_FINITE,
-            step(comp, robot, qp, 6, rp, nan6.as_ptr(), fp, o),
+            step(comp, qp, 6, rp, nan6.as_ptr(), fp, o),
         ),
         (
             "infinite feed",
             DEFLECT_ERR_NON_FINITE,
-            step(comp, robot, qp, 6, rp, ep, nan3.as_ptr(), o),
+            step(comp, qp, 6, rp, ep, nan3.as_ptr(), o),
         ),
     ];
     for (what, want, got) in cases {
@@ -644,7 +640,10 @@ fn step_returns_the_documented_codes_and_leaves_the_state_alone() {
         "failed steps write no output"
     );
 
-    // A robot with other springs than the compensator was made for.
+    // The compensator owns its robot's chain: it keeps working after the robot handle is
+    // destroyed, even when a robot with other springs then takes the freed memory.
+    // SAFETY: live handle, destroyed once and not used afterwards.
+    unsafe { deflect_serial_robot_destroy(robot) };
     let dir = std::env::temp_dir().join(format!("deflect-ffi-comp-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let toml = dir.join("one_spring.toml");
@@ -661,20 +660,15 @@ fn step_returns_the_documented_codes_and_leaves_the_state_alone() {
         DEFLECT_OK
     );
     assert_eq!((dof, springs), (6, 1));
-    assert_eq!(
-        step(comp, other, qp, 6, rp, ep, fp, o),
-        DEFLECT_ERR_INVALID_ARGUMENT
-    );
     std::fs::remove_dir_all(&dir).unwrap();
 
     // None of the refused calls moved the filters: the next good steps equal a fresh Rust
-    // compensator's.
+    // compensator's (of the KR 300 the compensator was made for, whose handle is gone).
     for k in 0..30 {
         let (q, reading, est, feed) = cycle(k);
         assert_eq!(
             step(
                 comp,
-                robot,
                 q.as_ptr(),
                 6,
                 reading.as_ptr(),
@@ -684,21 +678,20 @@ fn step_returns_the_documented_codes_and_leaves_the_state_alone() {
             ),
             DEFLECT_OK
         );
-        let want = rcomp
-            .step(
-                &rust.model,
-                &q,
-                &Vector6::from(reading),
-                Some(&Vector6::from(est)),
-                &Vector3::from(feed),
-            )
-            .unwrap();
+        let want = compensation::step(
+            &rmodel,
+            &mut rdata,
+            &q,
+            &Vector6::from(reading),
+            Some(&Vector6::from(est)),
+            &Vector3::from(feed),
+        )
+        .unwrap();
         assert_same(&out, &want, k);
     }
     // SAFETY: live handles, destroyed once.
     unsafe {
         deflect_compensator_destroy(comp);
         deflect_serial_robot_destroy(other);
-        deflect_serial_robot_destroy(robot);
     }
 }

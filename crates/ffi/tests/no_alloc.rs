@@ -100,7 +100,7 @@ fn per_tick_calls_do_not_allocate() {
             DEFLECT_OK
         );
         assert_eq!(
-            deflect_dalembert_create(ptr::null(), DEFLECT_PAPER_MASS, 3, 0.0, &mut corr),
+            deflect_dalembert_create(ptr::null(), map, DEFLECT_PAPER_MASS, 3, 0.0, &mut corr),
             DEFLECT_OK
         );
         let mut cfg = std::mem::MaybeUninit::<DeflectCompensatorConfig>::uninit();
@@ -127,7 +127,6 @@ fn per_tick_calls_do_not_allocate() {
     let mut n = 0usize;
     let mut st = DeflectState2::default();
     let mut tick = DeflectCorrectedTick2::default();
-    let mut seed = [0.0; 2];
     let mut out = [0.0; 2];
     // SAFETY: live handles from this test, arrays of the documented lengths.
     unsafe {
@@ -168,15 +167,12 @@ fn per_tick_calls_do_not_allocate() {
             assert_eq!(
                 deflect_dalembert_step(
                     corr,
-                    map,
                     st.position.as_ptr(),
                     st.acceleration.as_ptr(),
-                    seed.as_ptr(),
                     &mut tick
                 ),
                 DEFLECT_OK
             );
-            seed = tick.joints;
             assert_eq!(
                 deflect_compliance_map_displacement(
                     map,
@@ -214,7 +210,6 @@ fn per_tick_calls_do_not_allocate() {
             assert_eq!(
                 deflect_compensator_step(
                     comp,
-                    robot,
                     q.as_ptr(),
                     6,
                     reading.as_ptr(),
@@ -236,7 +231,6 @@ fn per_tick_calls_do_not_allocate() {
         assert_eq!(
             deflect_compensator_step(
                 comp,
-                robot,
                 q.as_ptr(),
                 6,
                 nan6.as_ptr(),
@@ -249,7 +243,6 @@ fn per_tick_calls_do_not_allocate() {
         assert_eq!(
             deflect_compensator_step(
                 comp,
-                robot,
                 q.as_ptr(),
                 5,
                 w.as_ptr(),
@@ -261,14 +254,7 @@ fn per_tick_calls_do_not_allocate() {
         );
         let nan = [f64::NAN; 2];
         assert_eq!(
-            deflect_dalembert_step(
-                corr,
-                map,
-                nan.as_ptr(),
-                nan.as_ptr(),
-                seed.as_ptr(),
-                &mut tick
-            ),
+            deflect_dalembert_step(corr, nan.as_ptr(), nan.as_ptr(), &mut tick),
             DEFLECT_ERR_NON_FINITE
         );
         assert_eq!(
@@ -285,6 +271,105 @@ fn per_tick_calls_do_not_allocate() {
         deflect_dalembert_destroy(corr);
         deflect_trajectory2_destroy(traj);
         deflect_compliance_map_destroy(map);
+        deflect_serial_robot_destroy(robot);
+    }
+}
+
+#[test]
+fn serial_corrector_ticks_do_not_allocate() {
+    let (urdf, toml) = (
+        repo("robots/kr300/kr300_r2500.urdf"),
+        repo("robots/kr300/kr300_r2500_stiffness.toml"),
+    );
+    let q0 = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+    let payload = DeflectPayload {
+        mass: 150.0,
+        com: [0.0, 0.0, 0.25],
+        inertia: [4.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 2.5],
+    };
+    let lim = DeflectLimits {
+        v_max: 2.0,
+        a_max: 9.81,
+        j_max: 200.0,
+    };
+    let (mut robot, mut motion, mut corr) = (ptr::null_mut(), ptr::null_mut(), ptr::null_mut());
+    let (mut start, mut duration, mut n) = ([0.0; 16], 0.0, 0usize);
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        assert_eq!(
+            deflect_serial_robot_load(
+                urdf.as_ptr(),
+                toml.as_ptr(),
+                c"tcp".as_ptr(),
+                &mut robot,
+                ptr::null_mut(),
+                0
+            ),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_serial_robot_forward(robot, q0.as_ptr(), 6, start.as_mut_ptr()),
+            DEFLECT_OK
+        );
+        let mut end = start;
+        end[3] += 0.1;
+        end[7] += 0.3;
+        assert_eq!(
+            deflect_pose_motion_line(start.as_ptr(), end.as_ptr(), &lim, &lim, &mut motion),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_pose_motion_info(motion, 2000.0, &mut duration, &mut n),
+            DEFLECT_OK
+        );
+        assert_eq!(
+            deflect_serial_dalembert_create(
+                robot,
+                &payload,
+                DEFLECT_SERIAL_EXACT,
+                q0.as_ptr(),
+                6,
+                &mut corr
+            ),
+            DEFLECT_OK
+        );
+    }
+    let before = allocations();
+    let (mut state, mut tick) = (DeflectPoseState::default(), DeflectSerialTick::default());
+    let process = [0.0, 0.0, -300.0, 0.0, 0.0, 0.0];
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        for k in 0..n {
+            let t = if k + 1 == n {
+                duration
+            } else {
+                k as f64 / 2000.0
+            };
+            assert_eq!(
+                deflect_pose_motion_sample(motion, t, &mut state),
+                DEFLECT_OK
+            );
+            assert_eq!(
+                deflect_serial_dalembert_step(corr, &state, process.as_ptr(), &mut tick),
+                DEFLECT_OK
+            );
+        }
+        state.acceleration[0] = f64::NAN;
+        assert_eq!(
+            deflect_serial_dalembert_step(corr, &state, ptr::null(), &mut tick),
+            DEFLECT_ERR_NON_FINITE
+        );
+        assert_eq!(
+            deflect_serial_dalembert_reset(corr, q0.as_ptr(), 6),
+            DEFLECT_OK
+        );
+    }
+    assert_eq!(allocations() - before, 0, "serial ticks allocated");
+    assert!(n > 500);
+    // SAFETY: live handles from this test.
+    unsafe {
+        deflect_serial_dalembert_destroy(corr);
+        deflect_pose_motion_destroy(motion);
         deflect_serial_robot_destroy(robot);
     }
 }
