@@ -1,31 +1,26 @@
 //! `deflect.ComplianceMap`: the static-test compliance map of deflect-core (Paksoy et al.
 //! 2025, Eq. 9-14). SI units in and out: positions m, forces N, displacements m.
 
+use deflect_core::TickError;
 use deflect_core::compliance_map::{
-    self as cm, ComplianceMap as CoreMap, ComplianceMapError, FitOptions, ForceUnit, HoldOutAxis,
-    Interpolation, LengthUnit, Measurement, OutOfGrid, QueryError, QueryOptions,
+    self as cm, ComplianceMap as CoreMap, FitOptions, HoldOutAxis, Interpolation, Measurement,
+    OutOfGrid, QueryOptions,
 };
+use deflect_core::io::{map_csv, map_json};
+use deflect_core::units::{ForceUnit, LengthUnit};
 use numpy::ndarray::{Array1, Array2, Array4};
-use numpy::{
-    IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray1, PyReadonlyArray2, ToPyArray,
-};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::{InputError, LoadError};
+use crate::InputError;
+use crate::args;
+use crate::convert::{
+    build_err, indices, load_err, matrix, shape_error, tick_err, tick_err_at, vector_any,
+};
 
 /// Batches of at least this many rows use several threads.
 const PARALLEL_MIN_ROWS: usize = 20_000;
-
-fn load_err(e: ComplianceMapError) -> PyErr {
-    LoadError::new_err(e.to_string())
-}
-fn input_err(e: ComplianceMapError) -> PyErr {
-    InputError::new_err(e.to_string())
-}
-fn query_err(e: QueryError) -> PyErr {
-    InputError::new_err(e.to_string())
-}
 
 fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
     match s.to_ascii_lowercase().as_str() {
@@ -77,11 +72,6 @@ fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit
     Ok((f, l))
 }
 
-fn read(path: &std::path::Path) -> PyResult<String> {
-    std::fs::read_to_string(path)
-        .map_err(|e| LoadError::new_err(format!("cannot read {}: {e}", path.display())))
-}
-
 /// A compliance map from static tests (Paksoy et al. 2025, Eq. 9-14): at each node of a
 /// rectilinear grid of positions, `disp_d = sum_f (slope[d, f] * F_f + offset[d, f])`; bilinear
 /// (Eq. 14) or C1 cubic Hermite interpolation between nodes. SI: positions m, forces N,
@@ -117,6 +107,13 @@ impl ComplianceMap {
     }
 }
 
+/// Why a batch stopped: the first refused row and why, or an internal failure.
+#[derive(Debug)]
+enum BatchFailure {
+    Row(usize, TickError),
+    Internal(&'static str),
+}
+
 /// Rows of a (N, k) float array as a contiguous row-major Vec.
 fn rows_of(a: &PyReadonlyArray2<'_, f64>) -> Vec<f64> {
     a.as_array().as_standard_layout().iter().copied().collect()
@@ -138,8 +135,9 @@ impl ComplianceMap {
         interpolation: &str,
         out_of_grid: &str,
     ) -> PyResult<Self> {
-        let text = read(&path)?;
-        Self::from_csv_text(&text, force_unit, length_unit, interpolation, out_of_grid)
+        let (f, l) = units(force_unit, length_unit)?;
+        let inner = map_csv::from_path(&path, f, l).map_err(load_err)?;
+        Self::wrap(inner, interpolation, out_of_grid)
     }
 
     /// Same as `from_csv`, from the CSV text.
@@ -153,7 +151,7 @@ impl ComplianceMap {
         out_of_grid: &str,
     ) -> PyResult<Self> {
         let (f, l) = units(force_unit, length_unit)?;
-        let inner = CoreMap::from_paper_csv(text, f, l).map_err(load_err)?;
+        let inner = map_csv::from_str(text, f, l).map_err(load_err)?;
         Self::wrap(inner, interpolation, out_of_grid)
     }
 
@@ -170,58 +168,59 @@ impl ComplianceMap {
         interpolation="bilinear", out_of_grid="error"))]
     #[allow(clippy::too_many_arguments)] // reason: mirrors the documented Python signature
     fn fit(
-        positions: PyReadonlyArray2<'_, f64>,
-        force_axis: PyReadonlyArray1<'_, i64>,
-        force: PyReadonlyArray1<'_, f64>,
-        displacement: Option<PyReadonlyArray2<'_, f64>>,
-        upper: Option<PyReadonlyArray2<'_, f64>>,
-        lower: Option<PyReadonlyArray2<'_, f64>>,
-        spacing: Option<f64>,
-        extension: f64,
-        n_force: Option<usize>,
-        position_tolerance: f64,
+        positions: &Bound<'_, PyAny>,
+        force_axis: &Bound<'_, PyAny>,
+        force: &Bound<'_, PyAny>,
+        displacement: Option<&Bound<'_, PyAny>>,
+        upper: Option<&Bound<'_, PyAny>>,
+        lower: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = args::opt_real::spacing)] spacing: Option<f64>,
+        #[pyo3(from_py_with = args::real::extension)] extension: f64,
+        #[pyo3(from_py_with = args::opt_count::n_force)] n_force: Option<usize>,
+        #[pyo3(from_py_with = args::real::position_tolerance)] position_tolerance: f64,
         interpolation: &str,
         out_of_grid: &str,
     ) -> PyResult<Self> {
+        let positions = matrix(positions, "positions", None, None)?;
         let p = positions.as_array();
         let n = p.nrows();
         if p.ncols() != 2 && p.ncols() != 3 {
-            return Err(InputError::new_err(format!(
-                "positions: expected shape (N, 2), got {:?}",
-                p.shape()
-            )));
+            return Err(shape_error("positions", "(N, 2) or (N, 3)", p.shape()));
         }
-        let (axes, forces) = (force_axis.as_array(), force.as_array());
-        if axes.len() != n || forces.len() != n {
-            return Err(InputError::new_err(format!(
-                "force_axis and force: expected shape ({n},), got ({},) and ({},)",
-                axes.len(),
-                forces.len()
-            )));
+        let axes = indices(force_axis, "force_axis")?;
+        if axes.len() != n {
+            return Err(shape_error("force_axis", &format!("({n},)"), &[axes.len()]));
         }
-        let check_disp = |a: &PyReadonlyArray2<'_, f64>, what: &str| -> PyResult<usize> {
-            let s = a.as_array().shape().to_vec();
-            match s.as_slice() {
-                [r, c] if *r == n && (1..=cm::MAX_AXES).contains(c) => Ok(*c),
-                _ => Err(InputError::new_err(format!(
-                    "{what}: expected shape ({n}, 1..6), got {s:?}"
-                ))),
+        let forces = vector_any(force, "force")?;
+        if forces.len() != n {
+            return Err(shape_error("force", &format!("({n},)"), &[forces.len()]));
+        }
+        let check_disp = |a: &Bound<'_, PyAny>, what: &str| -> PyResult<(usize, Vec<f64>)> {
+            let m = matrix(a, what, Some(n), None)?;
+            let c = m.as_array().ncols();
+            if !(1..=cm::MAX_AXES).contains(&c) {
+                return Err(shape_error(
+                    what,
+                    &format!("({n}, 1..{})", cm::MAX_AXES),
+                    m.as_array().shape(),
+                ));
             }
+            Ok((c, rows_of(&m)))
         };
         let (nd, disp): (usize, Vec<f64>) = match (displacement, upper, lower) {
-            (Some(d), None, None) => (check_disp(&d, "displacement")?, rows_of(&d)),
+            (Some(d), None, None) => check_disp(d, "displacement")?,
             (None, Some(u), Some(l)) => {
-                let nd = check_disp(&u, "upper")?;
-                if check_disp(&l, "lower")? != nd {
+                let (nd, u) = check_disp(u, "upper")?;
+                let (nl, l) = check_disp(l, "lower")?;
+                if nl != nd {
                     return Err(InputError::new_err("upper and lower: shapes differ"));
                 }
                 let spacing = spacing.ok_or_else(|| {
                     InputError::new_err("spacing (|P_u P_l| [m]) is required with upper/lower")
                 })?;
-                let (u, l) = (rows_of(&u), rows_of(&l));
                 let mut d = vec![0.0; n * nd];
                 for ((o, uu), ll) in d.chunks_mut(nd).zip(u.chunks(nd)).zip(l.chunks(nd)) {
-                    cm::two_point_displacement(uu, ll, spacing, extension, o).map_err(input_err)?;
+                    cm::two_point_displacement(uu, ll, spacing, extension, o).map_err(build_err)?;
                 }
                 (nd, d)
             }
@@ -239,11 +238,9 @@ impl ComplianceMap {
             .zip(forces.iter())
             .enumerate()
         {
-            let axis = usize::try_from(*a)
-                .map_err(|_| InputError::new_err(format!("force_axis[{r}] = {a} is negative")))?;
             let d = disp.get(r * nd..(r + 1) * nd).unwrap_or(&[]);
             let xy = |k: usize| prow.get(k).copied().unwrap_or(f64::NAN);
-            ms.push(Measurement::new(xy(0), xy(1), axis, *f, d));
+            ms.push(Measurement::new(xy(0), xy(1), *a, *f, d));
         }
         let n_force =
             n_force.unwrap_or_else(|| ms.iter().map(|m| m.force_axis + 1).max().unwrap_or(1));
@@ -252,7 +249,7 @@ impl ComplianceMap {
             n_displacement: nd,
             position_tolerance,
         };
-        let inner = cm::fit(&ms, &options).map_err(input_err)?;
+        let inner = cm::fit(&ms, &options).map_err(build_err)?;
         Self::wrap(inner, interpolation, out_of_grid)
     }
 
@@ -268,28 +265,27 @@ impl ComplianceMap {
         path: std::path::PathBuf,
         force_unit: &str,
         length_unit: &str,
-        n_force: Option<usize>,
-        position_tolerance: f64,
+        #[pyo3(from_py_with = args::opt_count::n_force)] n_force: Option<usize>,
+        #[pyo3(from_py_with = args::real::position_tolerance)] position_tolerance: f64,
         interpolation: &str,
         out_of_grid: &str,
     ) -> PyResult<Self> {
-        let text = read(&path)?;
         let (f, l) = units(force_unit, length_unit)?;
         let inner =
-            CoreMap::fit_static_csv(&text, f, l, n_force, position_tolerance).map_err(load_err)?;
+            map_csv::fit_static_path(&path, f, l, n_force, position_tolerance).map_err(load_err)?;
         Self::wrap(inner, interpolation, out_of_grid)
     }
 
     /// The map as versioned JSON (`"format_version": 1`, SI units recorded); exact round trip.
     fn to_json(&self) -> PyResult<String> {
-        self.inner.to_json().map_err(load_err)
+        map_json::to_string(&self.inner).map_err(load_err)
     }
 
     /// Loads a map saved by `to_json`.
     #[staticmethod]
     fn from_json(text: &str) -> PyResult<Self> {
         Ok(Self {
-            inner: CoreMap::from_json(text).map_err(load_err)?,
+            inner: map_json::from_str(text).map_err(load_err)?,
         })
     }
 
@@ -314,32 +310,21 @@ impl ComplianceMap {
     fn displacement<'py>(
         &self,
         py: Python<'py>,
-        position: PyReadonlyArray1<'py, f64>,
-        force: PyReadonlyArray1<'py, f64>,
+        position: &Bound<'py, PyAny>,
+        force: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let o = self.options(interpolation, out_of_grid)?;
-        let p = position.as_array();
-        if p.len() != 2 && p.len() != 3 {
-            return Err(InputError::new_err(format!(
-                "position: expected shape (2,) or (3,), got ({},)",
-                p.len()
-            )));
-        }
-        let f: Vec<f64> = force.as_array().iter().copied().collect();
+        let p = match vector_any(position, "position")?.as_slice() {
+            &[x, y] | &[x, y, _] => [x, y],
+            other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
+        };
+        let f = vector_any(force, "force")?;
         let mut out = vec![0.0; self.inner.n_displacement()];
         self.inner
-            .displacement_with(
-                [
-                    p.get(0).copied().unwrap_or(f64::NAN),
-                    p.get(1).copied().unwrap_or(f64::NAN),
-                ],
-                &f,
-                &mut out,
-                o,
-            )
-            .map_err(query_err)?;
+            .displacement_with(p, &f, &mut out, o)
+            .map_err(tick_err)?;
         Ok(out.into_pyarray(py))
     }
 
@@ -352,32 +337,26 @@ impl ComplianceMap {
     fn displacement_batch<'py>(
         &self,
         py: Python<'py>,
-        P: PyReadonlyArray2<'py, f64>,
-        F: PyReadonlyArray2<'py, f64>,
+        P: &Bound<'py, PyAny>,
+        F: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let o = self.options(interpolation, out_of_grid)?;
         let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
-        let (p, f) = (P.as_array(), F.as_array());
+        let pm = matrix(P, "P", None, None)?;
+        let p = pm.as_array();
         let n = p.nrows();
         if p.ncols() != 2 && p.ncols() != 3 {
-            return Err(InputError::new_err(format!(
-                "P: expected shape (N, 2) or (N, 3), got {:?}",
-                p.shape()
-            )));
+            return Err(shape_error("P", "(N, 2) or (N, 3)", p.shape()));
         }
-        if f.shape() != [n, nf] {
-            return Err(InputError::new_err(format!(
-                "F: expected shape ({n}, {nf}), got {:?}",
-                f.shape()
-            )));
-        }
+        let fm = matrix(F, "F", Some(n), Some(nf))?;
+        let f = fm.as_array();
         let map = &self.inner;
-        let out = py.detach(|| -> Result<Vec<f64>, String> {
+        let out = py.detach(|| -> Result<Vec<f64>, BatchFailure> {
             let (p, f) = (p.as_standard_layout(), f.as_standard_layout());
             let (Some(ps), Some(fs)) = (p.as_slice(), f.as_slice()) else {
-                return Err("internal: arrays not contiguous".to_string());
+                return Err(BatchFailure::Internal("arrays not contiguous"));
             };
             let view = map.view();
             let mut out = vec![0.0; n * nd];
@@ -389,7 +368,7 @@ impl ComplianceMap {
                 1
             };
             let rows = n.div_ceil(threads).max(1);
-            let results: Vec<Result<(), String>> = std::thread::scope(|scope| {
+            let results: Vec<Result<(), BatchFailure>> = std::thread::scope(|scope| {
                 let handles: Vec<_> = out
                     .chunks_mut(rows * nd)
                     .zip(ps.chunks(rows * pc))
@@ -399,7 +378,7 @@ impl ComplianceMap {
                         scope.spawn(move || {
                             view.displacement_batch(pchunk, pc, fchunk, oc, o)
                                 .map(|_| ())
-                                .map_err(|e| format!("row {}: {}", k * rows + e.row, e.error))
+                                .map_err(|e| BatchFailure::Row(k * rows + e.row, e.error))
                         })
                     })
                     .collect();
@@ -407,7 +386,7 @@ impl ComplianceMap {
                     .into_iter()
                     .map(|h| {
                         h.join()
-                            .unwrap_or_else(|_| Err("worker thread panicked".to_string()))
+                            .unwrap_or(Err(BatchFailure::Internal("worker thread panicked")))
                     })
                     .collect()
             });
@@ -417,7 +396,10 @@ impl ComplianceMap {
             }
             Ok(out)
         });
-        let out = out.map_err(InputError::new_err)?;
+        let out = out.map_err(|e| match e {
+            BatchFailure::Row(row, e) => tick_err_at(format_args!("row {row}"), e),
+            BatchFailure::Internal(what) => InputError::new_err(format!("internal: {what}")),
+        })?;
         let arr =
             Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
         Ok(arr.into_pyarray(py))
@@ -430,7 +412,7 @@ impl ComplianceMap {
     fn cross_validate<'py>(
         &self,
         py: Python<'py>,
-        forces: PyReadonlyArray2<'py, f64>,
+        forces: &Bound<'py, PyAny>,
         axis: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
         let a = match axis {
@@ -442,14 +424,20 @@ impl ComplianceMap {
                 )));
             }
         };
-        if forces.as_array().ncols() != self.inner.n_force() {
-            return Err(InputError::new_err(format!(
-                "forces: expected shape (K, {}), got {:?}",
-                self.inner.n_force(),
-                forces.as_array().shape()
-            )));
+        let forces = matrix(forces, "forces", None, Some(self.inner.n_force()))?;
+        let cv = cm::leave_one_node_out(&self.inner, &rows_of(&forces), a).map_err(build_err)?;
+        // deflect-core does not check these outputs: forces near f64::MAX overflow the RMS.
+        let rms = [cv.rms_bilinear, cv.rms_bicubic].into_iter().chain(
+            cv.nodes
+                .iter()
+                .flat_map(|n| [n.rms_bilinear, n.rms_bicubic]),
+        );
+        if let Some(index) = rms.into_iter().position(|x| !x.is_finite()) {
+            return Err(tick_err(TickError::NonFiniteOutput {
+                what: "cross-validation RMS",
+                index,
+            }));
         }
-        let cv = cm::leave_one_node_out(&self.inner, &rows_of(&forces), a).map_err(input_err)?;
         let d = PyDict::new(py);
         d.set_item("axis", axis)?;
         d.set_item("rms_bilinear", cv.rms_bilinear)?;

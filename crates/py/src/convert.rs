@@ -1,69 +1,478 @@
-//! numpy <-> nalgebra conversions and error mapping shared by the wrappers.
+//! Python -> Rust argument conversion and the one mapping of deflect-core's errors onto the
+//! exception tree: every wrapper maps core errors through [`build_err`], [`load_err`] and
+//! [`tick_err`] (or [`tick_err_at`]).
+//!
+//! Arguments are taken as `&Bound<PyAny>` (arrays) or through the named extractors of
+//! `crate::args` (scalars), so that every refusal is a `deflect.InputError` naming the
+//! argument: pyo3's own extraction would raise `TypeError` or `OverflowError` without the
+//! name. Arrays go through numpy once: `numpy.asarray`, a dtype-kind check (bool, int,
+//! unsigned and float convert; complex, object, string, datetime and void arrays are refused)
+//! and one conversion to float64.
 
-use deflect_core::TickError;
-use nalgebra::{Isometry3, Matrix4, Vector6};
-use numpy::ndarray::Array2;
-use numpy::{AllowTypeChange, PyArray2, PyArrayLike1, PyArrayLike2, PyReadonlyArray1, ToPyArray};
+use core::fmt::Display;
+
+use deflect_core::vjm::{self, Vector6};
+use deflect_core::{BuildError, LoadError as CoreLoadError, TickError};
+use nalgebra::{Isometry3, Matrix3, Matrix4, UnitQuaternion};
+use numpy::ndarray::{Array2, ArrayView2};
+use numpy::{
+    PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
+    PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods, ToPyArray,
+};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
+use pyo3::sync::PyOnceLock;
+use pyo3::types::{PyFloat, PyInt};
 
-use crate::{ConvergenceError, InputError, SingularError};
+use crate::{ConvergenceError, InputError, LoadError, SingularError};
 
-/// Maps a real-time status onto the exception tree.
-pub fn tick_err(e: TickError) -> PyErr {
+/// A model, configuration or fit that could not be built: `SingularError` for a singular
+/// matrix parameter, `InputError` otherwise (budgets included).
+pub fn build_err(e: BuildError) -> PyErr {
     match e {
-        TickError::Singular { .. } => SingularError::new_err(e.to_string()),
-        TickError::NotConverged { .. } => ConvergenceError::new_err(e.to_string()),
+        BuildError::Singular { .. } => SingularError::new_err(e.to_string()),
         _ => InputError::new_err(e.to_string()),
     }
 }
 
-/// A 1-D float array of exactly `n` entries, copied into a `Vec`.
-pub fn vec_of(a: &PyReadonlyArray1<'_, f64>, what: &str, n: usize) -> PyResult<Vec<f64>> {
-    let v = a.as_array();
-    if v.len() != n {
+/// A file that could not be read or validated: `LoadError`.
+pub fn load_err(e: CoreLoadError) -> PyErr {
+    LoadError::new_err(e.to_string())
+}
+
+/// A per-tick error: `SingularError` for a singular pose or stiffness and for a step without
+/// edge motion, `ConvergenceError` for a solve that missed its tolerance, `InputError` for
+/// everything else (shapes, NaN/inf, out of grid or workspace, budgets, joint limits,
+/// overflowing outputs, invalid arguments, ...).
+pub fn tick_err(e: TickError) -> PyErr {
+    tick_exception(e, e.to_string())
+}
+
+/// [`tick_err`] with the message prefixed by where it happened (`"row 3"`, `"tick 17"`).
+pub fn tick_err_at(context: impl Display, e: TickError) -> PyErr {
+    tick_exception(e, format!("{context}: {e}"))
+}
+
+fn tick_exception(e: TickError, message: String) -> PyErr {
+    match e {
+        TickError::Singular { .. } | TickError::NoEdgeMotion => SingularError::new_err(message),
+        TickError::NotConverged { .. } => ConvergenceError::new_err(message),
+        // OutOfGrid, OutOfWorkspace, ModelMismatch, NonFiniteOutput, Budget, JointLimit,
+        // InvalidArgument, WrongLength, NonFinite and any later variant.
+        _ => InputError::new_err(message),
+    }
+}
+
+/// A shape as Python prints it: `()`, `(6,)`, `(3, 6)`.
+pub fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => {
+            let parts: Vec<String> = shape.iter().map(usize::to_string).collect();
+            format!("({})", parts.join(", "))
+        }
+    }
+}
+
+/// `InputError`: `what` has the wrong shape.
+pub fn shape_error(what: &str, expected: &str, got: &[usize]) -> PyErr {
+    InputError::new_err(format!(
+        "{what}: expected shape {expected}, got {}",
+        shape_text(got)
+    ))
+}
+
+/// Shortens the text of a Python value for a message (a huge integer has many digits).
+fn short(o: &Bound<'_, PyAny>) -> String {
+    let s = o
+        .repr()
+        .map(|r| r.to_string())
+        .unwrap_or_else(|_| "<unprintable>".to_string());
+    if s.chars().count() > 48 {
+        let head: String = s.chars().take(40).collect();
+        format!("{head}... ({} characters)", s.chars().count())
+    } else {
+        s
+    }
+}
+
+/// The Python type name of `o` (`complex`, `str`, `numpy.ndarray`).
+fn type_name(o: &Bound<'_, PyAny>) -> String {
+    o.get_type()
+        .name()
+        .map(|n| n.to_string())
+        .unwrap_or_else(|_| "?".to_string())
+}
+
+/// `numpy.asarray(o)`; a ValueError of numpy (ragged nested lists) becomes an `InputError`
+/// naming `what`. numpy's own TypeErrors (an object whose `__array__` refuses) stay.
+fn asarray<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+    static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
+    let py = o.py();
+    let f = ASARRAY.import(py, "numpy", "asarray")?;
+    let a = f.call1((o,)).map_err(|e| {
+        if e.is_instance_of::<PyValueError>(py) {
+            InputError::new_err(format!("{what}: not an array of numbers ({e})"))
+        } else {
+            e
+        }
+    })?;
+    Ok(a.cast_into::<PyUntypedArray>()?)
+}
+
+/// dtype kinds that convert to float64 with their meaning: bool, signed and unsigned
+/// integers, floats.
+fn is_real_kind(kind: u8) -> bool {
+    matches!(kind, b'b' | b'i' | b'u' | b'f')
+}
+
+/// `o` as a float64 numpy array of any shape (no copy if it already is one). Complex,
+/// object, string, datetime and structured arrays are refused with an `InputError` naming
+/// `what`, the received dtype and shape: numpy would otherwise drop imaginary parts with a
+/// warning only.
+pub fn float_array<'py>(
+    o: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+    if let Ok(a) = o.cast::<PyArrayDyn<f64>>() {
+        return Ok(a.clone());
+    }
+    let a = asarray(o, what)?;
+    let dtype = a.dtype();
+    if !is_real_kind(dtype.kind()) {
         return Err(InputError::new_err(format!(
-            "{what}: expected shape ({n},), got ({},)",
-            v.len()
+            "{what}: expected an array of real numbers (float, int or bool dtype), got dtype \
+             {dtype} with shape {}",
+            shape_text(a.shape())
         )));
+    }
+    let f = a.call_method1("astype", ("float64",))?;
+    Ok(f.cast_into::<PyArrayDyn<f64>>()?)
+}
+
+/// Read access to a float64 array (refused while another thread writes to it).
+fn readonly<'py, D: numpy::ndarray::Dimension>(
+    a: &Bound<'py, numpy::PyArray<f64, D>>,
+    what: &str,
+) -> PyResult<numpy::PyReadonlyArray<'py, f64, D>> {
+    a.try_readonly()
+        .map_err(|e| InputError::new_err(format!("{what}: cannot be read: {e}")))
+}
+
+/// `o` as a float64 array of any shape, read-only.
+pub fn array_dyn<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyArrayDyn<'py, f64>> {
+    readonly(&float_array(o, what)?, what)
+}
+
+/// `o` as a 1-D float array of any length, copied.
+pub fn vector_any(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    let a = array_dyn(o, what)?;
+    let v = a.as_array();
+    if v.ndim() != 1 {
+        return Err(shape_error(what, "(n,)", v.shape()));
     }
     Ok(v.iter().copied().collect())
 }
 
-/// A 6-vector (wrench or pose change).
-pub fn vector6(a: &PyReadonlyArray1<'_, f64>, what: &str) -> PyResult<Vector6<f64>> {
-    Ok(Vector6::from_column_slice(&vec_of(a, what, 6)?))
+/// `o` as a 1-D float array of exactly `n` entries, copied (no finiteness check: the core
+/// call checks and names what it refuses).
+pub fn vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> {
+    let a = array_dyn(o, what)?;
+    let v = a.as_array();
+    if v.shape() != [n] {
+        return Err(shape_error(what, &format!("({n},)"), v.shape()));
+    }
+    Ok(v.iter().copied().collect())
 }
 
-/// A 4x4 homogeneous matrix as a numpy array.
-pub fn iso_to_py<'py>(py: Python<'py>, t: &Isometry3<f64>) -> Bound<'py, PyArray2<f64>> {
-    let m: Matrix4<f64> = t.to_homogeneous();
-    Array2::from_shape_fn((4, 4), |(i, j)| m[(i, j)]).to_pyarray(py)
-}
-
-/// Rejects NaN/inf in a 6-vector.
-pub fn check_finite6(v: &Vector6<f64>, what: &str) -> PyResult<()> {
+/// The index of the first non-finite entry, as `InputError` naming `what`.
+fn check_finite(what: &str, v: &[f64]) -> PyResult<()> {
     match v.iter().position(|x| !x.is_finite()) {
         Some(i) => Err(InputError::new_err(format!("{what}[{i}] is not finite"))),
         None => Ok(()),
     }
 }
 
-/// A 1-D array-like of floats (lists accepted, converted to f64).
-pub type Arr1<'py> = PyArrayLike1<'py, f64, AllowTypeChange>;
-/// A 2-D array-like of floats (lists accepted, converted to f64).
-pub type Arr2<'py> = PyArrayLike2<'py, f64, AllowTypeChange>;
+/// [`vector`] whose entries must all be finite.
+pub fn finite_vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> {
+    let v = vector(o, what, n)?;
+    check_finite(what, &v)?;
+    Ok(v)
+}
 
-/// A finite 1-D array of exactly `n` entries, copied into a `Vec`; errors name `what`.
-pub fn finite_vec(a: &Arr1<'_>, what: &str, n: usize) -> PyResult<Vec<f64>> {
+/// A finite 6-vector (wrench or pose change).
+pub fn vector6(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector6> {
+    Ok(Vector6::from_column_slice(&finite_vector(o, what, 6)?))
+}
+
+/// `o` as a 2-D float array; `rows`/`cols` fix a dimension (`None`: any). The message shows
+/// `N` and `M` for free dimensions.
+pub fn matrix<'py>(
+    o: &Bound<'py, PyAny>,
+    what: &str,
+    rows: Option<usize>,
+    cols: Option<usize>,
+) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let a = float_array(o, what)?;
+    let shape = a.shape().to_vec();
+    let fits = match shape.as_slice() {
+        [r, c] => rows.is_none_or(|n| n == *r) && cols.is_none_or(|n| n == *c),
+        _ => false,
+    };
+    if !fits {
+        let dim = |d: Option<usize>, free: &str| d.map_or(free.to_string(), |n| n.to_string());
+        return Err(shape_error(
+            what,
+            &format!("({}, {})", dim(rows, "N"), dim(cols, "M")),
+            &shape,
+        ));
+    }
+    let a2 = a.cast_into::<PyArray2<f64>>()?;
+    readonly(&a2, what)
+}
+
+/// Checks that every entry of a matrix is finite; names the first one that is not.
+pub fn check_finite_matrix(what: &str, m: &ArrayView2<'_, f64>) -> PyResult<()> {
+    for ((i, j), v) in m.indexed_iter() {
+        if !v.is_finite() {
+            return Err(InputError::new_err(format!(
+                "{what}[{i}, {j}] (row {i}) is not finite"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A finite `R x C` matrix as a nalgebra matrix.
+pub fn fixed_matrix<const R: usize, const C: usize>(
+    o: &Bound<'_, PyAny>,
+    what: &str,
+) -> PyResult<nalgebra::SMatrix<f64, R, C>> {
+    let a = matrix(o, what, Some(R), Some(C))?;
     let v = a.as_array();
-    if v.len() != n {
+    check_finite_matrix(what, &v)?;
+    let mut m = nalgebra::SMatrix::<f64, R, C>::zeros();
+    for ((i, j), x) in v.indexed_iter() {
+        if let Some(dst) = m.get_mut((i, j)) {
+            *dst = *x;
+        }
+    }
+    Ok(m)
+}
+
+/// A 4x4 homogeneous transform, checked by deflect-core's [`vjm::pose_from_matrix`]:
+/// finite, bottom row `0 0 0 1`, a proper rotation (no reflection, no projection).
+pub fn pose(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Isometry3<f64>> {
+    pose_of(&fixed_matrix::<4, 4>(o, what)?, what)
+}
+
+/// [`pose`] of a matrix already read.
+pub fn pose_of(m: &Matrix4<f64>, what: &str) -> PyResult<Isometry3<f64>> {
+    vjm::pose_from_matrix(m)
+        .map_err(|e| tick_err_at(format_args!("{what}: not a rigid transform"), e))
+}
+
+/// A 3x3 rotation matrix, checked by deflect-core's [`vjm::rotation_from_matrix`].
+pub fn rotation(o: &Bound<'_, PyAny>, what: &str) -> PyResult<UnitQuaternion<f64>> {
+    rotation_of(&fixed_matrix::<3, 3>(o, what)?, what)
+}
+
+/// [`rotation`] of a matrix already read.
+pub fn rotation_of(m: &Matrix3<f64>, what: &str) -> PyResult<UnitQuaternion<f64>> {
+    vjm::rotation_from_matrix(m)
+        .map_err(|e| tick_err_at(format_args!("{what}: not a rotation matrix"), e))
+}
+
+/// A 4x4 homogeneous matrix as a numpy array.
+pub fn iso_to_py<'py>(py: Python<'py>, t: &Isometry3<f64>) -> Bound<'py, PyArray2<f64>> {
+    matrix_to_py(py, &t.to_homogeneous())
+}
+
+/// Writes the 4x4 homogeneous matrix of `iso` into `arr[i]` of an (n, 4, 4) array (nothing
+/// past the end).
+pub fn put_pose(arr: &mut numpy::ndarray::Array3<f64>, i: usize, iso: &Isometry3<f64>) {
+    if i >= arr.shape().first().copied().unwrap_or(0) {
+        return;
+    }
+    let h = iso.to_homogeneous();
+    for ((r, c), v) in arr
+        .index_axis_mut(numpy::ndarray::Axis(0), i)
+        .indexed_iter_mut()
+    {
+        if let Some(x) = h.get((r, c)) {
+            *v = *x;
+        }
+    }
+}
+
+/// Any nalgebra matrix as a (rows, cols) numpy array.
+pub fn matrix_to_py<'py, const R: usize, const C: usize>(
+    py: Python<'py>,
+    m: &nalgebra::SMatrix<f64, R, C>,
+) -> Bound<'py, PyArray2<f64>> {
+    // nalgebra stores columns; the transpose's storage is the row-major order.
+    let rows: Vec<f64> = m.transpose().as_slice().to_vec();
+    match Array2::from_shape_vec((R, C), rows) {
+        Ok(a) => a.to_pyarray(py),
+        // Unreachable (R * C entries); an empty array rather than a panic.
+        Err(_) => Array2::<f64>::zeros((0, 0)).to_pyarray(py),
+    }
+}
+
+/// `o` as a 1-D array of non-negative integer indices: integer arrays (and float arrays of
+/// whole numbers) are accepted, anything else is an `InputError` naming `what`.
+pub fn indices(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<usize>> {
+    let a = asarray(o, what)?;
+    let dtype = a.dtype();
+    if !matches!(dtype.kind(), b'i' | b'u' | b'f' | b'b') {
         return Err(InputError::new_err(format!(
-            "{what}: expected shape ({n},), got ({},)",
-            v.len()
+            "{what}: expected an array of integers, got dtype {dtype} with shape {}",
+            shape_text(a.shape())
         )));
     }
-    if let Some(i) = v.iter().position(|x| !x.is_finite()) {
-        return Err(InputError::new_err(format!("{what}[{i}] is not finite")));
+    if a.ndim() != 1 {
+        return Err(shape_error(what, "(n,)", a.shape()));
     }
-    Ok(v.to_vec())
+    // Through float64: exact for every index below 2^53, and anything larger is refused.
+    let f = readonly(
+        &a.call_method1("astype", ("float64",))?
+            .cast_into::<PyArrayDyn<f64>>()?,
+        what,
+    )?;
+    f.as_array()
+        .iter()
+        .enumerate()
+        .map(|(i, &x)| {
+            if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x < 9.0e15 {
+                // Exact: a whole number below 2^53.
+                Ok(x as usize)
+            } else {
+                Err(InputError::new_err(format!(
+                    "{what}[{i}] = {x} is not an index (an integer >= 0)"
+                )))
+            }
+        })
+        .collect()
+}
+
+/// A real scalar: a Python int or float, a numpy real scalar or 0-d array, or an object with
+/// `__float__`. Complex numbers, strings, arrays and integers too large for a float are an
+/// `InputError` naming `what`. NaN and infinities pass (the core call names them).
+pub fn real(o: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
+    if let Ok(f) = o.cast::<PyFloat>() {
+        return Ok(f.value());
+    }
+    if o.is_instance_of::<PyInt>() {
+        return o.extract::<f64>().map_err(|_| {
+            InputError::new_err(format!("{what} = {} is too large for a float", short(o)))
+        });
+    }
+    let refuse = || {
+        InputError::new_err(format!(
+            "{what}: expected a real number, got {} {}",
+            type_name(o),
+            short(o)
+        ))
+    };
+    let a = asarray(o, what).map_err(|_| refuse())?;
+    if a.ndim() != 0 {
+        return Err(InputError::new_err(format!(
+            "{what}: expected a real number, got an array of shape {}",
+            shape_text(a.shape())
+        )));
+    }
+    match a.dtype().kind() {
+        k if is_real_kind(k) => a.extract::<f64>().map_err(|_| refuse()),
+        // Python objects with __float__ (fractions.Fraction, decimal.Decimal).
+        b'O' => o.extract::<f64>().map_err(|_| refuse()),
+        _ => Err(refuse()),
+    }
+}
+
+/// [`real`], or `None` for Python's None.
+pub fn opt_real(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<f64>> {
+    if o.is_none() {
+        Ok(None)
+    } else {
+        real(o, what).map(Some)
+    }
+}
+
+/// A count (iterations, window, index): a Python or numpy integer >= 0. Negative and huge
+/// integers, floats and anything else are an `InputError` naming `what` (pyo3 would raise
+/// `OverflowError` or `TypeError`); ranges beyond that are checked by the core call.
+pub fn count(o: &Bound<'_, PyAny>, what: &str) -> PyResult<usize> {
+    let index = if o.is_instance_of::<PyInt>() {
+        o.clone()
+    } else {
+        // numpy integers and other objects with __index__; floats have none.
+        o.call_method0("__index__").map_err(|_| {
+            InputError::new_err(format!(
+                "{what}: expected a non-negative integer, got {} {}",
+                type_name(o),
+                short(o)
+            ))
+        })?
+    };
+    if let Ok(n) = index.extract::<usize>() {
+        return Ok(n);
+    }
+    let negative = index.lt(0).unwrap_or(false);
+    Err(InputError::new_err(if negative {
+        format!(
+            "{what} = {} is negative; expected an integer >= 0",
+            short(&index)
+        )
+    } else {
+        format!(
+            "{what} = {} is too large; expected an integer in 0..={}",
+            short(&index),
+            usize::MAX
+        )
+    }))
+}
+
+/// [`count`], or `None` for Python's None.
+pub fn opt_count(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<usize>> {
+    if o.is_none() {
+        Ok(None)
+    } else {
+        count(o, what).map(Some)
+    }
+}
+
+/// A pair of reals (a tuple, list or array of 2), values unchecked.
+pub fn pair(o: &Bound<'_, PyAny>, what: &str) -> PyResult<(f64, f64)> {
+    match vector(o, what, 2)?.as_slice() {
+        &[a, b] => Ok((a, b)),
+        _ => Err(shape_error(what, "(2,)", &[])),
+    }
+}
+
+/// [`pair`], or `None` for Python's None.
+pub fn opt_pair(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<(f64, f64)>> {
+    if o.is_none() {
+        Ok(None)
+    } else {
+        pair(o, what).map(Some)
+    }
+}
+
+/// Three reals (a tuple, list or array of 3), values unchecked.
+pub fn triple(o: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
+    match vector(o, what, 3)?.as_slice() {
+        &[a, b, c] => Ok([a, b, c]),
+        _ => Err(shape_error(what, "(3,)", &[])),
+    }
+}
+
+/// Three reals (a tuple, list or array of 3), values unchecked; `None` for Python's None.
+pub fn opt_triple(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<[f64; 3]>> {
+    if o.is_none() {
+        return Ok(None);
+    }
+    match vector(o, what, 3)?.as_slice() {
+        &[a, b, c] => Ok(Some([a, b, c])),
+        _ => Err(shape_error(what, "(3,)", &[])),
+    }
 }

@@ -1,11 +1,12 @@
 //! `deflect.DalembertCorrector`: the 2 kHz D'Alembert trajectory corrector of the paper's
 //! parallel robot driven by a compliance map.
 
-use deflect_core::compliance_map::{ComplianceMap as CoreMap, QueryError};
-use deflect_core::dalembert::{
-    CorrectedTick, CorrectorError, DalembertCorrector as CoreCorrector, ModelStatus,
-};
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+use deflect_core::compliance_map::ComplianceMap as CoreMap;
+use deflect_core::dalembert::{self, CorrectedTick};
 use deflect_core::mechanism::ParallelRobot2 as CoreRobot2;
+use deflect_core::{Placement, TickError};
 use nalgebra::Vector2;
 use numpy::ndarray::{Array1, Array2};
 use numpy::{PyArray1, PyArray2, ToPyArray};
@@ -13,39 +14,39 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
+use crate::args;
 use crate::compliance_map::ComplianceMap;
-use crate::convert::{Arr1, finite_vec};
-use crate::motion::{ParallelRobot2, Trajectory, mech_err};
+use crate::convert::{build_err, finite_vector, tick_err, tick_err_at};
+use crate::mechanism::ParallelRobot2;
+use crate::motion::Trajectory;
 
-fn corr_err(e: CorrectorError) -> PyErr {
-    match e {
-        CorrectorError::Mechanism(m) => mech_err(m),
-        CorrectorError::Map(QueryError::OutOfGrid { .. }) => InputError::new_err(e.to_string()),
-        _ => InputError::new_err(e.to_string()),
-    }
+/// The corrector of the paper's robot driven by a compliance map (copied in at construction).
+type Model = dalembert::Model<CoreRobot2, CoreMap>;
+/// Its workspace and last joints (closed-form IK and a map: no buffers).
+type Data = dalembert::Data<(), (), 2>;
+
+fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
+    Ok(Vector2::from_column_slice(&finite_vector(a, what, 2)?))
 }
 
-fn status_name(s: ModelStatus) -> &'static str {
-    match s {
-        ModelStatus::Inside => "inside",
-        ModelStatus::Clamped => "clamped",
-        ModelStatus::Extrapolated => "extrapolated",
-    }
-}
-
-fn vec2(a: &Arr1<'_>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&finite_vec(a, what, 2)?))
-}
-
-/// D'Alembert trajectory correction (Paksoy et al., Fig. 2): per tick `F_D = -mass * a`
-/// (Eq. 5), displacement from the compliance map (Eq. 9-14), command = desired - displacement
-/// (iterated `iterations` times to a fixed point if > 0), closed-form IK. SI units.
+/// D'Alembert trajectory correction of the paper's five-bar (Paksoy et al., Fig. 2) from a
+/// compliance map: per tick `F_D = -mass * a` (Eq. 5), displacement from the compliance map
+/// (Eq. 9-14), command = desired - displacement (iterated `iterations` times to a fixed point
+/// if > 0), closed-form IK. SI units. For a serial arm, use `SerialDalembertCorrector`.
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct DalembertCorrector {
-    map: CoreMap,
-    robot: CoreRobot2,
-    corrector: CoreCorrector,
+    model: Model,
+    /// The tick state (the last joints, the next IK seed); locked per call so that the class
+    /// stays frozen and `correct` can run without the GIL.
+    data: Mutex<Data>,
+}
+
+impl DalembertCorrector {
+    fn data(&self) -> MutexGuard<'_, Data> {
+        // A poisoned lock only means another call failed mid-tick; the data stays valid.
+        self.data.lock().unwrap_or_else(PoisonError::into_inner)
+    }
 }
 
 /// Result of `DalembertCorrector.correct`: one row per tick.
@@ -71,68 +72,81 @@ pub struct CorrectedPath {
 #[pymethods]
 impl DalembertCorrector {
     /// `compliance_map` (2 forces x 2 displacements, its out-of-grid policy applies),
-    /// `mechanism` (a `ParallelRobot2`), `mass` m* [kg] (the paper tuned 5 kg).
+    /// `mechanism` (a `ParallelRobot2`), `mass` m* [kg] (the paper tuned 5 kg); fixed-point
+    /// `iterations` (a count) and `tolerance` [m] (finite, >= 0).
     #[new]
-    #[pyo3(signature = (compliance_map, mechanism, mass=CoreCorrector::PAPER_MASS, iterations=0, tolerance=0.0))]
+    #[pyo3(signature = (compliance_map, mechanism, mass=dalembert::PAPER_MASS, iterations=0, tolerance=0.0))]
     fn new(
         compliance_map: &ComplianceMap,
-        mechanism: &ParallelRobot2,
-        mass: f64,
-        iterations: usize,
-        tolerance: f64,
+        mechanism: &Bound<'_, PyAny>,
+        #[pyo3(from_py_with = args::real::mass)] mass: f64,
+        #[pyo3(from_py_with = args::count::iterations)] iterations: usize,
+        #[pyo3(from_py_with = args::real::tolerance)] tolerance: f64,
     ) -> PyResult<Self> {
-        let map = compliance_map.inner.clone();
-        if map.n_force() != 2 || map.n_displacement() != 2 {
+        let Ok(mechanism) = mechanism.cast::<ParallelRobot2>() else {
+            let hint = if mechanism.is_instance_of::<crate::vjm::SerialRobot>() {
+                "; for a serial arm use SerialDalembertCorrector(robot, mass, ...), which \
+                 corrects in 6-D through the robot's own stiffness model"
+            } else {
+                ""
+            };
             return Err(InputError::new_err(format!(
-                "compliance_map: needs 2 force and 2 displacement axes, has {} and {}",
-                map.n_force(),
-                map.n_displacement()
+                "mechanism: expected a ParallelRobot2 (the paper's five-bar, driven by a \
+                 compliance map), got {}{hint}",
+                mechanism.get_type().name()?
             )));
-        }
-        let corrector = CoreCorrector::new(mass)
-            .map_err(corr_err)?
-            .with_fixed_point(iterations, tolerance);
-        Ok(Self {
-            map,
-            robot: mechanism.inner,
-            corrector,
-        })
+        };
+        let model = Model::new(mechanism.get().inner, compliance_map.inner.clone(), mass)
+            .and_then(|m| m.with_fixed_point(iterations, tolerance))
+            .map_err(build_err)?;
+        let data = Mutex::new(Data::new(&model));
+        Ok(Self { model, data })
     }
 
     /// Mass parameter m* [kg].
     #[getter]
     fn mass(&self) -> f64 {
-        self.corrector.mass()
+        self.model.mass()
     }
 
     /// One tick: `position` (2,) [m], planned `acceleration` (2,) [m/s^2] -> dict with
-    /// `commanded`, `joints`, `force`, `displacement`, `iterations`, `model_status`.
+    /// `commanded`, `joints`, `force`, `displacement`, `iterations`, `model_status`. The IK
+    /// starts from the last tick's joints, or from `seed` (2,) [rad] if given (the paper's
+    /// closed-form IK ignores the seed).
+    #[pyo3(signature = (position, acceleration, seed=None))]
     fn step<'py>(
         &self,
         py: Python<'py>,
-        position: Arr1<'py>,
-        acceleration: Arr1<'py>,
+        position: &Bound<'py, PyAny>,
+        acceleration: &Bound<'py, PyAny>,
+        seed: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let x = vec2(&position, "position")?;
-        let a = vec2(&acceleration, "acceleration")?;
-        let t: CorrectedTick<2, 2> = self
-            .corrector
-            .step(&self.robot, &self.map.view(), &x, &a, &Vector2::zeros())
-            .map_err(corr_err)?;
+        let x = vec2(position, "position")?;
+        let a = vec2(acceleration, "acceleration")?;
+        let seed = seed.map(|s| vec2(s, "seed")).transpose()?;
+        let t: CorrectedTick<2, 2> = {
+            let mut data = self.data();
+            if let Some(q) = seed {
+                data.set_seed(q);
+            }
+            dalembert::step(&self.model, &mut data, &x, &a).map_err(tick_err)?
+        };
         let d = PyDict::new(py);
         d.set_item("commanded", t.commanded.as_slice().to_pyarray(py))?;
         d.set_item("joints", t.joints.as_slice().to_pyarray(py))?;
         d.set_item("force", t.force.as_slice().to_pyarray(py))?;
         d.set_item("displacement", t.displacement.as_slice().to_pyarray(py))?;
         d.set_item("iterations", t.iterations)?;
-        d.set_item("model_status", status_name(t.model_status))?;
+        d.set_item("model_status", t.placement.name())?;
         Ok(d)
     }
 
     /// Corrects every tick of a planned 2-D `trajectory` (from `plan_line`/`plan_polyline`),
-    /// without the GIL. The same arithmetic as `step`, tick by tick.
+    /// without the GIL. The same arithmetic as `step`, tick by tick, each IK seeded by the
+    /// previous tick (the first by the corrector's last joints).
     fn correct(&self, py: Python<'_>, trajectory: &Trajectory) -> PyResult<CorrectedPath> {
-        let (pos, acc) = (&trajectory.position, &trajectory.acceleration);
+        let samples = trajectory.samples(py)?;
+        let (pos, acc) = (&samples.position, &samples.acceleration);
         if pos.ncols() != 2 {
             return Err(InputError::new_err(format!(
                 "trajectory: the corrector needs a 2-D trajectory, got {} columns",
@@ -140,35 +154,33 @@ impl DalembertCorrector {
             )));
         }
         let n = pos.nrows();
-        let view = self.map.view();
-        let result = py.detach(|| -> Result<_, String> {
+        let result = py.detach(|| -> Result<_, (usize, TickError)> {
+            let mut data = self.data();
             let mut out: [Array2<f64>; 5] = core::array::from_fn(|_| Array2::zeros((n, 2)));
             let mut flagged = Vec::new();
-            let mut q = Vector2::zeros();
-            for i in 0..n {
-                let x = Vector2::new(pos[(i, 0)], pos[(i, 1)]);
-                let a = Vector2::new(acc[(i, 0)], acc[(i, 1)]);
-                let t = self
-                    .corrector
-                    .step(&self.robot, &view, &x, &a, &q)
-                    .map_err(|e| format!("tick {i}: {e}"))?;
-                q = t.joints;
+            let inputs = pos.rows().into_iter().zip(acc.rows());
+            for (i, (prow, arow)) in inputs.enumerate() {
+                let x = Vector2::from_iterator(prow.iter().copied());
+                let a = Vector2::from_iterator(arow.iter().copied());
+                let t = dalembert::step(&self.model, &mut data, &x, &a).map_err(|e| (i, e))?;
                 for (arr, v) in
                     out.iter_mut()
                         .zip([t.desired, t.commanded, t.joints, t.force, t.displacement])
                 {
-                    arr[(i, 0)] = v.x;
-                    arr[(i, 1)] = v.y;
+                    arr.row_mut(i)
+                        .iter_mut()
+                        .zip(v.iter())
+                        .for_each(|(d, s)| *d = *s);
                 }
-                if t.model_status != ModelStatus::Inside {
+                if t.placement != Placement::Inside {
                     flagged.push(i);
                 }
             }
             Ok((out, flagged))
         });
-        let (out, flagged) = result.map_err(InputError::new_err)?;
+        let (out, flagged) = result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
         let [desired, position, joints, force, displacement] = out;
-        let t: Array1<f64> = trajectory.t.clone();
+        let t: Array1<f64> = samples.t.clone();
         Ok(CorrectedPath {
             t: t.to_pyarray(py).unbind(),
             desired: desired.to_pyarray(py).unbind(),

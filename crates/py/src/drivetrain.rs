@@ -1,55 +1,76 @@
 //! Drive-train errors and force-feedback contour tracing (contour-tracking paper, Eq. 3-24):
 //! `deflect.DriveTrain`, `deflect.ContourTracer`, `edge_direction`, `edge_contact_force`.
 
-use deflect_core::contour::{
-    self, ContourError, ContourTracer as CoreTracer, TraceDirection, TracerConfig, TracerStep,
-};
-use deflect_core::drivetrain::{self as dt, DriveTrain as CoreDrive, DriveTrainError, LinkMasses};
-use deflect_core::drivetrain_io;
-use deflect_core::vjm::{Data, Model};
+use deflect_core::contour::{self, TraceDirection, TracerConfig, TracerStep};
+use deflect_core::drivetrain::{self as dt, LinkMasses};
+use deflect_core::io;
+use deflect_core::units::GRAVITY_Z_DOWN;
 use nalgebra::{Matrix2, Vector2, Vector3, Vector6};
-use numpy::ndarray::Array2;
 use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use crate::convert::{Arr1, Arr2, finite_vec, iso_to_py, tick_err};
+use crate::InputError;
+use crate::args;
+use crate::convert::{
+    build_err, count, finite_vector, fixed_matrix, iso_to_py, load_err, matrix_to_py, real,
+    tick_err, vector, vector_any,
+};
 use crate::vjm::SerialRobot;
-use crate::{InputError, LoadError, SingularError};
 
-fn v2(a: &Arr1<'_>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&finite_vec(a, what, 2)?))
+fn v2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
+    Ok(Vector2::from_column_slice(&finite_vector(a, what, 2)?))
 }
 
-fn m2(a: &Arr2<'_>, what: &str) -> PyResult<Matrix2<f64>> {
-    let m = a.as_array();
-    if m.shape() != [2, 2] || m.iter().any(|x| !x.is_finite()) {
-        return Err(InputError::new_err(format!(
-            "{what}: expected a finite (2, 2) matrix, got shape {:?}",
-            m.shape()
-        )));
-    }
-    Ok(Matrix2::from_fn(|i, j| m[(i, j)]))
-}
-
-fn drive_err(e: DriveTrainError) -> PyErr {
-    InputError::new_err(e.to_string())
-}
-
-fn contour_err(e: ContourError) -> PyErr {
-    match e {
-        ContourError::SingularStiffness { .. } | ContourError::NoEdgeMotion => {
-            SingularError::new_err(e.to_string())
-        }
-        _ => InputError::new_err(e.to_string()),
-    }
+fn m2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Matrix2<f64>> {
+    fixed_matrix::<2, 2>(a, what)
 }
 
 fn square<'py, const R: usize, const C: usize>(
     py: Python<'py>,
     m: &nalgebra::SMatrix<f64, R, C>,
 ) -> Bound<'py, PyArray2<f64>> {
-    Array2::from_shape_fn((R, C), |(i, j)| m[(i, j)]).to_pyarray(py)
+    matrix_to_py(py, m)
+}
+
+/// A point mass `(after_joint, mass_kg, com_xyz)` as the Python signature gives it.
+type MassEntry = (usize, f64, [f64; 3]);
+
+/// Point masses `[(after_joint, mass_kg, com_xyz), ...]` read item by item so that every
+/// refusal names its entry.
+fn masses_arg(o: &Bound<'_, PyAny>) -> PyResult<Option<Vec<MassEntry>>> {
+    if o.is_none() {
+        return Ok(None);
+    }
+    let items = o.try_iter().map_err(|_| {
+        InputError::new_err("masses: expected a list of (after_joint, mass_kg, com_xyz) tuples")
+    })?;
+    let mut out = Vec::new();
+    for (i, item) in items.enumerate() {
+        let item = item?;
+        let what = format!("masses[{i}]");
+        let fields = item
+            .try_iter()
+            .and_then(|it| it.collect::<PyResult<Vec<_>>>());
+        match fields.as_deref() {
+            Ok([j, m, c]) => {
+                let com = vector(c, &format!("{what}[2] (com_xyz)"), 3)?;
+                let mut xyz = [0.0; 3];
+                xyz.iter_mut().zip(&com).for_each(|(d, s)| *d = *s);
+                out.push((
+                    count(j, &format!("{what}[0] (after_joint)"))?,
+                    real(m, &format!("{what}[1] (mass_kg)"))?,
+                    xyz,
+                ));
+            }
+            _ => {
+                return Err(InputError::new_err(format!(
+                    "{what}: expected a tuple (after_joint, mass_kg, com_xyz)"
+                )));
+            }
+        }
+    }
+    Ok(Some(out))
 }
 
 /// Drive-train errors of a serial robot (contour-tracking paper, Eq. 3-13): joint stiffness
@@ -59,19 +80,23 @@ fn square<'py, const R: usize, const C: usize>(
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct DriveTrain {
-    model: Model,
-    inner: CoreDrive,
+    /// The drive train; it owns its kinematic chain.
+    inner: dt::Model,
 }
 
 impl DriveTrain {
-    fn q(&self, q: &Arr1<'_>) -> PyResult<Vec<f64>> {
-        finite_vec(q, "q", self.model.dof())
+    /// A workspace for one call.
+    fn data(&self) -> dt::Data {
+        dt::Data::new(&self.inner)
     }
-    fn wrench(w: &Arr1<'_>) -> PyResult<Vector6<f64>> {
-        Ok(Vector6::from_column_slice(&finite_vec(w, "wrench", 6)?))
+    fn q(&self, q: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+        finite_vector(q, "q", self.inner.dof())
+    }
+    fn wrench(w: &Bound<'_, PyAny>) -> PyResult<Vector6<f64>> {
+        Ok(Vector6::from_column_slice(&finite_vector(w, "wrench", 6)?))
     }
     fn out<'py>(&self, py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
-        v.get(..self.model.dof()).unwrap_or(&[]).to_pyarray(py)
+        v.get(..self.inner.dof()).unwrap_or(&[]).to_pyarray(py)
     }
 }
 
@@ -79,38 +104,38 @@ impl DriveTrain {
 impl DriveTrain {
     /// `stiffness` K_i [N m/rad] and `backlash` theta_b_i [rad] per joint of `robot`;
     /// `masses` a list of `(after_joint, mass_kg, com_xyz)` with the CoM in the frame after
-    /// that joint; gravity [m/s^2] in the base frame.
+    /// that joint; `gravity` [m/s^2] in the base frame, default standard gravity down the
+    /// base z axis, (0, 0, -9.80665).
     #[new]
     #[pyo3(signature = (robot, stiffness, backlash=None, masses=None, gravity=None,
                         torque_deadband=0.0, max_condition=dt::DEFAULT_MAX_CONDITION))]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
         robot: &SerialRobot,
-        stiffness: Arr1<'_>,
-        backlash: Option<Arr1<'_>>,
-        masses: Option<Vec<(usize, f64, [f64; 3])>>,
-        gravity: Option<[f64; 3]>,
-        torque_deadband: f64,
-        max_condition: f64,
+        stiffness: &Bound<'_, PyAny>,
+        backlash: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = masses_arg)] masses: Option<Vec<MassEntry>>,
+        #[pyo3(from_py_with = args::opt_triple::gravity)] gravity: Option<[f64; 3]>,
+        #[pyo3(from_py_with = args::real::torque_deadband)] torque_deadband: f64,
+        #[pyo3(from_py_with = args::real::max_condition)] max_condition: f64,
     ) -> PyResult<Self> {
-        let model = robot.inner.model.clone();
-        let n = model.dof();
-        let k = finite_vec(&stiffness, "stiffness", n)?;
+        // Values are validated by deflect-core's builders.
+        let k = vector_any(stiffness, "stiffness")?;
         let b = match backlash {
-            Some(b) => finite_vec(&b, "backlash", n)?,
-            None => vec![0.0; n],
+            Some(b) => vector_any(b, "backlash")?,
+            None => vec![0.0; robot.inner.model.dof()],
         };
         let mut table = LinkMasses::new();
         for (j, m, c) in masses.unwrap_or_default() {
-            table.push(j, m, Vector3::from(c)).map_err(drive_err)?;
+            table.push(j, m, Vector3::from(c)).map_err(build_err)?;
         }
-        let inner = CoreDrive::new(&model, &k, &b)
+        let inner = dt::Model::new(robot.inner.model.clone(), &k, &b)
             .and_then(|d| d.with_masses(table))
-            .and_then(|d| d.with_gravity(Vector3::from(gravity.unwrap_or(dt::STANDARD_GRAVITY))))
+            .and_then(|d| d.with_gravity(Vector3::from(gravity.unwrap_or(GRAVITY_Z_DOWN))))
             .and_then(|d| d.with_torque_deadband(torque_deadband))
             .and_then(|d| d.with_max_condition(max_condition))
-            .map_err(drive_err)?;
-        Ok(Self { model, inner })
+            .map_err(build_err)?;
+        Ok(Self { inner })
     }
 
     /// Stiffness and backlash from the `[[joint]]` entries of a TOML file (the robot's
@@ -121,23 +146,15 @@ impl DriveTrain {
         urdf_path: std::path::PathBuf,
         drive_path: std::path::PathBuf,
     ) -> PyResult<Self> {
-        let inner = drivetrain_io::drive_train_from_files(&robot.inner, urdf_path, drive_path)
-            .map_err(|e| LoadError::new_err(e.to_string()))?;
-        Ok(Self {
-            model: robot.inner.model.clone(),
-            inner,
-        })
+        let inner = io::drive::from_path(&robot.inner, urdf_path, drive_path).map_err(load_err)?;
+        Ok(Self { inner })
     }
 
     /// Same as `from_urdf`, from the files' texts.
     #[staticmethod]
     fn from_strings(robot: &SerialRobot, urdf: &str, drive_toml: &str) -> PyResult<Self> {
-        let inner = drivetrain_io::drive_train_from_strs(&robot.inner, urdf, drive_toml)
-            .map_err(|e| LoadError::new_err(e.to_string()))?;
-        Ok(Self {
-            model: robot.inner.model.clone(),
-            inner,
-        })
+        let inner = io::drive::from_str(&robot.inner, urdf, drive_toml).map_err(load_err)?;
+        Ok(Self { inner })
     }
 
     /// Joint stiffnesses [N m/rad].
@@ -171,10 +188,10 @@ impl DriveTrain {
     fn gravity_torques<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = self.q(&q)?;
-        let t = dt::gravity_torques(&self.model, &self.inner, &q).map_err(tick_err)?;
+        let q = self.q(q)?;
+        let t = dt::gravity_torques(&self.inner, &mut self.data(), &q).map_err(tick_err)?;
         Ok(self.out(py, &t))
     }
 
@@ -182,13 +199,12 @@ impl DriveTrain {
     fn contact_torques<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
-        wrench: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = self.q(&q)?;
-        let w = Self::wrench(&wrench)?;
-        let t = dt::contact_torques(&self.model, &mut Data::new(&self.model), &q, &w)
-            .map_err(tick_err)?;
+        let q = self.q(q)?;
+        let w = Self::wrench(wrench)?;
+        let t = dt::contact_torques(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(self.out(py, &t))
     }
 
@@ -196,19 +212,12 @@ impl DriveTrain {
     fn joint_torques<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
-        wrench: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = self.q(&q)?;
-        let w = Self::wrench(&wrench)?;
-        let c = dt::correct_joints(
-            &self.model,
-            &mut Data::new(&self.model),
-            &self.inner,
-            &q,
-            &w,
-        )
-        .map_err(tick_err)?;
+        let q = self.q(q)?;
+        let w = Self::wrench(wrench)?;
+        let c = dt::correct_joints(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(self.out(py, &c.torque))
     }
 
@@ -217,19 +226,12 @@ impl DriveTrain {
     fn correct_joints<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
-        wrench: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = self.q(&q)?;
-        let w = Self::wrench(&wrench)?;
-        let c = dt::correct_joints(
-            &self.model,
-            &mut Data::new(&self.model),
-            &self.inner,
-            &q,
-            &w,
-        )
-        .map_err(tick_err)?;
+        let q = self.q(q)?;
+        let w = Self::wrench(wrench)?;
+        let c = dt::correct_joints(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(self.out(py, &c.q))
     }
 
@@ -237,19 +239,12 @@ impl DriveTrain {
     fn compensated_forward<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
-        wrench: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let q = self.q(&q)?;
-        let w = Self::wrench(&wrench)?;
-        let t = dt::compensated_forward(
-            &self.model,
-            &mut Data::new(&self.model),
-            &self.inner,
-            &q,
-            &w,
-        )
-        .map_err(tick_err)?;
+        let q = self.q(q)?;
+        let w = Self::wrench(wrench)?;
+        let t = dt::compensated_forward(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(iso_to_py(py, &t))
     }
 
@@ -261,24 +256,20 @@ impl DriveTrain {
     fn cartesian_stiffness<'py>(
         &self,
         py: Python<'py>,
-        q: Arr1<'py>,
+        q: &Bound<'py, PyAny>,
         planar: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let q = self.q(&q)?;
-        let mut data = Data::new(&self.model);
-        let (m, d) = (&self.model, &self.inner);
+        let q = self.q(q)?;
+        let (m, data) = (&self.inner, &mut self.data());
         Ok(match planar {
-            None => square(
-                py,
-                &dt::cartesian_stiffness(m, &mut data, d, &q).map_err(tick_err)?,
-            ),
+            None => square(py, &dt::cartesian_stiffness(m, data, &q).map_err(tick_err)?),
             Some("xy") => square(
                 py,
-                &dt::cartesian_stiffness_xy(m, &mut data, d, &q).map_err(tick_err)?,
+                &dt::cartesian_stiffness_xy(m, data, &q).map_err(tick_err)?,
             ),
             Some("xyrz") => square(
                 py,
-                &dt::cartesian_stiffness_planar(m, &mut data, d, &q).map_err(tick_err)?,
+                &dt::cartesian_stiffness_planar(m, data, &q).map_err(tick_err)?,
             ),
             Some(other) => {
                 return Err(InputError::new_err(format!(
@@ -304,7 +295,8 @@ impl DriveTrain {
 #[pyclass(module = "deflect")]
 #[derive(Debug)]
 pub struct ContourTracer {
-    inner: CoreTracer,
+    model: contour::Model,
+    data: contour::Data,
     last: Option<TracerStep>,
 }
 
@@ -321,26 +313,26 @@ impl ContourTracer {
                         max_approach_steps=10_000, max_steps=100_000))]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
-        stiffness: Arr2<'_>,
-        step: f64,
-        contact_force: f64,
-        jam_force: f64,
-        target_force: Option<f64>,
-        approach_direction: (f64, f64),
-        approach_step: Option<f64>,
-        bias_samples: usize,
-        stop_radius: Option<f64>,
+        stiffness: &Bound<'_, PyAny>,
+        #[pyo3(from_py_with = args::real::step)] step: f64,
+        #[pyo3(from_py_with = args::real::contact_force)] contact_force: f64,
+        #[pyo3(from_py_with = args::real::jam_force)] jam_force: f64,
+        #[pyo3(from_py_with = args::opt_real::target_force)] target_force: Option<f64>,
+        #[pyo3(from_py_with = args::pair::approach_direction)] approach_direction: (f64, f64),
+        #[pyo3(from_py_with = args::opt_real::approach_step)] approach_step: Option<f64>,
+        #[pyo3(from_py_with = args::count::bias_samples)] bias_samples: usize,
+        #[pyo3(from_py_with = args::opt_real::stop_radius)] stop_radius: Option<f64>,
         clockwise: bool,
-        max_turn: f64,
-        min_motion_fraction: f64,
-        jam_margin: f64,
-        min_step_fraction: f64,
-        max_bisections: usize,
-        max_jam_steps: usize,
-        max_approach_steps: usize,
-        max_steps: usize,
+        #[pyo3(from_py_with = args::real::max_turn)] max_turn: f64,
+        #[pyo3(from_py_with = args::real::min_motion_fraction)] min_motion_fraction: f64,
+        #[pyo3(from_py_with = args::real::jam_margin)] jam_margin: f64,
+        #[pyo3(from_py_with = args::real::min_step_fraction)] min_step_fraction: f64,
+        #[pyo3(from_py_with = args::count::max_bisections)] max_bisections: usize,
+        #[pyo3(from_py_with = args::count::max_jam_steps)] max_jam_steps: usize,
+        #[pyo3(from_py_with = args::count::max_approach_steps)] max_approach_steps: usize,
+        #[pyo3(from_py_with = args::count::max_steps)] max_steps: usize,
     ) -> PyResult<Self> {
-        let k = m2(&stiffness, "stiffness")?;
+        let k = m2(stiffness, "stiffness")?;
         let mut cfg = TracerConfig::new(step, contact_force, jam_force);
         if let Some(t) = target_force {
             cfg.target_force = t;
@@ -366,14 +358,19 @@ impl ContourTracer {
         cfg.max_jam_steps = max_jam_steps;
         cfg.max_approach_steps = max_approach_steps;
         cfg.max_steps = max_steps;
-        let inner = CoreTracer::new(cfg, &k).map_err(contour_err)?;
-        Ok(Self { inner, last: None })
+        let model = contour::Model::new(cfg, &k).map_err(build_err)?;
+        let data = contour::Data::new(&model);
+        Ok(Self {
+            model,
+            data,
+            last: None,
+        })
     }
 
     /// Updates the xy stiffness (2, 2) [N/m] for the current pose.
-    fn set_stiffness(&mut self, stiffness: Arr2<'_>) -> PyResult<()> {
-        let k = m2(&stiffness, "stiffness")?;
-        self.inner.set_stiffness(&k).map_err(contour_err)
+    fn set_stiffness(&mut self, stiffness: &Bound<'_, PyAny>) -> PyResult<()> {
+        let k = m2(stiffness, "stiffness")?;
+        self.data.set_stiffness(&k).map_err(tick_err)
     }
 
     /// One steady-state reading -> `(next_command (2,), state_name)`. State names: "init",
@@ -382,12 +379,12 @@ impl ContourTracer {
     fn step<'py>(
         &mut self,
         py: Python<'py>,
-        position: Arr1<'py>,
-        force: Arr1<'py>,
+        position: &Bound<'py, PyAny>,
+        force: &Bound<'py, PyAny>,
     ) -> PyResult<(Bound<'py, PyArray1<f64>>, &'static str)> {
-        let p = v2(&position, "position")?;
-        let f = v2(&force, "force")?;
-        let out = self.inner.step(&p, &f).map_err(contour_err)?;
+        let p = v2(position, "position")?;
+        let f = v2(force, "force")?;
+        let out = contour::step(&self.model, &mut self.data, &p, &f).map_err(tick_err)?;
         self.last = Some(out);
         Ok((out.command.as_slice().to_pyarray(py), out.state.name()))
     }
@@ -395,12 +392,12 @@ impl ContourTracer {
     /// Current state name.
     #[getter]
     fn state(&self) -> &'static str {
-        self.inner.state().name()
+        self.data.state().name()
     }
     /// `True` once done or failed.
     #[getter]
     fn finished(&self) -> bool {
-        self.inner.state().is_finished()
+        self.data.state().is_finished()
     }
     /// Whether the last reading was a steady contact inside the force window (record the
     /// joints now).
@@ -421,18 +418,18 @@ impl ContourTracer {
     /// Force bias found at initialization [N].
     #[getter]
     fn bias(&self) -> (f64, f64) {
-        let b = self.inner.bias();
+        let b = self.data.bias();
         (b.x, b.y)
     }
     /// Estimated first contact point [m], or None.
     #[getter]
     fn start(&self) -> Option<(f64, f64)> {
-        self.inner.start().map(|s| (s.x, s.y))
+        self.data.start().map(|s| (s.x, s.y))
     }
     /// Counters: steps, contacts, eq21_steps, normal_steps, bisections, shortened, jams,
     /// longest_loss, max_force, path_length.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let s = self.inner.stats();
+        let s = self.data.stats();
         let d = PyDict::new(py);
         d.set_item("steps", s.steps)?;
         d.set_item("contacts", s.contacts)?;
@@ -448,20 +445,24 @@ impl ContourTracer {
     }
 
     fn __repr__(&self) -> String {
-        format!("ContourTracer(state='{}')", self.inner.state().name())
+        format!("ContourTracer(state='{}')", self.data.state().name())
     }
 }
 
 /// Eq. 21: edge direction [rad] from the demanded step (2,) [m] and the steady-state force
 /// (change) (2,) [N] under the xy stiffness (2, 2).
 #[pyfunction]
-fn edge_direction(stiffness: Arr2<'_>, step: Arr1<'_>, force: Arr1<'_>) -> PyResult<f64> {
+fn edge_direction(
+    stiffness: &Bound<'_, PyAny>,
+    step: &Bound<'_, PyAny>,
+    force: &Bound<'_, PyAny>,
+) -> PyResult<f64> {
     contour::edge_direction(
-        &m2(&stiffness, "stiffness")?,
-        &v2(&step, "step")?,
-        &v2(&force, "force")?,
+        &m2(stiffness, "stiffness")?,
+        &v2(step, "step")?,
+        &v2(force, "force")?,
     )
-    .map_err(contour_err)
+    .map_err(tick_err)
 }
 
 /// Eq. 16-20: the force (2,) [N] after the demanded step (2,) [m] against a rigid edge at
@@ -469,18 +470,13 @@ fn edge_direction(stiffness: Arr2<'_>, step: Arr1<'_>, force: Arr1<'_>) -> PyRes
 #[pyfunction]
 fn edge_contact_force<'py>(
     py: Python<'py>,
-    stiffness: Arr2<'py>,
-    step: Arr1<'py>,
-    edge_angle: f64,
+    stiffness: &Bound<'py, PyAny>,
+    step: &Bound<'py, PyAny>,
+    #[pyo3(from_py_with = args::real::edge_angle)] edge_angle: f64,
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-    if !edge_angle.is_finite() {
-        return Err(InputError::new_err("edge_angle is not finite"));
-    }
-    let f = contour::edge_contact_force(
-        &m2(&stiffness, "stiffness")?,
-        &v2(&step, "step")?,
-        edge_angle,
-    );
+    let f =
+        contour::edge_contact_force(&m2(stiffness, "stiffness")?, &v2(step, "step")?, edge_angle)
+            .map_err(tick_err)?;
     Ok(f.as_slice().to_pyarray(py))
 }
 

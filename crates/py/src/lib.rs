@@ -10,18 +10,32 @@
 //!     └── deflect.ConvergenceError an iterative solve missed its tolerance
 //! ```
 // Bindings must not crash the interpreter: errors become Python exceptions.
-#![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
+#![deny(
+    clippy::unwrap_used,
+    clippy::expect_used,
+    clippy::panic,
+    clippy::indexing_slicing
+)]
+#![deny(missing_docs)]
+// reason: the doc comments of this crate are the Python docstrings (pyo3 copies them into
+// `__doc__` for `help()`), so unit brackets such as [m] are plain text there, not rustdoc links.
+#![allow(rustdoc::broken_intra_doc_links)]
 
 use pyo3::create_exception;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
+mod args;
 mod compensation;
 mod compliance_map;
 mod convert;
 mod dalembert;
+mod dalembert_serial;
 mod drivetrain;
+mod identification;
+mod mechanism;
 mod motion;
+mod pose_motion;
 mod vjm;
 
 create_exception!(
@@ -66,9 +80,13 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     vjm::register(m)?;
     compensation::register(m)?;
+    identification::register(m)?;
     compliance_map::register(m)?;
     motion::register(m)?;
+    mechanism::register(m)?;
     dalembert::register(m)?;
+    dalembert_serial::register(m)?;
+    pose_motion::register(m)?;
     drivetrain::register(m)?;
     Ok(())
 }

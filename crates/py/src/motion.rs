@@ -1,275 +1,638 @@
-//! `deflect.plan_line`, `deflect.plan_polyline` (jerk-limited rest-to-rest motions sampled
-//! at a fixed rate) and `deflect.ParallelRobot2` (the paper's 2-DoF parallel robot).
+//! `deflect.plan_line`, `deflect.plan_polyline` and `deflect.Trajectory`: jerk-limited
+//! rest-to-rest motions in 1..=8 coordinates (Cartesian points or joint vectors), planned
+//! once and then evaluated at any time or sampled at a fixed rate, and trajectories built from
+//! the user's own samples. The planning and the finite differences are deflect-core's.
 
-use deflect_core::mechanism::{Mechanism, MechanismError, ParallelRobot2 as CoreRobot2};
-use deflect_core::motion::{DEFAULT_RATE_HZ, Limits, MotionError, Trajectory as CoreTraj};
-use nalgebra::{SVector, Vector2};
-use numpy::ndarray::{Array1, Array2};
-use numpy::{AllowTypeChange, PyArray1, PyArray2, PyArrayLike1, PyArrayLike2, ToPyArray};
+use std::sync::OnceLock;
+
+use deflect_core::TickError;
+use deflect_core::motion::{
+    AxisLimits, DEFAULT_RATE_HZ, Limits, SampledTrajectory, State, Trajectory as CoreTraj,
+};
+use nalgebra::SVector;
+use numpy::ndarray::{Array1, Array2, ArrayView2};
+use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
+use pyo3::types::PyDict;
 
-use crate::{ConvergenceError, InputError, SingularError};
+use crate::InputError;
+use crate::args;
+use crate::convert::{
+    build_err, check_finite_matrix, float_array, matrix, real, shape_error, tick_err, vector,
+    vector_any,
+};
 
-fn motion_err(e: MotionError) -> PyErr {
-    InputError::new_err(e.to_string())
+/// Most coordinates of a planned or sampled motion (joint vectors of up to 8 joints).
+pub const MAX_DIM: usize = 8;
+
+/// A plan in `N` coordinates, `N` known at run time.
+#[derive(Debug, Clone)]
+#[allow(clippy::large_enum_variant)] // reason: one plan per Python object, never in arrays
+pub(crate) enum Plan {
+    D1(CoreTraj<1>),
+    D2(CoreTraj<2>),
+    D3(CoreTraj<3>),
+    D4(CoreTraj<4>),
+    D5(CoreTraj<5>),
+    D6(CoreTraj<6>),
+    D7(CoreTraj<7>),
+    D8(CoreTraj<8>),
 }
 
-pub(crate) fn mech_err(e: MechanismError) -> PyErr {
-    match e {
-        MechanismError::Singular { .. } => SingularError::new_err(e.to_string()),
-        MechanismError::NotConverged { .. } => ConvergenceError::new_err(e.to_string()),
-        _ => InputError::new_err(e.to_string()),
+/// Runs `$body` with `$t` bound to the plan of whatever dimension `$plan` holds.
+macro_rules! with_plan {
+    ($plan:expr, $t:ident => $body:expr) => {
+        match $plan {
+            Plan::D1($t) => $body,
+            Plan::D2($t) => $body,
+            Plan::D3($t) => $body,
+            Plan::D4($t) => $body,
+            Plan::D5($t) => $body,
+            Plan::D6($t) => $body,
+            Plan::D7($t) => $body,
+            Plan::D8($t) => $body,
+        }
+    };
+}
+
+/// Calls `$f::<N>($($arg),*)` for the run-time dimension `$d` (1..=8); `$else` for any
+/// other dimension.
+macro_rules! dispatch_dim {
+    ($d:expr, $f:ident($($arg:expr),*), $else:expr) => {
+        match $d {
+            1 => $f::<1>($($arg),*),
+            2 => $f::<2>($($arg),*),
+            3 => $f::<3>($($arg),*),
+            4 => $f::<4>($($arg),*),
+            5 => $f::<5>($($arg),*),
+            6 => $f::<6>($($arg),*),
+            7 => $f::<7>($($arg),*),
+            8 => $f::<8>($($arg),*),
+            _ => $else,
+        }
+    };
+}
+
+/// Every tick of a trajectory, one row each.
+#[derive(Debug, Clone)]
+pub(crate) struct Samples {
+    pub(crate) t: Array1<f64>,
+    pub(crate) position: Array2<f64>,
+    pub(crate) velocity: Array2<f64>,
+    pub(crate) acceleration: Array2<f64>,
+    pub(crate) jerk: Array2<f64>,
+}
+
+impl Samples {
+    fn zeros(n: usize, d: usize) -> Self {
+        Self {
+            t: Array1::zeros(n),
+            position: Array2::zeros((n, d)),
+            velocity: Array2::zeros((n, d)),
+            acceleration: Array2::zeros((n, d)),
+            jerk: Array2::zeros((n, d)),
+        }
+    }
+
+    fn set<const N: usize>(&mut self, i: usize, s: &State<N>) {
+        if let Some(t) = self.t.get_mut(i) {
+            *t = s.t;
+        }
+        for (arr, v) in [
+            (&mut self.position, &s.position),
+            (&mut self.velocity, &s.velocity),
+            (&mut self.acceleration, &s.acceleration),
+            (&mut self.jerk, &s.jerk),
+        ] {
+            arr.row_mut(i)
+                .iter_mut()
+                .zip(v.iter())
+                .for_each(|(d, x)| *d = *x);
+        }
     }
 }
 
-/// A planned motion sampled at a fixed rate: one row per tick, the last tick exactly at the
-/// end point. SI units.
+/// Every tick of `traj` at `rate_hz`. The count comes first from deflect-core's
+/// [`CoreTraj::sample_count`], which refuses more than `deflect_core::motion::MAX_SAMPLES`
+/// ticks before anything is allocated.
+fn sample_plan<const N: usize>(traj: &CoreTraj<N>, rate_hz: f64) -> Result<Samples, TickError> {
+    let n = traj.sample_count(rate_hz)?;
+    let mut out = Samples::zeros(n, N);
+    for (i, s) in traj.ticks(rate_hz)?.enumerate().take(n) {
+        out.set(i, &s);
+    }
+    Ok(out)
+}
+
+/// The states of `traj` at `times`.
+fn eval_plan<const N: usize>(traj: &CoreTraj<N>, times: &[f64]) -> Result<Samples, TickError> {
+    let mut out = Samples::zeros(times.len(), N);
+    for (i, &t) in times.iter().enumerate() {
+        out.set(i, &traj.sample(t)?);
+    }
+    Ok(out)
+}
+
+impl Plan {
+    fn dim(&self) -> usize {
+        with_plan!(self, p => p.start().len())
+    }
+    fn duration(&self) -> f64 {
+        with_plan!(self, p => p.duration())
+    }
+    fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
+        with_plan!(self, p => p.sample_count(rate_hz))
+    }
+    fn sample(&self, rate_hz: f64) -> Result<Samples, TickError> {
+        with_plan!(self, p => sample_plan(p, rate_hz))
+    }
+    fn eval(&self, times: &[f64]) -> Result<Samples, TickError> {
+        with_plan!(self, p => eval_plan(p, times))
+    }
+}
+
+/// How a plan is limited: on the path (Euclidean norms), per coordinate, or per segment.
+#[derive(Debug, Clone)]
+enum LimitSpec {
+    Path(Limits),
+    Axis([Vec<f64>; 3]),
+    Segments(Vec<Limits>),
+}
+
+fn plan_points<const N: usize>(
+    points: &ArrayView2<'_, f64>,
+    spec: &LimitSpec,
+) -> PyResult<CoreTraj<N>> {
+    let pts: Vec<SVector<f64, N>> = points
+        .rows()
+        .into_iter()
+        .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied()))
+        .collect();
+    match spec {
+        LimitSpec::Path(l) => CoreTraj::polyline(&pts, l),
+        LimitSpec::Segments(l) => CoreTraj::polyline_with_limits(&pts, l),
+        LimitSpec::Axis([v, a, j]) => CoreTraj::polyline_axis_limits(
+            &pts,
+            &AxisLimits {
+                v_max: SVector::from_column_slice(v),
+                a_max: SVector::from_column_slice(a),
+                j_max: SVector::from_column_slice(j),
+            },
+        ),
+    }
+    .map_err(build_err)
+}
+
+fn plan_dyn(points: ArrayView2<'_, f64>, spec: &LimitSpec) -> PyResult<Plan> {
+    let p = &points;
+    Ok(match points.ncols() {
+        1 => Plan::D1(plan_points::<1>(p, spec)?),
+        2 => Plan::D2(plan_points::<2>(p, spec)?),
+        3 => Plan::D3(plan_points::<3>(p, spec)?),
+        4 => Plan::D4(plan_points::<4>(p, spec)?),
+        5 => Plan::D5(plan_points::<5>(p, spec)?),
+        6 => Plan::D6(plan_points::<6>(p, spec)?),
+        7 => Plan::D7(plan_points::<7>(p, spec)?),
+        8 => Plan::D8(plan_points::<8>(p, spec)?),
+        _ => {
+            return Err(shape_error(
+                "points",
+                &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
+                points.shape(),
+            ));
+        }
+    })
+}
+
+/// One of `v_max`, `a_max`, `j_max`: a real number, or one per coordinate (`d` of them).
+enum LimitArg {
+    Scalar(f64),
+    Axis(Vec<f64>),
+}
+
+fn limit_arg(o: &Bound<'_, PyAny>, what: &str, d: usize) -> PyResult<LimitArg> {
+    let a = float_array(o, what)?;
+    match a.ndim() {
+        0 => Ok(LimitArg::Scalar(real(o, what)?)),
+        1 => Ok(LimitArg::Axis(vector(o, what, d)?)),
+        _ => Err(shape_error(
+            what,
+            &format!("a real number or ({d},)"),
+            a.shape(),
+        )),
+    }
+}
+
+/// The limits from the `v_max`, `a_max`, `j_max` arguments: path limits if all three are
+/// numbers, per-coordinate limits (numbers broadcast) if any is an array.
+fn limit_spec(
+    v_max: &Bound<'_, PyAny>,
+    a_max: &Bound<'_, PyAny>,
+    j_max: &Bound<'_, PyAny>,
+    d: usize,
+) -> PyResult<LimitSpec> {
+    let args = [
+        limit_arg(v_max, "v_max", d)?,
+        limit_arg(a_max, "a_max", d)?,
+        limit_arg(j_max, "j_max", d)?,
+    ];
+    if let [
+        LimitArg::Scalar(v),
+        LimitArg::Scalar(a),
+        LimitArg::Scalar(j),
+    ] = args
+    {
+        return Ok(LimitSpec::Path(Limits::new(v, a, j).map_err(build_err)?));
+    }
+    let [v, a, j] = args.map(|x| match x {
+        LimitArg::Scalar(s) => vec![s; d],
+        LimitArg::Axis(v) => v,
+    });
+    Ok(LimitSpec::Axis([v, a, j]))
+}
+
+/// A planned or sampled motion in 1..=8 coordinates, SI units.
+///
+/// From `plan_line`/`plan_polyline`: the plan itself (exact at any `t`, `at(t)`) and, unless
+/// planned with `rate_hz=None` (plan only), its ticks at `rate_hz` (`t`, `position`, ...:
+/// one row per tick, tick `k` at `k / rate_hz`, the last exactly at the end point; computed
+/// on first access). From `Trajectory.from_samples`: the user's samples with their
+/// finite-difference derivatives (no plan: `at` and `sampled` are not available).
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct Trajectory {
-    pub(crate) t: Array1<f64>,
-    pub(crate) position: Array2<f64>,
-    velocity: Array2<f64>,
-    pub(crate) acceleration: Array2<f64>,
-    jerk: Array2<f64>,
+    plan: Option<Plan>,
+    dim: usize,
     duration: f64,
+    rate_hz: Option<f64>,
+    samples: OnceLock<Samples>,
+}
+
+impl Trajectory {
+    fn planned(plan: Plan, rate_hz: Option<f64>) -> PyResult<Self> {
+        if let Some(r) = rate_hz {
+            // Refuse a tick budget overrun now, not on first access.
+            plan.sample_count(r).map_err(tick_err)?;
+        }
+        Ok(Self {
+            dim: plan.dim(),
+            duration: plan.duration(),
+            plan: Some(plan),
+            rate_hz,
+            samples: OnceLock::new(),
+        })
+    }
+
+    /// The ticks, sampled on first use (without the GIL).
+    pub(crate) fn samples(&self, py: Python<'_>) -> PyResult<&Samples> {
+        if let Some(s) = self.samples.get() {
+            return Ok(s);
+        }
+        let (Some(plan), Some(rate)) = (&self.plan, self.rate_hz) else {
+            return Err(InputError::new_err(
+                "this Trajectory is plan-only (planned with rate_hz=None): evaluate it with \
+                 .at(t) or sample it with .sampled(rate_hz)",
+            ));
+        };
+        let s = py.detach(|| plan.sample(rate)).map_err(tick_err)?;
+        Ok(self.samples.get_or_init(|| s))
+    }
+}
+
+fn samples_to_dict<'py>(
+    py: Python<'py>,
+    s: &Samples,
+    scalar: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    if scalar {
+        d.set_item("t", s.t.first().copied().unwrap_or(f64::NAN))?;
+        for (k, a) in [
+            ("position", &s.position),
+            ("velocity", &s.velocity),
+            ("acceleration", &s.acceleration),
+            ("jerk", &s.jerk),
+        ] {
+            d.set_item(k, a.row(0).to_pyarray(py))?;
+        }
+    } else {
+        d.set_item("t", s.t.to_pyarray(py))?;
+        for (k, a) in [
+            ("position", &s.position),
+            ("velocity", &s.velocity),
+            ("acceleration", &s.acceleration),
+            ("jerk", &s.jerk),
+        ] {
+            d.set_item(k, a.to_pyarray(py))?;
+        }
+    }
+    Ok(d)
+}
+
+fn from_samples_n<const N: usize>(
     rate_hz: f64,
+    position: &ArrayView2<'_, f64>,
+    acceleration: Option<&ArrayView2<'_, f64>>,
+) -> PyResult<Samples> {
+    let rows = |m: &ArrayView2<'_, f64>| -> Vec<SVector<f64, N>> {
+        m.rows()
+            .into_iter()
+            .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied()))
+            .collect()
+    };
+    let traj = match acceleration {
+        None => SampledTrajectory::from_positions(rate_hz, rows(position)),
+        Some(a) => {
+            SampledTrajectory::from_positions_and_accelerations(rate_hz, rows(position), rows(a))
+        }
+    }
+    .map_err(build_err)?;
+    let mut out = Samples::zeros(traj.len(), N);
+    for i in 0..traj.len() {
+        out.set(i, &traj.state(i).map_err(tick_err)?);
+    }
+    Ok(out)
 }
 
 #[pymethods]
 impl Trajectory {
+    /// A trajectory from the user's own positions `position` (n, d) [m or rad], 1 <= d <= 8
+    /// (a 1-D array is one coordinate), sampled at `rate_hz` [Hz], sample `k` at
+    /// `k / rate_hz`. Velocities by central differences (second-order one-sided at the
+    /// ends), accelerations by `(p[k+1] - 2 p[k] + p[k-1]) / h^2` (second-order one-sided
+    /// at the ends, at least 4 samples), jerks by central differences of the accelerations,
+    /// unless `acceleration` (n, d) is given (then at least 3 samples). Differences amplify
+    /// noise by `1 / h^2`: filter measured paths first, or give the accelerations. At most
+    /// 2^22 samples.
+    #[staticmethod]
+    #[pyo3(signature = (position, rate_hz, acceleration=None))]
+    fn from_samples(
+        py: Python<'_>,
+        position: &Bound<'_, PyAny>,
+        #[pyo3(from_py_with = args::real::rate_hz)] rate_hz: f64,
+        acceleration: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let as_2d = |o: &Bound<'_, PyAny>, what: &str, cols: Option<usize>| {
+            let a = float_array(o, what)?;
+            let a = if a.ndim() == 1 {
+                let n = a.len();
+                a.reshape(vec![n, 1])?
+            } else {
+                a
+            };
+            matrix(a.as_any(), what, None, cols).map(|m| m.as_array().to_owned())
+        };
+        let p = as_2d(position, "position", None)?;
+        check_finite_matrix("position", &p.view())?;
+        let d = p.ncols();
+        let a = acceleration
+            .map(|a| as_2d(a, "acceleration", Some(d)))
+            .transpose()?;
+        if let Some(a) = &a {
+            check_finite_matrix("acceleration", &a.view())?;
+        }
+        let (pv, av) = (p.view(), a.as_ref().map(|a| a.view()));
+        let samples = py.detach(|| {
+            dispatch_dim!(
+                d,
+                from_samples_n(rate_hz, &pv, av.as_ref()),
+                Err(shape_error(
+                    "position",
+                    &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
+                    &[pv.nrows(), d]
+                ))
+            )
+        })?;
+        let duration = samples.t.last().copied().unwrap_or(0.0);
+        Ok(Self {
+            plan: None,
+            dim: d,
+            duration,
+            rate_hz: Some(rate_hz),
+            samples: OnceLock::from(samples),
+        })
+    }
+
+    /// The exact state at time `t` [s] (a number, or an array of times): a dict with `t`,
+    /// `position`, `velocity`, `acceleration`, `jerk`, each (d,) for a number and (m, d) for
+    /// m times. Before 0 the start at rest, from `duration` on the end at rest. Planned
+    /// trajectories only.
+    fn at<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
+        let Some(plan) = &self.plan else {
+            return Err(InputError::new_err(
+                "this Trajectory was built from samples and has no plan to evaluate between \
+                 them: index its arrays instead",
+            ));
+        };
+        let a = float_array(t, "t")?;
+        let (times, scalar) = match a.ndim() {
+            0 => (vec![real(t, "t")?], true),
+            1 => (vector_any(t, "t")?, false),
+            _ => {
+                return Err(shape_error("t", "a number or (m,)", a.shape()));
+            }
+        };
+        let s = py.detach(|| plan.eval(&times)).map_err(tick_err)?;
+        samples_to_dict(py, &s, scalar)
+    }
+
+    /// The same plan with its ticks at `rate_hz` [Hz] (at most 2^22 ticks).
+    fn sampled(&self, #[pyo3(from_py_with = args::real::rate_hz)] rate_hz: f64) -> PyResult<Self> {
+        let Some(plan) = &self.plan else {
+            return Err(InputError::new_err(
+                "this Trajectory was built from samples: it has no plan to sample again",
+            ));
+        };
+        Self::planned(plan.clone(), Some(rate_hz))
+    }
+
     /// Tick times [s], shape (n,).
     #[getter]
-    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
-        self.t.to_pyarray(py)
+    fn t<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        Ok(self.samples(py)?.t.to_pyarray(py))
     }
-    /// Positions [m], shape (n, d).
+    /// Positions [m or rad], shape (n, d).
     #[getter]
-    fn position<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.position.to_pyarray(py)
+    fn position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.samples(py)?.position.to_pyarray(py))
     }
-    /// Velocities [m/s], shape (n, d).
+    /// Velocities [m/s or rad/s], shape (n, d).
     #[getter]
-    fn velocity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.velocity.to_pyarray(py)
+    fn velocity<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.samples(py)?.velocity.to_pyarray(py))
     }
-    /// Accelerations [m/s^2], shape (n, d).
+    /// Accelerations [m/s^2 or rad/s^2], shape (n, d).
     #[getter]
-    fn acceleration<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.acceleration.to_pyarray(py)
+    fn acceleration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.samples(py)?.acceleration.to_pyarray(py))
     }
-    /// Jerks [m/s^3], shape (n, d).
+    /// Jerks [m/s^3 or rad/s^3], shape (n, d).
     #[getter]
-    fn jerk<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        self.jerk.to_pyarray(py)
+    fn jerk<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        Ok(self.samples(py)?.jerk.to_pyarray(py))
     }
     /// Total duration [s].
     #[getter]
     fn duration(&self) -> f64 {
         self.duration
     }
-    /// Sampling rate [Hz].
+    /// Number of coordinates d.
     #[getter]
-    fn rate_hz(&self) -> f64 {
+    fn dim(&self) -> usize {
+        self.dim
+    }
+    /// Sampling rate [Hz]; None for a plan-only trajectory.
+    #[getter]
+    fn rate_hz(&self) -> Option<f64> {
         self.rate_hz
     }
-    fn __len__(&self) -> usize {
-        self.t.len()
+    /// Whether this trajectory comes from the planner (`at` and `sampled` work).
+    #[getter]
+    fn is_planned(&self) -> bool {
+        self.plan.is_some()
+    }
+    /// Number of ticks; `InputError` for a plan-only trajectory.
+    fn __len__(&self) -> PyResult<usize> {
+        if let Some(s) = self.samples.get() {
+            return Ok(s.t.len());
+        }
+        match (&self.plan, self.rate_hz) {
+            (Some(p), Some(r)) => p.sample_count(r).map_err(tick_err),
+            _ => Err(InputError::new_err(
+                "a plan-only Trajectory (rate_hz=None) has no ticks: use .sampled(rate_hz)",
+            )),
+        }
     }
     fn __repr__(&self) -> String {
+        let ticks = match (&self.plan, self.rate_hz) {
+            (_, None) => "plan only".to_string(),
+            (Some(p), Some(r)) => format!(
+                "ticks={}, rate_hz={r}",
+                p.sample_count(r).unwrap_or_default()
+            ),
+            (None, Some(r)) => format!(
+                "samples={}, rate_hz={r}",
+                self.samples.get().map_or(0, |s| s.t.len())
+            ),
+        };
         format!(
-            "Trajectory(duration={:.6} s, ticks={}, dim={}, rate_hz={})",
-            self.duration,
-            self.t.len(),
-            self.position.ncols(),
-            self.rate_hz
+            "Trajectory(duration={:.6} s, dim={}, {ticks})",
+            self.duration, self.dim
         )
     }
 }
 
-fn sample_all<const N: usize>(traj: &CoreTraj<N>, rate_hz: f64) -> PyResult<Trajectory> {
-    let states: Vec<_> = traj.ticks(rate_hz).map_err(motion_err)?.collect();
-    let n = states.len();
-    let rows = |f: &dyn Fn(usize) -> SVector<f64, N>| {
-        Array2::from_shape_fn((n, N), |(i, j)| f(i).get(j).copied().unwrap_or(f64::NAN))
-    };
-    let at = |i: usize| states.get(i);
-    Ok(Trajectory {
-        t: states.iter().map(|s| s.t).collect(),
-        position: rows(&|i| at(i).map_or(SVector::zeros(), |s| s.position)),
-        velocity: rows(&|i| at(i).map_or(SVector::zeros(), |s| s.velocity)),
-        acceleration: rows(&|i| at(i).map_or(SVector::zeros(), |s| s.acceleration)),
-        jerk: rows(&|i| at(i).map_or(SVector::zeros(), |s| s.jerk)),
-        duration: traj.duration(),
-        rate_hz,
-    })
-}
-
-fn points_of<const N: usize>(rows: &numpy::ndarray::ArrayView2<'_, f64>) -> Vec<SVector<f64, N>> {
-    rows.rows()
-        .into_iter()
-        .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied()))
-        .collect()
-}
-
-fn plan(
-    points: numpy::ndarray::ArrayView2<'_, f64>,
-    limits: &Limits,
-    rate_hz: f64,
-) -> PyResult<Trajectory> {
-    match points.ncols() {
-        2 => sample_all(
-            &CoreTraj::polyline(&points_of::<2>(&points), limits).map_err(motion_err)?,
-            rate_hz,
-        ),
-        3 => sample_all(
-            &CoreTraj::polyline(&points_of::<3>(&points), limits).map_err(motion_err)?,
-            rate_hz,
-        ),
-        d => Err(InputError::new_err(format!(
-            "points must be 2-D or 3-D, got dimension {d}"
-        ))),
-    }
-}
-
-/// Time-optimal jerk-limited rest-to-rest straight move from `start` to `end` (2 or 3
-/// coordinates [m]) under `v_max` [m/s], `a_max` [m/s^2], `j_max` [m/s^3], sampled at
-/// `rate_hz`.
+/// Time-optimal jerk-limited rest-to-rest straight move from `start` to `end` (1 to 8
+/// coordinates: a point [m] or a joint vector [rad]). `v_max`, `a_max`, `j_max` are either
+/// numbers, limiting the path's speed, acceleration and jerk (Euclidean norms), or arrays of
+/// one limit per coordinate (numbers broadcast), for joint space: each coordinate stays
+/// within its own limits and all arrive together. Sampled at `rate_hz` [Hz] on first access
+/// of the arrays (at most 2^22 ticks, `InputError` beyond); `rate_hz=None` plans only (see
+/// `Trajectory.at`).
 #[pyfunction]
-#[pyo3(signature = (start, end, v_max, a_max, j_max, rate_hz=DEFAULT_RATE_HZ))]
+#[pyo3(signature = (start, end, v_max, a_max, j_max, rate_hz=Some(DEFAULT_RATE_HZ)))]
 fn plan_line(
-    start: PyArrayLike1<'_, f64, AllowTypeChange>,
-    end: PyArrayLike1<'_, f64, AllowTypeChange>,
-    v_max: f64,
-    a_max: f64,
-    j_max: f64,
-    rate_hz: f64,
+    start: &Bound<'_, PyAny>,
+    end: &Bound<'_, PyAny>,
+    v_max: &Bound<'_, PyAny>,
+    a_max: &Bound<'_, PyAny>,
+    j_max: &Bound<'_, PyAny>,
+    #[pyo3(from_py_with = args::opt_real::rate_hz)] rate_hz: Option<f64>,
 ) -> PyResult<Trajectory> {
-    let (s, e) = (start.as_array(), end.as_array());
-    if s.len() != e.len() {
-        return Err(InputError::new_err(format!(
-            "start has {} coordinates, end {}",
-            s.len(),
-            e.len()
-        )));
-    }
+    let s = vector_any(start, "start")?;
+    let e = vector(end, "end", s.len())?;
     let d = s.len();
-    let pts = Array2::from_shape_fn((2, d), |(i, j)| {
-        let row = if i == 0 { &s } else { &e };
-        row.get(j).copied().unwrap_or(f64::NAN)
-    });
-    let limits = Limits::new(v_max, a_max, j_max).map_err(motion_err)?;
-    plan(pts.view(), &limits, rate_hz)
+    let pts = Array2::from_shape_vec((2, d), [s, e].concat())
+        .map_err(|e| InputError::new_err(e.to_string()))?;
+    if !(1..=MAX_DIM).contains(&d) {
+        return Err(shape_error(
+            "start",
+            &format!("(d,) with 1 <= d <= {MAX_DIM}"),
+            &[d],
+        ));
+    }
+    let spec = limit_spec(v_max, a_max, j_max, d)?;
+    Trajectory::planned(plan_dyn(pts.view(), &spec)?, rate_hz)
 }
 
-/// Rest-to-rest moves through `points` (shape (n, 2) or (n, 3), 2 <= n <= 32 [m]), stopping
-/// at every point; repeated points are skipped.
+/// Rest-to-rest moves through `points` (n, d), 2 <= n <= 32, 1 <= d <= 8, stopping at every
+/// point; repeated points are skipped. Limits as `plan_line` (`v_max`, `a_max`, `j_max`:
+/// numbers for the path, arrays per coordinate), or per segment: `segment_limits` (n - 1, 3),
+/// row `i` the `(v_max, a_max, j_max)` of the move from `points[i]` to `points[i + 1]` (then
+/// leave `v_max`, `a_max`, `j_max` out). Ticks and `rate_hz` as `plan_line`.
 #[pyfunction]
-#[pyo3(signature = (points, v_max, a_max, j_max, rate_hz=DEFAULT_RATE_HZ))]
+#[pyo3(signature = (points, v_max=None, a_max=None, j_max=None, rate_hz=Some(DEFAULT_RATE_HZ), segment_limits=None))]
 fn plan_polyline(
-    points: PyArrayLike2<'_, f64, AllowTypeChange>,
-    v_max: f64,
-    a_max: f64,
-    j_max: f64,
-    rate_hz: f64,
+    points: &Bound<'_, PyAny>,
+    v_max: Option<&Bound<'_, PyAny>>,
+    a_max: Option<&Bound<'_, PyAny>>,
+    j_max: Option<&Bound<'_, PyAny>>,
+    #[pyo3(from_py_with = args::opt_real::rate_hz)] rate_hz: Option<f64>,
+    segment_limits: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<Trajectory> {
-    let limits = Limits::new(v_max, a_max, j_max).map_err(motion_err)?;
-    plan(points.as_array(), &limits, rate_hz)
+    let points = matrix(points, "points", None, None)?;
+    let points = points.as_array();
+    let spec = match (v_max, a_max, j_max, segment_limits) {
+        (Some(v), Some(a), Some(j), None) => limit_spec(v, a, j, points.ncols())?,
+        (None, None, None, Some(s)) => {
+            let rows = points.nrows().saturating_sub(1);
+            let m = matrix(s, "segment_limits", Some(rows), Some(3))?;
+            let limits = m
+                .as_array()
+                .rows()
+                .into_iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let at = |k: usize| r.get(k).copied().unwrap_or(f64::NAN);
+                    Limits::new(at(0), at(1), at(2))
+                        .map_err(|e| InputError::new_err(format!("segment_limits row {i}: {e}")))
+                })
+                .collect::<PyResult<Vec<_>>>()?;
+            LimitSpec::Segments(limits)
+        }
+        (None, None, None, None) => {
+            return Err(InputError::new_err(
+                "plan_polyline needs limits: v_max, a_max and j_max, or segment_limits",
+            ));
+        }
+        (_, _, _, Some(_)) => {
+            return Err(InputError::new_err(
+                "plan_polyline: give either v_max, a_max and j_max or segment_limits, not both",
+            ));
+        }
+        _ => {
+            return Err(InputError::new_err(
+                "plan_polyline: v_max, a_max and j_max go together (all three)",
+            ));
+        }
+    };
+    if points.ncols() == 0 || points.ncols() > MAX_DIM {
+        return Err(shape_error(
+            "points",
+            &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
+            &[points.nrows(), points.ncols()],
+        ));
+    }
+    Trajectory::planned(plan_dyn(points, &spec)?, rate_hz)
 }
 
 /// Limits `(v_max, a_max, j_max)` that reproduce the paper's motions at `g_level` g (1..5).
 #[pyfunction]
-fn paper_limits(g_level: u8) -> PyResult<(f64, f64, f64)> {
-    let l = deflect_core::motion::paper_limits(g_level).map_err(motion_err)?;
+fn paper_limits(
+    #[pyo3(from_py_with = args::count::g_level)] g_level: usize,
+) -> PyResult<(f64, f64, f64)> {
+    let g = u8::try_from(g_level).map_err(|_| {
+        InputError::new_err(format!(
+            "g_level = {g_level}: the paper's motions exist for 1..=5 g"
+        ))
+    })?;
+    let l = deflect_core::motion::paper_limits(g).map_err(build_err)?;
     Ok((l.v_max, l.a_max, l.j_max))
 }
 
-fn vec2(a: &PyArrayLike1<'_, f64, AllowTypeChange>, what: &str) -> PyResult<Vector2<f64>> {
-    let v = a.as_array();
-    match (v.len(), v.get(0), v.get(1)) {
-        (2, Some(&x), Some(&y)) => Ok(Vector2::new(x, y)),
-        _ => Err(InputError::new_err(format!(
-            "{what}: expected shape (2,), got ({},)",
-            v.len()
-        ))),
-    }
-}
-
-/// The paper's 2-DoF planar parallel robot (links 150 mm, pivots 90 mm from O). Task point
-/// `p = (x, y)` = C - O [m] in the static-test grid's frame; joints `q = (theta_A, theta_B)`
-/// [rad], the actuated links' angles from +x; working mode "elbows out".
-#[pyclass(module = "deflect", frozen)]
-#[derive(Debug)]
-pub struct ParallelRobot2 {
-    pub(crate) inner: CoreRobot2,
-}
-
-#[pymethods]
-impl ParallelRobot2 {
-    /// Paper geometry by default; `min_sigma` [m/rad] is the singularity threshold.
-    #[new]
-    #[pyo3(signature = (link=0.150, half_width=0.090, min_sigma=deflect_core::mechanism::DEFAULT_MIN_SIGMA))]
-    fn new(link: f64, half_width: f64, min_sigma: f64) -> PyResult<Self> {
-        Ok(Self {
-            inner: CoreRobot2::new(link, half_width, min_sigma).map_err(mech_err)?,
-        })
-    }
-    /// Joints `q` [rad] that put C on `p` [m]; InputError out of reach, SingularError near a
-    /// singularity.
-    fn ik<'py>(
-        &self,
-        py: Python<'py>,
-        p: PyArrayLike1<'py, f64, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let q = self.inner.ik(&vec2(&p, "p")?).map_err(mech_err)?;
-        Ok(q.as_slice().to_pyarray(py))
-    }
-    /// Task point `p` [m] of joints `q` [rad].
-    fn fk<'py>(
-        &self,
-        py: Python<'py>,
-        q: PyArrayLike1<'py, f64, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = self.inner.fk(&vec2(&q, "q")?).map_err(mech_err)?;
-        Ok(p.as_slice().to_pyarray(py))
-    }
-    /// Jacobian `dp/dq` [m/rad], shape (2, 2).
-    fn jacobian<'py>(
-        &self,
-        py: Python<'py>,
-        q: PyArrayLike1<'py, f64, AllowTypeChange>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let j = self.inner.jacobian_at(&vec2(&q, "q")?).map_err(mech_err)?;
-        Ok(
-            Array2::from_shape_fn((2, 2), |(r, c)| j.get((r, c)).copied().unwrap_or(f64::NAN))
-                .to_pyarray(py),
-        )
-    }
-    /// Smallest singular value of the Jacobian at `q` [m/rad].
-    fn singularity_distance(&self, q: PyArrayLike1<'_, f64, AllowTypeChange>) -> PyResult<f64> {
-        self.inner
-            .singularity_distance(&vec2(&q, "q")?)
-            .map_err(mech_err)
-    }
-    /// Largest reach 2 L [m].
-    #[getter]
-    fn reach(&self) -> f64 {
-        self.inner.reach()
-    }
-    fn __repr__(&self) -> String {
-        format!(
-            "ParallelRobot2(link={}, half_width={}, min_sigma={})",
-            self.inner.link(),
-            self.inner.half_width(),
-            self.inner.min_sigma()
-        )
-    }
-}
-
-/// Adds the motion planner and the parallel robot to the module.
+/// Adds the motion planner to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
-    m.add_class::<ParallelRobot2>()?;
     m.add_function(wrap_pyfunction!(plan_line, m)?)?;
     m.add_function(wrap_pyfunction!(plan_polyline, m)?)?;
     m.add_function(wrap_pyfunction!(paper_limits, m)?)?;

@@ -1,17 +1,17 @@
 //! `deflect.SerialRobot`: the virtual-joint model of deflect-core.
 
+use deflect_core::SerialRobot as CoreRobot;
+use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_core::{LoadError as CoreLoadError, SerialRobot as CoreRobot};
 use numpy::ndarray::{Array1, Array2};
-use numpy::{PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2, ToPyArray};
+use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 
-use crate::convert::{iso_to_py, tick_err, vec_of, vector6};
-use crate::{InputError, LoadError};
-
-fn load_err(e: CoreLoadError) -> PyErr {
-    LoadError::new_err(e.to_string())
-}
+use crate::InputError;
+use crate::args;
+use crate::convert::{
+    iso_to_py, load_err, matrix, matrix_to_py, pose, tick_err, tick_err_at, vector, vector6,
+};
 
 /// A serial robot with virtual joints (VJM paper, Eq. 1-9). All arrays are SI, base frame.
 #[pyclass(module = "deflect", frozen)]
@@ -22,8 +22,8 @@ pub struct SerialRobot {
 
 #[pymethods]
 impl SerialRobot {
-    /// Loads a URDF file and a stiffness TOML file; the chain runs from the URDF root (or
-    /// `base_link`) to `tip_link`.
+    /// Loads a URDF file and a stiffness TOML file; the chain runs from `base_link` (default:
+    /// the URDF root) to `tip_link`.
     #[staticmethod]
     #[pyo3(signature = (urdf_path, stiffness_path, tip_link, base_link=None))]
     fn from_urdf(
@@ -32,16 +32,13 @@ impl SerialRobot {
         tip_link: &str,
         base_link: Option<&str>,
     ) -> PyResult<Self> {
-        let read = |p: &std::path::Path| {
-            std::fs::read_to_string(p)
-                .map_err(|e| LoadError::new_err(format!("cannot read {}: {e}", p.display())))
-        };
-        let urdf = read(&urdf_path)?;
-        let stiffness = read(&stiffness_path)?;
-        Self::from_strings(&urdf, &stiffness, tip_link, base_link)
+        let inner = io::urdf::from_path(&urdf_path, &stiffness_path, base_link, tip_link)
+            .map_err(load_err)?;
+        Ok(Self { inner })
     }
 
-    /// Same as `from_urdf`, from the files' texts.
+    /// Same as `from_urdf`, from the files' texts; the chain runs from `base_link` (default:
+    /// the URDF root) to `tip_link`.
     #[staticmethod]
     #[pyo3(signature = (urdf, stiffness, tip_link, base_link=None))]
     fn from_strings(
@@ -50,7 +47,7 @@ impl SerialRobot {
         tip_link: &str,
         base_link: Option<&str>,
     ) -> PyResult<Self> {
-        let inner = CoreRobot::from_strs(urdf, stiffness, base_link, tip_link).map_err(load_err)?;
+        let inner = io::urdf::from_str(urdf, stiffness, base_link, tip_link).map_err(load_err)?;
         Ok(Self { inner })
     }
 
@@ -89,10 +86,10 @@ impl SerialRobot {
     fn forward<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
+        q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
+        let q = vector(q, "q", model.dof())?;
         let t = vjm::forward(model, &mut Data::new(model), &q).map_err(tick_err)?;
         Ok(iso_to_py(py, &t))
     }
@@ -102,14 +99,43 @@ impl SerialRobot {
     fn deflection<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
-        wrench: PyReadonlyArray1<'py, f64>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
-        let w = vector6(&wrench, "wrench")?;
+        let q = vector(q, "q", model.dof())?;
+        let w = vector6(wrench, "wrench")?;
         let d = vjm::deflection(model, &mut Data::new(model), &q, &w).map_err(tick_err)?;
         Ok(d.as_slice().to_pyarray(py))
+    }
+
+    /// TCP deflection in static equilibrium, laid out as `deflection`: the spring moments
+    /// taken in the deflected pose (the force acts at the deflected TCP, lever arms and
+    /// spring axes move with the chain), each spring a conservative element, solved by
+    /// Newton's method on the spring angles (at most `max_iterations`, 1..=64, until no angle
+    /// changes by more than `tolerance` [rad]; `ConvergenceError` otherwise). The paper's
+    /// `deflection` takes the moments in the undeformed pose; the two differ at second
+    /// order in the load, about the deflection times its own angular size (0.1-1 % for
+    /// millimetre deflections of a metre-size arm).
+    #[pyo3(signature = (q, wrench, max_iterations=20, tolerance=1e-12))]
+    fn equilibrium<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = args::count::max_iterations)] max_iterations: usize,
+        #[pyo3(from_py_with = args::real::tolerance)] tolerance: f64,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let model = &self.inner.model;
+        let q = vector(q, "q", model.dof())?;
+        let w = vector6(wrench, "wrench")?;
+        let options = vjm::EquilibriumOptions {
+            max_iterations,
+            tolerance,
+        };
+        let e =
+            vjm::equilibrium(model, &mut Data::new(model), &q, &w, &options).map_err(tick_err)?;
+        Ok(e.deflection.as_slice().to_pyarray(py))
     }
 
     /// Elastic angles `[alpha, beta, gamma]` [rad] of every virtual joint (Eq. 7), shape
@@ -117,59 +143,74 @@ impl SerialRobot {
     fn spring_angles<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
-        wrench: PyReadonlyArray1<'py, f64>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
-        let w = vector6(&wrench, "wrench")?;
+        let q = vector(q, "q", model.dof())?;
+        let w = vector6(wrench, "wrench")?;
         let mut data = Data::new(model);
         vjm::deflection(model, &mut data, &q, &w).map_err(tick_err)?;
         let n = model.spring_count();
-        Ok(Array2::from_shape_fn((n, 3), |(i, j)| data.spring_angles[i][j]).to_pyarray(py))
+        let flat: Vec<f64> = data
+            .spring_angles
+            .iter()
+            .take(n)
+            .flatten()
+            .copied()
+            .collect();
+        let a =
+            Array2::from_shape_vec((n, 3), flat).map_err(|e| InputError::new_err(e.to_string()))?;
+        Ok(a.to_pyarray(py))
     }
 
     /// Cartesian compliance of the linearized model, (6, 6), `[F; M] -> [dp; dr]`.
     fn compliance<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
+        q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
+        let q = vector(q, "q", model.dof())?;
         let c = vjm::compliance(model, &mut Data::new(model), &q).map_err(tick_err)?;
-        Ok(Array2::from_shape_fn((6, 6), |(i, j)| c[(i, j)]).to_pyarray(py))
+        Ok(matrix_to_py(py, &c))
     }
 
     /// Actuated-joint Jacobian of the rigid TCP, (6, dof), rows `[v; w]`, base frame.
     fn joint_jacobian<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
+        q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
+        let q = vector(q, "q", model.dof())?;
         let mut data = Data::new(model);
         vjm::joint_jacobian(model, &mut data, &q).map_err(tick_err)?;
-        Ok(Array2::from_shape_fn((6, model.dof()), |(i, j)| data.jacobian[(i, j)]).to_pyarray(py))
+        let j = &data.jacobian;
+        Ok(Array2::from_shape_fn((6, model.dof()), |ij| {
+            j.get(ij).copied().unwrap_or(f64::NAN)
+        })
+        .to_pyarray(py))
     }
 
     /// Axis-specific correction `dq` (dof,) so that the robot commanded to `q + dq` under
     /// `wrench` puts its deflected TCP on the rigid TCP of `q`. `max_iterations=1` gives the
-    /// first-order `-J^+ delta`. Raises `ConvergenceError` when the pose error left exceeds
-    /// `tolerance` (an arm with fewer than 6 joints rarely cancels it all: pass a looser one).
+    /// first-order `-J^+ delta`; at most 256 iterations (`InputError` beyond). Raises
+    /// `ConvergenceError` when the pose error left exceeds `tolerance` (finite, >= 0), also
+    /// when the iteration stalled at a least-squares fixed point (an arm with fewer than 6
+    /// joints rarely cancels it all: pass a looser tolerance).
     #[pyo3(signature = (q, wrench, max_iterations=10, tolerance=1e-12))]
     fn joint_correction<'py>(
         &self,
         py: Python<'py>,
-        q: PyReadonlyArray1<'py, f64>,
-        wrench: PyReadonlyArray1<'py, f64>,
-        max_iterations: usize,
-        tolerance: f64,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
+        #[pyo3(from_py_with = args::count::max_iterations)] max_iterations: usize,
+        #[pyo3(from_py_with = args::real::tolerance)] tolerance: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let model = &self.inner.model;
-        let q = vec_of(&q, "q", model.dof())?;
-        let w = vector6(&wrench, "wrench")?;
+        let q = vector(q, "q", model.dof())?;
+        let w = vector6(wrench, "wrench")?;
         let c = vjm::joint_correction(
             model,
             &mut Data::new(model),
@@ -180,8 +221,14 @@ impl SerialRobot {
         )
         .map_err(tick_err)?;
         if !c.converged {
+            let why = if c.stalled {
+                "stalled: a step no longer lowers the residual (least-squares fixed point)"
+            } else {
+                "iteration budget used"
+            };
             return Err(crate::ConvergenceError::new_err(format!(
-                "joint correction: residual {:e} > tolerance {tolerance:e} after {} iterations",
+                "joint correction: residual {:e} > tolerance {tolerance:e} after {} iterations \
+                 ({why})",
                 c.residual, c.iterations
             )));
         }
@@ -194,39 +241,31 @@ impl SerialRobot {
     fn deflection_batch<'py>(
         &self,
         py: Python<'py>,
-        Q: PyReadonlyArray2<'py, f64>,
-        W: PyReadonlyArray2<'py, f64>,
+        Q: &Bound<'py, PyAny>,
+        W: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let (q, w) = (Q.as_array(), W.as_array());
+        let q = matrix(Q, "Q", None, Some(model.dof()))?;
+        let q = q.as_array();
         let n = q.nrows();
-        if q.ncols() != model.dof() {
-            return Err(InputError::new_err(format!(
-                "Q: expected shape (N, {}), got {:?}",
-                model.dof(),
-                q.shape()
-            )));
-        }
-        if w.shape() != [n, 6] {
-            return Err(InputError::new_err(format!(
-                "W: expected shape ({n}, 6), got {:?}",
-                w.shape()
-            )));
-        }
-        let out = py.detach(|| -> Result<Array2<f64>, String> {
-            let mut data = Data::new(model);
-            let mut out = Array2::zeros((n, 6));
-            let mut qi = vec![0.0; model.dof()];
-            for (i, (qrow, wrow)) in q.rows().into_iter().zip(w.rows()).enumerate() {
-                qi.iter_mut().zip(qrow.iter()).for_each(|(d, s)| *d = *s);
-                let wi = Vector6::from_iterator(wrow.iter().copied());
-                let d = vjm::deflection(model, &mut data, &qi, &wi)
-                    .map_err(|e| format!("row {i}: {e}"))?;
-                out.row_mut(i).assign(&Array1::from_iter(d.iter().copied()));
-            }
-            Ok(out)
-        });
-        Ok(out.map_err(InputError::new_err)?.to_pyarray(py))
+        let w = matrix(W, "W", Some(n), Some(6))?;
+        let w = w.as_array();
+        let out = py.detach(
+            || -> Result<Array2<f64>, (usize, deflect_core::TickError)> {
+                let mut data = Data::new(model);
+                let mut out = Array2::zeros((n, 6));
+                let mut qi = vec![0.0; model.dof()];
+                for (i, (qrow, wrow)) in q.rows().into_iter().zip(w.rows()).enumerate() {
+                    qi.iter_mut().zip(qrow.iter()).for_each(|(d, s)| *d = *s);
+                    let wi = Vector6::from_iterator(wrow.iter().copied());
+                    let d = vjm::deflection(model, &mut data, &qi, &wi).map_err(|e| (i, e))?;
+                    out.row_mut(i).assign(&Array1::from_iter(d.iter().copied()));
+                }
+                Ok(out)
+            },
+        );
+        let out = out.map_err(|(i, e)| tick_err_at(format_args!("row {i}"), e))?;
+        Ok(out.to_pyarray(py))
     }
 
     fn __repr__(&self) -> String {
@@ -241,31 +280,16 @@ impl SerialRobot {
 }
 
 /// The pose to command, (4, 4), so that a TCP deflecting by `deflection` (6,) lands on
-/// `target` (4, 4).
+/// `target` (4, 4), a rigid transform (finite, bottom row 0 0 0 1, a proper rotation within
+/// 1e-9: `InputError` otherwise, nothing is projected).
 #[pyfunction]
 fn commanded_pose<'py>(
     py: Python<'py>,
-    target: PyReadonlyArray2<'py, f64>,
-    deflection: PyReadonlyArray1<'py, f64>,
+    target: &Bound<'py, PyAny>,
+    deflection: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-    let t = target.as_array();
-    if t.shape() != [4, 4] {
-        return Err(InputError::new_err(format!(
-            "target: expected shape (4, 4), got {:?}",
-            t.shape()
-        )));
-    }
-    if t.iter().any(|v| !v.is_finite()) {
-        return Err(InputError::new_err("target: not finite"));
-    }
-    let m = nalgebra::Matrix4::from_fn(|i, j| t[(i, j)]);
-    let rot = nalgebra::Rotation3::from_matrix(&m.fixed_view::<3, 3>(0, 0).into_owned());
-    let iso = nalgebra::Isometry3::from_parts(
-        nalgebra::Translation3::new(m[(0, 3)], m[(1, 3)], m[(2, 3)]),
-        nalgebra::UnitQuaternion::from_rotation_matrix(&rot),
-    );
-    let d = vector6(&deflection, "deflection")?;
-    crate::convert::check_finite6(&d, "deflection")?;
+    let iso = pose(target, "target")?;
+    let d = vector6(deflection, "deflection")?;
     Ok(iso_to_py(py, &vjm::commanded_pose(&iso, &d)))
 }
 

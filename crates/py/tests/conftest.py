@@ -55,11 +55,31 @@ class NumpyChain:
         # Elements: ("fixed", T) | ("joint", kind, axis) | ("spring", compliance 3-vector)
         self.elements = []
 
+        by_name = {j.get("name"): j for j in root.findall("joint")}
+
+        def placement(s):
+            """(link, offset) of a spring: `link` + xyz/rpy, or `joint`: the joint's child
+            link frame turned so that its x axis is the joint axis (shortest rotation)."""
+            if "link" in s:
+                return s["link"], homogeneous(rpy_matrix(*s.get("rpy", [0, 0, 0])), s.get("xyz", [0, 0, 0]))
+            j = by_name[s["joint"]]
+            axis = np.array([float(v) for v in j.find("axis").get("xyz").split()])
+            axis /= np.linalg.norm(axis)
+            x = np.array([1.0, 0.0, 0.0])
+            c = float(x @ axis)
+            if c < -1 + 1e-12:
+                rot = axis_angle([0, 0, 1], math.pi)
+            elif c > 1 - 1e-12:
+                rot = np.eye(3)
+            else:
+                rot = axis_angle(np.cross(x, axis), math.acos(c))
+            return j.find("child").get("link"), homogeneous(rot)
+
         def add_springs(link_name):
             for s in springs:
-                if s["link"] != link_name:
+                on, off = placement(s)
+                if on != link_name:
                     continue
-                off = homogeneous(rpy_matrix(*s.get("rpy", [0, 0, 0])), s.get("xyz", [0, 0, 0]))
                 self.elements.append(("fixed", off))
                 self.elements.append(("spring", np.array([1.0 / k for k in s["k"]])))
                 self.elements.append(("fixed", np.linalg.inv(off)))
@@ -126,6 +146,49 @@ class NumpyChain:
                 [rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]]
             )
         return np.concatenate([dp, rv])
+
+
+    def equilibrium(self, q, wrench, h=1e-5):
+        """Static equilibrium by the principle of virtual work, independently of deflect: the
+        spring angles theta solve theta = C (Q(theta)), Q_i = F . dp/dtheta_i + M . w_i, with
+        dp/dtheta_i and the angular velocity w_i = vee(dR/dtheta_i R^T) of the TCP by central
+        differences of this class's own deflected forward kinematics, solved by
+        scipy.optimize.root. Returns the deflection laid out as `deflection`."""
+        from scipy.optimize import root
+
+        f, m = np.asarray(wrench[:3], float), np.asarray(wrench[3:], float)
+        comp = np.concatenate([e[1] for e in self.elements if e[0] == "spring"])
+        n = comp.size
+
+        def tcp(x):
+            return self._walk(q, x.reshape(-1, 3))[0]
+
+        def residual(x):
+            g = np.empty(n)
+            base = tcp(x)
+            for i in range(n):
+                e = np.zeros(n)
+                e[i] = h
+                tp, tm = tcp(x + e), tcp(x - e)
+                dp = (tp[:3, 3] - tm[:3, 3]) / (2 * h)
+                dr = (tp[:3, :3] - tm[:3, :3]) / (2 * h) @ base[:3, :3].T
+                w = 0.5 * np.array([dr[2, 1] - dr[1, 2], dr[0, 2] - dr[2, 0], dr[1, 0] - dr[0, 1]])
+                g[i] = f @ dp + m @ w
+            return x - comp * g
+
+        sol = root(residual, np.zeros(n), method="hybr", options={"xtol": 1e-14})
+        # hybr may report slow progress at the rounding floor: judge the residual itself.
+        assert np.abs(residual(sol.x)).max() < 1e-12, (sol.message, np.abs(residual(sol.x)).max())
+        rigid = self.forward(q)
+        d = tcp(sol.x)
+        rel = d[:3, :3] @ rigid[:3, :3].T
+        angle = math.acos(max(-1.0, min(1.0, (np.trace(rel) - 1) / 2)))
+        rv = np.zeros(3)
+        if angle > 1e-300:
+            rv = angle / (2 * math.sin(angle)) * np.array(
+                [rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]]
+            )
+        return np.concatenate([d[:3, 3] - rigid[:3, 3], rv])
 
 
 @pytest.fixture(scope="session")

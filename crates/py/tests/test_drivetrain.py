@@ -79,7 +79,7 @@ def test_gravity_and_eq10_by_hand(two_link):
     # At q = 0 the CoMs sit 0.4 m (12 kg) and 0.8 + 0.3 m (6 kg) from a1 along x; about +y
     # gravity turns them down, so the drives hold u = -(sum x m) g.
     g = drive.gravity_torques(np.zeros(2))
-    assert g == pytest.approx([-(0.4 * 12 + 1.1 * 6) * 9.81, -(0.3 * 6) * 9.81])
+    assert g == pytest.approx([-(0.4 * 12 + 1.1 * 6) * 9.80665, -(0.3 * 6) * 9.80665])
     # Eq. 10 with a contact force of 100 N along +z at the TCP (x = 1.4 m from a1, 0.6 m from
     # a2): J^T F about +y is -x F_z.
     w = np.array([0.0, 0.0, 100.0, 0.0, 0.0, 0.0])

@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension ``deflect._deflect``."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Tuple, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -14,7 +14,9 @@ StrPath = Union[str, PathLike]
 
 class DeflectError(ValueError): ...
 class LoadError(DeflectError): ...
-class InputError(DeflectError): ...
+class InputError(DeflectError):
+    """Wrong shape, dtype (complex, object, string arrays) or value (NaN/inf, out of range,
+    negative or huge counts, budgets exceeded); the message names the argument."""
 class SingularError(DeflectError): ...
 class ConvergenceError(DeflectError): ...
 
@@ -24,7 +26,8 @@ class SerialRobot:
     @staticmethod
     def from_urdf(
         urdf_path: StrPath, stiffness_path: StrPath, tip_link: str, base_link: Optional[str] = None
-    ) -> "SerialRobot": ...
+    ) -> "SerialRobot":
+        """The chain from ``base_link`` (default: the URDF root) to ``tip_link``."""
     @staticmethod
     def from_strings(
         urdf: str, stiffness: str, tip_link: str, base_link: Optional[str] = None
@@ -41,25 +44,34 @@ class SerialRobot:
     def base_link(self) -> str: ...
     @property
     def tip_link(self) -> str: ...
-    def forward(self, q: FloatArray) -> FloatArray:
+    def forward(self, q: ArrayLike) -> FloatArray:
         """Rigid TCP pose, (4, 4)."""
-    def deflection(self, q: FloatArray, wrench: FloatArray) -> FloatArray:
-        """[dx, dy, dz, rx, ry, rz] [m, rad] under wrench [Fx, Fy, Fz, Mx, My, Mz] [N, N m]."""
-    def spring_angles(self, q: FloatArray, wrench: FloatArray) -> FloatArray:
+    def deflection(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray:
+        """[dx, dy, dz, rx, ry, rz] [m, rad] under wrench [Fx, Fy, Fz, Mx, My, Mz] [N, N m].
+        ``InputError`` for a load that turns a virtual joint beyond the small-deflection model."""
+    def spring_angles(self, q: ArrayLike, wrench: ArrayLike) -> FloatArray:
         """(n_springs, 3) elastic angles [rad] (Eq. 7)."""
-    def compliance(self, q: FloatArray) -> FloatArray:
+    def compliance(self, q: ArrayLike) -> FloatArray:
         """(6, 6) Cartesian compliance of the linearized model."""
-    def joint_jacobian(self, q: FloatArray) -> FloatArray:
+    def joint_jacobian(self, q: ArrayLike) -> FloatArray:
         """(6, dof) actuated-joint Jacobian, rows [v; w]."""
     def joint_correction(
-        self, q: FloatArray, wrench: FloatArray, max_iterations: int = 10, tolerance: float = 1e-12
+        self, q: ArrayLike, wrench: ArrayLike, max_iterations: int = 10, tolerance: float = 1e-12
     ) -> FloatArray:
-        """(dof,) axis-specific correction."""
-    def deflection_batch(self, Q: FloatArray, W: FloatArray) -> FloatArray:
+        """(dof,) axis-specific correction. ``max_iterations`` 0..=256 and ``tolerance`` finite
+        and >= 0 (``InputError`` otherwise); ``ConvergenceError`` when the residual stays above
+        ``tolerance`` (the message says whether the iteration stalled at its fixed point)."""
+    def deflection_batch(self, Q: ArrayLike, W: ArrayLike) -> FloatArray:
         """(N, dof), (N, 6) -> (N, 6); releases the GIL."""
+    def equilibrium(
+        self, q: ArrayLike, wrench: ArrayLike, max_iterations: int = 20, tolerance: float = 1e-12
+    ) -> FloatArray:
+        """Deflection (6,) in static equilibrium (moments in the deflected pose), laid out as
+        ``deflection``; Newton on the spring angles, ``ConvergenceError`` past the budget."""
 
-def commanded_pose(target: FloatArray, deflection: FloatArray) -> FloatArray:
-    """(4, 4) pose to command so that the deflected TCP lands on ``target``."""
+def commanded_pose(target: ArrayLike, deflection: ArrayLike) -> FloatArray:
+    """(4, 4) pose to command so that the deflected TCP lands on ``target``, a rigid transform
+    (finite, bottom row 0 0 0 1, a proper rotation within 1e-9; ``InputError`` otherwise)."""
 
 class ComplianceMap:
     """Compliance map from static tests (Paksoy et al. 2025, Eq. 9-14): per-node lines
@@ -89,13 +101,13 @@ class ComplianceMap:
     ) -> "ComplianceMap": ...
     @staticmethod
     def fit(
-        positions: FloatArray,
-        force_axis: npt.NDArray[np.int64],
-        force: FloatArray,
-        displacement: Optional[FloatArray] = None,
+        positions: ArrayLike,
+        force_axis: ArrayLike,
+        force: ArrayLike,
+        displacement: Optional[ArrayLike] = None,
         *,
-        upper: Optional[FloatArray] = None,
-        lower: Optional[FloatArray] = None,
+        upper: Optional[ArrayLike] = None,
+        lower: Optional[ArrayLike] = None,
         spacing: Optional[float] = None,
         extension: float = 0.0,
         n_force: Optional[int] = None,
@@ -125,8 +137,8 @@ class ComplianceMap:
     ) -> "ComplianceMap": ...
     def displacement(
         self,
-        position: FloatArray,
-        force: FloatArray,
+        position: ArrayLike,
+        force: ArrayLike,
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
@@ -134,14 +146,14 @@ class ComplianceMap:
         """(n_displacement,) [m] at position (2,) or (3,) [m] (z ignored) under force [N]."""
     def displacement_batch(
         self,
-        P: FloatArray,
-        F: FloatArray,
+        P: ArrayLike,
+        F: ArrayLike,
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
     ) -> FloatArray:
         """(N, 2|3), (N, n_force) -> (N, n_displacement); releases the GIL."""
-    def cross_validate(self, forces: FloatArray, axis: str = "y") -> Dict[str, Any]:
+    def cross_validate(self, forces: ArrayLike, axis: str = "y") -> Dict[str, Any]:
         """Leave-one-node-out RMS [m] of bilinear vs bicubic."""
     @property
     def residuals(self) -> Optional[List[Dict[str, Any]]]:
@@ -165,8 +177,19 @@ class ComplianceMap:
     def offsets(self) -> FloatArray:
         """(nx, ny, n_displacement, n_force) [m]."""
 
+Limit = Union[float, ArrayLike]
+
 class Trajectory:
-    """A planned motion sampled at a fixed rate; one row per tick, SI units."""
+    """A motion in 1..=8 coordinates: a plan (exact at any t) with its ticks at ``rate_hz``
+    (computed on first access; ``rate_hz`` None: plan only), or the user's own samples."""
+    @staticmethod
+    def from_samples(
+        position: ArrayLike, rate_hz: float, acceleration: Optional[ArrayLike] = None
+    ) -> "Trajectory":
+        """(n, d) positions at ``rate_hz``; derivatives by second-order finite differences."""
+    def at(self, t: Union[float, ArrayLike]) -> Dict[str, Any]:
+        """State at ``t`` (a number or (m,)): t, position, velocity, acceleration, jerk."""
+    def sampled(self, rate_hz: float) -> "Trajectory": ...
     @property
     def t(self) -> FloatArray: ...
     @property
@@ -180,17 +203,74 @@ class Trajectory:
     @property
     def duration(self) -> float: ...
     @property
-    def rate_hz(self) -> float: ...
+    def dim(self) -> int: ...
+    @property
+    def rate_hz(self) -> Optional[float]: ...
+    @property
+    def is_planned(self) -> bool: ...
     def __len__(self) -> int: ...
 
 def plan_line(
-    start: ArrayLike, end: ArrayLike, v_max: float, a_max: float, j_max: float, rate_hz: float = 2000.0
-) -> Trajectory: ...
+    start: ArrayLike,
+    end: ArrayLike,
+    v_max: Limit,
+    a_max: Limit,
+    j_max: Limit,
+    rate_hz: Optional[float] = 2000.0,
+) -> Trajectory:
+    """1..=8 coordinates; numbers limit the path (Euclidean norms), arrays each coordinate.
+    At most 2**22 ticks: ``InputError`` (before allocating) for a longer motion or rate."""
 def plan_polyline(
-    points: ArrayLike, v_max: float, a_max: float, j_max: float, rate_hz: float = 2000.0
-) -> Trajectory: ...
+    points: ArrayLike,
+    v_max: Optional[Limit] = None,
+    a_max: Optional[Limit] = None,
+    j_max: Optional[Limit] = None,
+    rate_hz: Optional[float] = 2000.0,
+    segment_limits: Optional[ArrayLike] = None,
+) -> Trajectory:
+    """(n, d) points; limits as ``plan_line`` or per segment, (n - 1, 3)."""
 def paper_limits(g_level: int) -> Tuple[float, float, float]:
     """(v_max, a_max, j_max) reproducing the paper's motion durations at 1..5 g."""
+
+class PoseTrajectory:
+    """A 6-D rest-to-rest pose motion: straight line and a turn about a fixed axis, synchronised."""
+    def at(self, t: Union[float, ArrayLike]) -> Dict[str, Any]:
+        """t, pose (4, 4), velocity, acceleration, angular_velocity, angular_acceleration."""
+    def sampled(self, rate_hz: float) -> "PoseTrajectory": ...
+    @property
+    def t(self) -> FloatArray: ...
+    @property
+    def pose(self) -> FloatArray: ...
+    @property
+    def velocity(self) -> FloatArray: ...
+    @property
+    def acceleration(self) -> FloatArray: ...
+    @property
+    def angular_velocity(self) -> FloatArray: ...
+    @property
+    def angular_acceleration(self) -> FloatArray: ...
+    @property
+    def start(self) -> FloatArray: ...
+    @property
+    def end(self) -> FloatArray: ...
+    @property
+    def axis(self) -> FloatArray: ...
+    @property
+    def angle(self) -> float: ...
+    @property
+    def duration(self) -> float: ...
+    @property
+    def rate_hz(self) -> Optional[float]: ...
+    def __len__(self) -> int: ...
+
+def plan_pose(
+    start: ArrayLike,
+    end: ArrayLike,
+    linear: Tuple[float, float, float],
+    angular: Tuple[float, float, float],
+    rate_hz: Optional[float] = 2000.0,
+) -> PoseTrajectory:
+    """linear (v [m/s], a [m/s^2], j [m/s^3]), angular (w [rad/s], alpha [rad/s^2], [rad/s^3])."""
 
 class ParallelRobot2:
     """The paper's 2-DoF planar parallel robot; p = C - O [m], q = (theta_A, theta_B) [rad]."""
@@ -213,7 +293,8 @@ class CorrectedPath:
     flagged_ticks: List[int]
 
 class DalembertCorrector:
-    """D'Alembert trajectory correction: F_D = -mass * a, map displacement, command, IK."""
+    """D'Alembert correction of the paper's five-bar from a compliance map; for a serial arm,
+    ``SerialDalembertCorrector``."""
     def __init__(
         self,
         compliance_map: ComplianceMap,
@@ -224,8 +305,64 @@ class DalembertCorrector:
     ) -> None: ...
     @property
     def mass(self) -> float: ...
-    def step(self, position: ArrayLike, acceleration: ArrayLike) -> Dict[str, Any]: ...
+    def step(
+        self, position: ArrayLike, acceleration: ArrayLike, seed: Optional[ArrayLike] = None
+    ) -> Dict[str, Any]:
+        """One tick; the IK starts from the last tick's joints, or from ``seed`` (2,) [rad]."""
     def correct(self, trajectory: Trajectory) -> CorrectedPath: ...
+
+class CorrectedPoses:
+    """Output of SerialDalembertCorrector.correct: one row per tick, base frame."""
+    t: FloatArray
+    desired: FloatArray
+    commanded: FloatArray
+    joints: FloatArray
+    wrench: FloatArray
+    deflection: FloatArray
+    iterations: npt.NDArray[np.uint32]
+    position_error: FloatArray
+    orientation_error: FloatArray
+
+class SerialDalembertCorrector:
+    """The 6-D D'Alembert corrector for a serial arm (a SerialRobot with >= 6 joints)."""
+    def __init__(
+        self,
+        robot: SerialRobot,
+        mass: float,
+        com: Optional[ArrayLike] = None,
+        inertia: Optional[ArrayLike] = None,
+        model: str = "exact",
+        joint_limits: Optional[ArrayLike] = None,
+        max_iterations: int = 20,
+        position_tolerance: float = 1e-8,
+        orientation_tolerance: float = 1e-8,
+        seed: Optional[ArrayLike] = None,
+    ) -> None: ...
+    @property
+    def dof(self) -> int: ...
+    @property
+    def joint_names(self) -> List[str]: ...
+    @property
+    def mass(self) -> float: ...
+    @property
+    def model(self) -> str: ...
+    @property
+    def joints(self) -> FloatArray: ...
+    def reset(self, q: ArrayLike) -> None: ...
+    def step(
+        self,
+        pose: ArrayLike,
+        velocity: Optional[ArrayLike] = None,
+        acceleration: Optional[ArrayLike] = None,
+        angular_velocity: Optional[ArrayLike] = None,
+        angular_acceleration: Optional[ArrayLike] = None,
+        process_wrench: Optional[ArrayLike] = None,
+        t: Optional[float] = None,
+    ) -> Dict[str, Any]:
+        """One tick; ``step(**trajectory.at(t))`` works."""
+    def correct(
+        self, trajectory: PoseTrajectory, process_wrench: Optional[ArrayLike] = None
+    ) -> CorrectedPoses: ...
 
 class SensorCalibration:
     """Force/torque sensor calibration (VJM paper Eq. 12-20); SI units, sensor frame."""
@@ -295,7 +432,7 @@ class OnlineCompensator:
         calibration: Optional[SensorCalibration] = None,
         lowpass_cutoff_hz: float = 10.0,
         moving_average_window: int = 5,
-        pilot: Optional[Tuple[float, float]] = (150.0, 0.08),
+        pilot: Optional[ArrayLike] = (150.0, 0.08),
         project_on_feed: bool = True,
         max_correction: float = 3.0e-3,
         max_rate: float = 0.05,
@@ -316,10 +453,12 @@ class OnlineCompensator:
 
 def identify_stiffness_from_tcp(
     robot: SerialRobot, Q: ArrayLike, W: ArrayLike, D: ArrayLike, translation_only: bool = False, all_axes: bool = False
-) -> Dict[str, Any]: ...
+) -> Dict[str, Any]:
+    """At most 100000 measurements (``InputError`` beyond)."""
 def identify_stiffness_from_frames(
-    robot: SerialRobot, Q: ArrayLike, W: ArrayLike, springs: List[int], rotations: ArrayLike, all_axes: bool = False
-) -> Dict[str, Any]: ...
+    robot: SerialRobot, Q: ArrayLike, W: ArrayLike, springs: ArrayLike, rotations: ArrayLike, all_axes: bool = False
+) -> Dict[str, Any]:
+    """``springs``: (N,) virtual-joint indices. At most 100000 measurements."""
 def identify_sensor(
     rotations: ArrayLike, readings: ArrayLike, fit_polynomial: bool = False, sensor_to_tcp: Optional[ArrayLike] = None
 ) -> Tuple[SensorCalibration, Dict[str, Any]]: ...
@@ -332,11 +471,12 @@ class DriveTrain:
         robot: SerialRobot,
         stiffness: ArrayLike,
         backlash: Optional[ArrayLike] = None,
-        masses: Optional[List[Tuple[int, float, Tuple[float, float, float]]]] = None,
-        gravity: Optional[Tuple[float, float, float]] = None,
+        masses: Optional[Sequence[Tuple[int, float, ArrayLike]]] = None,
+        gravity: Optional[ArrayLike] = None,
         torque_deadband: float = 0.0,
         max_condition: float = 1.0e6,
-    ) -> None: ...
+    ) -> None:
+        """``gravity`` defaults to (0, 0, -9.80665) m/s^2 (standard gravity down base z)."""
     @staticmethod
     def from_urdf(robot: SerialRobot, urdf_path: StrPath, drive_path: StrPath) -> "DriveTrain": ...
     @staticmethod
@@ -368,7 +508,7 @@ class ContourTracer:
         jam_force: float,
         *,
         target_force: Optional[float] = None,
-        approach_direction: Tuple[float, float] = (1.0, 0.0),
+        approach_direction: ArrayLike = (1.0, 0.0),
         approach_step: Optional[float] = None,
         bias_samples: int = 10,
         stop_radius: Optional[float] = None,

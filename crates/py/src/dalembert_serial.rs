@@ -1,0 +1,370 @@
+//! `deflect.SerialDalembertCorrector`: the 6-D D'Alembert corrector of deflect-core for any
+//! serial arm loaded from URDF and a stiffness file.
+
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
+use deflect_core::dalembert::serial::{
+    self, Deflection, Payload, SerialData, SerialModel, SerialTick,
+};
+use deflect_core::mechanism::pose_ik::PoseIkOptions;
+use deflect_core::motion::PoseState;
+use deflect_core::vjm::Vector6;
+use nalgebra::{Matrix3, Vector3};
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods, ToPyArray};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::InputError;
+use crate::args;
+use crate::convert::{
+    build_err, fixed_matrix, float_array, iso_to_py, matrix, put_pose, tick_err, tick_err_at,
+    vector, vector6,
+};
+use crate::pose_motion::{PoseTrajectory, pose_ticks};
+use crate::vjm::SerialRobot;
+
+fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
+    match o {
+        None => Ok(Vector3::zeros()),
+        Some(o) => Ok(Vector3::from_column_slice(&vector(o, what, 3)?)),
+    }
+}
+
+/// The D'Alembert corrector for a serial arm (any `SerialRobot` with at least 6 joints), in
+/// 6-D: per tick, the inertial wrench of the payload and tool (`F = -m a_c`,
+/// `M = r x F - (I alpha + omega x I omega)`, Paksoy, Dede and Kiper 2025, Eq. 3-5, with the
+/// moment part) plus an optional process wrench goes through the virtual-joint deflection
+/// (`model="exact"`: Hähn and Weigold 2020, Eq. 2-9; `"linearized"`: `C(q) w`), and a
+/// damped-least-squares pose IK of the loaded arm, warm-started from the last ticks, gives
+/// the joints at which the deflected TCP lands on the desired pose. For the paper's
+/// five-bar and a compliance map, use `DalembertCorrector`.
+///
+/// `mass` [kg], `com` (3,) [m] and `inertia` (3, 3) [kg m^2] about the centre of mass, both
+/// in the TCP frame (default: a point mass at the TCP); `joint_limits` (dof, 2) [rad or m]
+/// (default: the robot's URDF limits; a command outside them is an `InputError`);
+/// `max_iterations` (1..=256), `position_tolerance` [m] and `orientation_tolerance` [rad]
+/// of the IK (`ConvergenceError` when missed); `seed` (dof,): the joints the motion starts
+/// from (default zeros; the first tick solves from there).
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct SerialDalembertCorrector {
+    model: SerialModel,
+    /// The tick state (the last joints, the next IK seed), locked per call.
+    data: Mutex<SerialData>,
+    joint_names: Vec<String>,
+}
+
+impl SerialDalembertCorrector {
+    fn data(&self) -> MutexGuard<'_, SerialData> {
+        // A poisoned lock only means another call failed mid-tick; the data stays valid.
+        self.data.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+    fn dof(&self) -> usize {
+        self.model.chain().dof()
+    }
+}
+
+/// Result of `SerialDalembertCorrector.correct`: one row per tick, base frame.
+#[pyclass(module = "deflect", frozen, get_all)]
+#[derive(Debug)]
+pub struct CorrectedPoses {
+    /// Tick times [s], (N,).
+    t: Py<PyArray1<f64>>,
+    /// Desired TCP poses, (N, 4, 4).
+    desired: Py<PyArray3<f64>>,
+    /// Commanded (rigid) TCP poses, (N, 4, 4): where the joints put the unloaded TCP.
+    commanded: Py<PyArray3<f64>>,
+    /// Joint commands [rad or m], (N, dof).
+    joints: Py<PyArray2<f64>>,
+    /// Wrench cancelled (D'Alembert plus process) [N, N m], (N, 6).
+    wrench: Py<PyArray2<f64>>,
+    /// Predicted TCP deflection at the command [m, rad], (N, 6).
+    deflection: Py<PyArray2<f64>>,
+    /// IK iterations per tick, (N,).
+    iterations: Py<PyArray1<u32>>,
+    /// Position error left per tick [m], (N,).
+    position_error: Py<PyArray1<f64>>,
+    /// Orientation error left per tick [rad], (N,).
+    orientation_error: Py<PyArray1<f64>>,
+}
+
+fn tick_dict<'py>(py: Python<'py>, t: &SerialTick, dof: usize) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("desired", iso_to_py(py, &t.desired))?;
+    d.set_item("commanded", iso_to_py(py, &t.commanded))?;
+    d.set_item("joints", t.joints.get(..dof).unwrap_or(&[]).to_pyarray(py))?;
+    d.set_item("wrench", t.wrench.as_slice().to_pyarray(py))?;
+    d.set_item("deflection", t.deflection.as_slice().to_pyarray(py))?;
+    d.set_item("iterations", t.iterations)?;
+    d.set_item("position_error", t.position_error)?;
+    d.set_item("orientation_error", t.orientation_error)?;
+    d.set_item("sigma_min", t.sigma_min)?;
+    Ok(d)
+}
+
+#[pymethods]
+impl SerialDalembertCorrector {
+    #[new]
+    #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None))]
+    #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
+    fn new(
+        robot: &SerialRobot,
+        #[pyo3(from_py_with = args::real::mass)] mass: f64,
+        com: Option<&Bound<'_, PyAny>>,
+        inertia: Option<&Bound<'_, PyAny>>,
+        model: &str,
+        joint_limits: Option<&Bound<'_, PyAny>>,
+        #[pyo3(from_py_with = args::count::max_iterations)] max_iterations: usize,
+        #[pyo3(from_py_with = args::real::position_tolerance)] position_tolerance: f64,
+        #[pyo3(from_py_with = args::real::orientation_tolerance)] orientation_tolerance: f64,
+        seed: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let chain = robot.inner.model.clone();
+        let dof = chain.dof();
+        let payload = Payload {
+            mass,
+            com: vec3(com, "com")?,
+            inertia: match inertia {
+                None => Matrix3::zeros(),
+                Some(i) => fixed_matrix::<3, 3>(i, "inertia")?,
+            },
+        };
+        let deflection = match model {
+            "exact" => Deflection::Exact,
+            "linearized" => Deflection::Linearized,
+            other => {
+                return Err(InputError::new_err(format!(
+                    "model = '{other}': expected 'exact' or 'linearized'"
+                )));
+            }
+        };
+        let limits: Vec<(f64, f64)> = match joint_limits {
+            None => robot.inner.joint_limits.clone(),
+            Some(l) => {
+                let m = matrix(l, "joint_limits", Some(dof), Some(2))?;
+                m.as_array()
+                    .rows()
+                    .into_iter()
+                    .map(|r| {
+                        let at = |k: usize| r.get(k).copied().unwrap_or(f64::NAN);
+                        (at(0), at(1))
+                    })
+                    .collect()
+            }
+        };
+        let ik = PoseIkOptions {
+            max_iterations,
+            position_tolerance,
+            orientation_tolerance,
+            ..PoseIkOptions::default()
+        };
+        let model = SerialModel::new(chain, payload)
+            .and_then(|m| m.with_joint_limits(&limits))
+            .and_then(|m| m.with_ik_options(ik))
+            .map(|m| m.with_deflection(deflection))
+            .map_err(build_err)?;
+        let mut data = SerialData::new(&model);
+        if let Some(s) = seed {
+            let q = vector(s, "seed", dof)?;
+            if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                return Err(InputError::new_err(format!("seed[{i}] is not finite")));
+            }
+            data.set_seed(&q);
+        }
+        Ok(Self {
+            model,
+            data: Mutex::new(data),
+            joint_names: robot.inner.joint_names.clone(),
+        })
+    }
+
+    /// Number of joints.
+    #[getter(dof)]
+    fn dof_py(&self) -> usize {
+        self.dof()
+    }
+    /// Joint names in `joints` order.
+    #[getter]
+    fn joint_names(&self) -> Vec<String> {
+        self.joint_names.clone()
+    }
+    /// Payload mass [kg].
+    #[getter]
+    fn mass(&self) -> f64 {
+        self.model.payload().mass
+    }
+    /// Deflection model inverted: 'exact' or 'linearized'.
+    #[getter]
+    fn model(&self) -> &'static str {
+        match self.model.deflection() {
+            Deflection::Exact => "exact",
+            Deflection::Linearized => "linearized",
+        }
+    }
+    /// The last tick's joints (the next tick's warm start), (dof,).
+    #[getter]
+    fn joints<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let q = self.data().joints();
+        q.get(..self.dof()).unwrap_or(&[]).to_pyarray(py)
+    }
+
+    /// Restarts the warm start from joints `q` (dof,) [rad or m]: call it before a motion
+    /// that does not continue the last one.
+    fn reset(&self, q: &Bound<'_, PyAny>) -> PyResult<()> {
+        let q = vector(q, "q", self.dof())?;
+        if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+            return Err(InputError::new_err(format!("q[{i}] is not finite")));
+        }
+        self.data().set_seed(&q);
+        Ok(())
+    }
+
+    /// One tick: the desired TCP `pose` (4, 4) and its `velocity`, `acceleration` (3,)
+    /// [m/s, m/s^2], `angular_velocity`, `angular_acceleration` (3,) [rad/s, rad/s^2] (zeros
+    /// if left out), all base frame, and an optional `process_wrench` (6,) [N, N m] at the TCP.
+    /// `t` is ignored, so that `step(**trajectory.at(t))` works. Returns a dict: `desired`,
+    /// `commanded` (4, 4), `joints` (dof,), `wrench` (6,), `deflection` (6,), `iterations`,
+    /// `position_error`, `orientation_error`, `sigma_min`.
+    #[pyo3(signature = (pose, velocity=None, acceleration=None, angular_velocity=None, angular_acceleration=None, process_wrench=None, t=None))]
+    #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
+    fn step<'py>(
+        &self,
+        py: Python<'py>,
+        pose: &Bound<'py, PyAny>,
+        velocity: Option<&Bound<'py, PyAny>>,
+        acceleration: Option<&Bound<'py, PyAny>>,
+        angular_velocity: Option<&Bound<'py, PyAny>>,
+        angular_acceleration: Option<&Bound<'py, PyAny>>,
+        process_wrench: Option<&Bound<'py, PyAny>>,
+        t: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let _ = t;
+        let state = PoseState {
+            t: 0.0,
+            pose: crate::convert::pose(pose, "pose")?,
+            velocity: vec3(velocity, "velocity")?,
+            acceleration: vec3(acceleration, "acceleration")?,
+            angular_velocity: vec3(angular_velocity, "angular_velocity")?,
+            angular_acceleration: vec3(angular_acceleration, "angular_acceleration")?,
+        };
+        let process = process_wrench
+            .map(|w| vector6(w, "process_wrench"))
+            .transpose()?;
+        let tick = serial::step(&self.model, &mut self.data(), &state, process.as_ref())
+            .map_err(tick_err)?;
+        tick_dict(py, &tick, self.dof())
+    }
+
+    /// Corrects every tick of a `PoseTrajectory` (from `plan_pose`, with a `rate_hz`),
+    /// without the GIL, continuing from the corrector's last joints (call `reset` first for
+    /// a new motion). `process_wrench`: none, one (6,) for every tick, or (N, 6) per tick
+    /// [N, N m]. A tick that fails raises with its index.
+    #[pyo3(signature = (trajectory, process_wrench=None))]
+    fn correct(
+        &self,
+        py: Python<'_>,
+        trajectory: &PoseTrajectory,
+        process_wrench: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<CorrectedPoses> {
+        let Some(rate) = trajectory.rate_hz else {
+            return Err(InputError::new_err(
+                "trajectory is plan-only (rate_hz=None): correct trajectory.sampled(rate_hz)",
+            ));
+        };
+        let n = trajectory.plan.sample_count(rate).map_err(tick_err)?;
+        let process: Option<Array2<f64>> = match process_wrench {
+            None => None,
+            Some(w) => {
+                let a = float_array(w, "process_wrench")?;
+                match a.ndim() {
+                    1 => {
+                        let v = vector6(w, "process_wrench")?;
+                        Some(Array2::from_shape_fn((n, 6), |(_, j)| {
+                            v.get(j).copied().unwrap_or(0.0)
+                        }))
+                    }
+                    _ => Some(
+                        matrix(w, "process_wrench", Some(n), Some(6))?
+                            .as_array()
+                            .to_owned(),
+                    ),
+                }
+            }
+        };
+        let dof = self.dof();
+        let result = py.detach(|| -> Result<_, (usize, deflect_core::TickError)> {
+            let states = pose_ticks(&trajectory.plan, rate).map_err(|e| (0, e))?;
+            let mut data = self.data();
+            let mut t = Array1::zeros(n);
+            let mut desired = Array3::zeros((n, 4, 4));
+            let mut commanded = Array3::zeros((n, 4, 4));
+            let mut joints = Array2::zeros((n, dof));
+            let mut wrench = Array2::zeros((n, 6));
+            let mut deflection = Array2::zeros((n, 6));
+            let mut iterations = Array1::<u32>::zeros(n);
+            let mut pos_err = Array1::zeros(n);
+            let mut ori_err = Array1::zeros(n);
+            for (i, s) in states.iter().enumerate() {
+                let p = process
+                    .as_ref()
+                    .map(|w| Vector6::from_iterator(w.row(i).iter().copied()));
+                let tick =
+                    serial::step(&self.model, &mut data, s, p.as_ref()).map_err(|e| (i, e))?;
+                if let Some(x) = t.get_mut(i) {
+                    *x = s.t;
+                }
+                put_pose(&mut desired, i, &tick.desired);
+                put_pose(&mut commanded, i, &tick.commanded);
+                for (arr, v) in [
+                    (&mut joints, tick.joints.get(..dof).unwrap_or(&[])),
+                    (&mut wrench, tick.wrench.as_slice()),
+                    (&mut deflection, tick.deflection.as_slice()),
+                ] {
+                    arr.row_mut(i).iter_mut().zip(v).for_each(|(d, x)| *d = *x);
+                }
+                if let Some(x) = iterations.get_mut(i) {
+                    *x = u32::try_from(tick.iterations).unwrap_or(u32::MAX);
+                }
+                if let Some(x) = pos_err.get_mut(i) {
+                    *x = tick.position_error;
+                }
+                if let Some(x) = ori_err.get_mut(i) {
+                    *x = tick.orientation_error;
+                }
+            }
+            Ok((
+                t, desired, commanded, joints, wrench, deflection, iterations, pos_err, ori_err,
+            ))
+        });
+        let (t, desired, commanded, joints, wrench, deflection, iterations, pos_err, ori_err) =
+            result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
+        Ok(CorrectedPoses {
+            t: t.to_pyarray(py).unbind(),
+            desired: desired.to_pyarray(py).unbind(),
+            commanded: commanded.to_pyarray(py).unbind(),
+            joints: joints.to_pyarray(py).unbind(),
+            wrench: wrench.to_pyarray(py).unbind(),
+            deflection: deflection.to_pyarray(py).unbind(),
+            iterations: iterations.to_pyarray(py).unbind(),
+            position_error: pos_err.to_pyarray(py).unbind(),
+            orientation_error: ori_err.to_pyarray(py).unbind(),
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "SerialDalembertCorrector(dof={}, mass={}, model='{}')",
+            self.dof(),
+            self.model.payload().mass,
+            self.model()
+        )
+    }
+}
+
+/// Adds the serial-arm corrector to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<SerialDalembertCorrector>()?;
+    m.add_class::<CorrectedPoses>()?;
+    Ok(())
+}

@@ -1,0 +1,92 @@
+//! `deflect.ParallelRobot2`: the paper's 2-DoF parallel robot (Paksoy, Dede and Kiper 2025).
+
+use deflect_core::mechanism::{Mechanism, ParallelRobot2 as CoreRobot2};
+use nalgebra::Vector2;
+use numpy::{PyArray1, PyArray2, ToPyArray};
+use pyo3::prelude::*;
+
+use crate::args;
+use crate::convert::{build_err, matrix_to_py, tick_err, vector};
+
+fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
+    Ok(Vector2::from_column_slice(&vector(a, what, 2)?))
+}
+
+/// The paper's 2-DoF planar parallel robot (links 150 mm, pivots 90 mm from O). Task point
+/// `p = (x, y)` = C - O [m] in the static-test grid's frame; joints `q = (theta_A, theta_B)`
+/// [rad], the actuated links' angles from +x; working mode "elbows out".
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct ParallelRobot2 {
+    pub(crate) inner: CoreRobot2,
+}
+
+#[pymethods]
+impl ParallelRobot2 {
+    /// Paper geometry by default; `min_sigma` [m/rad] is the singularity threshold.
+    #[new]
+    #[pyo3(signature = (link=0.150, half_width=0.090, min_sigma=deflect_core::mechanism::DEFAULT_MIN_SIGMA))]
+    fn new(
+        #[pyo3(from_py_with = args::real::link)] link: f64,
+        #[pyo3(from_py_with = args::real::half_width)] half_width: f64,
+        #[pyo3(from_py_with = args::real::min_sigma)] min_sigma: f64,
+    ) -> PyResult<Self> {
+        Ok(Self {
+            inner: CoreRobot2::new(link, half_width, min_sigma).map_err(build_err)?,
+        })
+    }
+    /// Joints `q` [rad] that put C on `p` [m]; InputError out of reach, SingularError near a
+    /// singularity.
+    fn ik<'py>(
+        &self,
+        py: Python<'py>,
+        p: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let q = self.inner.ik(&vec2(p, "p")?).map_err(tick_err)?;
+        Ok(q.as_slice().to_pyarray(py))
+    }
+    /// Task point `p` [m] of joints `q` [rad].
+    fn fk<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = self.inner.fk(&vec2(q, "q")?).map_err(tick_err)?;
+        Ok(p.as_slice().to_pyarray(py))
+    }
+    /// Jacobian `dp/dq` [m/rad], shape (2, 2).
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let j = self.inner.jacobian_at(&vec2(q, "q")?).map_err(tick_err)?;
+        Ok(matrix_to_py(py, &j))
+    }
+    /// Smallest singular value of the Jacobian at `q` [m/rad].
+    fn singularity_distance(&self, q: &Bound<'_, PyAny>) -> PyResult<f64> {
+        // The closed-form robot's workspace is `()`.
+        self.inner
+            .singularity_distance(&mut (), &vec2(q, "q")?)
+            .map_err(tick_err)
+    }
+    /// Largest reach 2 L [m].
+    #[getter]
+    fn reach(&self) -> f64 {
+        self.inner.reach()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "ParallelRobot2(link={}, half_width={}, min_sigma={})",
+            self.inner.link(),
+            self.inner.half_width(),
+            self.inner.min_sigma()
+        )
+    }
+}
+
+/// Adds the parallel robot to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<ParallelRobot2>()?;
+    Ok(())
+}
