@@ -16,7 +16,7 @@
 //! Besides the paper's figures we report the maximum and RMS perpendicular distance of the
 //! raw path samples from the desired line ("path deviation").
 
-/// Scanner pixel pitch [mm] (1200 dpi).
+/// Scanner pixel pitch \[mm\] (1200 dpi).
 pub const PIXEL_PITCH_MM: f64 = 0.02117;
 /// Smoothing parameter of the spline (Appendix C).
 pub const SPLINE_P: f64 = 0.01;
@@ -24,15 +24,15 @@ pub const SPLINE_P: f64 = 0.01;
 /// Figures of one straight path.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct LineMetrics {
-    /// Desired length [mm].
+    /// Desired length \[mm\].
     pub desired_length_mm: f64,
-    /// Length between the spline's end points, Eq. C2 [mm].
+    /// Length between the spline's end points, Eq. C2 \[mm\].
     pub length_mm: f64,
-    /// Area between fitted line and spline, Eq. C6 [mm^2].
+    /// Area between fitted line and spline, Eq. C6 \[mm^2\].
     pub area_mm2: f64,
-    /// Largest perpendicular distance of a path sample from the desired line [mm].
+    /// Largest perpendicular distance of a path sample from the desired line \[mm\].
     pub max_dev_mm: f64,
-    /// RMS of the perpendicular distances [mm].
+    /// RMS of the perpendicular distances \[mm\].
     pub rms_dev_mm: f64,
     /// Samples used.
     pub samples: usize,
@@ -129,7 +129,7 @@ pub fn line_fit(u: &[f64], v: &[f64]) -> (f64, f64) {
     (mv - b * mu, b)
 }
 
-/// Evaluates a path `points` ((x, y) [m]) that should follow the segment `start -> end` [m].
+/// Evaluates a path `points` ((x, y) \[m\]) that should follow the segment `start -> end` \[m\].
 pub fn evaluate_line(points: &[[f64; 2]], start: [f64; 2], end: [f64; 2]) -> LineMetrics {
     let (dx, dy) = (end[0] - start[0], end[1] - start[1]);
     let len = (dx * dx + dy * dy).sqrt();

@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 use std::fs::File;
 use std::io::BufWriter;
 use std::ops::Range;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use mcap::records::MessageHeader;
 use plotters::coord::Shift;
@@ -14,8 +14,8 @@ use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use serde_json::json;
 
-use crate::SimError;
 use crate::pipeline::{Motion, RunResult, Sample};
+use crate::{SimError, write_file};
 
 /// Topics written for each run (prefixed by the run's name in multi-run logs).
 pub const TOPICS: [&str; 5] = [
@@ -70,12 +70,12 @@ fn schemas() -> [(String, serde_json::Value); 5] {
     ]
 }
 
-/// Log time `t` [s] in nanoseconds.
+/// Log time `t` \[s\] in nanoseconds.
 fn nanos(t: f64) -> u64 {
     (t * 1e9).round() as u64
 }
 
-/// A message timestamp `{"sec", "nsec"}` for time `t` [s].
+/// A message timestamp `{"sec", "nsec"}` for time `t` \[s\].
 pub(crate) fn stamp(t: f64) -> serde_json::Value {
     let ns = nanos(t);
     json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
@@ -90,15 +90,24 @@ pub(crate) fn stamp_schema() -> serde_json::Value {
 pub(crate) struct McapLog {
     w: mcap::Writer<BufWriter<File>>,
     count: usize,
+    path: PathBuf,
 }
 
 impl McapLog {
     /// Creates the file at `path`.
     pub(crate) fn create(path: &Path) -> Result<Self, SimError> {
+        let err = |e: &dyn std::fmt::Display| SimError::file(path, "create the MCAP log", e);
+        let file = File::create(path).map_err(|e| err(&e))?;
         Ok(Self {
-            w: mcap::Writer::new(BufWriter::new(File::create(path)?))?,
+            w: mcap::Writer::new(BufWriter::new(file)).map_err(|e| err(&e))?,
             count: 0,
+            path: path.to_path_buf(),
         })
+    }
+
+    /// An MCAP error naming the file.
+    fn err(&self, e: mcap::McapError) -> SimError {
+        SimError::file(&self.path, "write the MCAP log", e)
     }
 
     /// Adds a JSON schema named `name`; returns its id.
@@ -107,11 +116,13 @@ impl McapLog {
         name: &str,
         schema: &serde_json::Value,
     ) -> Result<u16, SimError> {
-        Ok(self.w.add_schema(
-            name,
-            "jsonschema",
-            serde_json::to_string(schema)?.as_bytes(),
-        )?)
+        self.w
+            .add_schema(
+                name,
+                "jsonschema",
+                serde_json::to_string(schema)?.as_bytes(),
+            )
+            .map_err(|e| self.err(e))
     }
 
     /// Adds a JSON channel on `topic` with one metadata entry `key: value`; returns its id.
@@ -124,10 +135,12 @@ impl McapLog {
     ) -> Result<u16, SimError> {
         let mut meta = BTreeMap::new();
         meta.insert(key.to_string(), value.to_string());
-        Ok(self.w.add_channel(schema, topic, "json", &meta)?)
+        self.w
+            .add_channel(schema, topic, "json", &meta)
+            .map_err(|e| self.err(e))
     }
 
-    /// Writes `msg` on `channel` with sequence number `seq`, logged and published at `t` [s].
+    /// Writes `msg` on `channel` with sequence number `seq`, logged and published at `t` \[s\].
     pub(crate) fn write(
         &mut self,
         channel: u16,
@@ -142,15 +155,19 @@ impl McapLog {
             log_time: ns,
             publish_time: ns,
         };
-        self.w
-            .write_to_known_channel(&header, serde_json::to_string(msg)?.as_bytes())?;
+        let data = serde_json::to_string(msg)?;
+        if let Err(e) = self.w.write_to_known_channel(&header, data.as_bytes()) {
+            return Err(self.err(e));
+        }
         self.count += 1;
         Ok(())
     }
 
     /// Finishes the file; returns the number of messages written.
     pub(crate) fn finish(mut self) -> Result<usize, SimError> {
-        self.w.finish()?;
+        if let Err(e) = self.w.finish() {
+            return Err(self.err(e));
+        }
         Ok(self.count)
     }
 }
@@ -268,6 +285,15 @@ pub(crate) fn canvas(
     Ok(root)
 }
 
+/// Writes the PNG of `root` to `path` (the file it was created on); the error names the file.
+pub(crate) fn present(
+    root: &DrawingArea<BitMapBackend<'_>, Shift>,
+    path: &Path,
+) -> Result<(), SimError> {
+    root.present()
+        .map_err(|e| SimError::file(path, "write the PNG plot", e))
+}
+
 /// A 2-D chart of `f64` axes as the scenarios draw them.
 pub(crate) type Chart<'a, 'b> =
     ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
@@ -357,10 +383,11 @@ pub fn write_summary<T: serde::Serialize + ?Sized>(
     csv: &str,
     json: &T,
 ) -> Result<(), SimError> {
-    std::fs::write(out.join(format!("{stem}.txt")), txt)?;
-    std::fs::write(out.join(format!("{stem}.csv")), csv)?;
-    std::fs::write(
-        out.join(format!("{stem}.json")),
+    write_file(&out.join(format!("{stem}.txt")), "the summary table", txt)?;
+    write_file(&out.join(format!("{stem}.csv")), "the summary CSV", csv)?;
+    write_file(
+        &out.join(format!("{stem}.json")),
+        "the summary JSON",
         serde_json::to_string_pretty(json)?,
     )?;
     Ok(())
@@ -425,7 +452,7 @@ pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), S
         labelled_line(&mut chart, series, c, width, label)?;
     }
     legend(&mut chart, 0.8, 15)?;
-    root.present().map_err(perr)?;
+    present(&root, path)?;
     Ok(())
 }
 
@@ -474,6 +501,48 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
         }
     }
     legend(&mut chart, 0.8, 14)?;
-    root.present().map_err(perr)?;
+    present(&root, path)?;
     Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// A scratch directory holding a file `a_file`: paths under it cannot be created.
+    fn blocked(name: &str) -> std::path::PathBuf {
+        let d = std::env::temp_dir().join(format!("deflect-sim-out-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        std::fs::write(d.join("a_file"), "").unwrap();
+        d
+    }
+
+    #[test]
+    fn write_errors_name_the_file_and_what_it_is() {
+        let d = blocked("write");
+        let under = d.join("a_file");
+        let e = write_summary(&under, "summary", "t", "c", &1).unwrap_err();
+        let p = under.join("summary.txt");
+        assert!(
+            e.0.starts_with(&format!("cannot write the summary table {}: ", p.display())),
+            "{e}"
+        );
+        let m = d.join("a_file/log.mcap");
+        let e = McapLog::create(&m).err().unwrap();
+        assert!(
+            e.0.starts_with(&format!("cannot create the MCAP log {}: ", m.display())),
+            "{e}"
+        );
+        // A PNG is written on `present`.
+        let png = d.join("a_file/plot.png");
+        let root = canvas(&png, (10, 10)).unwrap();
+        let e = present(&root, &png).unwrap_err();
+        assert!(
+            e.0.starts_with(&format!("cannot write the PNG plot {}: ", png.display())),
+            "{e}"
+        );
+        let _ = std::fs::remove_dir_all(&d);
+    }
 }

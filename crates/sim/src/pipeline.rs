@@ -1,11 +1,12 @@
-//! The paper's pipeline in simulation: static tests -> compliance map -> motions at 1-5 g with
-//! and without the D'Alembert correction -> evaluation (Appendix C).
+//! The pipeline of Paksoy, Dede and Kiper (2025) in simulation: static tests (sec. 3.1) ->
+//! compliance map (sec. 3.2, Eq. 9-14) -> motions at 1-5 g with and without the D'Alembert
+//! correction (sec. 3.3, Eq. 5) -> evaluation (Appendix C).
 
 use deflect_core::compliance_map::{
     self, ComplianceMap, FitOptions, HoldOutAxis, Interpolation, Measurement, OutOfGrid,
     QueryOptions,
 };
-use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::dalembert;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
 use nalgebra::{Vector2, Vector3};
@@ -14,10 +15,11 @@ use crate::SimError;
 use crate::analysis::{LineMetrics, evaluate_line};
 use crate::robot::{Constraint, DT, ParallelSim, RobotParams, linear_compliance};
 
-/// The paper's force levels: 5..25 kgf in 5 kgf steps [N].
+/// The paper's force levels: 5..25 kgf in 5 kgf steps \[N\], as the paper converts them (with
+/// 9.81 m/s^2, like [`deflect_core::motion::PAPER_G`]; not a gravity of the simulation).
 pub const STATIC_FORCES: [f64; 5] = [49.05, 98.1, 147.15, 196.2, 245.25];
 
-/// Grid node (i, j), i = 1..3, j = 1..5 [m].
+/// Grid node (i, j), i = 1..3, j = 1..5 \[m\].
 pub fn grid_node(i: usize, j: usize) -> Vector2<f64> {
     Vector2::new(0.122132 + 0.05 * i as f64, -0.1125 + 0.0375 * j as f64)
 }
@@ -25,17 +27,17 @@ pub fn grid_node(i: usize, j: usize) -> Vector2<f64> {
 /// One simulated static reading.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct StaticReading {
-    /// Node position [m].
+    /// Node position \[m\].
     pub x: f64,
-    /// Node position [m].
+    /// Node position \[m\].
     pub y: f64,
     /// 0 = force along x, 1 = along y.
     pub axis: usize,
-    /// Force [N].
+    /// Force \[N\].
     pub force: f64,
-    /// Measured tool-point displacement [m].
+    /// Measured tool-point displacement \[m\].
     pub d: [f64; 2],
-    /// Linearized model `J K^-1 J^T F` [m].
+    /// Linearized model `J K^-1 J^T F` \[m\].
     pub d_linear: [f64; 2],
 }
 
@@ -57,7 +59,7 @@ impl Default for StaticOptions {
     }
 }
 
-/// Static test at `node`: forces `forces` [N] applied one after the other along `axis`,
+/// Static test at `node`: forces `forces` \[N\] applied one after the other along `axis`,
 /// motors locked; displacement of the tool point from its unloaded position.
 pub fn static_test_node(
     params: &RobotParams,
@@ -121,7 +123,7 @@ pub fn static_tests(
 }
 
 /// Agreement of simulated static compliance with `J K^-1 J^T`: worst and RMS of
-/// `|d_sim - d_lin| / |d_lin|` over the readings with force at most `max_force` [N] (the
+/// `|d_sim - d_lin| / |d_lin|` over the readings with force at most `max_force` \[N\] (the
 /// linear model is the small-load limit; at 245 N geometric nonlinearity adds about 0.5 %).
 pub fn linear_agreement(readings: &[StaticReading], max_force: f64) -> (f64, f64) {
     let mut worst: f64 = 0.0;
@@ -158,15 +160,15 @@ pub fn map_options() -> QueryOptions {
 /// Prediction errors of a map on held-out data.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct HeldOut {
-    /// Leave-one-grid-line-out RMS error (deflect-core), along y, bilinear [m].
+    /// Leave-one-grid-line-out RMS error (deflect-core), along y, bilinear \[m\].
     pub loo_rms_y: f64,
-    /// Same along x [m].
+    /// Same along x \[m\].
     pub loo_rms_x: f64,
-    /// Static tests at the 8 cell centres (245 N along x and y): RMS error of the map [m].
+    /// Static tests at the 8 cell centres (245 N along x and y): RMS error of the map \[m\].
     pub centre_rms: f64,
-    /// Worst error at the cell centres [m].
+    /// Worst error at the cell centres \[m\].
     pub centre_max: f64,
-    /// RMS displacement there (for scale) [m].
+    /// RMS displacement there (for scale) \[m\].
     pub centre_rms_displacement: f64,
 }
 
@@ -232,7 +234,7 @@ impl Motion {
         }
     }
 
-    /// Corner points [m].
+    /// Corner points \[m\].
     pub fn points(self) -> Vec<Vector2<f64>> {
         let xc = 0.222132;
         match self {
@@ -267,25 +269,25 @@ impl Motion {
 /// One recorded servo tick.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Sample {
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
     /// Segment of the planned path.
     pub segment: usize,
     /// Whether the motion is still commanded (the laser is on).
     pub active: bool,
-    /// Desired tool point [m].
+    /// Desired tool point \[m\].
     pub desired: [f64; 2],
-    /// Commanded tool point (desired minus predicted displacement) [m].
+    /// Commanded tool point (desired minus predicted displacement) \[m\].
     pub commanded: [f64; 2],
-    /// Actual tool point after the step [m] (x, y, z).
+    /// Actual tool point after the step \[m\] (x, y, z).
     pub actual: [f64; 3],
-    /// D'Alembert force `-m* a` [N].
+    /// D'Alembert force `-m* a` \[N\].
     pub force: [f64; 2],
-    /// Joint command [rad].
+    /// Joint command \[rad\].
     pub q_cmd: [f64; 2],
-    /// Motor angles [rad].
+    /// Motor angles \[rad\].
     pub q_motor: [f64; 2],
-    /// Actuated link angles [rad].
+    /// Actuated link angles \[rad\].
     pub q_link: [f64; 2],
 }
 
@@ -294,17 +296,17 @@ pub struct Sample {
 pub struct RunMetrics {
     /// Per evaluated segment.
     pub segments: Vec<LineMetrics>,
-    /// Sum of the segments' areas [mm^2].
+    /// Sum of the segments' areas \[mm^2\].
     pub area_mm2: f64,
-    /// Length minus desired length of the first segment [mm] (Eq. C2).
+    /// Length minus desired length of the first segment \[mm\] (Eq. C2).
     pub length_dev_mm: f64,
-    /// Largest path deviation over the evaluated segments [mm].
+    /// Largest path deviation over the evaluated segments \[mm\].
     pub max_dev_mm: f64,
-    /// RMS path deviation [mm].
+    /// RMS path deviation \[mm\].
     pub rms_dev_mm: f64,
-    /// Largest tracking error |actual - desired| while commanded [mm].
+    /// Largest tracking error |actual - desired| while commanded \[mm\].
     pub max_track_mm: f64,
-    /// RMS tracking error [mm].
+    /// RMS tracking error \[mm\].
     pub rms_track_mm: f64,
 }
 
@@ -315,11 +317,11 @@ pub struct RunResult {
     pub config: String,
     /// Motion.
     pub motion: Motion,
-    /// Acceleration level [g].
+    /// Acceleration level \[g\].
     pub g: u8,
     /// Whether the correction was on.
     pub corrected: bool,
-    /// Mass parameter m* [kg].
+    /// Mass parameter m* \[kg\].
     pub mass: f64,
     /// Evaluation.
     pub metrics: RunMetrics,
@@ -331,18 +333,18 @@ pub struct RunResult {
 /// Settings of a run.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RunOptions {
-    /// Mass parameter m* [kg].
+    /// Mass parameter m* \[kg\].
     pub mass: f64,
     /// Fixed-point iterations of the corrector (0 = the paper's one-shot update).
     pub fixed_point: usize,
-    /// Time simulated after the motion ends [s].
+    /// Time simulated after the motion ends \[s\].
     pub tail: f64,
 }
 
 impl Default for RunOptions {
     fn default() -> Self {
         Self {
-            mass: DalembertCorrector::PAPER_MASS,
+            mass: dalembert::PAPER_MASS,
             fixed_point: 0,
             tail: 0.05,
         }
@@ -361,8 +363,24 @@ pub fn run(
     let mech = ParallelRobot2::paper();
     let start = traj.start();
     let mut sim = ParallelSim::new(*params, &start)?;
-    let corrector = DalembertCorrector::new(opts.mass)?.with_fixed_point(opts.fixed_point, 1e-9);
-    let view = map.map(|m| m.view().with_options(map_options()));
+    if !(opts.mass.is_finite() && opts.mass >= 0.0) {
+        return Err(SimError::new(format!(
+            "mass parameter {} kg: expected finite and >= 0",
+            opts.mass
+        )));
+    }
+    // The corrector (Paksoy, Dede and Kiper (2025), sec. 3.3, Eq. 5) with its workspace, when
+    // a map is given.
+    let mut corrector = match map {
+        Some(m) => {
+            let view = m.view().with_options(map_options());
+            let model = dalembert::Model::new(mech, view, opts.mass)?
+                .with_fixed_point(opts.fixed_point, 1e-9)?;
+            let data = dalembert::Data::new(&model);
+            Some((model, data))
+        }
+        None => None,
+    };
     let n_motion = (traj.duration() / DT).ceil() as usize + 1;
     let n_total = n_motion + (opts.tail / DT).ceil() as usize;
     let mut samples = Vec::with_capacity(n_total);
@@ -372,9 +390,10 @@ pub fn run(
         let t = (k as f64 * DT).min(traj.duration());
         let state = traj.sample(t)?;
         let desired = state.position;
-        let (commanded, force, q) = match &view {
-            Some(v) => {
-                let tick = corrector.step(&mech, v, &desired, &state.acceleration, &q_prev)?;
+        let (commanded, force, q) = match corrector.as_mut() {
+            Some((model, data)) => {
+                data.set_seed(q_prev);
+                let tick = dalembert::step(model, data, &desired, &state.acceleration)?;
                 (tick.commanded, tick.force, tick.joints)
             }
             None => (desired, -opts.mass * state.acceleration, mech.ik(&desired)?),

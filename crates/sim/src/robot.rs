@@ -35,28 +35,31 @@ use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use rapier3d_f64::prelude::*;
 
 use crate::SimError;
+use crate::rapier_util::{
+    ANG_X, ANG_Y, ANG_Z, body_point, gravity_z_down, new_world, revolute_z_state, set_spring,
+};
 
-/// Simulation step [s]: the paper's 2 kHz servo rate.
+/// Simulation step \[s\]: the paper's 2 kHz servo rate.
 pub const DT: f64 = 1.0 / 2000.0;
-/// Link length [m] (section 4.1).
+/// Link length \[m\] (section 4.1).
 pub const LINK: f64 = 0.150;
-/// Half width |A0O| = |BC| [m].
+/// Half width |A0O| = |BC| \[m\].
 pub const HALF_WIDTH: f64 = 0.090;
-/// Moving platform with end effector [kg].
+/// Moving platform with end effector \[kg\].
 pub const PLATFORM_MASS: f64 = 3.6;
-/// Thick distal link [kg].
+/// Thick distal link \[kg\].
 pub const THICK_LINK_MASS: f64 = 0.2194;
-/// Thin link [kg].
+/// Thin link \[kg\].
 pub const THIN_LINK_MASS: f64 = 0.1236;
-/// Intermediate platform [kg].
+/// Intermediate platform \[kg\].
 pub const INTERMEDIATE_MASS: f64 = 0.2512;
-/// Actuated link: not reported by the paper ("assumed rigid"); our value [kg].
+/// Actuated link: not reported by the paper ("assumed rigid"); our value \[kg\].
 pub const ACTUATED_LINK_MASS: f64 = 0.30;
-/// CoM height above G, upper head [m].
+/// CoM height above G, upper head \[m\].
 pub const D_UPPER: f64 = 0.0359;
-/// CoM height above G, lower head [m].
+/// CoM height above G, lower head \[m\].
 pub const D_LOWER: f64 = 0.0053;
-/// Tool point W (laser working point) below G [m]: our choice.
+/// Tool point W (laser working point) below G \[m\]: our choice.
 pub const Z_TOOL: f64 = 0.030;
 
 /// Over- or normal-constrained mechanism.
@@ -95,7 +98,7 @@ impl Head {
             Self::Lower => "GL",
         }
     }
-    /// CoM height above G [m].
+    /// CoM height above G \[m\].
     pub fn com_height(self) -> f64 {
         match self {
             Self::Upper => D_UPPER,
@@ -111,29 +114,29 @@ pub struct RobotParams {
     pub constraint: Constraint,
     /// Head position.
     pub head: Head,
-    /// Drive stiffness of arm A [N m/rad].
+    /// Drive stiffness of arm A \[N m/rad\].
     pub k_a: f64,
-    /// Drive stiffness of arm B [N m/rad].
+    /// Drive stiffness of arm B \[N m/rad\].
     pub k_b: f64,
-    /// Relative damping of each drive spring [N m s/rad].
+    /// Relative damping of each drive spring \[N m s/rad\].
     pub c_drive: f64,
-    /// Out-of-plane bending (tilt) stiffness of the head about G [N m/rad].
+    /// Out-of-plane bending (tilt) stiffness of the head about G \[N m/rad\].
     pub k_tilt: f64,
-    /// Tilt damping [N m s/rad].
+    /// Tilt damping \[N m s/rad\].
     pub c_tilt: f64,
-    /// Orientation stiffness of the parallelograms [N m/rad].
+    /// Orientation stiffness of the parallelograms \[N m/rad\].
     pub k_orient: f64,
-    /// Orientation damping [N m s/rad].
+    /// Orientation damping \[N m s/rad\].
     pub c_orient: f64,
-    /// Reflected motor inertia [kg m^2].
+    /// Reflected motor inertia \[kg m^2\].
     pub j_motor: f64,
-    /// Servo position gain [N m/rad].
+    /// Servo position gain \[N m/rad\].
     pub kp: f64,
-    /// Servo velocity gain [N m s/rad].
+    /// Servo velocity gain \[N m s/rad\].
     pub kd: f64,
-    /// Head CoM height above G [m].
+    /// Head CoM height above G \[m\].
     pub com_height: f64,
-    /// Tool point below G [m].
+    /// Tool point below G \[m\].
     pub z_tool: f64,
     /// rapier solver iterations (substeps).
     pub solver_iterations: usize,
@@ -181,9 +184,9 @@ impl RobotParams {
 }
 
 /// The linearized static compliance of the model at the tool point for an in-plane force at
-/// G: `J K^-1 J^T` [m/N] over the three elastic coordinates of the closed chain,
+/// G: `J K^-1 J^T` \[m/N\] over the three elastic coordinates of the closed chain,
 /// `K = diag(k_a, k_b, k_orient)` (the two drive springs and the parallelograms' orientation
-/// spring) and `J = d(x, y, psi)/d(theta_a, theta_b, psi)` at the tool point `p` [m] (x, y
+/// spring) and `J = d(x, y, psi)/d(theta_a, theta_b, psi)` at the tool point `p` \[m\] (x, y
 /// block returned). Without the orientation spring (`k_orient -> inf`) this is the robot's
 /// 2 x 2 `J K^-1 J^T` with [`ParallelRobot2::jacobian_at`].
 ///
@@ -240,7 +243,7 @@ fn pose(x: f64, y: f64, angle: f64) -> Pose {
     Pose::from_parts(Vector::new(x, y, 0.0), rz(angle))
 }
 
-/// One servo motor: rotor angle and speed [rad, rad/s] (absolute, like the link angle).
+/// One servo motor: rotor angle and speed \[rad, rad/s\] (absolute, like the link angle).
 #[derive(Debug, Clone, Copy, PartialEq)]
 struct Motor {
     angle: f64,
@@ -270,14 +273,14 @@ impl core::fmt::Debug for ParallelSim {
 }
 
 impl ParallelSim {
-    /// Builds the robot at rest with its tool point at `start` = (x, y) [m] (task frame C - O).
+    /// Builds the robot at rest with its tool point at `start` = (x, y) \[m\] (task frame C - O),
+    /// under standard gravity down z ([`deflect_core::units::GRAVITY_Z_DOWN`]), normal to the
+    /// plane of motion.
     pub fn new(params: RobotParams, start: &Vector2<f64>) -> Result<Self, SimError> {
         let mech = ParallelRobot2::paper();
         let q = mech.ik(start)?;
         let (l, h) = (LINK, HALF_WIDTH);
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::new(0.0, 0.0, -9.81);
-        world.integration_parameters.dt = DT;
+        let mut world = new_world(gravity_z_down(), DT);
         world.integration_parameters.num_solver_iterations = params.solver_iterations;
         world.integration_parameters.num_internal_pgs_iterations = params.pgs_iterations;
 
@@ -366,18 +369,12 @@ impl ParallelSim {
         let drive = [joints[0].0, joints[1].0];
         let (ka, kb) = (params.k_a, params.k_b);
         for (hd, k) in [(drive[0], ka), (drive[1], kb)] {
-            if let Some((mb, id)) = world.multibody_joints.get_mut(hd) {
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint.set_spring(5, k, 0.0);
-                }
-            }
+            set_spring(&mut world, hd, ANG_Z, k, 0.0);
         }
-        if let Some((mb, id)) = world.multibody_joints.get_mut(ph) {
-            if let Some(link) = mb.link_mut(id) {
-                link.joint.set_spring(3, params.k_tilt, 0.0);
-                link.joint.set_spring(4, params.k_tilt, 0.0);
-                link.joint.set_spring(5, params.k_orient, 0.0);
-            }
+        set_spring(&mut world, ph, ANG_X, params.k_tilt, 0.0);
+        set_spring(&mut world, ph, ANG_Y, params.k_tilt, 0.0);
+        set_spring(&mut world, ph, ANG_Z, params.k_orient, 0.0);
+        if let Some((mb, _)) = world.multibody_joints.get_mut(ph) {
             // Generalized damping, in link order (assembly ids are the running DoF count).
             let mut offsets = Vec::new();
             let mut n = 0;
@@ -431,63 +428,55 @@ impl ParallelSim {
         &self.params
     }
 
-    /// Simulated time [s].
+    /// Simulated time \[s\].
     pub fn time(&self) -> f64 {
         self.time
     }
 
-    /// Joints at construction (IK of the start point) [rad].
+    /// Joints at construction (IK of the start point) \[rad\].
     pub fn q_ref(&self) -> Vector2<f64> {
         self.q_ref
     }
 
-    /// Angle and rate of the actuated links (absolute, from +x) [rad, rad/s].
+    /// Angle and rate of the actuated links (absolute, from +x) \[rad, rad/s\].
     pub fn link_state(&self) -> (Vector2<f64>, Vector2<f64>) {
         let mut q = self.q_ref;
         let mut w = Vector2::zeros();
         for k in 0..2 {
-            if let Some((mb, id)) = self.world.multibody_joints.get(self.joints[k]) {
-                if let Some(link) = mb.link(id) {
-                    q[k] += link.joint().coords()[5];
-                    w[k] = mb.joint_velocity(link).get(0).copied().unwrap_or(0.0);
-                }
+            if let Some((dq, rate)) = revolute_z_state(&self.world, self.joints[k]) {
+                q[k] += dq;
+                w[k] = rate;
             }
         }
         (q, w)
     }
 
-    /// Motor angles [rad].
+    /// Motor angles \[rad\].
     pub fn motor_angles(&self) -> Vector2<f64> {
         Vector2::new(self.motors[0].angle, self.motors[1].angle)
     }
 
-    /// World position of a platform-local point [m].
+    /// World position of a platform-local point \[m\].
     fn platform_point(&self, local: Vector) -> Vector3<f64> {
-        let p = self
-            .world
-            .bodies
-            .get(self.platform)
-            .map(|rb| rb.position().transform_point(local))
-            .unwrap_or(Vector::ZERO);
-        Vector3::new(p.x, p.y, p.z)
+        body_point(&self.world, self.platform, local)
     }
 
-    /// The tool point W (x, y, z) [m]; (x, y) is in the task frame.
+    /// The tool point W (x, y, z) \[m\]; (x, y) is in the task frame.
     pub fn tool_point(&self) -> Vector3<f64> {
         self.platform_point(Vector::new(0.0, 0.0, -self.params.z_tool))
     }
 
-    /// The static-test force point G [m].
+    /// The static-test force point G \[m\].
     pub fn force_point(&self) -> Vector3<f64> {
         self.platform_point(Vector::ZERO)
     }
 
-    /// The head's centre of mass [m].
+    /// The head's centre of mass \[m\].
     pub fn com(&self) -> Vector3<f64> {
         self.platform_point(Vector::new(0.0, 0.0, self.params.com_height))
     }
 
-    /// One servo tick: joint command `q` [rad] with its rate and acceleration (feed-forward),
+    /// One servo tick: joint command `q` \[rad\] with its rate and acceleration (feed-forward),
     /// then one physics step of [`DT`].
     pub fn step_servo(&mut self, q: &Vector2<f64>, qd: &Vector2<f64>, qdd: &Vector2<f64>) {
         let (ql, wl) = self.link_state();
@@ -513,7 +502,7 @@ impl ParallelSim {
     }
 
     /// One physics step with the motors locked at their current angles and an in-plane force
-    /// `force` [N] at G (the static test). `damping_scale` multiplies the drive damping (to
+    /// `force` \[N\] at G (the static test). `damping_scale` multiplies the drive damping (to
     /// settle faster).
     pub fn step_locked(&mut self, force: &Vector2<f64>, damping_scale: f64) {
         let (_, wl) = self.link_state();
@@ -537,11 +526,7 @@ impl ParallelSim {
         let k = [self.params.k_a, self.params.k_b];
         for i in 0..2 {
             let rest = self.motors[i].angle - self.q_ref[i];
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(self.joints[i]) {
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint.set_spring(5, k[i], rest);
-                }
-            }
+            set_spring(&mut self.world, self.joints[i], ANG_Z, k[i], rest);
             let torque = -self.params.c_drive * scale * (wl[i] - self.motors[i].speed);
             if let Some(rb) = self.world.bodies.get_mut(self.links[i]) {
                 rb.reset_forces(false);

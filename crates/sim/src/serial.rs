@@ -6,52 +6,10 @@ use nalgebra::{DMatrix, Matrix2, Vector2};
 use rapier3d_f64::prelude::*;
 
 use crate::SimError;
+use crate::rapier_util::{
+    ANG_Z, body_point, insert_planar_chain, new_world, set_last_dof_damping, set_spring,
+};
 use crate::robot::DT;
-
-/// Inserts a planar chain of links on revolute-z multibody joints into `world`, on a fixed base
-/// at the origin: link `i` has length `links[i].0` and mass properties `links[i].1` (its frame
-/// at the joint, x along the link) and is built at relative joint angle `q[i]` [rad].
-/// `on_joint(world, joint, i)` runs right after joint `i` is inserted (drive spring, damping).
-/// Returns the joints and the link bodies, base to tip; `rejected` is the error if rapier
-/// refuses a joint.
-pub(crate) fn insert_planar_chain(
-    world: &mut PhysicsWorld,
-    links: &[(f64, MassProperties)],
-    q: &[f64],
-    rejected: &str,
-    mut on_joint: impl FnMut(&mut PhysicsWorld, MultibodyJointHandle, usize),
-) -> Result<(Vec<MultibodyJointHandle>, Vec<RigidBodyHandle>), SimError> {
-    let mut parent = world.insert_body(RigidBodyBuilder::fixed());
-    let locked = JointAxesMask::LIN_AXES | JointAxesMask::ANG_X | JointAxesMask::ANG_Y;
-    let (mut angle, mut at, mut parent_len) = (0.0, Vector::ZERO, 0.0);
-    let (mut joints, mut bodies) = (Vec::new(), Vec::new());
-    for (i, (&(l, props), &qi)) in links.iter().zip(q).enumerate() {
-        angle += qi;
-        let body = world.insert_body(
-            RigidBodyBuilder::dynamic()
-                .pose(Pose::from_parts(at, Rotation::from_rotation_z(angle)))
-                .additional_mass_properties(props)
-                .can_sleep(false),
-        );
-        let joint = GenericJointBuilder::new(locked)
-            .local_frame1(Pose::from_parts(
-                Vector::new(parent_len, 0.0, 0.0),
-                Rotation::from_rotation_z(qi),
-            ))
-            .contacts_enabled(false)
-            .build();
-        let h = world
-            .insert_multibody_joint(parent, body, joint)
-            .ok_or_else(|| SimError::new(rejected))?;
-        on_joint(world, h, i);
-        joints.push(h);
-        bodies.push(body);
-        at += Rotation::from_rotation_z(angle) * Vector::new(l, 0.0, 0.0);
-        parent = body;
-        parent_len = l;
-    }
-    Ok((joints, bodies))
-}
 
 /// A planar serial arm with compliant joints in rapier.
 pub struct SerialArmSim {
@@ -73,8 +31,8 @@ impl core::fmt::Debug for SerialArmSim {
 }
 
 impl SerialArmSim {
-    /// Links of `lengths` [m] and `masses` [kg] (uniform rods), joint stiffnesses `stiffness`
-    /// [N m/rad], built at absolute-relative joint angles `q` [rad].
+    /// Links of `lengths` \[m\] and `masses` \[kg\] (uniform rods), joint stiffnesses `stiffness`
+    /// \[N m/rad\], built at absolute-relative joint angles `q` \[rad\].
     pub fn new(
         lengths: &[f64],
         masses: &[f64],
@@ -85,9 +43,7 @@ impl SerialArmSim {
         if masses.len() != n || stiffness.len() != n || q.len() != n || n == 0 {
             return Err(SimError::new("serial arm: inconsistent lengths"));
         }
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::ZERO;
-        world.integration_parameters.dt = DT;
+        let mut world = new_world(Vector::ZERO, DT);
         let links: Vec<(f64, MassProperties)> = lengths
             .iter()
             .zip(masses)
@@ -106,14 +62,9 @@ impl SerialArmSim {
             q,
             "serial joint rejected",
             |world, h, i| {
-                if let Some((mb, id)) = world.multibody_joints.get_mut(h) {
-                    if let Some(link) = mb.link_mut(id) {
-                        link.joint.set_spring(5, stiffness[i], 0.0);
-                    }
-                    if let Some(d) = mb.damping_mut().iter_mut().last() {
-                        *d = 20.0; // structural damping [N m s/rad]: 10-40 % of critical for the default test arm
-                    }
-                }
+                set_spring(world, h, ANG_Z, stiffness[i], 0.0);
+                // structural damping [N m s/rad]: 10-40 % of critical for the default test arm
+                set_last_dof_damping(world, h, 20.0);
             },
         )?;
         let tip_body = *bodies
@@ -129,27 +80,17 @@ impl SerialArmSim {
         })
     }
 
-    /// Tip position (x, y) [m].
+    /// Tip position (x, y) \[m\].
     pub fn tip(&self) -> Vector2<f64> {
         let l = self.lengths.last().copied().unwrap_or(0.0);
-        let p = self
-            .world
-            .bodies
-            .get(self.tip_body)
-            .map(|rb| rb.position().transform_point(Vector::new(l, 0.0, 0.0)))
-            .unwrap_or(Vector::ZERO);
-        Vector2::new(p.x, p.y)
+        body_point(&self.world, self.tip_body, Vector::new(l, 0.0, 0.0)).xy()
     }
 
-    /// One step with joint commands `q` [rad] (spring rest angles) and a tip force [N].
+    /// One step with joint commands `q` \[rad\] (spring rest angles) and a tip force \[N\].
     pub fn step(&mut self, q: &[f64], force: &Vector2<f64>) {
         for (i, h) in self.joints.iter().enumerate() {
             let rest = q.get(i).copied().unwrap_or(0.0) - self.q_ref.get(i).copied().unwrap_or(0.0);
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(*h) {
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint.set_spring(5, self.stiffness[i], rest);
-                }
-            }
+            set_spring(&mut self.world, *h, ANG_Z, self.stiffness[i], rest);
         }
         let tip = self.tip();
         if let Some(rb) = self.world.bodies.get_mut(self.tip_body) {
@@ -164,7 +105,7 @@ impl SerialArmSim {
         self.world.step();
     }
 
-    /// `J K^-1 J^T` at the reference angles [m/N].
+    /// `J K^-1 J^T` at the reference angles \[m/N\].
     pub fn linear_compliance(&self) -> Matrix2<f64> {
         let n = self.lengths.len();
         let mut j = DMatrix::zeros(2, n);

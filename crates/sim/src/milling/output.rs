@@ -6,10 +6,10 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde_json::json;
 
+use super::{MillingResult, Sample};
 use crate::SimError;
-use crate::milling::{MillingResult, Sample};
 use crate::output::{
-    CHART, McapLog, canvas, labelled_line, legend, new_chart, perr, stamp, stamp_schema,
+    CHART, McapLog, canvas, labelled_line, legend, new_chart, perr, present, stamp, stamp_schema,
     write_summary,
 };
 
@@ -313,7 +313,7 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
         )?;
     }
     legend(&mut chart, 0.8, 15)?;
-    root.present().map_err(perr)?;
+    present(&root, path)?;
     Ok(())
 }
 
@@ -382,14 +382,15 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             .map_err(perr)?;
     }
     legend(&mut chart, 0.8, 15)?;
-    root.present().map_err(perr)?;
+    present(&root, path)?;
     Ok(())
 }
 
 /// Writes `milling_summary.{txt,csv,json}`, `milling.mcap`, `milling_error.png` and
 /// `milling_stiffness.png` into `out`.
 pub fn write_all(out: &Path, r: &MillingResult) -> Result<(), SimError> {
-    std::fs::create_dir_all(out)?;
+    std::fs::create_dir_all(out)
+        .map_err(|e| SimError::file(out, "create the output directory", e))?;
     write_summary(out, "milling_summary", &table(r), &csv(r), &json(r))?;
     write_mcap(&out.join("milling.mcap"), r)?;
     plot_error(&out.join("milling_error.png"), r)?;

@@ -9,10 +9,10 @@ use nalgebra::Vector2;
 use plotters::prelude::*;
 use serde_json::json;
 
+use super::{ContourRun, Sample};
 use crate::SimError;
-use crate::contour_scene::{ContourRun, Sample};
 use crate::output::{
-    ChartStyle, McapLog, canvas, labelled_line, legend, new_chart, perr, stamp, stamp_schema,
+    ChartStyle, McapLog, canvas, labelled_line, legend, new_chart, present, stamp, stamp_schema,
     write_summary,
 };
 use crate::report::reduction;
@@ -308,7 +308,7 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
         labelled_line(&mut chart, pts, c, 2, label)?;
     }
     legend(&mut chart, 0.85, 14)?;
-    root.present().map_err(perr)?;
+    present(&root, path)?;
     Ok(())
 }
 

@@ -1,0 +1,639 @@
+//! Command line of `deflect-sim` (binary): the clap definitions and the argument types, with
+//! their conversions to the library's types; the documented range of every numeric flag
+//! ([`Range`], shown in its `--help`) and the checks of the arguments before any work
+//! ([`Command::check`]); the two kinds of errors and their exit codes ([`CliError`]).
+//!
+//! The ranges keep every accepted command within a few minutes of run time and a few hundred
+//! MB of memory. Release build, measured: `milling` at its largest cut, force and smallest
+//! cycle about 2 s and 30 MB; `contour` is bounded by the tracer's 4000-step limit per object
+//! (about 0.7 M physics steps, under 10 s per object); `reproduce` with 50 fixed-point
+//! iterations about 2 s.
+
+use std::fmt;
+use std::path::PathBuf;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use deflect_sim::pipeline::Motion;
+use deflect_sim::robot::{Constraint, Head};
+use deflect_sim::{SimError, robot};
+
+/// Why a command did not succeed, with its exit code.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CliError {
+    /// A refused command line: a value out of range, an input path that is not a readable
+    /// file, an output directory that cannot be created or written. Exit code 2, as clap's
+    /// own usage errors.
+    Usage(String),
+    /// The command failed: an input file's content, a scenario error, a file that could not be
+    /// written. Exit code 1.
+    Failure(String),
+}
+
+impl CliError {
+    /// The process exit code: 2 for usage, 1 for failure.
+    pub fn code(&self) -> u8 {
+        match self {
+            Self::Usage(_) => 2,
+            Self::Failure(_) => 1,
+        }
+    }
+
+    /// The message.
+    pub fn message(&self) -> &str {
+        match self {
+            Self::Usage(m) | Self::Failure(m) => m,
+        }
+    }
+}
+
+impl From<SimError> for CliError {
+    fn from(e: SimError) -> Self {
+        Self::Failure(e.0)
+    }
+}
+
+/// The documented range of a numeric flag: `[min, max]` (`(min, max)` if `open`), with its
+/// unit. Shown in the flag's `--help` ([`Range::help`]) and checked before any work
+/// ([`Range::check`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Range {
+    /// The flag, `--cut`.
+    pub flag: &'static str,
+    /// Smallest value.
+    pub min: f64,
+    /// Largest value.
+    pub max: f64,
+    /// Both ends excluded.
+    pub open: bool,
+    /// Unit ("" if none).
+    pub unit: &'static str,
+}
+
+impl Range {
+    /// `[min, max]` in `unit`.
+    const fn closed(flag: &'static str, min: f64, max: f64, unit: &'static str) -> Self {
+        Self {
+            flag,
+            min,
+            max,
+            open: false,
+            unit,
+        }
+    }
+
+    /// The range as written in help and errors: "[0.01, 5] s", "(1.5, 30) N", "[1, 64]".
+    pub fn text(&self) -> String {
+        let (l, r) = if self.open { ('(', ')') } else { ('[', ']') };
+        let unit = if self.unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {}", self.unit)
+        };
+        format!("{l}{}, {}{r}{unit}", self.min, self.max)
+    }
+
+    /// The help of the flag: "`what`. Range: <text>. `more`."
+    pub fn help(&self, what: &str, more: &str) -> String {
+        let more = if more.is_empty() {
+            String::new()
+        } else {
+            format!(" {more}.")
+        };
+        format!("{what}. Range: {}.{more}", self.text())
+    }
+
+    /// Whether `v` is in the range (NaN is not).
+    pub fn contains(&self, v: f64) -> bool {
+        if self.open {
+            v > self.min && v < self.max
+        } else {
+            v >= self.min && v <= self.max
+        }
+    }
+
+    /// `v` in the range, or the usage error "--flag v is out of range: allowed <text>".
+    pub fn check(&self, v: f64) -> Result<(), CliError> {
+        self.check_shown(v, &shown(v))
+    }
+
+    /// [`Range::check`] of an integer flag (shown as given; u64 -> f64 rounds only above
+    /// 2^53, far outside every integer range here).
+    pub fn check_int(&self, v: impl Into<u64> + Copy + fmt::Display) -> Result<(), CliError> {
+        self.check_shown(v.into() as f64, &v.to_string())
+    }
+
+    fn check_shown(&self, v: f64, shown: &str) -> Result<(), CliError> {
+        if self.contains(v) {
+            Ok(())
+        } else {
+            Err(CliError::Usage(format!(
+                "{} {shown} is out of range: allowed {}",
+                self.flag,
+                self.text()
+            )))
+        }
+    }
+}
+
+/// A float as the errors show it: plain, or in exponent form when very large or small.
+fn shown(v: f64) -> String {
+    let a = v.abs();
+    if v.is_finite() && a != 0.0 && !(1e-4..1e6).contains(&a) {
+        format!("{v:e}")
+    } else {
+        format!("{v}")
+    }
+}
+
+/// `reproduce --mass`, `run --mass` \[kg\].
+pub const MASS: Range = Range::closed("--mass", 0.0, 50.0, "kg");
+/// `reproduce --g` (each level), `run --g`.
+pub const G_LEVEL: Range = Range::closed("--g", 1.0, 5.0, "g");
+/// `reproduce --fixed-point`.
+pub const FIXED_POINT: Range = Range::closed("--fixed-point", 0.0, 50.0, "");
+/// `reproduce --jobs`, `contour --jobs`: 0 is refused (it used to mean 1).
+pub const JOBS: Range = Range::closed("--jobs", 1.0, 64.0, "");
+/// `milling --feed` \[mm/s\]: with the longest cut the groove stays within 300 mm, well inside
+/// the arm's reach.
+pub const FEED: Range = Range::closed("--feed", 0.1, 50.0, "mm/s");
+/// `milling --force` \[N\].
+pub const FORCE: Range = Range::closed("--force", 0.0, 2000.0, "N");
+/// `milling --cut` \[s\]: at most 4 x 5.8 s simulated at 0.5 ms plus the identification.
+pub const CUT: Range = Range::closed("--cut", 0.01, 5.0, "s");
+/// `milling --rise-ms` \[ms\]: within the 0.4 s run-out.
+pub const RISE_MS: Range = Range::closed("--rise-ms", 0.1, 300.0, "ms");
+/// `milling --cycle-ms` \[ms\], also a multiple of the 0.5 ms physics step.
+pub const CYCLE_MS: Range = Range::closed("--cycle-ms", 0.5, 20.0, "ms");
+/// `milling --lead-ms` \[ms\].
+pub const LEAD_MS: Range = Range::closed("--lead-ms", 0.0, 500.0, "ms");
+/// `milling --estimate-error`.
+pub const ESTIMATE_ERROR: Range = Range::closed("--estimate-error", -1.0, 1.0, "");
+/// `contour --step-mm` \[mm\].
+pub const STEP_MM: Range = Range::closed("--step-mm", 0.2, 20.0, "mm");
+/// `contour --target-force` \[N\]: strictly between the tracer's contact and jam forces.
+pub const TARGET_FORCE: Range = Range {
+    flag: "--target-force",
+    min: 1.5,
+    max: 30.0,
+    open: true,
+    unit: "N",
+};
+/// `contour --noise` \[N\].
+pub const NOISE: Range = Range::closed("--noise", 0.0, 5.0, "N");
+
+// The command line.
+#[derive(Parser, Debug)]
+#[command(
+    name = "deflect-sim",
+    version,
+    about = "Simulated reproduction of the D'Alembert trajectory correction (Paksoy et al.) on a \
+             rapier3d-f64 model of the 2-DoF parallel robot. Without a subcommand: reproduce."
+)]
+pub struct Cli {
+    // The scenario; `reproduce` if none.
+    #[command(subcommand)]
+    pub command: Option<Command>,
+    /// Output directory (created if missing; must be writable).
+    #[arg(long, global = true, default_value = "out")]
+    pub out: PathBuf,
+}
+
+// The scenario commands.
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// The whole pipeline: static tests, fit, all motions at 1-5 g for OC/NC x GU/GL, with and
+    /// without correction; tables, CSV/JSON, MCAP and plots.
+    Reproduce(ReproduceArgs),
+    /// Simulated static tests (15 nodes x 2 axes x 49..245 N), written as CSV (mm, N).
+    StaticTest {
+        /// Mechanism.
+        #[arg(long, value_enum, default_value_t = Mech::Oc)]
+        mechanism: Mech,
+    },
+    /// Fits a compliance map from a static-test CSV (or runs the static tests first) and
+    /// reports its held-out prediction error.
+    Fit {
+        /// Mechanism (for fresh static tests and the held-out tests).
+        #[arg(long, value_enum, default_value_t = Mech::Oc)]
+        mechanism: Mech,
+        /// Static-test CSV written by `static-test` (columns x, y \[mm\], force_axis, force \[N\],
+        /// dx, dy \[mm\]); a regular file of at most 16 MiB.
+        #[arg(long)]
+        input: Option<PathBuf>,
+    },
+    /// One motion on one configuration, uncorrected and/or corrected; writes an MCAP log.
+    Run(RunArgs),
+    /// Milling scenario for the online force-based compensation (Hähn & Weigold): a 4-axis
+    /// flexible arm mills a groove; uncompensated, Cartesian compensation and pilot control;
+    /// stiffness and sensor identification. Writes milling_summary.{txt,csv,json},
+    /// milling.mcap and PNG plots.
+    Milling(MillingArgs),
+    /// Force-feedback contour tracing (deflect-core's contour tracer, Eq. 21) of a circle, a
+    /// rectangle and an L-shape by a 2R arm with compliant, backlashed joints; shape recovered
+    /// raw and with the Eq. 10 compensation. Writes contour_summary.{txt,csv,json},
+    /// contour.mcap, contour_*.png.
+    Contour(ContourArgs),
+}
+
+// Arguments of `contour` (help texts with their ranges in the `help` attributes).
+#[derive(clap::Args, Debug)]
+pub struct ContourArgs {
+    #[arg(long, default_value_t = 1.5, help = STEP_MM.help("Tracer step along the edge [mm]", ""))]
+    pub step_mm: f64,
+    #[arg(long, default_value_t = 6.0, help = TARGET_FORCE.help(
+        "Target contact force [N]",
+        "Between the tracer's contact (1.5 N) and jam (30 N) forces, both excluded"
+    ))]
+    pub target_force: f64,
+    #[arg(long, default_value_t = 0.3, help = NOISE.help(
+        "Force sensor noise, standard deviation per sample and axis [N]",
+        ""
+    ))]
+    pub noise: f64,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 7)]
+    pub seed: u64,
+    #[arg(long, default_value_t = 2, help = JOBS.help(
+        "Worker threads (one object each; results do not depend on it)",
+        "0 is refused"
+    ))]
+    pub jobs: usize,
+}
+
+// Arguments of `milling` (help texts with their ranges in the `help` attributes).
+#[derive(clap::Args, Debug)]
+pub struct MillingArgs {
+    #[arg(long, default_value_t = 25.0, help = FEED.help("Feed speed [mm/s] (paper: 25)", ""))]
+    pub feed: f64,
+    #[arg(long, default_value_t = 550.0, help = FORCE.help(
+        "Magnitude of the process force [N] (direction as the default [-386, 386, -60] N)",
+        ""
+    ))]
+    pub force: f64,
+    #[arg(long, default_value_t = 1.2, help = CUT.help("Cutting time [s]", ""))]
+    pub cut: f64,
+    #[arg(long, default_value_t = 100.0, help = RISE_MS.help(
+        "Rise and fall time of the force at cutter entry and exit [ms]",
+        ""
+    ))]
+    pub rise_ms: f64,
+    #[arg(long, default_value_t = 4.0, help = CYCLE_MS.help(
+        "Control cycle [ms] (paper: 4, KUKA RSI)",
+        "A multiple of the 0.5 ms physics step"
+    ))]
+    pub cycle_ms: f64,
+    #[arg(long, default_value_t = 40.0, help = LEAD_MS.help(
+        "Lead of the offline force estimate over the real force [ms]",
+        ""
+    ))]
+    pub lead_ms: f64,
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true, help = ESTIMATE_ERROR.help(
+        "Relative error of the offline force estimate (0.1 = 10 % too large)",
+        "Negative values: an estimate too small"
+    ))]
+    pub estimate_error: f64,
+    /// Seed of the sensor and measurement noise.
+    #[arg(long, default_value_t = 6)]
+    pub seed: u64,
+}
+
+// Arguments of `reproduce` (help texts with their ranges in the `help` attributes).
+#[derive(clap::Args, Debug)]
+pub struct ReproduceArgs {
+    #[arg(long, default_value_t = 5.0,
+        help = MASS.help("Mass parameter m* of the correction [kg]", ""))]
+    pub mass: f64,
+    #[arg(long, value_delimiter = ',', default_values_t = vec![1u8, 2, 3, 4, 5],
+        help = G_LEVEL.help("Acceleration levels [g], comma-separated", "Each level at most once"))]
+    pub g: Vec<u8>,
+    #[arg(long, default_value_t = 0, help = FIXED_POINT.help(
+        "Fixed-point iterations of the corrector (0 = the paper's one-shot update)",
+        ""
+    ))]
+    pub fixed_point: usize,
+    #[arg(long, default_value_t = 2, help = JOBS.help(
+        "Worker threads for the runs (results do not depend on it)",
+        "0 is refused"
+    ))]
+    pub jobs: usize,
+}
+
+impl Default for ReproduceArgs {
+    /// What `deflect-sim` without a subcommand runs: the defaults above.
+    fn default() -> Self {
+        Self {
+            mass: 5.0,
+            g: vec![1, 2, 3, 4, 5],
+            fixed_point: 0,
+            jobs: 2,
+        }
+    }
+}
+
+// Arguments of `run`.
+#[derive(clap::Args, Debug)]
+pub struct RunArgs {
+    /// Mechanism.
+    #[arg(long, value_enum, default_value_t = Mech::Oc)]
+    pub mechanism: Mech,
+    /// Head position.
+    #[arg(long, value_enum, default_value_t = HeadArg::Upper)]
+    pub head: HeadArg,
+    /// Motion.
+    #[arg(long, value_enum, default_value_t = MotionArg::Y)]
+    pub motion: MotionArg,
+    #[arg(long, default_value_t = 5, help = G_LEVEL.help("Acceleration level [g]", ""))]
+    pub g: u8,
+    /// Correction off, on, or both runs.
+    #[arg(long, value_enum, default_value_t = Correction::Both)]
+    pub correction: Correction,
+    #[arg(long, default_value_t = 5.0, help = MASS.help("Mass parameter m* [kg]", ""))]
+    pub mass: f64,
+    /// Compliance map JSON (from `fit`; a regular file of at most 16 MiB); default: simulate
+    /// the static tests and fit.
+    #[arg(long)]
+    pub map: Option<PathBuf>,
+}
+
+// Mechanism variant.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum Mech {
+    // Over-constrained.
+    Oc,
+    // Normal-constrained.
+    Nc,
+}
+
+// Head position.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum HeadArg {
+    // Centre of mass high above G.
+    Upper,
+    // Centre of mass low above G.
+    Lower,
+}
+
+// One of the paper's motions.
+#[derive(ValueEnum, Clone, Copy, Debug)]
+pub enum MotionArg {
+    // 100 mm along x.
+    X,
+    // 150 mm along y.
+    Y,
+    // The triangle (combined motion).
+    Triangle,
+}
+
+// Which runs of `run`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum Correction {
+    // Uncorrected only.
+    Off,
+    // Corrected only.
+    On,
+    // Both.
+    Both,
+}
+
+/// `n` as a `u64` (saturating; usize is 64 bits or less on every supported target).
+fn count(n: usize) -> u64 {
+    u64::try_from(n).unwrap_or(u64::MAX)
+}
+
+impl Command {
+    /// Checks the arguments against their documented ranges before any work: the first value
+    /// out of range is a usage error naming the flag, the value and the range.
+    pub fn check(&self) -> Result<(), CliError> {
+        match self {
+            Self::Reproduce(a) => a.check(),
+            Self::StaticTest { .. } | Self::Fit { .. } => Ok(()),
+            Self::Run(a) => a.check(),
+            Self::Milling(a) => a.check(),
+            Self::Contour(a) => a.check(),
+        }
+    }
+}
+
+impl ReproduceArgs {
+    /// See [`Command::check`]; the levels are also distinct.
+    pub fn check(&self) -> Result<(), CliError> {
+        MASS.check(self.mass)?;
+        if self.g.is_empty() {
+            return Err(CliError::Usage(
+                "--g: no acceleration level given: allowed 1 to 5 levels, each in [1, 5] g".into(),
+            ));
+        }
+        for (k, &g) in self.g.iter().enumerate() {
+            G_LEVEL.check_int(g)?;
+            if self.g.iter().take(k).any(|&h| h == g) {
+                return Err(CliError::Usage(format!(
+                    "--g {g} is given twice: allowed each level in {} at most once",
+                    G_LEVEL.text()
+                )));
+            }
+        }
+        FIXED_POINT.check_int(count(self.fixed_point))?;
+        JOBS.check_int(count(self.jobs))
+    }
+}
+
+impl RunArgs {
+    /// See [`Command::check`].
+    pub fn check(&self) -> Result<(), CliError> {
+        G_LEVEL.check_int(self.g)?;
+        MASS.check(self.mass)
+    }
+}
+
+impl MillingArgs {
+    /// See [`Command::check`]; the control cycle is also a whole number of physics steps.
+    pub fn check(&self) -> Result<(), CliError> {
+        FEED.check(self.feed)?;
+        FORCE.check(self.force)?;
+        CUT.check(self.cut)?;
+        RISE_MS.check(self.rise_ms)?;
+        CYCLE_MS.check(self.cycle_ms)?;
+        let dt_ms = robot::DT * 1e3;
+        let steps = self.cycle_ms / dt_ms;
+        if (steps - steps.round()).abs() > 1e-9 {
+            return Err(CliError::Usage(format!(
+                "--cycle-ms {} is not a multiple of the {dt_ms} ms physics step: allowed {}, \
+                 in steps of {dt_ms} ms",
+                shown(self.cycle_ms),
+                CYCLE_MS.text()
+            )));
+        }
+        LEAD_MS.check(self.lead_ms)?;
+        ESTIMATE_ERROR.check(self.estimate_error)
+    }
+}
+
+impl ContourArgs {
+    /// See [`Command::check`].
+    pub fn check(&self) -> Result<(), CliError> {
+        STEP_MM.check(self.step_mm)?;
+        TARGET_FORCE.check(self.target_force)?;
+        NOISE.check(self.noise)?;
+        JOBS.check_int(count(self.jobs))
+    }
+}
+
+impl Mech {
+    /// The library's mechanism variant.
+    pub fn constraint(self) -> Constraint {
+        match self {
+            Self::Oc => Constraint::Oc,
+            Self::Nc => Constraint::Nc,
+        }
+    }
+}
+
+impl HeadArg {
+    /// The library's head position.
+    pub fn head(self) -> Head {
+        match self {
+            Self::Upper => Head::Upper,
+            Self::Lower => Head::Lower,
+        }
+    }
+}
+
+impl MotionArg {
+    /// The library's motion.
+    pub fn motion(self) -> Motion {
+        match self {
+            Self::X => Motion::XLine,
+            Self::Y => Motion::YLine,
+            Self::Triangle => Motion::Triangle,
+        }
+    }
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used, clippy::panic)]
+mod tests {
+    use clap::{CommandFactory, Parser};
+
+    use super::*;
+
+    fn parse(args: &[&str]) -> Command {
+        let mut all = vec!["deflect-sim"];
+        all.extend_from_slice(args);
+        Cli::try_parse_from(all).unwrap().command.unwrap()
+    }
+
+    /// The ranges of each subcommand's flags.
+    fn ranged() -> [(&'static str, Vec<Range>); 4] {
+        [
+            ("reproduce", vec![MASS, G_LEVEL, FIXED_POINT, JOBS]),
+            ("run", vec![G_LEVEL, MASS]),
+            (
+                "milling",
+                vec![FEED, FORCE, CUT, RISE_MS, CYCLE_MS, LEAD_MS, ESTIMATE_ERROR],
+            ),
+            ("contour", vec![STEP_MM, TARGET_FORCE, NOISE, JOBS]),
+        ]
+    }
+
+    #[test]
+    fn every_range_is_in_the_help_of_its_flag() {
+        let mut cmd = Cli::command();
+        cmd.build();
+        for (sub, ranges) in ranged() {
+            let sc = cmd.find_subcommand(sub).unwrap();
+            for r in ranges {
+                let long = r.flag.trim_start_matches("--");
+                let arg = sc
+                    .get_arguments()
+                    .find(|a| a.get_long() == Some(long))
+                    .unwrap_or_else(|| panic!("{sub} {}", r.flag));
+                let help = arg.get_help().unwrap().to_string();
+                assert!(
+                    help.contains(&format!("Range: {}.", r.text())),
+                    "{sub} {}: {help}",
+                    r.flag
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn defaults_are_in_range() {
+        ReproduceArgs::default().check().unwrap();
+        for sub in [
+            "reproduce",
+            "static-test",
+            "fit",
+            "run",
+            "milling",
+            "contour",
+        ] {
+            parse(&[sub]).check().unwrap();
+        }
+        let Command::Reproduce(a) = parse(&["reproduce"]) else {
+            panic!("reproduce");
+        };
+        let d = ReproduceArgs::default();
+        assert_eq!(
+            (a.mass, &a.g, a.fixed_point, a.jobs),
+            (d.mass, &d.g, d.fixed_point, d.jobs)
+        );
+    }
+
+    #[test]
+    fn ranges_match_the_scenes() {
+        let t = deflect_sim::contour_scene::TraceOptions::default();
+        assert_eq!(
+            (TARGET_FORCE.min, TARGET_FORCE.max),
+            (t.contact_force, t.jam_force)
+        );
+        assert_eq!(
+            deflect_sim::milling::MillingOptions::default().dt,
+            robot::DT
+        );
+        assert_eq!(CYCLE_MS.min, robot::DT * 1e3);
+    }
+
+    #[test]
+    fn range_text_and_checks() {
+        assert_eq!(CUT.text(), "[0.01, 5] s");
+        assert_eq!(TARGET_FORCE.text(), "(1.5, 30) N");
+        assert_eq!(JOBS.text(), "[1, 64]");
+        assert!(CUT.check(0.01).is_ok() && CUT.check(5.0).is_ok());
+        for v in [0.0099, 5.0001, f64::NAN, f64::INFINITY, -1.0] {
+            assert_eq!(CUT.check(v).unwrap_err().code(), 2, "{v}");
+        }
+        assert!(TARGET_FORCE.check(1.5).is_err() && TARGET_FORCE.check(30.0).is_err());
+        assert!(TARGET_FORCE.check(1.51).is_ok());
+        assert_eq!(
+            CUT.check(1e9).unwrap_err().message(),
+            "--cut 1e9 is out of range: allowed [0.01, 5] s"
+        );
+        assert_eq!(
+            JOBS.check_int(u64::MAX).unwrap_err().message(),
+            format!("--jobs {} is out of range: allowed [1, 64]", u64::MAX)
+        );
+    }
+
+    #[test]
+    fn cycle_is_a_whole_number_of_physics_steps() {
+        for (v, ok) in [
+            ("0.5", true),
+            ("4", true),
+            ("19.5", true),
+            ("0.7", false),
+            ("4.25", false),
+        ] {
+            let c = parse(&["milling", "--cycle-ms", v]);
+            assert_eq!(c.check().is_ok(), ok, "{v}");
+        }
+    }
+
+    #[test]
+    fn levels_are_distinct() {
+        assert!(parse(&["reproduce", "--g", "5,1,3"]).check().is_ok());
+        let e = parse(&["reproduce", "--g", "1,3,1"]).check().unwrap_err();
+        assert_eq!(e.code(), 2);
+        assert!(e.message().contains("--g 1 is given twice"), "{e:?}");
+    }
+}

@@ -1,0 +1,436 @@
+//! The milling runs: settings and nominal motion ([`MillingOptions`]), the process force and
+//! its offline estimate, one run of the groove per compensation [`Mode`] with the online
+//! compensation of Hähn and Weigold (sec. 2.2-2.4) in the loop, its path-error [`Metrics`],
+//! and the whole scenario ([`milling`]).
+
+use deflect_core::compensation::{self, CompensatorConfig, SensorCalibration};
+use deflect_core::vjm::{Model, Vector6};
+use nalgebra::Vector3;
+use serde::Serialize;
+
+use super::arm::{ArmParams, FlexArm, JOINTS, vjm_model};
+use super::identification::{
+    JointEstimate, SensorEstimate, identify_sensor_calibration, identify_stiffness,
+};
+use super::sensor::SensorParams;
+use crate::SimError;
+use crate::noise::Noise;
+use crate::robot::DT;
+
+/// The milling scenario's settings.
+#[derive(Debug, Clone, Serialize)]
+pub struct MillingOptions {
+    /// The arm.
+    pub arm: ArmParams,
+    /// The sensor.
+    pub sensor: SensorParams,
+    /// Start of the groove (tool point) \[m\]; the groove runs along +x.
+    pub start: [f64; 3],
+    /// Feed speed \[m/s\] (paper: 25 mm/s).
+    pub feed: f64,
+    /// Process force while cutting \[N\], base frame (paper: 546 N in the xy plane).
+    pub force: [f64; 3],
+    /// Standstill before the motion \[s\].
+    pub settle: f64,
+    /// Acceleration ramp to the feed speed \[s\].
+    pub ramp: f64,
+    /// Travel from reaching the feed to cutter entry \[s\].
+    pub approach: f64,
+    /// Cutting time \[s\].
+    pub cut: f64,
+    /// Travel after cutter exit \[s\].
+    pub runout: f64,
+    /// Rise (and fall) time of the force at entry and exit \[s\]: the cutter's engagement, 0.1 s
+    /// = 2.5 mm of travel at 25 mm/s.
+    pub force_rise: f64,
+    /// Control cycle \[s\] (paper: 4 ms, KUKA RSI).
+    pub cycle: f64,
+    /// Transport delay of a correction into the servos \[cycles\].
+    pub delay_cycles: usize,
+    /// Servo lag time constant for corrections \[s\].
+    pub servo_tau: f64,
+    /// Lead of the offline force estimate over the real force \[s\] (paper Fig. 3: ~40 ms).
+    pub estimate_lead: f64,
+    /// Relative error of the offline estimate (0.1 = 10 % too large).
+    pub estimate_error: f64,
+    /// Pilot control `(threshold [N], ramp [s])` (paper: 150 N, 80 ms).
+    pub pilot: (f64, f64),
+    /// Physics step \[s\] (0.5 ms; tests use 2 ms).
+    pub dt: f64,
+    /// Static test loads for the stiffness identification \[N\].
+    pub id_load: f64,
+    /// Number of poses for the stiffness identification (1..=3).
+    pub id_poses: usize,
+    /// Hold time of each static load before reading \[s\].
+    pub id_hold: f64,
+    /// Noise of the frame-pair rotation measurements \[rad\] and TCP deflections \[m\].
+    pub id_noise: [f64; 2],
+    /// Seed of all noise.
+    pub seed: u64,
+}
+
+impl Default for MillingOptions {
+    fn default() -> Self {
+        Self {
+            arm: ArmParams::default(),
+            sensor: SensorParams::default(),
+            start: [1.05, -0.15, 0.1],
+            feed: 0.025,
+            force: [-386.1, 386.1, -60.0],
+            settle: 0.1,
+            ramp: 0.2,
+            approach: 0.3,
+            cut: 1.2,
+            runout: 0.4,
+            force_rise: 0.1,
+            cycle: 0.004,
+            delay_cycles: 2,
+            servo_tau: 0.012,
+            estimate_lead: 0.04,
+            estimate_error: 0.1,
+            pilot: (150.0, 0.08),
+            dt: DT,
+            id_load: 800.0,
+            id_poses: 3,
+            id_hold: 0.2,
+            id_noise: [2.0e-6, 2.0e-6],
+            seed: 6,
+        }
+    }
+}
+
+impl MillingOptions {
+    /// A short scenario for tests (seconds in a debug build): 2 ms physics step, shorter
+    /// approach, cut and run-out, one identification pose with shorter holds, noise-free
+    /// identification.
+    pub fn short() -> Self {
+        Self {
+            settle: 0.02,
+            ramp: 0.05,
+            approach: 0.1,
+            cut: 0.35,
+            runout: 0.2,
+            dt: 0.002,
+            id_poses: 1,
+            id_hold: 0.12,
+            id_noise: [0.0, 0.0],
+            ..Self::default()
+        }
+    }
+
+    /// Cutter entry time \[s\].
+    pub fn t_entry(&self) -> f64 {
+        self.settle + self.ramp + self.approach
+    }
+
+    /// Cutter exit time \[s\].
+    pub fn t_exit(&self) -> f64 {
+        self.t_entry() + self.cut
+    }
+
+    /// End of the run \[s\].
+    pub fn t_end(&self) -> f64 {
+        self.t_exit() + self.runout
+    }
+
+    /// Nominal tool point and velocity at time `t`: standstill, a (1 - cos) ramp to the feed,
+    /// then constant feed along +x.
+    pub fn nominal(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let start = Vector3::from(self.start);
+        let tm = t - self.settle;
+        let (s, v) = if tm <= 0.0 {
+            (0.0, 0.0)
+        } else if tm < self.ramp {
+            let w = core::f64::consts::PI / self.ramp;
+            (
+                0.5 * self.feed * (tm - (w * tm).sin() / w),
+                0.5 * self.feed * (1.0 - (w * tm).cos()),
+            )
+        } else {
+            (
+                0.5 * self.feed * self.ramp + self.feed * (tm - self.ramp),
+                self.feed,
+            )
+        };
+        (start + Vector3::x() * s, Vector3::x() * v)
+    }
+
+    /// The real process force at time `t` \[N\]: smooth steps at entry and exit.
+    pub fn process_force(&self, t: f64) -> Vector3<f64> {
+        let smooth = |x: f64| {
+            let x = (x / self.force_rise.max(1e-9)).clamp(0.0, 1.0);
+            x * x * (3.0 - 2.0 * x)
+        };
+        let level = smooth(t - self.t_entry()) - smooth(t - self.t_exit());
+        Vector3::from(self.force) * level
+    }
+
+    /// The offline estimate: the real force `estimate_lead` earlier and `estimate_error` off.
+    pub fn estimated_force(&self, t: f64) -> Vector3<f64> {
+        self.process_force(t + self.estimate_lead) * (1.0 + self.estimate_error)
+    }
+}
+
+/// Which compensation a run uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Mode {
+    /// No compensation.
+    Uncompensated,
+    /// Online compensation with measured forces (pilot off).
+    Cartesian,
+    /// Online compensation with pilot control from the offline estimate.
+    Pilot,
+    /// As `Cartesian`, but with an empty sensor calibration (offsets and tool weight not
+    /// removed): shows why the sensor identification matters.
+    Uncalibrated,
+}
+
+impl Mode {
+    /// Short name for topics and files.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Uncompensated => "uncompensated",
+            Self::Cartesian => "cartesian",
+            Self::Pilot => "pilot",
+            Self::Uncalibrated => "uncalibrated",
+        }
+    }
+}
+
+/// One control cycle of a run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Sample {
+    /// Time \[s\].
+    pub t: f64,
+    /// Nominal tool point \[m\].
+    pub nominal: [f64; 3],
+    /// Simulated tool point \[m\].
+    pub actual: [f64; 3],
+    /// Commanded tool point (nominal + correction) \[m\].
+    pub commanded: [f64; 3],
+    /// Motor angles \[rad\].
+    pub q_motor: [f64; JOINTS],
+    /// True process force \[N\].
+    pub force_true: [f64; 3],
+    /// Raw sensor reading (sensor frame) \[N, N m\].
+    pub force_measured: [f64; 6],
+    /// Filtered, compensated TCP wrench (base frame) \[N, N m\].
+    pub force_filtered: [f64; 6],
+    /// Wrench fed to the model (after pilot control) \[N, N m\].
+    pub force_used: [f64; 6],
+    /// Correction `[dp; dr]` \[m, rad\].
+    pub correction: [f64; 6],
+    /// Pilot weight of the estimate.
+    pub pilot_weight: f64,
+    /// Distance of the tool point from the nominal line (across the feed) \[mm\].
+    pub error_mm: f64,
+}
+
+/// Path-error metrics of a run \[mm\].
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Metrics {
+    /// Max deviation from cutter entry (start of the force rise) to 0.1 s after the force
+    /// has fallen at exit.
+    pub max_mm: f64,
+    /// RMS deviation over the same window.
+    pub rms_mm: f64,
+    /// Max deviation from 0.1 s after the force has risen to exit (steady cutting).
+    pub steady_max_mm: f64,
+    /// Max deviation around entry (from 0.1 s before to 0.1 s after the force has risen).
+    pub entry_max_mm: f64,
+    /// Max deviation around exit (from 0.1 s before to 0.1 s after the force has fallen).
+    pub exit_max_mm: f64,
+}
+
+/// A finished run.
+#[derive(Debug, Clone, Serialize)]
+pub struct Run {
+    /// The compensation used.
+    pub mode: Mode,
+    /// Errors.
+    pub metrics: Metrics,
+    /// Per-cycle log.
+    pub samples: Vec<Sample>,
+}
+
+/// Everything the scenario produced.
+#[derive(Debug, Clone, Serialize)]
+pub struct MillingResult {
+    /// Settings.
+    pub options: MillingOptions,
+    /// Stiffness identification per joint.
+    pub stiffness: Vec<JointEstimate>,
+    /// Sensor identification.
+    pub sensor: SensorEstimate,
+    /// The runs: uncompensated, Cartesian, pilot, uncalibrated.
+    pub runs: Vec<Run>,
+    /// Simulated time of the runs and the static tests \[s\].
+    pub sim_seconds: f64,
+    /// Wall-clock seconds.
+    pub wall_seconds: f64,
+}
+
+fn metrics(opts: &MillingOptions, samples: &[Sample]) -> Metrics {
+    let (te, tx) = (opts.t_entry(), opts.t_exit());
+    let max_in = |a: f64, b: f64| {
+        samples
+            .iter()
+            .filter(|s| s.t >= a && s.t <= b)
+            .map(|s| s.error_mm)
+            .fold(0.0, f64::max)
+    };
+    let win: Vec<f64> = samples
+        .iter()
+        .filter(|s| s.t >= te && s.t <= tx + opts.force_rise + 0.1)
+        .map(|s| s.error_mm)
+        .collect();
+    let rms = (win.iter().map(|e| e * e).sum::<f64>() / win.len().max(1) as f64).sqrt();
+    Metrics {
+        max_mm: max_in(te, tx + opts.force_rise + 0.1),
+        rms_mm: rms,
+        steady_max_mm: max_in(te + opts.force_rise + 0.1, tx),
+        entry_max_mm: max_in(te - 0.1, te + opts.force_rise + 0.1),
+        exit_max_mm: max_in(tx - 0.1, tx + opts.force_rise + 0.1),
+    }
+}
+
+/// One run of the groove with `mode`, the compensator using `model` (identified stiffnesses)
+/// and `calibration` (identified sensor).
+pub fn run(
+    opts: &MillingOptions,
+    mode: Mode,
+    model: &Model,
+    calibration: &SensorCalibration,
+) -> Result<Run, SimError> {
+    let arm = &opts.arm;
+    let truth = opts.sensor.calibration(arm.sensor_to_tcp());
+    let (p0, _) = opts.nominal(0.0);
+    let q0 = arm.ik(&p0);
+    let mut sim = FlexArm::new(arm, &q0, 1.0, opts.dt)?;
+    let mut comp = match mode {
+        Mode::Uncompensated => None,
+        Mode::Cartesian | Mode::Pilot | Mode::Uncalibrated => {
+            let cal = if mode == Mode::Uncalibrated {
+                SensorCalibration {
+                    sensor_to_tcp: calibration.sensor_to_tcp,
+                    ..SensorCalibration::default()
+                }
+            } else {
+                *calibration
+            };
+            let mut cfg = CompensatorConfig::paper(opts.cycle, cal);
+            cfg.pilot = (mode == Mode::Pilot).then_some(opts.pilot);
+            let comp = compensation::Model::new(model.clone(), cfg)
+                .map_err(|e| SimError::new(format!("compensator: {e}")))?;
+            let data = compensation::Data::new(&comp);
+            Some((comp, data))
+        }
+    };
+    let mut noise = Noise::new(opts.seed);
+    let dt = opts.dt;
+    let sub = ((opts.cycle / dt).round() as usize).max(1);
+    let cycles = (opts.t_end() / (sub as f64 * dt)).ceil() as usize;
+    // Corrections (joint offsets) in flight to the servos, and the servo's lagged offset.
+    let mut queue: std::collections::VecDeque<[f64; JOINTS]> =
+        std::iter::repeat_n([0.0; JOINTS], opts.delay_cycles).collect();
+    let mut lagged = [0.0; JOINTS];
+    let alpha = dt / (opts.servo_tau + dt);
+    let mut dq_target = [0.0; JOINTS];
+    let mut samples = Vec::with_capacity(cycles);
+    let mut q_motor = q0;
+    let mut step_index = 0usize;
+    for c in 0..cycles {
+        let t = c as f64 * sub as f64 * dt;
+        let (p_nom, v_nom) = opts.nominal(t);
+        let q_nom = arm.ik(&p_nom);
+        // The sensor is read at the start of the cycle.
+        let f_true = opts.process_force(t);
+        let sensor = sim.sensor_pose();
+        let tcp = sim.tcp();
+        let reading = opts
+            .sensor
+            .reading(&truth, &sensor, &tcp, &f_true, &mut noise, 1.0);
+        let mut sample = Sample {
+            t,
+            nominal: p_nom.into(),
+            actual: tcp.into(),
+            commanded: p_nom.into(),
+            q_motor,
+            force_true: f_true.into(),
+            force_measured: reading.into(),
+            force_filtered: [0.0; 6],
+            force_used: [0.0; 6],
+            correction: [0.0; 6],
+            pilot_weight: 0.0,
+            error_mm: ((tcp.y - p_nom.y).powi(2) + (tcp.z - p_nom.z).powi(2)).sqrt() * 1e3,
+        };
+        if let Some((comp, data)) = comp.as_mut() {
+            let f_est = opts.estimated_force(t);
+            let est = Vector6::new(f_est.x, f_est.y, f_est.z, 0.0, 0.0, 0.0);
+            let out = compensation::step(comp, data, &q_motor, &reading, Some(&est), &v_nom)
+                .map_err(|e| SimError::new(format!("compensator step: {e}")))?;
+            let target = p_nom + out.correction.fixed_rows::<3>(0).into_owned();
+            let q_cmd = arm.ik(&target);
+            dq_target = core::array::from_fn(|j| q_cmd[j] - q_nom[j]);
+            sample.commanded = target.into();
+            sample.force_filtered = out.measured_wrench.into();
+            sample.force_used = out.wrench.into();
+            sample.correction = out.correction.into();
+            sample.pilot_weight = out.pilot_weight;
+        }
+        samples.push(sample);
+        queue.push_back(dq_target);
+        let dq_servo = queue.pop_front().unwrap_or([0.0; JOINTS]);
+        for _ in 0..sub {
+            let ts = step_index as f64 * dt;
+            let (p, _) = opts.nominal(ts);
+            let qn = arm.ik(&p);
+            for (((l, m), d), n) in lagged.iter_mut().zip(&mut q_motor).zip(&dq_servo).zip(&qn) {
+                *l += alpha * (d - *l);
+                *m = n + *l;
+            }
+            sim.step(&q_motor, &opts.process_force(ts));
+            step_index += 1;
+        }
+    }
+    Ok(Run {
+        mode,
+        metrics: metrics(opts, &samples),
+        samples,
+    })
+}
+
+/// The whole scenario: identification of stiffnesses and sensor, then the three runs with the
+/// identified values (and a fourth, Cartesian compensation without sensor calibration).
+pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
+    let start = std::time::Instant::now();
+    let stiffness = identify_stiffness(opts)?;
+    let mut k = [0.0; JOINTS];
+    for (dst, e) in k.iter_mut().zip(&stiffness) {
+        *dst = if e.k_frames.is_finite() && e.k_frames > 0.0 {
+            e.k_frames
+        } else {
+            e.k_true
+        };
+    }
+    let model = vjm_model(&opts.arm, &k)?;
+    let (calibration, sensor) = identify_sensor_calibration(opts)?;
+    let mut runs = Vec::new();
+    for mode in [
+        Mode::Uncompensated,
+        Mode::Cartesian,
+        Mode::Pilot,
+        Mode::Uncalibrated,
+    ] {
+        runs.push(run(opts, mode, &model, &calibration)?);
+    }
+    Ok(MillingResult {
+        options: opts.clone(),
+        stiffness,
+        sensor,
+        runs,
+        sim_seconds: opts.t_end() * 4.0
+            + opts.id_poses.clamp(1, 3) as f64 * 6.0 * (opts.id_hold + 0.03),
+        wall_seconds: start.elapsed().as_secs_f64(),
+    })
+}

@@ -1,0 +1,35 @@
+//! `static-test`: the paper's simulated static tests (Paksoy, Dede and Kiper (2025), sec.
+//! 3.1: 15 nodes x 2 axes x 5 forces) on one mechanism, written as CSV, with their agreement
+//! with the linearized `J K^-1 J^T`.
+
+use std::path::Path;
+
+use deflect_sim::jobs::progress;
+use deflect_sim::pipeline::{self, StaticOptions};
+use deflect_sim::robot::{Head, RobotParams};
+use deflect_sim::{SimError, write_file};
+
+use super::calibrate::static_csv;
+use crate::cli::Mech;
+
+/// The `static-test` command.
+pub fn static_test(mechanism: Mech, out: &Path) -> Result<(), SimError> {
+    let params = RobotParams::new(mechanism.constraint(), Head::Upper);
+    let pb = progress(30, "static");
+    let r = pipeline::static_tests(&params, &StaticOptions::default(), || pb.inc(1))?;
+    pb.finish_and_clear();
+    let (worst, rms) = pipeline::linear_agreement(&r, 50.0);
+    let path = out.join(format!(
+        "static_tests_{}.csv",
+        mechanism.constraint().label().to_lowercase()
+    ));
+    write_file(&path, "the static-test CSV", static_csv(&r))?;
+    say!(
+        "{} readings -> {}; vs J K^-1 J^T at 49 N: worst {:.2e}, RMS {:.2e} (relative)",
+        r.len(),
+        path.display(),
+        worst,
+        rms
+    );
+    Ok(())
+}

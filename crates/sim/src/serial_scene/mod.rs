@@ -1,0 +1,312 @@
+//! The serial testbed: a flexible arm from any URDF and stiffness file in rapier
+//! ([`crate::urdf_arm`]) carries a payload through a line and a circle in pose at high
+//! acceleration, commanded by the rigid inverse kinematics (uncorrected) or by deflect-core's
+//! 6-D D'Alembert corrector for serial arms (`dalembert::serial`: the payload's inertial
+//! wrench through the virtual-joint deflection, loaded-pose IK per tick).
+//!
+//! Per run the servo gets the joint command of each 2 kHz tick with its rate and acceleration
+//! (backward differences, as in the five-bar scene); the TCP pose after each physics step is
+//! compared with the desired pose of that tick: the distance from the planned path, the
+//! tracking error and the orientation error, over the motion. The static compliance of the
+//! rapier arm at the start pose is checked against deflect-core's `J K^-1 J^T` first.
+
+pub mod motion;
+
+use deflect_core::dalembert::{self, Deflection, Payload, SerialData, SerialModel};
+use deflect_core::motion::PoseState;
+use deflect_core::vjm::{self, Data, Vector6};
+use nalgebra::Isometry3;
+use serde::Serialize;
+
+use crate::SimError;
+use crate::urdf_arm::{ArmSpec, FlexSerialArm, ServoParams};
+pub use motion::{MotionParams, PathKind};
+
+/// Everything a serial testbed run needs besides the arm.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SerialOptions {
+    /// The robot's label for tables and logs ("KR 300 R2500", a file name).
+    pub robot: String,
+    /// Start joints \[rad\].
+    pub q0: Vec<f64>,
+    /// Payload and tool beyond the TCP.
+    #[serde(serialize_with = "payload_json")]
+    pub payload: Payload,
+    /// Size and pace of the motions.
+    pub motion: MotionParams,
+    /// Servo and structure of the simulated arm.
+    pub servo: ServoParams,
+    /// Hold after the motion \[s\] (logged, not evaluated).
+    pub tail: f64,
+    /// Deflection model the corrector inverts.
+    #[serde(serialize_with = "deflection_json")]
+    pub model: Deflection,
+}
+
+fn payload_json<S: serde::Serializer>(p: &Payload, s: S) -> Result<S::Ok, S::Error> {
+    let i = p.inertia;
+    serde_json::json!({
+        "mass_kg": p.mass,
+        "com_m": [p.com.x, p.com.y, p.com.z],
+        "inertia_kg_m2": [[i[(0, 0)], i[(0, 1)], i[(0, 2)]], [i[(1, 0)], i[(1, 1)], i[(1, 2)]],
+                          [i[(2, 0)], i[(2, 1)], i[(2, 2)]]],
+    })
+    .serialize(s)
+}
+
+fn deflection_json<S: serde::Serializer>(d: &Deflection, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(match d {
+        Deflection::Exact => "exact",
+        Deflection::Linearized => "linearized",
+    })
+}
+
+/// One tick of a run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SerialSample {
+    /// Time \[s\].
+    pub t: f64,
+    /// Whether the motion is running (evaluated), not the hold after it.
+    pub active: bool,
+    /// Desired TCP position \[m\] and orientation (quaternion w, x, y, z).
+    pub desired: [f64; 7],
+    /// Actual TCP position \[m\] and orientation (quaternion w, x, y, z).
+    pub actual: [f64; 7],
+    /// Commanded rigid TCP position \[m\] (what the joints command without load).
+    pub commanded: [f64; 3],
+    /// Joint command \[rad\].
+    pub q_cmd: Vec<f64>,
+    /// Link-side joint angles \[rad\].
+    pub q_link: Vec<f64>,
+    /// Inertial wrench the corrector cancels \[N, N m\] (zero uncorrected).
+    pub wrench: [f64; 6],
+}
+
+/// What a run scores (over the motion), in mm and mrad.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct SerialMetrics {
+    /// Largest distance of the TCP from the planned path \[mm\].
+    pub path_max_mm: f64,
+    /// RMS distance from the planned path \[mm\].
+    pub path_rms_mm: f64,
+    /// Largest tracking error (actual minus desired position at the same tick) \[mm\].
+    pub track_max_mm: f64,
+    /// Largest orientation error (angle of actual against desired) \[mrad\].
+    pub rot_max_mrad: f64,
+    /// RMS orientation error \[mrad\].
+    pub rot_rms_mrad: f64,
+    /// Largest commanded correction (commanded minus desired position) \[mm\].
+    pub correction_max_mm: f64,
+}
+
+/// One run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SerialRun {
+    /// The path.
+    pub path: PathKind,
+    /// With the D'Alembert corrector.
+    pub corrected: bool,
+    /// Motion duration \[s\].
+    pub duration: f64,
+    /// Scores.
+    pub metrics: SerialMetrics,
+    /// Every tick.
+    #[serde(skip)]
+    pub samples: Vec<SerialSample>,
+}
+
+/// The static check and every run.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct SerialResult {
+    /// Settings.
+    pub options: SerialOptions,
+    /// Rigid bodies of the simulated arm.
+    pub bodies: usize,
+    /// Largest relative difference of the rapier arm's static TCP deflection and
+    /// deflect-core's `J K^-1 J^T w` over six small wrenches at the start pose.
+    pub static_rel_error: f64,
+    /// Runs: line and circle, each uncorrected and corrected.
+    pub runs: Vec<SerialRun>,
+}
+
+fn pose7(p: &Isometry3<f64>) -> [f64; 7] {
+    let t = p.translation.vector;
+    let q = p.rotation;
+    [t.x, t.y, t.z, q.w, q.i, q.j, q.k]
+}
+
+/// The rapier arm's static TCP deflection against `J K^-1 J^T w` at `q0`: the largest
+/// relative difference over forces of 100 N along x, y, z and moments of 20 N m.
+pub fn static_check(spec: &ArmSpec, q0: &[f64], servo: &ServoParams) -> Result<f64, SimError> {
+    let model = &spec.robot.model;
+    let c = vjm::compliance(model, &mut Data::new(model), q0)?;
+    let mut worst = 0.0f64;
+    for k in 0..6 {
+        let mut w = Vector6::zeros();
+        if let Some(x) = w.get_mut(k) {
+            *x = if k < 3 { 100.0 } else { 20.0 };
+        }
+        let mut arm = FlexSerialArm::new(spec, q0, None, servo, 1.0)?;
+        let d = arm.static_deflection(&w, 5000);
+        let want = c * w;
+        worst = worst.max((d - want).norm() / want.norm().max(f64::MIN_POSITIVE));
+    }
+    Ok(worst)
+}
+
+/// The planned ticks of `path` from the start pose.
+pub fn plan(
+    path: PathKind,
+    start: &Isometry3<f64>,
+    params: &MotionParams,
+    rate_hz: f64,
+) -> Result<Vec<PoseState>, SimError> {
+    match path {
+        PathKind::Line => motion::line(start, params, rate_hz),
+        PathKind::Circle => motion::circle(start, params, rate_hz),
+    }
+}
+
+/// One run of `path`, with or without the corrector.
+pub fn run(
+    spec: &ArmSpec,
+    opts: &SerialOptions,
+    path: PathKind,
+    corrected: bool,
+) -> Result<SerialRun, SimError> {
+    let model = &spec.robot.model;
+    let start = vjm::forward(model, &mut Data::new(model), &opts.q0)?;
+    let dt = opts.servo.dt;
+    let states = plan(path, &start, &opts.motion, 1.0 / dt)?;
+    let duration = states.last().map_or(0.0, |s| s.t);
+    // The corrector; uncorrected = the same solver with no load (rigid pose IK).
+    let payload = if corrected {
+        opts.payload
+    } else {
+        Payload::point(0.0, nalgebra::Vector3::zeros())
+    };
+    let corrector = SerialModel::new(model.clone(), payload)?
+        .with_joint_limits(&spec.robot.joint_limits)?
+        .with_deflection(opts.model);
+    let mut data = SerialData::new(&corrector);
+    data.set_seed(&opts.q0);
+    let mut arm = FlexSerialArm::new(spec, &opts.q0, Some(&opts.payload), &opts.servo, 1.0)?;
+    let dof = model.dof();
+    let n_motion = states.len();
+    let n_total = n_motion + (opts.tail / dt).ceil() as usize;
+    let mut samples = Vec::with_capacity(n_total);
+    let (mut q_prev, mut qd_prev) = (opts.q0.clone(), vec![0.0; dof]);
+    let mut last = None;
+    for k in 0..n_total {
+        let state = match states.get(k) {
+            Some(s) => *s,
+            None => match states.last() {
+                Some(s) => PoseState::at_rest(k as f64 * dt, s.pose),
+                None => PoseState::at_rest(0.0, start),
+            },
+        };
+        let tick = match (k < n_motion, last) {
+            (false, Some(t)) => t,
+            _ => dalembert::serial::step(&corrector, &mut data, &state, None)
+                .map_err(|e| SimError::new(format!("{} tick {k}: {e}", path.label())))?,
+        };
+        last = Some(tick);
+        let q: Vec<f64> = tick.joints.iter().take(dof).copied().collect();
+        let qd: Vec<f64> = if k == 0 {
+            vec![0.0; dof]
+        } else {
+            q.iter().zip(&q_prev).map(|(a, b)| (a - b) / dt).collect()
+        };
+        let qdd: Vec<f64> = if k == 0 {
+            vec![0.0; dof]
+        } else {
+            qd.iter().zip(&qd_prev).map(|(a, b)| (a - b) / dt).collect()
+        };
+        arm.step_servo(&q, &qd, &qdd, None);
+        let actual = arm.tcp_pose();
+        let (q_link, _) = arm.joint_state();
+        let c = tick.commanded.translation.vector;
+        let w = if corrected {
+            tick.wrench
+        } else {
+            Vector6::zeros()
+        };
+        samples.push(SerialSample {
+            t: k as f64 * dt,
+            active: k < n_motion,
+            desired: pose7(&state.pose),
+            actual: pose7(&actual),
+            commanded: [c.x, c.y, c.z],
+            q_cmd: q.clone(),
+            q_link,
+            wrench: [w[0], w[1], w[2], w[3], w[4], w[5]],
+        });
+        q_prev = q;
+        qd_prev = qd;
+    }
+    let metrics = evaluate(path, &start, &opts.motion, &samples);
+    Ok(SerialRun {
+        path,
+        corrected,
+        duration,
+        metrics,
+        samples,
+    })
+}
+
+fn pose_of(p: &[f64; 7]) -> Isometry3<f64> {
+    Isometry3::from_parts(
+        nalgebra::Translation3::new(p[0], p[1], p[2]),
+        nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(p[3], p[4], p[5], p[6])),
+    )
+}
+
+/// The scores of a run's samples (over the motion).
+pub fn evaluate(
+    path: PathKind,
+    start: &Isometry3<f64>,
+    params: &MotionParams,
+    samples: &[SerialSample],
+) -> SerialMetrics {
+    let mut m = SerialMetrics::default();
+    let (mut sq_p, mut sq_r, mut n) = (0.0, 0.0, 0usize);
+    for s in samples.iter().filter(|s| s.active) {
+        let (a, d) = (pose_of(&s.actual), pose_of(&s.desired));
+        let dist = motion::path_distance(path, start, params, &a.translation.vector) * 1e3;
+        let track = (a.translation.vector - d.translation.vector).norm() * 1e3;
+        let rot = a.rotation.angle_to(&d.rotation) * 1e3;
+        let corr = (nalgebra::Vector3::from(s.commanded) - d.translation.vector).norm() * 1e3;
+        m.path_max_mm = m.path_max_mm.max(dist);
+        m.track_max_mm = m.track_max_mm.max(track);
+        m.rot_max_mrad = m.rot_max_mrad.max(rot);
+        m.correction_max_mm = m.correction_max_mm.max(corr);
+        sq_p += dist * dist;
+        sq_r += rot * rot;
+        n += 1;
+    }
+    if n > 0 {
+        m.path_rms_mm = (sq_p / n as f64).sqrt();
+        m.rot_rms_mrad = (sq_r / n as f64).sqrt();
+    }
+    m
+}
+
+/// The static check and the four runs (line and circle, uncorrected and corrected) on up to
+/// `jobs` threads; results do not depend on `jobs`.
+pub fn serial(spec: &ArmSpec, opts: &SerialOptions, jobs: usize) -> Result<SerialResult, SimError> {
+    let static_rel_error = static_check(spec, &opts.q0, &opts.servo)?;
+    let cases: Vec<(PathKind, bool)> = [PathKind::Line, PathKind::Circle]
+        .into_iter()
+        .flat_map(|p| [(p, false), (p, true)])
+        .collect();
+    let runs = crate::jobs::parallel_map(&cases, jobs, |&(p, c)| run(spec, opts, p, c))?
+        .into_iter()
+        .collect::<Result<Vec<_>, _>>()?;
+    let bodies = FlexSerialArm::new(spec, &opts.q0, None, &opts.servo, 1.0)?.body_count();
+    Ok(SerialResult {
+        options: opts.clone(),
+        bodies,
+        static_rel_error,
+        runs,
+    })
+}

@@ -1,0 +1,516 @@
+//! The arm of an [`ArmSpec`] in rapier3d-f64: a reduced-coordinate multibody, one rigid body
+//! per actuated joint and per virtual joint, with servo motors outside rapier.
+//!
+//! * **Virtual joints** are multibody joints with rapier's implicit joint springs, rest angle
+//!   zero: one free rotation when one stiffness is finite, all three when two or three are
+//!   (rapier's multibody joints take 0, 1 or 3 free rotations; a rigid axis among three gets a
+//!   spring [`STIFF_RATIO`] times the joint's stiffest), and stiffness-proportional structural
+//!   damping `beta k`. For small angles the three rotations are the virtual joint's `M / k`,
+//!   so the arm's static compliance is deflect-core's `J K^-1 J^T` (a test checks it to 1 %).
+//! * **Actuated joints** are revolute multibody joints (exact angle coordinate). The link
+//!   hangs on its motor through a drive spring of stiffness [`ServoParams::drive_ratio`] times
+//!   the arm's stiffest virtual joint (gearbox and shaft, nearly rigid: the compliance under
+//!   test is the virtual joints'), with relative damping. Each motor is a rotor of reflected
+//!   inertia under a discrete PD position loop with velocity and acceleration feed-forward at
+//!   the simulation rate, integrated implicitly with the drive spring's reaction: the five-bar
+//!   scene's servo ([`crate::robot`]). Its gains come from a bandwidth and a loop stiffness
+//!   [`ServoParams::kp_ratio`] times the stiffest virtual joint.
+//! * The URDF links' mass properties sit on the body after the link's last spring (the
+//!   proximal part of a link split by an in-link spring is lumped distally); bodies that carry
+//!   no link get a small mass ([`ServoParams::filler_mass`]). A payload adds to the last body.
+//!   Gravity is off: a robot's static sag under its own weight is calibrated out in practice,
+//!   and the scenarios study inertial and process loads.
+
+use deflect_core::dalembert::Payload;
+use deflect_core::vjm::Vector6;
+use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
+use rapier3d_f64::prelude::*;
+
+use super::spec::{ArmSpec, Inertia, Piece, RIGID};
+use crate::SimError;
+use crate::rapier_util::{ANG_X, ANG_Y, ANG_Z, new_world, pose_na, set_spring};
+
+/// A rigid axis among a virtual joint's three free rotations gets this many times the joint's
+/// stiffest finite stiffness.
+pub const STIFF_RATIO: f64 = 1.0e3;
+
+/// Servo and structure settings of the testbed arm.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ServoParams {
+    /// Position-loop bandwidth of every motor \[Hz\].
+    pub bandwidth_hz: f64,
+    /// Damping ratio of the position loop.
+    pub zeta: f64,
+    /// Loop stiffness `kp` over the arm's stiffest virtual joint: the motor's reflected
+    /// inertia is `kp / (2 pi bandwidth)^2`.
+    pub kp_ratio: f64,
+    /// Drive-spring stiffness over the arm's stiffest virtual joint.
+    pub drive_ratio: f64,
+    /// Damping ratio of the drive spring (relative motor-link damping, against the motor's
+    /// reflected inertia).
+    pub drive_zeta: f64,
+    /// Stiffness-proportional damping of the virtual joints, `c = beta k` \[s\].
+    pub beta: f64,
+    /// Mass of a body that carries no URDF link \[kg\] (inertia of a 5 cm sphere).
+    pub filler_mass: f64,
+    /// Time step \[s\].
+    pub dt: f64,
+}
+
+impl Default for ServoParams {
+    /// 150 Hz, 0.7; loop 50x and drive 100x the stiffest virtual joint; drive 0.7 damped;
+    /// beta 1 ms (2-4 % of critical on the arms' first modes); 0.5 kg fillers; 0.5 ms.
+    fn default() -> Self {
+        Self {
+            bandwidth_hz: 150.0,
+            zeta: 0.7,
+            kp_ratio: 50.0,
+            drive_ratio: 100.0,
+            drive_zeta: 0.7,
+            beta: 1.0e-3,
+            filler_mass: 0.5,
+            dt: 1.0 / 2000.0,
+        }
+    }
+}
+
+/// One servo motor: rotor angle and speed \[rad, rad/s\], absolute like the joint angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Motor {
+    angle: f64,
+    speed: f64,
+}
+
+/// The arm in rapier (see the module docs).
+pub struct FlexSerialArm {
+    world: PhysicsWorld,
+    bodies: Vec<RigidBodyHandle>,
+    joints: Vec<MultibodyJointHandle>,
+    /// Body index of each actuated joint, in `q` order.
+    actuated: Vec<usize>,
+    /// Joint axis of each actuated joint in its body frame.
+    axes: Vec<Vector3<f64>>,
+    q0: Vec<f64>,
+    motors: Vec<Motor>,
+    tcp: Isometry3<f64>,
+    k_drive: f64,
+    j_motor: f64,
+    kp: f64,
+    kd: f64,
+    c_drive: f64,
+    dt: f64,
+    time: f64,
+}
+
+impl core::fmt::Debug for FlexSerialArm {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct("FlexSerialArm")
+            .field("bodies", &self.bodies.len())
+            .field("q0", &self.q0)
+            .field("k_drive", &self.k_drive)
+            .field("kp", &self.kp)
+            .finish_non_exhaustive()
+    }
+}
+
+fn to_pose(iso: &Isometry3<f64>) -> Pose {
+    let t = iso.translation.vector;
+    let q = iso.rotation;
+    Pose::from_parts(
+        Vector::new(t.x, t.y, t.z),
+        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
+    )
+}
+
+fn mass_properties(i: &Inertia) -> MassProperties {
+    let m = &i.inertia;
+    let cols = [
+        m[(0, 0)],
+        m[(1, 0)],
+        m[(2, 0)],
+        m[(0, 1)],
+        m[(1, 1)],
+        m[(2, 1)],
+        m[(0, 2)],
+        m[(1, 2)],
+        m[(2, 2)],
+    ];
+    MassProperties::with_inertia_matrix(
+        Vector::new(i.com.x, i.com.y, i.com.z),
+        i.mass,
+        Matrix::from_cols_array(&cols),
+    )
+}
+
+impl FlexSerialArm {
+    /// The arm of `spec` at rest at joints `q0` \[rad\], carrying `payload` (TCP frame), with
+    /// `servo` settings. `damping_scale` multiplies every damping (> 1 to settle static tests
+    /// quickly).
+    pub fn new(
+        spec: &ArmSpec,
+        q0: &[f64],
+        payload: Option<&Payload>,
+        servo: &ServoParams,
+        damping_scale: f64,
+    ) -> Result<Self, SimError> {
+        let dof = spec.robot.model.dof();
+        if q0.len() != dof {
+            return Err(SimError::new(format!(
+                "start joints: {} values for a {dof}-joint arm",
+                q0.len()
+            )));
+        }
+        let k_max = spec
+            .bodies
+            .iter()
+            .filter_map(|b| match &b.piece {
+                Piece::Spring { k, .. } => {
+                    k.iter().copied().filter(|v| *v < RIGID).reduce(f64::max)
+                }
+                Piece::Revolute { .. } => None,
+            })
+            .fold(0.0f64, f64::max);
+        if !(k_max > 0.0) {
+            return Err(SimError::new(
+                "the stiffness file gives the arm no finite stiffness: nothing to simulate",
+            ));
+        }
+        let w = 2.0 * core::f64::consts::PI * servo.bandwidth_hz;
+        let kp = servo.kp_ratio * k_max;
+        let j_motor = kp / (w * w);
+        let kd = 2.0 * servo.zeta * w * j_motor;
+        let k_drive = servo.drive_ratio * k_max;
+        let c_drive = 2.0 * servo.drive_zeta * (k_drive * j_motor).sqrt();
+
+        let mut world = new_world(Vector::ZERO, servo.dt);
+        let mut parent = world.insert_body(RigidBodyBuilder::fixed());
+        let mut at = Isometry3::identity();
+        let (mut bodies, mut joints, mut actuated, mut axes) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let last = spec.bodies.len().saturating_sub(1);
+        let mut qi = 0usize;
+        for (index, b) in spec.bodies.iter().enumerate() {
+            let mut inertia = b.inertia;
+            if index == last {
+                if let Some(p) = payload {
+                    inertia.add(
+                        &Inertia {
+                            mass: p.mass,
+                            com: p.com,
+                            inertia: p.inertia,
+                        },
+                        &spec.tcp,
+                    );
+                }
+            }
+            if inertia.mass <= 0.0 {
+                let m = servo.filler_mass;
+                inertia = Inertia {
+                    mass: m,
+                    com: Vector3::zeros(),
+                    inertia: Matrix3::identity() * (0.4 * m * 0.05 * 0.05),
+                };
+            }
+            let (frame1, frame2, locked, springs) = match &b.piece {
+                Piece::Revolute { axis, .. } => {
+                    let q = q0.get(qi).copied().unwrap_or(0.0);
+                    qi += 1;
+                    let align = UnitQuaternion::rotation_between(&Vector3::x(), axis)
+                        .unwrap_or_else(|| {
+                            UnitQuaternion::from_axis_angle(
+                                &Vector3::z_axis(),
+                                core::f64::consts::PI,
+                            )
+                        });
+                    let align = Isometry3::from_parts(Translation3::identity(), align);
+                    let turn = Isometry3::from_parts(
+                        Translation3::identity(),
+                        UnitQuaternion::from_axis_angle(axis, q),
+                    );
+                    actuated.push(index);
+                    axes.push(axis.into_inner());
+                    (
+                        b.attach * turn * align,
+                        align,
+                        JointAxesMask::LIN_AXES | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z,
+                        vec![(ANG_X, k_drive, 0.0)],
+                    )
+                }
+                Piece::Spring { k, .. } => {
+                    let finite: Vec<usize> = (0..3).filter(|&a| k[a] < RIGID).collect();
+                    let stiffest = finite.iter().map(|&a| k[a]).fold(0.0f64, f64::max);
+                    let names = [ANG_X, ANG_Y, ANG_Z];
+                    let (locked, springs) = if finite.len() == 1 {
+                        let a = finite.first().copied().unwrap_or(0);
+                        let lock = [
+                            JointAxesMask::ANG_X,
+                            JointAxesMask::ANG_Y,
+                            JointAxesMask::ANG_Z,
+                        ]
+                        .iter()
+                        .enumerate()
+                        .filter(|(i, _)| *i != a)
+                        .fold(JointAxesMask::LIN_AXES, |m, (_, x)| m | *x);
+                        (lock, vec![(names[a], k[a], servo.beta * k[a])])
+                    } else {
+                        let springs = (0..3)
+                            .map(|a| {
+                                let ka = if k[a] < RIGID {
+                                    k[a]
+                                } else {
+                                    STIFF_RATIO * stiffest
+                                };
+                                (names[a], ka, servo.beta * ka)
+                            })
+                            .collect();
+                        (JointAxesMask::LIN_AXES, springs)
+                    };
+                    (b.attach, Isometry3::identity(), locked, springs)
+                }
+            };
+            at *= match &b.piece {
+                Piece::Revolute { axis, .. } => {
+                    b.attach
+                        * Isometry3::from_parts(
+                            Translation3::identity(),
+                            UnitQuaternion::from_axis_angle(
+                                axis,
+                                q0.get(qi.saturating_sub(1)).copied().unwrap_or(0.0),
+                            ),
+                        )
+                }
+                Piece::Spring { .. } => b.attach,
+            };
+            let body = world.insert_body(
+                RigidBodyBuilder::dynamic()
+                    .pose(to_pose(&at))
+                    .additional_mass_properties(mass_properties(&inertia))
+                    .can_sleep(false),
+            );
+            let joint = GenericJointBuilder::new(locked)
+                .local_frame1(to_pose(&frame1))
+                .local_frame2(to_pose(&frame2))
+                .contacts_enabled(false)
+                .build();
+            let h = world
+                .insert_multibody_joint(parent, body, joint)
+                .ok_or_else(|| {
+                    SimError::new(format!("rapier refused the joint of body {index}"))
+                })?;
+            for (axis, stiffness, _) in &springs {
+                set_spring(&mut world, h, *axis, *stiffness, 0.0);
+            }
+            // Per-DOF damping: the joint's free DOFs are its last ones so far, in axis order.
+            if let Some((mb, _)) = world.multibody_joints.get_mut(h) {
+                let n = mb.damping_mut().len();
+                let dampings: Vec<f64> = springs
+                    .iter()
+                    .map(|(_, _, c)| match &b.piece {
+                        // The drive's damping `c (w_link - w_motor)`: the link part is
+                        // implicit here, the motor part an explicit torque ([`Self::apply`]).
+                        Piece::Revolute { .. } => c_drive,
+                        Piece::Spring { .. } => *c * damping_scale,
+                    })
+                    .collect();
+                let start = n.saturating_sub(dampings.len());
+                for (d, c) in mb.damping_mut().iter_mut().skip(start).zip(&dampings) {
+                    *d = *c;
+                }
+            }
+            bodies.push(body);
+            joints.push(h);
+            parent = body;
+        }
+        let motors = q0
+            .iter()
+            .map(|&angle| Motor { angle, speed: 0.0 })
+            .collect();
+        Ok(Self {
+            world,
+            bodies,
+            joints,
+            actuated,
+            axes,
+            q0: q0.to_vec(),
+            motors,
+            tcp: spec.tcp,
+            k_drive,
+            j_motor,
+            kp,
+            kd,
+            c_drive,
+            dt: servo.dt,
+            time: 0.0,
+        })
+    }
+
+    /// Simulated time \[s\].
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Number of rigid bodies of the arm (the fixed base excluded).
+    pub fn body_count(&self) -> usize {
+        self.bodies.len()
+    }
+
+    /// The motor's reflected inertia \[kg m^2\], loop stiffness \[N m/rad\] and drive stiffness
+    /// \[N m/rad\] (the same for every joint).
+    pub fn servo_constants(&self) -> (f64, f64, f64) {
+        (self.j_motor, self.kp, self.k_drive)
+    }
+
+    fn pose_of(&self, body: RigidBodyHandle) -> Isometry3<f64> {
+        self.world
+            .bodies
+            .get(body)
+            .map(|rb| pose_na(rb.position()))
+            .unwrap_or_else(Isometry3::identity)
+    }
+
+    /// The TCP pose, base frame.
+    pub fn tcp_pose(&self) -> Isometry3<f64> {
+        match self.bodies.last() {
+            Some(b) => self.pose_of(*b) * self.tcp,
+            None => self.tcp,
+        }
+    }
+
+    /// Joint angles and rates of the link side \[rad, rad/s\].
+    pub fn joint_state(&self) -> (Vec<f64>, Vec<f64>) {
+        let mut q = self.q0.clone();
+        let mut w = vec![0.0; self.q0.len()];
+        for (k, &b) in self.actuated.iter().enumerate() {
+            let Some(h) = self.joints.get(b) else {
+                continue;
+            };
+            let Some((mb, id)) = self.world.multibody_joints.get(*h) else {
+                continue;
+            };
+            let Some(link) = mb.link(id) else { continue };
+            if let (Some(qk), Some(wk)) = (q.get_mut(k), w.get_mut(k)) {
+                *qk += link.joint().coords()[ANG_X];
+                *wk = mb.joint_velocity(link).get(0).copied().unwrap_or(0.0);
+            }
+        }
+        (q, w)
+    }
+
+    /// Motor angles \[rad\].
+    pub fn motor_angles(&self) -> Vec<f64> {
+        self.motors.iter().map(|m| m.angle).collect()
+    }
+
+    /// Sets the drive springs' rest angles to the motors, the relative drive damping torques,
+    /// and an optional TCP wrench `[F; M]` (base frame, moment about the TCP).
+    fn apply(&mut self, wrench: Option<&Vector6>) {
+        for b in &self.bodies {
+            if let Some(rb) = self.world.bodies.get_mut(*b) {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+            }
+        }
+        for (k, &b) in self.actuated.iter().enumerate() {
+            let (Some(m), Some(h)) = (self.motors.get(k), self.joints.get(b)) else {
+                continue;
+            };
+            let rest = m.angle - self.q0.get(k).copied().unwrap_or(0.0);
+            set_spring(&mut self.world, *h, ANG_X, self.k_drive, rest);
+            // The motor's part of the relative drive damping, `+c w_motor` about the joint
+            // axis (world frame), reacted by the body before (the link's part, `-c w_link`,
+            // is rapier's implicit joint damping).
+            let body = self.bodies.get(b).copied();
+            let axis_w = body
+                .map(|h| self.pose_of(h).rotation * self.axes.get(k).copied().unwrap_or_default())
+                .unwrap_or_default();
+            let t = axis_w * (self.c_drive * m.speed);
+            let torque = Vector::new(t.x, t.y, t.z);
+            if let Some(rb) = body.and_then(|h| self.world.bodies.get_mut(h)) {
+                rb.add_torque(torque, false);
+            }
+            if b > 0 {
+                if let Some(rb) = self
+                    .bodies
+                    .get(b - 1)
+                    .and_then(|h| self.world.bodies.get_mut(*h))
+                {
+                    rb.add_torque(-torque, false);
+                }
+            }
+        }
+        if let (Some(w), Some(last)) = (wrench, self.bodies.last().copied()) {
+            let p = self.tcp_pose().translation.vector;
+            if let Some(rb) = self.world.bodies.get_mut(last) {
+                rb.add_force_at_point(
+                    Vector::new(w[0], w[1], w[2]),
+                    Vector::new(p.x, p.y, p.z),
+                    false,
+                );
+                rb.add_torque(Vector::new(w[3], w[4], w[5]), false);
+            }
+        }
+    }
+
+    /// One servo tick: joint command `q` \[rad\] with its rate and acceleration (feed-forward)
+    /// and an optional process wrench at the TCP, then one physics step.
+    pub fn step_servo(&mut self, q: &[f64], qd: &[f64], qdd: &[f64], wrench: Option<&Vector6>) {
+        let (ql, wl) = self.joint_state();
+        let dt = self.dt;
+        for (k, m) in self.motors.iter_mut().enumerate() {
+            let at = |v: &[f64]| v.get(k).copied().unwrap_or(0.0);
+            let (qc, wc, ac) = (at(q), at(qd), at(qdd));
+            // Implicit Euler of J w' = kp (qc - qm) + kd (wc - w) + J ac - k (qm - ql) - c (w - wl).
+            let a = self.j_motor / dt + self.kd + self.c_drive + dt * (self.kp + self.k_drive);
+            let b = self.j_motor / dt * m.speed
+                + self.kp * (qc - m.angle)
+                + self.kd * wc
+                + self.j_motor * ac
+                - self.k_drive * (m.angle - at(&ql))
+                + self.c_drive * at(&wl);
+            let speed = b / a;
+            *m = Motor {
+                angle: m.angle + dt * speed,
+                speed,
+            };
+        }
+        self.apply(wrench);
+        self.world.step();
+        self.time += dt;
+    }
+
+    /// One physics step with the motors locked at their angles and a TCP wrench.
+    pub fn step_locked(&mut self, wrench: &Vector6) {
+        for m in &mut self.motors {
+            m.speed = 0.0;
+        }
+        self.apply(Some(wrench));
+        self.world.step();
+        self.time += self.dt;
+    }
+
+    /// The TCP's displacement `[dp; dr]` \[m, rad\] under a static TCP `wrench`, motors locked:
+    /// steps until the TCP moves less than 1e-12 m (and rad) per step, at most `max_steps`.
+    /// Build the arm with a large damping scale for quick settling.
+    pub fn static_deflection(&mut self, wrench: &Vector6, max_steps: usize) -> Vector6 {
+        let start = self.tcp_pose();
+        let mut last = start;
+        for _ in 0..max_steps {
+            self.step_locked(wrench);
+            let now = self.tcp_pose();
+            let dp = (now.translation.vector - last.translation.vector).norm();
+            let dr = now.rotation.angle_to(&last.rotation);
+            last = now;
+            if dp < 1e-12 && dr < 1e-12 {
+                break;
+            }
+        }
+        let dp = last.translation.vector - start.translation.vector;
+        let dr = (last.rotation * start.rotation.inverse()).scaled_axis();
+        Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z)
+    }
+
+    /// World position of the TCP-frame point `p` \[m\].
+    pub fn tcp_point(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        (self.tcp_pose() * Point3::from(*p)).coords
+    }
+}
