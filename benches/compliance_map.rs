@@ -5,16 +5,13 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use deflect_core::compliance_map::{
-    ComplianceMap, ForceUnit, Interpolation, LengthUnit, OutOfGrid, QueryOptions,
-};
+use deflect_core::compliance_map::{ComplianceMap, Interpolation, OutOfGrid, QueryOptions};
+use deflect_core::io::map_csv;
+use deflect_core::units::{ForceUnit, LengthUnit};
 
 fn maps() -> (ComplianceMap, ComplianceMap) {
-    let text = std::fs::read_to_string(deflect_tests::repo_path(
-        "data/paksoy2025_compliance_oc.csv",
-    ))
-    .unwrap_or_default();
-    let oc = match ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre) {
+    let path = deflect_tests::repo_path("data/paksoy2025_compliance_oc.csv");
+    let oc = match map_csv::from_path(path, ForceUnit::Newton, LengthUnit::Millimetre) {
         Ok(m) => m,
         Err(e) => panic!("the shipped OC table must load: {e}"),
     };

@@ -9,9 +9,9 @@ use std::hint::black_box;
 use std::ptr;
 
 use deflect::*;
-use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::dalembert::{self, Data, Model};
 use deflect_core::mechanism::ParallelRobot2;
-use deflect_core::vjm::{self, Data, Vector6};
+use deflect_core::vjm::{self, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
 use nalgebra::Vector2;
 
@@ -33,12 +33,14 @@ fn main() {
     let robot2 = ParallelRobot2::paper();
     let traj = deflect_tests::paper_y_line_5g();
     let period = traj.duration();
-    let corr = DalembertCorrector::new(5.0).expect("mass");
+    let corr = Model::new(robot2, view, 5.0).expect("mass");
+    // The corrector's data keeps the last tick's joints (the next IK seed).
+    let mut corr_data = Data::new(&corr);
     let mut q2 = Vector2::zeros();
     deflect_tests::latency_report("rust: dalembert tick (sample+step)", n, None, |i| {
         let t = (i as f64 / 2000.0) % period;
         let s = traj.sample(black_box(t)).expect("in range");
-        if let Ok(tick) = corr.step(&robot2, &view, &s.position, &s.acceleration, &q2) {
+        if let Ok(tick) = dalembert::step(&corr, &mut corr_data, &s.position, &s.acceleration) {
             q2 = tick.joints;
         }
         black_box(q2);
@@ -68,7 +70,8 @@ fn main() {
         deflect_paper_limits(5, &mut lim);
         let (a, b) = ([0.222132, -0.075], [0.222132, 0.075]);
         deflect_trajectory2_line(a.as_ptr(), b.as_ptr(), &lim, &mut ctraj);
-        deflect_dalembert_create(ptr::null(), DEFLECT_PAPER_MASS, 0, 0.0, &mut ccorr);
+        // The corrector copies the (clamping) map; it keeps the last tick's joints itself.
+        deflect_dalembert_create(ptr::null(), cmap, DEFLECT_PAPER_MASS, 0, 0.0, &mut ccorr);
     }
     let mut q = [0.0; 2];
     let mut st = DeflectState2::default();
@@ -80,10 +83,8 @@ fn main() {
             deflect_trajectory2_sample(ctraj, black_box(t), &mut st) == DEFLECT_OK
                 && deflect_dalembert_step(
                     ccorr,
-                    cmap,
                     st.position.as_ptr(),
                     st.acceleration.as_ptr(),
-                    q.as_ptr(),
                     &mut tick,
                 ) == DEFLECT_OK
         };
@@ -95,7 +96,7 @@ fn main() {
 
     // --- VJM deflection of the KR 300 (6 joints, 11 virtual joints). ---
     let robot = kr300();
-    let mut data = Data::new(&robot.model);
+    let mut data = vjm::Data::new(&robot.model);
     let w = Vector6::from_row_slice(&MILLING_WRENCH);
     let mut qk = KR300_MILLING_POSE;
     deflect_tests::latency_report("rust: vjm::deflection (KR 300)", n, None, |i| {

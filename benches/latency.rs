@@ -4,12 +4,12 @@
 
 use std::hint::black_box;
 
-use deflect_core::compensation::{CompensatorConfig, OnlineCompensator, SensorCalibration};
-use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::compensation::{self, CompensatorConfig, SensorCalibration};
+use deflect_core::dalembert;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::vjm::{self, Data, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, latency_report};
-use nalgebra::{Vector2, Vector3};
+use nalgebra::Vector3;
 
 fn main() {
     let rt = deflect_tests::realtime_setup();
@@ -45,27 +45,20 @@ fn main() {
     let robot2 = ParallelRobot2::paper();
     let traj = deflect_tests::paper_y_line_5g();
     let period = traj.duration();
+    let one_shot = dalembert::Model::new(robot2, view, 5.0).expect("valid corrector");
+    let fixed_point = one_shot.clone().with_fixed_point(3, 0.0).expect("valid");
     for (name, corr) in [
-        (
-            "dalembert tick (one-shot)",
-            DalembertCorrector::new(5.0).expect("mass"),
-        ),
-        (
-            "dalembert tick (3 fixed-pt)",
-            DalembertCorrector::new(5.0)
-                .expect("mass")
-                .with_fixed_point(3, 0.0),
-        ),
+        ("dalembert tick (one-shot)", one_shot),
+        ("dalembert tick (3 fixed-pt)", fixed_point),
     ] {
-        let mut q2 = Vector2::zeros();
+        let mut data = dalembert::Data::new(&corr);
         latency_report(name, n, Some(budget), |i| {
             // Tick-by-tick sampling at 2 kHz, wrapping around the 375 ms motion.
             let t = (i as f64 / 2000.0) % period;
             let s = traj.sample(black_box(t)).expect("in range");
-            if let Ok(tick) = corr.step(&robot2, &view, &s.position, &s.acceleration, &q2) {
-                q2 = tick.joints;
+            if let Ok(tick) = dalembert::step(&corr, &mut data, &s.position, &s.acceleration) {
+                black_box(tick.joints);
             }
-            black_box(q2);
         });
     }
 
@@ -77,7 +70,8 @@ fn main() {
         ("compensation cycle (2 kHz)", 0.0005),
     ] {
         let cfg = CompensatorConfig::paper(dt, SensorCalibration::default());
-        let mut comp = OnlineCompensator::new(model, cfg).expect("valid config");
+        let comp = compensation::Model::new(model.clone(), cfg).expect("valid config");
+        let mut cdata = compensation::Data::new(&comp);
         let feed = Vector3::new(0.0, 0.025, 0.0);
         let estimated = Vector6::from_row_slice(&MILLING_WRENCH);
         latency_report(name, n, Some(budget), |i| {
@@ -88,9 +82,64 @@ fn main() {
                 Vector6::zeros()
             };
             black_box(
-                comp.step(model, &q, black_box(&reading), Some(&estimated), &feed)
-                    .ok(),
+                compensation::step(
+                    &comp,
+                    &mut cdata,
+                    &q,
+                    black_box(&reading),
+                    Some(&estimated),
+                    &feed,
+                )
+                .ok(),
             );
+        });
+    }
+
+    // The 6-D D'Alembert corrector of a serial arm on the KR 300 (150 kg payload): inertial
+    // wrench -> loaded pose IK (exact VJM deflection) warm-started from the last ticks, along
+    // a 0.33 m / 0.3 rad pose motion at about 1 g, wrapping around; the payload alone (the
+    // paper's D'Alembert force) and with the links' own inertia (the URDF's masses).
+    let serial = dalembert::SerialModel::new(
+        model.clone(),
+        dalembert::Payload {
+            mass: 150.0,
+            com: nalgebra::Vector3::new(0.0, 0.0, 0.25),
+            inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(4.0, 4.0, 2.5)),
+        },
+    )
+    .expect("valid corrector")
+    .with_joint_limits(&robot.joint_limits)
+    .expect("limits");
+    let traj = deflect_tests::kr300_pose_motion();
+    let rate = 2000.0;
+    let count = traj.tick_count(rate).expect("ticks");
+    let states: Vec<_> = (0..count)
+        .map(|k| traj.sample(traj.tick_time(rate, k, count)).expect("sample"))
+        .collect();
+    for (name, corrector) in [
+        ("serial 6-D tick (KR 300, payload)", serial.clone()),
+        (
+            "serial 6-D tick (KR 300, +links)",
+            serial.with_link_inertia(true),
+        ),
+    ] {
+        let mut sdata = dalembert::SerialData::new(&corrector);
+        sdata.set_seed(&KR300_MILLING_POSE);
+        let mut back = false;
+        latency_report(name, n, Some(budget), |i| {
+            // Forth and back along the motion, so the warm start follows a smooth path.
+            let k = i % count;
+            if k == 0 {
+                back = !back;
+            }
+            let s = if back {
+                &states[count - 1 - k]
+            } else {
+                &states[k]
+            };
+            if let Ok(tick) = dalembert::serial::step(&corrector, &mut sdata, black_box(s), None) {
+                black_box(tick.joints);
+            }
         });
     }
 }

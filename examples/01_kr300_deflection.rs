@@ -7,6 +7,12 @@
 use deflect_core::SerialRobot;
 use deflect_core::vjm::{self, Data, Vector6};
 
+/// A milling pose [rad]: flange pointing down, TCP 1.80 m in front of A1 and 0.48 m above the
+/// base, tool axis horizontal.
+const MILLING_POSE: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+/// A 546 N milling force (the paper's largest) in the horizontal plane, base frame [N, N m].
+const MILLING_WRENCH: [f64; 6] = [-386.1, 386.1, 0.0, 0.0, 0.0, 0.0];
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = env!("CARGO_MANIFEST_DIR");
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -18,14 +24,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "tcp".to_string(),
         ),
     };
-    let robot = SerialRobot::from_files(&urdf, &toml, &tip)?;
+    let robot = SerialRobot::from_path(&urdf, &toml, &tip)?;
     let q: Vec<f64> = if args.len() > 3 {
         args[3..]
             .iter()
             .map(|s| s.parse())
             .collect::<Result<_, _>>()?
     } else {
-        deflect_tests::KR300_MILLING_POSE.to_vec()
+        MILLING_POSE.to_vec()
     };
     let model = &robot.model;
     let mut data = Data::new(model);
@@ -44,7 +50,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("750 N along +x", [750.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
         ("750 N along +y", [0.0, 750.0, 0.0, 0.0, 0.0, 0.0]),
         ("750 N along -z", [0.0, 0.0, -750.0, 0.0, 0.0, 0.0]),
-        ("546 N milling (xy)", deflect_tests::MILLING_WRENCH),
+        ("546 N milling (xy)", MILLING_WRENCH),
     ];
     for (name, w) in loads {
         let d = vjm::deflection(model, &mut data, &q, &Vector6::from_row_slice(&w))?;

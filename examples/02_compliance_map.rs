@@ -4,10 +4,9 @@
 //!
 //! Run: `cargo run --release --example 02_compliance_map`
 
-use deflect_core::compliance_map::{
-    ComplianceMap, ForceUnit, HoldOutAxis, Interpolation, LengthUnit, QueryOptions,
-    leave_one_node_out,
-};
+use deflect_core::compliance_map::{HoldOutAxis, Interpolation, QueryOptions, leave_one_node_out};
+use deflect_core::io::map_csv;
+use deflect_core::units::{ForceUnit, LengthUnit};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = env!("CARGO_MANIFEST_DIR");
@@ -15,10 +14,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("OC", "paksoy2025_compliance_oc.csv"),
         ("NC", "paksoy2025_compliance_nc.csv"),
     ] {
-        let text = std::fs::read_to_string(format!("{root}/data/{file}"))?;
         // The paper does not say in which unit its lines were fitted; newtons is our reading
         // (see data/README.md), passed explicitly.
-        let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)?;
+        let path = format!("{root}/data/{file}");
+        let map = map_csv::from_path(path, ForceUnit::Newton, LengthUnit::Millimetre)?;
         let mut d = [0.0; 2];
         // 5 g on the tuned 5 kg mass along y, at the workspace centre and between nodes.
         let force = [0.0, -5.0 * 5.0 * 9.81];

@@ -4,25 +4,29 @@
 //!
 //! Run: `cargo run --release --example 03_dalembert_correction`
 
-use deflect_core::compliance_map::{ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions};
-use deflect_core::dalembert::DalembertCorrector;
+use deflect_core::Placement;
+use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
+use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::io::map_csv;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
+use deflect_core::units::{ForceUnit, LengthUnit};
 use nalgebra::Vector2;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(format!(
-        "{}/data/paksoy2025_compliance_oc.csv",
-        env!("CARGO_MANIFEST_DIR")
-    ))?;
-    let map = ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre)?
-        .with_options(QueryOptions {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/data/paksoy2025_compliance_oc.csv"
+    );
+    let map = map_csv::from_path(path, ForceUnit::Newton, LengthUnit::Millimetre)?.with_options(
+        QueryOptions {
             out_of_grid: OutOfGrid::Clamp,
             ..QueryOptions::default()
-        });
-    let robot = ParallelRobot2::paper();
-    let corrector =
-        DalembertCorrector::new(DalembertCorrector::PAPER_MASS)?.with_fixed_point(3, 1e-12);
+        },
+    );
+    let corrector = Model::new(ParallelRobot2::paper(), map, dalembert::PAPER_MASS)?
+        .with_fixed_point(3, 1e-12)?;
+    let mut data = Data::new(&corrector);
     println!("g   duration [ms]  ticks  max |correction| [mm]  max |F_D| [N]  clamped ticks");
     for g in 1..=5u8 {
         let traj = Trajectory::line(
@@ -31,20 +35,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &paper_limits(g)?,
         )?;
         let (mut max_c, mut max_f, mut clamped) = (0.0f64, 0.0f64, 0);
-        let ticks = corrector.correct_each(
-            &robot,
-            &map.view(),
-            &traj,
-            2000.0,
-            &Vector2::zeros(),
-            |_, t| {
-                max_c = max_c.max((t.commanded - t.desired).norm());
-                max_f = max_f.max(t.force.norm());
-                if t.model_status != deflect_core::dalembert::ModelStatus::Inside {
-                    clamped += 1;
-                }
-            },
-        )?;
+        let ticks = dalembert::correct_each(&corrector, &mut data, &traj, 2000.0, |_, t| {
+            max_c = max_c.max((t.commanded - t.desired).norm());
+            max_f = max_f.max(t.force.norm());
+            if t.placement != Placement::Inside {
+                clamped += 1;
+            }
+        })?;
         println!(
             "{g}   {:>13.1}  {ticks:>5}  {:>21.4}  {max_f:>13.1}  {clamped:>13}",
             traj.duration() * 1e3,

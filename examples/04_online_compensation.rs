@@ -7,14 +7,25 @@
 //!
 //! Run: `cargo run --release --example 04_online_compensation`
 
-use deflect_core::compensation::{CompensatorConfig, OnlineCompensator, SensorCalibration};
+use deflect_core::SerialRobot;
+use deflect_core::compensation::{self, CompensatorConfig, SensorCalibration};
 use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::{Isometry3, Vector3};
 
+/// A milling pose of the KR 300 [rad] (as in example 1).
+const MILLING_POSE: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+/// A 546 N milling force in the horizontal plane, base frame [N, N m].
+const MILLING_WRENCH: [f64; 6] = [-386.1, 386.1, 0.0, 0.0, 0.0, 0.0];
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let robot = deflect_tests::kr300();
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/robots/kr300/");
+    let robot = SerialRobot::from_path(
+        format!("{dir}kr300_r2500.urdf"),
+        format!("{dir}kr300_r2500_stiffness.toml"),
+        "tcp",
+    )?;
     let model = &robot.model;
-    let q = deflect_tests::KR300_MILLING_POSE;
+    let q = MILLING_POSE;
     let dt = 0.004;
     // The sensor sits 0.43 m behind the TCP along the spindle (our KR 300 end effector).
     let tcp = vjm::forward(model, &mut Data::new(model), &q)?;
@@ -24,7 +35,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             * Isometry3::translation(0.0, 0.0, 0.12),
         ..SensorCalibration::default()
     };
-    let cutting = Vector6::from_row_slice(&deflect_tests::MILLING_WRENCH);
+    let cutting = Vector6::from_row_slice(&MILLING_WRENCH);
     // What the sensor reads for a TCP force: the force and its moment about the sensor.
     let sensor_reading = |w_base: &Vector6| {
         let r_bs = tcp.rotation * cal.sensor_to_tcp.rotation.inverse();
@@ -37,7 +48,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cfg.pilot = pilot;
         cfg.project_on_feed = false;
         cfg.max_rate = 1.0;
-        let mut comp = OnlineCompensator::new(model, cfg)?;
+        let comp = compensation::Model::new(model.clone(), cfg)?;
+        let mut state = compensation::Data::new(&comp);
+        let mut data = Data::new(model);
         println!(
             "pilot control {:<18} filter delay {:.1} cycles = {:.1} ms",
             format!("{pilot:?}"),
@@ -51,8 +64,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // changes 10 cycles earlier.
             let true_w = if k < 100 { cutting } else { Vector6::zeros() };
             let estimate = if k < 90 { cutting } else { Vector6::zeros() };
-            let out = comp.step(
-                model,
+            let out = compensation::step(
+                &comp,
+                &mut state,
                 &q,
                 &sensor_reading(&true_w),
                 Some(&estimate),
@@ -61,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sent.push_back(out.correction);
             let applied = sent.pop_front().unwrap_or_else(Vector6::zeros);
             // Path error: what the true load deflects minus what the applied correction cancels.
-            let d_true = vjm::deflection(model, &mut Data::new(model), &q, &true_w)?;
+            let d_true = vjm::deflection(model, &mut data, &q, &true_w)?;
             let err = (d_true.fixed_rows::<3>(0) + applied.fixed_rows::<3>(0)).norm();
             if k >= 20 {
                 worst = worst.max(err);

@@ -9,6 +9,8 @@ PY="${PYTHON:-python3}"
 echo "== Rust: format, lints, tests =="
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
+# API docs build without a warning (broken links, missing docs) for every crate.
+RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 # The C/C++ example tests link target/debug/libdeflect.a: build the static library first
 # (a workspace-wide test build may only produce the rlib).
 cargo build -p deflect-ffi --quiet
@@ -39,7 +41,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest mcap "example-robot-data>=4"
+"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19"
 "$VENV/bin/python" -m pip install --quiet ./crates/py
 "$VENV/bin/python" -m pytest -q crates/py/tests
 for ex in examples/[0-9][0-9]_*.py; do

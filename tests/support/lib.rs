@@ -1,4 +1,7 @@
-//! Shared fixtures of deflect's cross-crate tests, examples and benchmarks.
+//! Shared fixtures of deflect's cross-crate tests, examples and benchmarks, and the fuzz
+//! harnesses of its loaders ([`fuzz`]).
+
+pub mod fuzz;
 
 /// Path of a file shipped in the repository, from the workspace root.
 pub fn repo_path(relative: &str) -> String {
@@ -7,7 +10,7 @@ pub fn repo_path(relative: &str) -> String {
 
 /// The shipped KR 300 R2500 model (URDF + Table 1 stiffnesses), chain base_link -> tcp.
 pub fn kr300() -> deflect_core::SerialRobot {
-    match deflect_core::SerialRobot::from_files(
+    match deflect_core::SerialRobot::from_path(
         repo_path("robots/kr300/kr300_r2500.urdf"),
         repo_path("robots/kr300/kr300_r2500_stiffness.toml"),
         "tcp",
@@ -17,11 +20,11 @@ pub fn kr300() -> deflect_core::SerialRobot {
     }
 }
 
-/// A milling pose of the KR 300 model [rad]: flange pointing down, TCP 1.80 m in front of A1 and
+/// A milling pose of the KR 300 model \[rad\]: flange pointing down, TCP 1.80 m in front of A1 and
 /// 0.48 m above the base, tool axis horizontal.
 pub const KR300_MILLING_POSE: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
 
-/// A 546 N milling force (the paper's largest) in the horizontal plane, base frame [N, N m].
+/// A 546 N milling force (the paper's largest) in the horizontal plane, base frame \[N, N m\].
 pub const MILLING_WRENCH: [f64; 6] = [-386.1, 386.1, 0.0, 0.0, 0.0, 0.0];
 
 /// Runs `tick(i)` `n` times after a warm-up and prints median / p99.9 / max wall time per tick
@@ -79,14 +82,10 @@ pub fn realtime_setup() -> &'static str {
 /// The shipped OC compliance map of Paksoy et al. (force unit N, lengths mm), clamped at the
 /// grid boundary: the map the 2 kHz benchmarks and examples drive.
 pub fn paper_oc_map_clamped() -> deflect_core::compliance_map::ComplianceMap {
-    use deflect_core::compliance_map::{
-        ComplianceMap, ForceUnit, LengthUnit, OutOfGrid, QueryOptions,
-    };
-    let text = match std::fs::read_to_string(repo_path("data/paksoy2025_compliance_oc.csv")) {
-        Ok(t) => t,
-        Err(e) => panic!("the shipped OC table must be readable: {e}"),
-    };
-    match ComplianceMap::from_paper_csv(&text, ForceUnit::Newton, LengthUnit::Millimetre) {
+    use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
+    use deflect_core::units::{ForceUnit, LengthUnit};
+    let path = repo_path("data/paksoy2025_compliance_oc.csv");
+    match deflect_core::io::map_csv::from_path(path, ForceUnit::Newton, LengthUnit::Millimetre) {
         Ok(m) => m.with_options(QueryOptions {
             out_of_grid: OutOfGrid::Clamp,
             ..QueryOptions::default()
@@ -109,5 +108,31 @@ pub fn paper_y_line_5g() -> deflect_core::motion::Trajectory<2> {
     ) {
         Ok(t) => t,
         Err(e) => panic!("the y-line must plan: {e}"),
+    }
+}
+
+/// A pose motion of the KR 300 from its milling pose: 0.33 m and 0.3 rad about the base z
+/// axis, at about 1 g (linear 2 m/s, 9.81 m/s^2, 200 m/s^3; angular 1.5 rad/s, 8 rad/s^2,
+/// 100 rad/s^3).
+pub fn kr300_pose_motion() -> deflect_core::motion::PoseTrajectory {
+    use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
+    use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
+    let robot = kr300();
+    let mut data = deflect_core::vjm::Data::new(&robot.model);
+    let start = match deflect_core::vjm::forward(&robot.model, &mut data, &KR300_MILLING_POSE) {
+        Ok(t) => t,
+        Err(e) => panic!("forward kinematics: {e}"),
+    };
+    let end = Isometry3::from_parts(
+        Translation3::from(start.translation.vector + Vector3::new(0.1, 0.3, -0.1)),
+        UnitQuaternion::from_scaled_axis(Vector3::new(0.0, 0.0, 0.3)) * start.rotation,
+    );
+    let limits = match (Limits::new(2.0, 9.81, 200.0), Limits::new(1.5, 8.0, 100.0)) {
+        (Ok(linear), Ok(angular)) => PoseLimits { linear, angular },
+        _ => panic!("valid limits"),
+    };
+    match PoseTrajectory::line(&start, &end, &limits) {
+        Ok(t) => t,
+        Err(e) => panic!("the pose motion must plan: {e}"),
     }
 }

@@ -1,0 +1,6 @@
+//! Fuzz target `static_csv`: the harness is `deflect_tests::fuzz::static_csv` (tests/support/fuzz.rs).
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| {
+    deflect_tests::fuzz::static_csv(data);
+});
