@@ -142,7 +142,8 @@ fn reference_deflection(model: &Model, q: &[f64], w: &Vector6) -> Vector6 {
             Translation3::from(axis.into_inner() * q[index]),
             UnitQuaternion::identity(),
         )),
-        Element::Spring { .. } => None,
+        // A link mass moves nothing: it loads the springs only under motion or gravity.
+        Element::Spring { .. } | Element::Mass { .. } => None,
     };
     let tcp = model
         .elements()

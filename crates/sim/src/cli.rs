@@ -180,6 +180,18 @@ pub const TARGET_FORCE: Range = Range {
 };
 /// `contour --noise` \[N\].
 pub const NOISE: Range = Range::closed("--noise", 0.0, 5.0, "N");
+/// `serial --g`: peak acceleration of the motions.
+pub const SERIAL_G: Range = Range::closed("--g", 0.05, 5.0, "g");
+/// `serial --payload-mass` \[kg\].
+pub const PAYLOAD_MASS: Range = Range::closed("--payload-mass", 0.0, 2000.0, "kg");
+/// `serial --scale` \[m\]: the line is `(0.3, 0.2, -0.1) scale`, the circle's radius `0.15 scale`.
+pub const SCALE: Range = Range::closed("--scale", 0.01, 3.0, "m");
+/// `serial --v-max` \[m/s\].
+pub const V_MAX: Range = Range::closed("--v-max", 0.01, 10.0, "m/s");
+/// `serial --ramp` \[s\]: time to ramp the acceleration up (sets the jerk).
+pub const RAMP: Range = Range::closed("--ramp", 0.005, 1.0, "s");
+/// `serial --turn` \[rad\]: turn about the vertical over a motion.
+pub const TURN: Range = Range::closed("--turn", 0.0, 3.0, "rad");
 
 // The command line.
 #[derive(Parser, Debug)]
@@ -233,6 +245,108 @@ pub enum Command {
     /// raw and with the Eq. 10 compensation. Writes contour_summary.{txt,csv,json},
     /// contour.mcap, contour_*.png.
     Contour(ContourArgs),
+    /// A flexible serial arm from a URDF and a stiffness file (default: the KR 300 R2500 of
+    /// deflect's robots/) in rapier carries a payload along a line and a circle in pose at
+    /// high acceleration, uncorrected and with deflect-core's 6-D D'Alembert corrector for
+    /// serial arms. Writes serial_summary.{txt,csv,json}, serial.mcap, serial.png.
+    Serial(SerialArgs),
+}
+
+// Arguments of `serial` (help texts with their ranges in the `help` attributes).
+#[derive(clap::Args, Debug)]
+pub struct SerialArgs {
+    /// Robot URDF (a regular file of at most 16 MiB, with <inertial> for the links' masses);
+    /// default: the KR 300 R2500 built into deflect-sim. Needs --stiffness.
+    #[arg(long, requires = "stiffness")]
+    pub urdf: Option<PathBuf>,
+    /// Stiffness TOML of the virtual joints (deflect's format, see robots/); default: the
+    /// KR 300's.
+    #[arg(long)]
+    pub stiffness: Option<PathBuf>,
+    /// Base link of the chain (default: the URDF's root).
+    #[arg(long)]
+    pub base: Option<String>,
+    /// Tip (TCP) link of the chain; default: "tcp" for the KR 300, else the URDF's deepest
+    /// leaf link (an error if two leaves are equally deep).
+    #[arg(long)]
+    pub tip: Option<String>,
+    /// Start joints [rad], comma-separated, one per actuated joint; default: the KR 300's
+    /// milling pose, else the most dexterous pose of the grid {-1, -0.5, 0, 0.5, 1}^n rad
+    /// inside the joint limits (largest smallest singular value of the Jacobian).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub q0: Option<Vec<f64>>,
+    #[arg(long, allow_negative_numbers = true, help = PAYLOAD_MASS.help(
+        "Payload and tool mass [kg], a cube of aluminium (2700 kg/m^3) centred on the tool \
+         axis half a side beyond the flange",
+        "Default: 150 kg on the KR 300, else 10 % of the URDF's link masses"
+    ))]
+    pub payload_mass: Option<f64>,
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true, help = SERIAL_G.help("Peak acceleration [g]", ""))]
+    pub g: f64,
+    #[arg(long, allow_negative_numbers = true, help = SCALE.help(
+        "Size of the motions [m]: line (0.3, 0.2, -0.1) x scale, circle radius 0.15 x scale",
+        "Default: 1 on the KR 300, else a third of the TCP's distance from the base at zero joints"
+    ))]
+    pub scale: Option<f64>,
+    #[arg(long, allow_negative_numbers = true, help = V_MAX.help("Largest speed [m/s]", "Default: 2 x scale per second"))]
+    pub v_max: Option<f64>,
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true, help = RAMP.help(
+        "Time to ramp the acceleration up [s] (sets the jerk)",
+        ""
+    ))]
+    pub ramp: f64,
+    #[arg(long, default_value_t = 0.3, allow_negative_numbers = true, help = TURN.help(
+        "Turn of the tool about the vertical over each motion [rad]",
+        ""
+    ))]
+    pub turn: f64,
+    /// Correct the payload's inertial wrench only (the paper's D'Alembert force); by default
+    /// the links' own inertial loads are corrected as well when the URDF has masses.
+    #[arg(long)]
+    pub payload_only: bool,
+    /// Deflection model the corrector inverts.
+    #[arg(long, value_enum, default_value_t = ModelArg::Exact)]
+    pub model: ModelArg,
+    #[arg(long, default_value_t = 2, help = JOBS.help(
+        "Worker threads (one run each; results do not depend on it)",
+        "0 is refused"
+    ))]
+    pub jobs: usize,
+}
+
+// Deflection model of the serial corrector.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum ModelArg {
+    // Virtual-joint deflection, Eq. 2-9 of Hahn and Weigold.
+    Exact,
+    // The linearized compliance J K^-1 J^T.
+    Linearized,
+}
+
+impl SerialArgs {
+    /// See [`Command::check`]; the files are checked and loaded by the scenario's `load`.
+    pub fn check(&self) -> Result<(), CliError> {
+        if let Some(m) = self.payload_mass {
+            PAYLOAD_MASS.check(m)?;
+        }
+        SERIAL_G.check(self.g)?;
+        if let Some(v) = self.scale {
+            SCALE.check(v)?;
+        }
+        if let Some(v) = self.v_max {
+            V_MAX.check(v)?;
+        }
+        RAMP.check(self.ramp)?;
+        TURN.check(self.turn)?;
+        if let Some(q) = &self.q0 {
+            if let Some((i, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+                return Err(CliError::Usage(format!(
+                    "--q0: joint {i} is {v}: expected a finite angle [rad]"
+                )));
+            }
+        }
+        JOBS.check_int(count(self.jobs))
+    }
 }
 
 // Arguments of `contour` (help texts with their ranges in the `help` attributes).
@@ -410,6 +524,7 @@ impl Command {
             Self::Run(a) => a.check(),
             Self::Milling(a) => a.check(),
             Self::Contour(a) => a.check(),
+            Self::Serial(a) => a.check(),
         }
     }
 }
@@ -523,7 +638,7 @@ mod tests {
     }
 
     /// The ranges of each subcommand's flags.
-    fn ranged() -> [(&'static str, Vec<Range>); 4] {
+    fn ranged() -> [(&'static str, Vec<Range>); 5] {
         [
             ("reproduce", vec![MASS, G_LEVEL, FIXED_POINT, JOBS]),
             ("run", vec![G_LEVEL, MASS]),
@@ -532,6 +647,10 @@ mod tests {
                 vec![FEED, FORCE, CUT, RISE_MS, CYCLE_MS, LEAD_MS, ESTIMATE_ERROR],
             ),
             ("contour", vec![STEP_MM, TARGET_FORCE, NOISE, JOBS]),
+            (
+                "serial",
+                vec![PAYLOAD_MASS, SERIAL_G, SCALE, V_MAX, RAMP, TURN, JOBS],
+            ),
         ]
     }
 
@@ -567,6 +686,7 @@ mod tests {
             "run",
             "milling",
             "contour",
+            "serial",
         ] {
             parse(&[sub]).check().unwrap();
         }

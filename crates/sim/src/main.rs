@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use scenario::{contour, fit, milling, reproduce, run, static_test};
+use scenario::{contour, fit, milling, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -42,17 +42,28 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
     let command = cli.command.as_ref().unwrap_or(&default);
     let out = &cli.out;
     command.check()?;
-    let input = match command {
+    let fit_input = match command {
         Command::Fit { input: Some(p), .. } => Some(fit::load_input(p)?),
+        _ => None,
+    };
+    let map = match command {
         Command::Run(a) => a.map.as_deref().map(run::load_map).transpose()?,
+        _ => None,
+    };
+    let arm = match command {
+        Command::Serial(a) => Some(serial::load(a)?),
         _ => None,
     };
     scenario::prepare_out(out)?;
     match command {
         Command::Reproduce(a) => reproduce::reproduce(a, out),
         Command::StaticTest { mechanism } => static_test::static_test(*mechanism, out),
-        Command::Fit { mechanism, .. } => fit::fit_cmd(*mechanism, input, out),
-        Command::Run(a) => run::run_one(a, input, out),
+        Command::Fit { mechanism, .. } => fit::fit_cmd(*mechanism, fit_input, out),
+        Command::Run(a) => run::run_one(a, map, out),
+        Command::Serial(a) => match arm {
+            Some(arm) => serial::serial_cmd(a, arm, out),
+            None => Err(deflect_sim::SimError::new("serial: inputs not loaded")),
+        },
         Command::Milling(a) => milling::milling_cmd(a, out),
         Command::Contour(a) => contour::contour_cmd(a, out),
     }

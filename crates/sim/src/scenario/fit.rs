@@ -23,6 +23,11 @@ const INPUT: &str =
 /// such regular file) or a failure (content) naming the file.
 pub fn load_input(path: &Path) -> Result<ComplianceMap, CliError> {
     input_file("--input", path, INPUT)?;
+    fit_csv(path).map_err(|e| load_error("--input", path, INPUT, e))
+}
+
+/// The map fitted from the static-test CSV at `path` (mm, N), with the scenario's options.
+pub fn fit_csv(path: &Path) -> Result<ComplianceMap, deflect_core::LoadError> {
     map_csv::fit_static_path(
         path,
         ForceUnit::Newton,
@@ -31,7 +36,6 @@ pub fn load_input(path: &Path) -> Result<ComplianceMap, CliError> {
         1e-6,
     )
     .map(|m| m.with_options(pipeline::map_options()))
-    .map_err(|e| load_error("--input", path, INPUT, e))
 }
 
 /// The `fit` command: the map of `mech` fitted from `--input` (`input`, loaded by

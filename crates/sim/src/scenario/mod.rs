@@ -32,6 +32,7 @@ pub mod fit;
 pub mod milling;
 pub mod reproduce;
 pub mod run;
+pub mod serial;
 pub mod static_test;
 
 /// Writes `args` to stdout; an error if stdout is closed or fails.

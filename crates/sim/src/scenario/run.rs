@@ -16,16 +16,69 @@ use super::{input_file, load_error};
 use crate::cli::{CliError, Correction, RunArgs};
 
 /// What `run --map` expects.
-const MAP: &str = "compliance map JSON written by `fit`";
+const MAP: &str = "compliance map JSON written by `fit` or static-test CSV written by \
+                   `static-test`";
 
-/// Loads the map of `run --map` before any work (checked even with `--correction off`).
-pub fn load_map(path: &Path) -> Result<ComplianceMap, CliError> {
+/// A map given by `run --map` and what the file was.
+#[derive(Debug)]
+pub struct LoadedMap {
+    /// The map.
+    pub map: ComplianceMap,
+    /// "compliance map JSON" or "static-test CSV (fitted)".
+    pub kind: &'static str,
+}
+
+/// Loads the map of `run --map` before any work (checked even with `--correction off`): a
+/// JSON of `fit` (the file's first non-blank character is `{`) or a static-test CSV, fitted
+/// as `fit --input` does.
+pub fn load_map(path: &Path) -> Result<LoadedMap, CliError> {
     input_file("--map", path, MAP)?;
-    map_json::from_path(path).map_err(|e| load_error("--map", path, MAP, e))
+    let mut head = [0u8; 256];
+    let n = std::fs::File::open(path)
+        .and_then(|mut f| std::io::Read::read(&mut f, &mut head))
+        .map_err(|e| {
+            let io = deflect_core::LoadError::Io {
+                path: path.display().to_string(),
+                message: e.to_string(),
+            };
+            load_error("--map", path, MAP, io)
+        })?;
+    let json = head
+        .get(..n)
+        .unwrap_or_default()
+        .iter()
+        .find(|b| !b.is_ascii_whitespace())
+        .is_some_and(|&b| b == b'{');
+    if json {
+        const WHAT: &str = "compliance map JSON written by `fit` (the file starts with `{`)";
+        let map = map_json::from_path(path).map_err(|e| load_error("--map", path, WHAT, e))?;
+        Ok(LoadedMap {
+            map,
+            kind: "compliance map JSON",
+        })
+    } else {
+        const WHAT: &str = "static-test CSV written by `static-test` (columns x, y \
+                            [mm], force_axis, force [N], dx, dy [mm]; a JSON map starts with `{`)";
+        let map = super::fit::fit_csv(path).map_err(|e| load_error("--map", path, WHAT, e))?;
+        Ok(LoadedMap {
+            map,
+            kind: "static-test CSV (fitted)",
+        })
+    }
 }
 
 /// The `run` command; `map` is the loaded `--map`, if given.
-pub fn run_one(args: &RunArgs, map: Option<ComplianceMap>, out: &Path) -> Result<(), SimError> {
+pub fn run_one(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
+    if let (Some(m), Some(p)) = (&map, &args.map) {
+        say!(
+            "--map {}: {}, {} x {} nodes",
+            p.display(),
+            m.kind,
+            m.map.x().len(),
+            m.map.y().len()
+        );
+    }
+    let map = map.map(|m| m.map);
     let head = args.head.head();
     let constraint = args.mechanism.constraint();
     let params = RobotParams::new(constraint, head);
@@ -97,4 +150,59 @@ pub fn run_one(args: &RunArgs, map: Option<ComplianceMap>, out: &Path) -> Result
     )?;
     say!("{} messages in {}", n, mcap_path.display());
     Ok(())
+}
+
+#[cfg(test)]
+#[allow(clippy::unwrap_used)]
+mod tests {
+    use super::*;
+
+    /// A static-test table on a 3 x 5 grid (mm, N), displacement linear in the force.
+    fn static_table() -> String {
+        let mut s = String::from("x,y,force_axis,force,dx,dy\n");
+        for i in 0..3 {
+            for j in 0..5 {
+                let (x, y) = (122.132 + 50.0 * f64::from(i), -75.0 + 37.5 * f64::from(j));
+                for axis in ["x", "y"] {
+                    for f in [49.05, 98.1, 147.15] {
+                        let c = 1e-3 * (1.0 + 0.1 * f64::from(i) + 0.05 * f64::from(j));
+                        let (dx, dy) = if axis == "x" {
+                            (c * f, 0.1 * c * f)
+                        } else {
+                            (0.1 * c * f, 2.0 * c * f)
+                        };
+                        s.push_str(&format!("{x},{y},{axis},{f},{dx:e},{dy:e}\n"));
+                    }
+                }
+            }
+        }
+        s
+    }
+
+    #[test]
+    fn map_accepts_the_static_test_csv_and_the_json_and_says_which() {
+        let dir = std::env::temp_dir().join(format!("deflect-sim-map-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let csv = dir.join("static.csv");
+        std::fs::write(&csv, static_table()).unwrap();
+        let fitted = load_map(&csv).unwrap();
+        assert_eq!(fitted.kind, "static-test CSV (fitted)");
+        assert_eq!((fitted.map.x().len(), fitted.map.y().len()), (3, 5));
+        // The JSON of that map, with leading blanks, reads back as the same map.
+        let json = dir.join("map.json");
+        std::fs::write(
+            &json,
+            format!("\n  {}", map_json::to_string(&fitted.map).unwrap()),
+        )
+        .unwrap();
+        let read = load_map(&json).unwrap();
+        assert_eq!(read.kind, "compliance map JSON");
+        let (p, f) = ([0.2, 0.0], [0.0, -245.0]);
+        let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
+        read.map.displacement(p, &f, &mut a).unwrap();
+        fitted.map.displacement(p, &f, &mut b).unwrap();
+        assert!(a[1].abs() > 1e-4, "{a:?}");
+        assert_eq!(a, b);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

@@ -11,6 +11,7 @@
 //! rapier arm at the start pose is checked against deflect-core's `J K^-1 J^T` first.
 
 pub mod motion;
+pub mod output;
 
 use deflect_core::dalembert::{self, Deflection, Payload, SerialData, SerialModel};
 use deflect_core::motion::PoseState;
@@ -41,6 +42,9 @@ pub struct SerialOptions {
     /// Deflection model the corrector inverts.
     #[serde(serialize_with = "deflection_json")]
     pub model: Deflection,
+    /// Whether the corrector also cancels the links' own inertial loads (deflect-core's
+    /// `SerialModel::with_link_inertia`), from the URDF's inertials; off, only the payload's.
+    pub link_inertia: bool,
 }
 
 fn payload_json<S: serde::Serializer>(p: &Payload, s: S) -> Result<S::Ok, S::Error> {
@@ -127,6 +131,10 @@ pub struct SerialResult {
     pub static_rel_error: f64,
     /// Runs: line and circle, each uncorrected and corrected.
     pub runs: Vec<SerialRun>,
+    /// Simulated time of the runs \[s\] (static check excluded).
+    pub sim_seconds: f64,
+    /// Wall-clock time of the runs \[s\] (static check excluded).
+    pub wall_seconds: f64,
 }
 
 fn pose7(p: &Isometry3<f64>) -> [f64; 7] {
@@ -136,12 +144,18 @@ fn pose7(p: &Isometry3<f64>) -> [f64; 7] {
 }
 
 /// The rapier arm's static TCP deflection against `J K^-1 J^T w` at `q0`: the largest
-/// relative difference over forces of 100 N along x, y, z and moments of 20 N m.
-pub fn static_check(spec: &ArmSpec, q0: &[f64], servo: &ServoParams) -> Result<f64, SimError> {
+/// relative difference over forces of 100 N along x, y, z and moments of 20 N m, the six
+/// loads on up to `jobs` threads.
+pub fn static_check(
+    spec: &ArmSpec,
+    q0: &[f64],
+    servo: &ServoParams,
+    jobs: usize,
+) -> Result<f64, SimError> {
     let model = &spec.robot.model;
     let c = vjm::compliance(model, &mut Data::new(model), q0)?;
-    let mut worst = 0.0f64;
-    for k in 0..6 {
+    let loads: Vec<usize> = (0..6).collect();
+    let errors = crate::jobs::parallel_map(&loads, jobs, |&k| {
         let mut w = Vector6::zeros();
         if let Some(x) = w.get_mut(k) {
             *x = if k < 3 { 100.0 } else { 20.0 };
@@ -149,9 +163,11 @@ pub fn static_check(spec: &ArmSpec, q0: &[f64], servo: &ServoParams) -> Result<f
         let mut arm = FlexSerialArm::new(spec, q0, None, servo, 1.0)?;
         let d = arm.static_deflection(&w, 5000);
         let want = c * w;
-        worst = worst.max((d - want).norm() / want.norm().max(f64::MIN_POSITIVE));
-    }
-    Ok(worst)
+        Ok::<f64, SimError>((d - want).norm() / want.norm().max(f64::MIN_POSITIVE))
+    })?;
+    errors
+        .into_iter()
+        .try_fold(0.0f64, |worst, e| e.map(|e| worst.max(e)))
 }
 
 /// The planned ticks of `path` from the start pose.
@@ -165,6 +181,34 @@ pub fn plan(
         PathKind::Line => motion::line(start, params, rate_hz),
         PathKind::Circle => motion::circle(start, params, rate_hz),
     }
+}
+
+/// Checks that both motions from `opts.q0` plan and that the rigid pose IK follows them
+/// within the joint limits, in deflect-core alone (no physics): the error names the path
+/// and the tick.
+pub fn check_motions(spec: &ArmSpec, opts: &SerialOptions) -> Result<(), SimError> {
+    let model = &spec.robot.model;
+    let start = vjm::forward(model, &mut Data::new(model), &opts.q0)?;
+    let rigid = SerialModel::new(
+        model.clone(),
+        Payload::point(0.0, nalgebra::Vector3::zeros()),
+    )?
+    .with_joint_limits(&spec.robot.joint_limits)?;
+    for path in [PathKind::Line, PathKind::Circle] {
+        let states = plan(path, &start, &opts.motion, 1.0 / opts.servo.dt)?;
+        let mut data = SerialData::new(&rigid);
+        data.set_seed(&opts.q0);
+        for (k, s) in states.iter().enumerate() {
+            dalembert::serial::step(&rigid, &mut data, s, None).map_err(|e| {
+                SimError::new(format!(
+                    "{} at t = {:.3} s (tick {k}): {e}",
+                    path.label(),
+                    s.t
+                ))
+            })?;
+        }
+    }
+    Ok(())
 }
 
 /// One run of `path`, with or without the corrector.
@@ -187,7 +231,8 @@ pub fn run(
     };
     let corrector = SerialModel::new(model.clone(), payload)?
         .with_joint_limits(&spec.robot.joint_limits)?
-        .with_deflection(opts.model);
+        .with_deflection(opts.model)
+        .with_link_inertia(corrected && opts.link_inertia);
     let mut data = SerialData::new(&corrector);
     data.set_seed(&opts.q0);
     let mut arm = FlexSerialArm::new(spec, &opts.q0, Some(&opts.payload), &opts.servo, 1.0)?;
@@ -254,7 +299,7 @@ pub fn run(
     })
 }
 
-fn pose_of(p: &[f64; 7]) -> Isometry3<f64> {
+pub(crate) fn pose_of(p: &[f64; 7]) -> Isometry3<f64> {
     Isometry3::from_parts(
         nalgebra::Translation3::new(p[0], p[1], p[2]),
         nalgebra::UnitQuaternion::new_normalize(nalgebra::Quaternion::new(p[3], p[4], p[5], p[6])),
@@ -294,7 +339,8 @@ pub fn evaluate(
 /// The static check and the four runs (line and circle, uncorrected and corrected) on up to
 /// `jobs` threads; results do not depend on `jobs`.
 pub fn serial(spec: &ArmSpec, opts: &SerialOptions, jobs: usize) -> Result<SerialResult, SimError> {
-    let static_rel_error = static_check(spec, &opts.q0, &opts.servo)?;
+    let static_rel_error = static_check(spec, &opts.q0, &opts.servo, jobs)?;
+    let start = std::time::Instant::now();
     let cases: Vec<(PathKind, bool)> = [PathKind::Line, PathKind::Circle]
         .into_iter()
         .flat_map(|p| [(p, false), (p, true)])
@@ -302,11 +348,18 @@ pub fn serial(spec: &ArmSpec, opts: &SerialOptions, jobs: usize) -> Result<Seria
     let runs = crate::jobs::parallel_map(&cases, jobs, |&(p, c)| run(spec, opts, p, c))?
         .into_iter()
         .collect::<Result<Vec<_>, _>>()?;
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let sim_seconds = runs
+        .iter()
+        .map(|r| r.samples.len() as f64 * opts.servo.dt)
+        .sum();
     let bodies = FlexSerialArm::new(spec, &opts.q0, None, &opts.servo, 1.0)?.body_count();
     Ok(SerialResult {
         options: opts.clone(),
         bodies,
         static_rel_error,
         runs,
+        sim_seconds,
+        wall_seconds,
     })
 }

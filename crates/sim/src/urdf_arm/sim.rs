@@ -170,7 +170,7 @@ impl FlexSerialArm {
                 Piece::Revolute { .. } => None,
             })
             .fold(0.0f64, f64::max);
-        if !(k_max > 0.0) {
+        if k_max <= 0.0 || k_max.is_nan() {
             return Err(SimError::new(
                 "the stiffness file gives the arm no finite stiffness: nothing to simulate",
             ));

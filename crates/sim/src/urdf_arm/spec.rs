@@ -172,7 +172,8 @@ pub fn arm_spec(
     let base = link;
 
     // The springs of each link, in file order, as (frame in the link, k, name).
-    let mut on_link: HashMap<String, Vec<(Isometry3<f64>, [f64; 3], String)>> = HashMap::new();
+    type Spring = (Isometry3<f64>, [f64; 3], String);
+    let mut on_link: HashMap<String, Vec<Spring>> = HashMap::new();
     for s in &springs {
         let (link, frame, name) = match (&s.link, &s.joint) {
             (Some(l), _) => (

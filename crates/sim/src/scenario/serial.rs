@@ -1,0 +1,289 @@
+//! `serial`: the serial testbed of [`deflect_sim::serial_scene`] on the built-in KR 300 or
+//! on the user's URDF and stiffness file. [`load`] reads and checks everything before any
+//! work (files, chain, start pose, motion reach); [`serial_cmd`] runs, prints the table and
+//! writes the files.
+
+use std::path::Path;
+
+use deflect_core::dalembert::{Deflection, Payload};
+use deflect_core::io::{stiffness, urdf};
+use deflect_core::vjm::{self, Data};
+use deflect_sim::SimError;
+use deflect_sim::serial_scene::{self, MotionParams, SerialOptions, output};
+use deflect_sim::urdf_arm::{ArmSpec, ServoParams, arm_spec};
+use nalgebra::{Matrix3, Vector3};
+
+use super::input_file;
+use crate::cli::{CliError, ModelArg, SerialArgs};
+
+/// The KR 300 R2500 URDF of deflect's `robots/` (link masses are our estimates).
+const KR300_URDF: &str = include_str!("../../../../robots/kr300/kr300_r2500.urdf");
+/// Its stiffness file (Hähn and Weigold's identified values).
+const KR300_STIFFNESS: &str = include_str!("../../../../robots/kr300/kr300_r2500_stiffness.toml");
+/// The KR 300's start pose: the milling pose of the examples.
+const KR300_Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+/// Largest input file read \[bytes\].
+const MAX_FILE: u64 = 16 << 20;
+/// Density of the payload cube \[kg/m^3\] (aluminium).
+const PAYLOAD_DENSITY: f64 = 2700.0;
+
+/// Everything `serial` needs, checked.
+#[derive(Debug)]
+pub struct SerialInput {
+    /// The arm.
+    pub spec: ArmSpec,
+    /// The scenario's settings.
+    pub options: SerialOptions,
+}
+
+/// Reads a text file of `flag` (regular, at most 16 MiB): a usage error naming the flag and
+/// the file otherwise.
+fn read_text(flag: &str, path: &Path, expected: &str) -> Result<String, CliError> {
+    input_file(flag, path, expected)?;
+    let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if len > MAX_FILE {
+        return Err(CliError::Usage(format!(
+            "{flag} {}: {len} bytes; expected the {expected} of at most {MAX_FILE} bytes",
+            path.display()
+        )));
+    }
+    std::fs::read_to_string(path).map_err(|e| {
+        CliError::Failure(format!(
+            "{flag} {}: cannot read the {expected}: {e}",
+            path.display()
+        ))
+    })
+}
+
+/// The deepest leaf link of the URDF (the default tip); an error naming the candidates if two
+/// are equally deep.
+fn deepest_leaf(robot: &urdf_rs::Robot, base: Option<&str>) -> Result<String, String> {
+    let parent_of = |link: &str| {
+        robot
+            .joints
+            .iter()
+            .find(|j| j.child.link == link)
+            .map(|j| j.parent.link.as_str())
+    };
+    let mut best: Vec<(usize, &str)> = Vec::new();
+    for l in &robot.links {
+        if robot.joints.iter().any(|j| j.parent.link == l.name) {
+            continue;
+        }
+        let (mut depth, mut at) = (0usize, l.name.as_str());
+        while Some(at) != base {
+            match parent_of(at) {
+                Some(p) if depth <= robot.joints.len() => {
+                    depth += 1;
+                    at = p;
+                }
+                _ => break,
+            }
+        }
+        best.push((depth, l.name.as_str()));
+    }
+    best.sort_by_key(|b| std::cmp::Reverse(b.0));
+    match best.as_slice() {
+        [(d, name), (d2, other), ..] if d == d2 => Err(format!(
+            "the URDF has several deepest leaf links ({name}, {other}, ...): name the TCP link \
+             with --tip"
+        )),
+        [(_, name), ..] => Ok((*name).to_string()),
+        [] => Err("the URDF has no links".into()),
+    }
+}
+
+/// The most dexterous pose of the grid {-1, -0.5, 0, 0.5, 1}^n inside the limits: the
+/// largest smallest singular value of the position-scaled Jacobian. At most 6 joints are
+/// searched (5^6 poses); further joints stay at 0 (or the middle of their limits).
+fn dexterous_pose(spec: &ArmSpec, reach: f64) -> Option<Vec<f64>> {
+    let robot = &spec.robot;
+    let n = robot.model.dof();
+    let mut data = Data::new(&robot.model);
+    let grid = [-1.0, -0.5, 0.0, 0.5, 1.0];
+    let searched = n.min(6);
+    let mid = |(lo, hi): (f64, f64)| {
+        if lo.is_finite() && hi.is_finite() {
+            0.5 * (lo + hi)
+        } else {
+            0.0f64.clamp(lo, hi)
+        }
+    };
+    let mut q: Vec<f64> = robot.joint_limits.iter().map(|&l| mid(l)).collect();
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    for code in 0..grid.len().pow(searched as u32) {
+        let mut c = code;
+        let mut inside = true;
+        for (k, qk) in q.iter_mut().enumerate().take(searched) {
+            *qk = grid.get(c % grid.len()).copied().unwrap_or(0.0);
+            c /= grid.len();
+            let (lo, hi) = robot.joint_limits.get(k).copied().unwrap_or((-1e9, 1e9));
+            inside &= *qk >= lo && *qk <= hi;
+        }
+        if !inside || vjm::joint_jacobian(&robot.model, &mut data, &q).is_err() {
+            continue;
+        }
+        let mut j = data.jacobian.columns(0, n).into_owned();
+        for r in 3..6 {
+            j.row_mut(r).scale_mut(reach);
+        }
+        let s = j.svd(false, false).singular_values.min();
+        if best.as_ref().is_none_or(|(b, _)| s > *b) {
+            best = Some((s, q.clone()));
+        }
+    }
+    best.filter(|(s, _)| *s > 1e-6).map(|(_, q)| q)
+}
+
+/// Reads and checks the arm, the start pose and the settings before any work.
+pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
+    const URDF: &str = "robot URDF";
+    const STIFF: &str = "stiffness TOML (deflect's virtual-joint format)";
+    let builtin = a.urdf.is_none();
+    let urdf_text = match &a.urdf {
+        Some(p) => read_text("--urdf", p, URDF)?,
+        None => KR300_URDF.to_string(),
+    };
+    let stiff_text = match &a.stiffness {
+        Some(p) => read_text("--stiffness", p, STIFF)?,
+        None => KR300_STIFFNESS.to_string(),
+    };
+    let urdf_name = a
+        .urdf
+        .as_ref()
+        .map_or("the built-in KR 300 URDF".to_string(), |p| {
+            format!("--urdf {}", p.display())
+        });
+    let stiff_name = a
+        .stiffness
+        .as_ref()
+        .map_or("the built-in KR 300 stiffness file".to_string(), |p| {
+            format!("--stiffness {}", p.display())
+        });
+    // Each file alone first, so that an error names the file it is in.
+    let parsed = urdf::parse(&urdf_text)
+        .map_err(|e| CliError::Failure(format!("{urdf_name}: not a valid {URDF}: {e}")))?;
+    stiffness::from_str(&stiff_text)
+        .map_err(|e| CliError::Failure(format!("{stiff_name}: not a valid {STIFF}: {e}")))?;
+    let tip = match (&a.tip, builtin) {
+        (Some(t), _) => t.clone(),
+        (None, true) => "tcp".to_string(),
+        (None, false) => deepest_leaf(&parsed, a.base.as_deref())
+            .map_err(|e| CliError::Usage(format!("--tip: {e}")))?,
+    };
+    let spec = arm_spec(&urdf_text, &stiff_text, a.base.as_deref(), &tip).map_err(|e| {
+        CliError::Failure(format!("{urdf_name} with {stiff_name}, tip {tip}: {}", e.0))
+    })?;
+    let model = &spec.robot.model;
+    let dof = model.dof();
+    if dof < 6 {
+        return Err(CliError::Failure(format!(
+            "{urdf_name}, tip {tip}: the chain has {dof} actuated joints; the 6-D pose \
+             correction needs at least 6"
+        )));
+    }
+    // Summed link lengths: the motion's size and the dexterity's length scale.
+    let mut data = Data::new(model);
+    let reach = {
+        let zeros = vec![0.0; dof];
+        vjm::forward(model, &mut data, &zeros)
+            .map(|p| p.translation.vector.norm())
+            .unwrap_or(1.0)
+            .max(0.1)
+    };
+    let scale = match (a.scale, builtin) {
+        (Some(s), _) => s,
+        (None, true) => 1.0,
+        (None, false) => (reach / 3.0).clamp(0.05, 3.0),
+    };
+    let q0 = match (&a.q0, builtin) {
+        (Some(q), _) => q.clone(),
+        (None, true) => KR300_Q0.to_vec(),
+        (None, false) => dexterous_pose(&spec, reach).ok_or_else(|| {
+            CliError::Usage(format!(
+                "--q0: no non-singular start pose found on the grid for {urdf_name}; give one"
+            ))
+        })?,
+    };
+    if q0.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
+            q0.len(),
+            spec.robot.joint_names.join(", ")
+        )));
+    }
+    for (k, (&q, &(lo, hi))) in q0.iter().zip(&spec.robot.joint_limits).enumerate() {
+        if q < lo || q > hi {
+            return Err(CliError::Usage(format!(
+                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
+                spec.robot.joint_names.get(k).map_or("?", String::as_str)
+            )));
+        }
+    }
+    let links_mass: f64 = spec.bodies.iter().map(|b| b.inertia.mass).sum();
+    let mass = match (a.payload_mass, builtin) {
+        (Some(m), _) => m,
+        (None, true) => 150.0,
+        (None, false) if links_mass > 0.0 => (0.1 * links_mass * 10.0).round() / 10.0,
+        (None, false) => {
+            return Err(CliError::Usage(format!(
+                "--payload-mass: {urdf_name} has no link masses to take 10 % of; give the \
+                 payload mass [kg]"
+            )));
+        }
+    };
+    // A cube of aluminium centred on the tool axis, half a side beyond the flange.
+    let side = (mass / PAYLOAD_DENSITY).cbrt();
+    let payload = Payload {
+        mass,
+        com: Vector3::new(0.0, 0.0, 0.5 * side),
+        inertia: Matrix3::from_diagonal_element(mass * side * side / 6.0),
+    };
+    let options = SerialOptions {
+        robot: if builtin {
+            "KR 300 R2500".to_string()
+        } else {
+            a.urdf
+                .as_ref()
+                .and_then(|p| p.file_stem())
+                .map_or("robot".into(), |s| s.to_string_lossy().into_owned())
+        },
+        q0,
+        payload,
+        motion: MotionParams {
+            g: a.g,
+            scale,
+            ramp: a.ramp,
+            turn: a.turn,
+            v_max: a.v_max.unwrap_or(2.0 * scale),
+        },
+        servo: ServoParams::default(),
+        tail: 0.3,
+        model: match a.model {
+            ModelArg::Exact => Deflection::Exact,
+            ModelArg::Linearized => Deflection::Linearized,
+        },
+        link_inertia: !a.payload_only && spec.robot.model.mass_count() > 0,
+    };
+    // The motions must be plannable and reachable (rigid IK along them) before the runs.
+    serial_scene::check_motions(&spec, &options).map_err(|e| {
+        CliError::Usage(format!(
+            "the motions from the start pose do not fit {urdf_name} (change --q0, --scale or \
+             --turn): {}",
+            e.0
+        ))
+    })?;
+    Ok(SerialInput { spec, options })
+}
+
+/// The `serial` command (arguments checked by [`SerialArgs::check`], inputs by [`load`]).
+pub fn serial_cmd(a: &SerialArgs, input: SerialInput, out: &Path) -> Result<(), SimError> {
+    let r = serial_scene::serial(&input.spec, &input.options, a.jobs)?;
+    put!("{}", output::table(&r));
+    let n = output::write_all(out, &r)?;
+    say!(
+        "wrote {}/serial_summary.{{txt,csv,json}}, serial.mcap ({n} messages), serial.png",
+        out.display()
+    );
+    Ok(())
+}
