@@ -889,6 +889,20 @@ DeflectStatus deflect_serial_dalembert_create(const struct DeflectSerialRobot *r
 // `corrector` is NULL or a live handle, not used afterwards.
 void deflect_serial_dalembert_destroy(struct DeflectSerialDalembert *corrector);
 
+// Sets which loads the corrector cancels besides the payload's inertial wrench: with
+// `link_inertia` nonzero, the links' own inertial loads (every URDF `<inertial>`, from the
+// joint rates of the motion; off by default, as in the paper), and `gravity[3]` [m/s^2],
+// base frame (NULL: zero, the default), whose weights then load the springs too. Init time
+// (rebuilds the model; allocates); the warm start is kept. Returns `DEFLECT_ERR_NULL` or
+// `DEFLECT_ERR_NON_FINITE` (gravity).
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `gravity` is NULL or
+// holds 3 doubles.
+DeflectStatus deflect_serial_dalembert_set_loads(struct DeflectSerialDalembert *corrector,
+                                                 int32_t link_inertia,
+                                                 const double *gravity);
+
 // Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
 // that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
 // `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.

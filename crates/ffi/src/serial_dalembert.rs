@@ -141,6 +141,45 @@ pub unsafe extern "C" fn deflect_serial_dalembert_destroy(corrector: *mut Deflec
     });
 }
 
+/// Sets which loads the corrector cancels besides the payload's inertial wrench: with
+/// `link_inertia` nonzero, the links' own inertial loads (every URDF `<inertial>`, from the
+/// joint rates of the motion; off by default, as in the paper), and `gravity[3]` \[m/s^2\],
+/// base frame (NULL: zero, the default), whose weights then load the springs too. Init time
+/// (rebuilds the model; allocates); the warm start is kept. Returns `DEFLECT_ERR_NULL` or
+/// `DEFLECT_ERR_NON_FINITE` (gravity).
+///
+/// # Safety
+/// `corrector` is NULL or a live handle not used by another thread; `gravity` is NULL or
+/// holds 3 doubles.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn deflect_serial_dalembert_set_loads(
+    corrector: *mut DeflectSerialDalembert,
+    link_inertia: i32,
+    gravity: *const f64,
+) -> DeflectStatus {
+    guard(|| {
+        // SAFETY: NULL or a live handle by contract.
+        let c = unsafe { handle_mut(corrector)? };
+        let g = if gravity.is_null() {
+            Vector3::zeros()
+        } else {
+            // SAFETY: `gravity` holds 3 doubles by contract.
+            Vector3::from_column_slice(unsafe { slice(gravity, 3)? })
+        };
+        if g.iter().any(|v| !v.is_finite()) {
+            return Err(DEFLECT_ERR_NON_FINITE);
+        }
+        let model = c
+            .model
+            .clone()
+            .with_link_inertia(link_inertia != 0)
+            .with_gravity(g)
+            .map_err(|_| DEFLECT_ERR_NON_FINITE)?;
+        c.model = model;
+        Ok(())
+    })
+}
+
 /// Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
 /// that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
 /// `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.

@@ -45,7 +45,11 @@ fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
 /// (default: the robot's URDF limits; a command outside them is an `InputError`);
 /// `max_iterations` (1..=256), `position_tolerance` [m] and `orientation_tolerance` [rad]
 /// of the IK (`ConvergenceError` when missed); `seed` (dof,): the joints the motion starts
-/// from (default zeros; the first tick solves from there).
+/// from (default zeros; the first tick solves from there). `link_inertia=True` also
+/// cancels the links' own inertial loads (`-m a_c`, `-(I alpha + omega x I omega)` of every
+/// URDF `<inertial>`, from the joint rates of the motion; default off, as in the paper);
+/// `gravity` (3,) [m/s^2], base frame (default zero): the weights then load the springs too,
+/// so the command also cancels the static sag.
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct SerialDalembertCorrector {
@@ -106,7 +110,7 @@ fn tick_dict<'py>(py: Python<'py>, t: &SerialTick, dof: usize) -> PyResult<Bound
 #[pymethods]
 impl SerialDalembertCorrector {
     #[new]
-    #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None))]
+    #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None, link_inertia=false, gravity=None))]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: &SerialRobot,
@@ -119,6 +123,8 @@ impl SerialDalembertCorrector {
         #[pyo3(from_py_with = args::real::position_tolerance)] position_tolerance: f64,
         #[pyo3(from_py_with = args::real::orientation_tolerance)] orientation_tolerance: f64,
         seed: Option<&Bound<'_, PyAny>>,
+        link_inertia: bool,
+        gravity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         let chain = robot.inner.model.clone();
         let dof = chain.dof();
@@ -159,10 +165,15 @@ impl SerialDalembertCorrector {
             orientation_tolerance,
             ..PoseIkOptions::default()
         };
+        let g = vec3(gravity, "gravity")?;
         let model = SerialModel::new(chain, payload)
             .and_then(|m| m.with_joint_limits(&limits))
             .and_then(|m| m.with_ik_options(ik))
-            .map(|m| m.with_deflection(deflection))
+            .map(|m| {
+                m.with_deflection(deflection)
+                    .with_link_inertia(link_inertia)
+            })
+            .and_then(|m| m.with_gravity(g))
             .map_err(build_err)?;
         let mut data = SerialData::new(&model);
         if let Some(s) = seed {
@@ -188,6 +199,16 @@ impl SerialDalembertCorrector {
     #[getter]
     fn joint_names(&self) -> Vec<String> {
         self.joint_names.clone()
+    }
+    /// Whether the links' own inertial loads (from the URDF's inertials) are corrected too.
+    #[getter]
+    fn link_inertia(&self) -> bool {
+        self.model.link_inertia()
+    }
+    /// Gravity [m/s^2], base frame, (3,): zero unless given.
+    #[getter]
+    fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.model.gravity().as_slice().to_pyarray(py)
     }
     /// Payload mass [kg].
     #[getter]

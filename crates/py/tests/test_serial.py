@@ -219,3 +219,30 @@ def test_stiffness_file_errors_name_the_entry(tmp_path, entry, match):
     toml.write_text("[[virtual_joint]]\n" + entry + "\n")
     with pytest.raises(deflect.LoadError, match=match):
         deflect.SerialRobot.from_urdf(ur5_urdf(), toml, "tool0")
+
+
+def test_link_inertia_and_gravity_are_opt_in(ur5):
+    traj = motion(ur5, rate_hz=500.0)
+    plain = deflect.SerialDalembertCorrector(ur5, 3.0, seed=Q0)
+    assert plain.link_inertia is False
+    np.testing.assert_array_equal(plain.gravity, [0.0, 0.0, 0.0])
+    links = deflect.SerialDalembertCorrector(ur5, 3.0, seed=Q0, link_inertia=True)
+    assert links.link_inertia is True
+    a, b = plain.correct(traj), links.correct(traj)
+    # The UR5's links (18 kg) outweigh a 3 kg payload: their inertia adds a correction of the
+    # same order, and the payload's wrench itself is unchanged.
+    np.testing.assert_allclose(a.wrench, b.wrench, atol=1e-9)
+    extra = np.linalg.norm(b.commanded[:, :3, 3] - a.commanded[:, :3, 3], axis=1).max()
+    own = np.linalg.norm(a.commanded[:, :3, 3] - a.desired[:, :3, 3], axis=1).max()
+    assert extra > 0.3 * own > 0, (extra, own)
+    # At rest under gravity: the payload's weight (F = m g, M = r x F) is cancelled.
+    g = np.array([0.0, 0.0, -9.81])
+    sag = deflect.SerialDalembertCorrector(ur5, 3.0, com=[0.0, 0.0, 0.1], seed=Q0, gravity=g)
+    rest = ur5.forward(Q0)
+    tick = sag.step(rest)
+    r = rest[:3, :3] @ np.array([0.0, 0.0, 0.1])
+    np.testing.assert_allclose(tick["wrench"][:3], 3.0 * g, rtol=1e-12)
+    np.testing.assert_allclose(tick["wrench"][3:], np.cross(r, 3.0 * g), rtol=1e-9, atol=1e-12)
+    assert np.linalg.norm(tick["commanded"][:3, 3] - rest[:3, 3]) > 1e-5
+    with pytest.raises(deflect.InputError, match="gravity"):
+        deflect.SerialDalembertCorrector(ur5, 3.0, gravity=[0.0, np.nan, 0.0])

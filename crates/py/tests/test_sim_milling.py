@@ -1,7 +1,7 @@
 """deflect-sim milling writes an MCAP log the Python `mcap` reader can read back.
 
-Runs the release binary (`cargo run --release -p deflect-sim -- milling --cut 0.4`, about half
-a second in release) and checks channels, schemas, message counts and what the runs show:
+Runs the release binary (`cargo run --release -p deflect-sim -- milling --cut 0.4`, the KR 300
+in rapier: about 10-20 s on 2 cores, most of it the identification's static tests) and checks channels, schemas, message counts and what the runs show:
 compensation reduces the path error, pilot control more so.
 """
 
@@ -77,8 +77,12 @@ def test_runs(out_dir):
 def test_other_outputs(out_dir):
     s = json.loads((out_dir / "milling_summary.json").read_text())
     assert [r["run"] for r in s["runs"]] == RUNS
+    # 30 axes of the KR 300's ten finite virtual joints, from frame pairs with 2 urad noise:
+    # each within 4 standard errors and 5 % of the stiffness file's value.
+    assert len(s["stiffness"]) == 30
     for e in s["stiffness"]:
-        assert abs(e["k_frames"] / e["k_true"] - 1) < 0.02, e
+        err = abs(e["k_frames"] - e["k_true"])
+        assert err < 4 * e["se_frames"] and err < 0.05 * e["k_true"], e
     assert abs(s["sensor"]["weight"][1] / s["sensor"]["weight"][0] - 1) < 0.01
     for name in ["milling_error.png", "milling_stiffness.png"]:
         assert (out_dir / name).stat().st_size > 10_000

@@ -235,9 +235,9 @@ pub enum Command {
     },
     /// One motion on one configuration, uncorrected and/or corrected; writes an MCAP log.
     Run(RunArgs),
-    /// Milling scenario for the online force-based compensation (Hähn & Weigold): a 4-axis
-    /// flexible arm mills a groove; uncompensated, Cartesian compensation and pilot control;
-    /// stiffness and sensor identification. Writes milling_summary.{txt,csv,json},
+    /// Milling scenario for the online force-based compensation (Hähn & Weigold): their
+    /// KR 300 R2500 (robots/) as a flexible arm in rapier mills a groove; uncompensated,
+    /// Cartesian compensation and pilot control; stiffness and sensor identification. Writes milling_summary.{txt,csv,json},
     /// milling.mcap and PNG plots.
     Milling(MillingArgs),
     /// Force-feedback contour tracing (deflect-core's contour tracer, Eq. 21) of a circle, a

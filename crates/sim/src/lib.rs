@@ -9,7 +9,9 @@
 //!   ([`pipeline`]) and the paper's evaluation (Appendix C, [`analysis`], [`report`],
 //!   [`output`]).
 //! * The online force-based compensation of Hähn and Weigold (sec. 2.2-2.6) in a milling
-//!   scenario on a flexible 4-axis arm ([`milling`]).
+//!   scenario on the flexible KR 300 R2500 ([`milling`]).
+//! * Any serial arm from a URDF and a stiffness file as a flexible arm ([`urdf_arm`]) and the
+//!   6-D D'Alembert corrector for serial arms at high acceleration on it ([`serial_scene`]).
 //! * Force-feedback contour tracing and shape recovery ("Shape recovery from robot contour
 //!   tracking with force feedback", Eq. 10 and 21) by a 2R arm with compliant, backlashed
 //!   joints ([`contour_scene`]).

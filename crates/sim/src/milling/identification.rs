@@ -1,34 +1,39 @@
-//! Identification before the milling runs (Hähn and Weigold, sec. 2.5-2.6): the joint
-//! stiffnesses from static loads on the arm in rapier (frame-pair rotations across each
-//! spring and TCP deflections, each by least squares), and the flange sensor's offsets,
-//! weight and centre of gravity from unloaded readings at several orientations.
+//! Identification before the milling runs (Hähn and Weigold, sec. 2.5-2.6): the virtual-joint
+//! stiffnesses of the KR 300 from static loads on the arm in rapier (frame-pair rotations
+//! across each virtual joint, and 6-D TCP deflections, each by least squares), and the flange
+//! sensor's offsets, weight and centre of gravity from unloaded readings at several
+//! orientations.
 
 use deflect_core::compensation::SensorCalibration;
 use deflect_core::identification::{
     FrameMeasurement, StiffnessIdentification, TcpMeasurement, identify_from_frames,
     identify_from_tcp, identify_sensor,
 };
-use deflect_core::vjm::{self, Data, Vector6};
+use deflect_core::vjm::Vector6;
 use nalgebra::Vector3;
 use serde::Serialize;
 
-use super::arm::{FlexArm, JOINTS, vjm_model};
+use super::arm::MillingArm;
 use super::scenario::MillingOptions;
 use crate::SimError;
 use crate::noise::Noise;
 
-/// Identification of one joint's stiffness.
-#[derive(Debug, Clone, Copy, Serialize)]
+/// Identification of one stiffness (one axis of one virtual joint).
+#[derive(Debug, Clone, Serialize)]
 pub struct JointEstimate {
-    /// Joint index (0 = yaw).
-    pub joint: usize,
-    /// True stiffness \[N m/rad\].
+    /// Virtual joint index (chain order).
+    pub spring: usize,
+    /// Axis of the spring frame (0 = x, 1 = y, 2 = z).
+    pub axis: usize,
+    /// "link_2 y", "spindle z".
+    pub label: String,
+    /// True stiffness \[N m/rad\] (the stiffness file's).
     pub k_true: f64,
-    /// From frame-pair rotations \[N m/rad\].
+    /// From frame-pair rotations \[N m/rad\] (NaN: not identifiable from these loads).
     pub k_frames: f64,
     /// Its standard error \[N m/rad\].
     pub se_frames: f64,
-    /// From TCP deflections (translation only) \[N m/rad\].
+    /// From 6-D TCP deflections \[N m/rad\] (NaN: not identifiable).
     pub k_tcp: f64,
     /// Its standard error \[N m/rad\].
     pub se_tcp: f64,
@@ -51,10 +56,10 @@ pub struct SensorEstimate {
     pub force_rms: f64,
 }
 
-fn stiffness_of(id: &StiffnessIdentification, joint: usize) -> (f64, f64) {
+fn stiffness_of(id: &StiffnessIdentification, spring: usize, axis: usize) -> (f64, f64) {
     id.axes
         .iter()
-        .find(|a| a.spring == joint)
+        .find(|a| a.spring == spring && a.axis == axis)
         .map(|a| match a.compliance {
             Some(c) if c > 0.0 => (1.0 / c, a.std_error / (c * c)),
             _ => (f64::NAN, f64::NAN),
@@ -62,123 +67,194 @@ fn stiffness_of(id: &StiffnessIdentification, joint: usize) -> (f64, f64) {
         .unwrap_or((f64::NAN, f64::NAN))
 }
 
-/// Static tests in rapier: at several poses, loads of `id_load` along ±x, ±y, ±z at the tool
-/// point with the motors locked; frame-pair rotations across each spring and the TCP
-/// translation (loaded minus unloaded), with measurement noise; least squares for each.
-pub fn identify_stiffness(opts: &MillingOptions) -> Result<Vec<JointEstimate>, SimError> {
-    let arm = &opts.arm;
-    // The structure of the model matters, not its values.
-    let guess = vjm_model(arm, &[1.0e5; JOINTS])?;
-    let poses = [
-        Vector3::new(1.1, -0.2, 0.1),
-        Vector3::new(1.3, 0.25, 0.3),
-        Vector3::new(0.9, 0.1, -0.05),
+/// The identification poses: the milling pose and two others across the workspace \[rad\].
+pub fn poses(q0: &[f64]) -> Vec<Vec<f64>> {
+    let offsets: [[f64; 6]; 3] = [
+        [0.0; 6],
+        [0.5, 0.15, -0.2, 0.6, -0.3, 0.8],
+        [-0.6, -0.1, 0.25, -0.7, 0.35, -0.5],
     ];
-    let loads = [
-        Vector3::x(),
-        -Vector3::x(),
-        Vector3::y(),
-        -Vector3::y(),
-        Vector3::z(),
-        -Vector3::z(),
-    ];
-    let mut noise = Noise::new(opts.seed ^ 0x1D);
-    let mut qs = Vec::new();
-    let mut frame_data = Vec::new(); // (pose, wrench, spring, rotation)
-    let mut tcp_data = Vec::new(); // (pose, wrench, deflection)
-    let hold = (opts.id_hold / opts.dt).round().max(1.0) as usize;
-    let ramp = (0.03 / opts.dt).round().max(1.0) as usize;
-    for (pi, p) in poses.iter().take(opts.id_poses.clamp(1, 3)).enumerate() {
-        let q = arm.ik(p);
-        qs.push(q);
-        // Critically damped (about) so that each load settles quickly.
-        let mut sim = FlexArm::new(arm, &q, 4.0, opts.dt)?;
-        sim.step(&q, &Vector3::zeros());
-        let rot0 = sim.spring_rotations(&q);
-        let tcp0 = sim.tcp();
-        let mut prev = Vector3::zeros();
-        for dir in &loads {
-            let target = dir * opts.id_load;
-            for k in 0..ramp {
-                let s = (k + 1) as f64 / ramp as f64;
-                sim.step(&q, &(prev + (target - prev) * s));
+    offsets
+        .iter()
+        .map(|o| q0.iter().zip(o).map(|(q, d)| q + d).collect())
+        .collect()
+}
+
+/// The static loads at the TCP: forces of `f` N along +-x, +-y, +-z and moments of `f / 4`
+/// N m about them (a lever on the spindle), base frame.
+fn loads(f: f64) -> Vec<Vector6> {
+    let mut out = Vec::new();
+    for k in 0..6 {
+        for sign in [1.0, -1.0] {
+            let mut w = Vector6::zeros();
+            if let Some(v) = w.get_mut(k) {
+                *v = sign * if k < 3 { f } else { 0.25 * f };
             }
-            for _ in 0..hold {
-                sim.step(&q, &target);
-            }
-            prev = target;
-            let rot = sim.spring_rotations(&q);
-            let w = Vector6::new(target.x, target.y, target.z, 0.0, 0.0, 0.0);
-            for (j, (r1, r0)) in rot.iter().zip(&rot0).enumerate() {
-                let mut r = r1 - r0;
-                for v in r.iter_mut() {
-                    *v += opts.id_noise[0] * noise.gauss();
-                }
-                frame_data.push((pi, w, j, r));
-            }
-            let mut d = sim.tcp() - tcp0;
-            for v in d.iter_mut() {
-                *v += opts.id_noise[1] * noise.gauss();
-            }
-            tcp_data.push((pi, w, Vector6::new(d.x, d.y, d.z, 0.0, 0.0, 0.0)));
+            out.push(w);
         }
     }
-    let frames: Vec<FrameMeasurement<'_>> = frame_data
-        .iter()
-        .map(|(pi, w, j, r)| FrameMeasurement {
-            q: &qs[*pi],
-            wrench: *w,
-            spring: *j,
-            rotation: *r,
-        })
+    out
+}
+
+/// What one pose's static tests read: the frame-pair rotations per load and spring, and the
+/// TCP deflection per load.
+struct PoseReadings {
+    rotations: Vec<(Vector6, Vec<Vector3<f64>>)>,
+    tcp: Vec<(Vector6, Vector6)>,
+}
+
+/// Damping multiplier of the static tests: the arm's structural damping (2-4 % of critical)
+/// times this is about critical on its first modes, so each load settles within the hold
+/// (static readings do not depend on damping). The damping is stiffness-proportional, so
+/// every spring also creeps with the time constant `30 beta` = 30 ms: a hold of 0.25 s leaves
+/// e^-8 of the load unread.
+const STATIC_DAMPING: f64 = 30.0;
+
+/// Static tests at joints `q`: motors locked, each load ramped in 30 ms and held `id_hold`,
+/// readings loaded minus unloaded with noise.
+fn static_tests(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+    q: &[f64],
+    seed: u64,
+) -> Result<PoseReadings, SimError> {
+    let mut noise = Noise::new(seed);
+    let mut sim = arm.sim(q, STATIC_DAMPING, opts.dt)?;
+    let hold = (opts.id_hold / opts.dt).round().max(1.0) as usize;
+    let ramp = (0.03 / opts.dt).round().max(1.0) as usize;
+    sim.step_locked(&Vector6::zeros());
+    let rot0 = sim.spring_rotations();
+    let tcp0 = sim.tcp_pose();
+    let mut prev = Vector6::zeros();
+    let mut out = PoseReadings {
+        rotations: Vec::new(),
+        tcp: Vec::new(),
+    };
+    for target in loads(opts.id_load) {
+        for k in 0..ramp {
+            let s = (k + 1) as f64 / ramp as f64;
+            sim.step_locked(&(prev + (target - prev) * s));
+        }
+        for _ in 0..hold {
+            sim.step_locked(&target);
+        }
+        prev = target;
+        let rot: Vec<Vector3<f64>> = sim
+            .spring_rotations()
+            .iter()
+            .zip(&rot0)
+            .map(|(r1, r0)| (r1 - r0).map(|v| v + opts.id_noise[0] * noise.gauss()))
+            .collect();
+        out.rotations.push((target, rot));
+        let now = sim.tcp_pose();
+        let dp = now.translation.vector - tcp0.translation.vector;
+        let dr = (now.rotation * tcp0.rotation.inverse()).scaled_axis();
+        let mut d = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z);
+        for (k, v) in d.iter_mut().enumerate() {
+            // The tracker's position noise [m]; its orientation noise over a 0.1 m target.
+            let sd = if k < 3 {
+                opts.id_noise[1]
+            } else {
+                opts.id_noise[1] / 0.1
+            };
+            *v += sd * noise.gauss();
+        }
+        out.tcp.push((target, d));
+    }
+    Ok(out)
+}
+
+/// Static tests in rapier at `id_poses` poses (one thread each, up to `jobs`): frame-pair
+/// rotations across each virtual joint and the 6-D TCP deflection under every load; least
+/// squares for each, per axis of every finite virtual joint.
+pub fn identify_stiffness(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+    jobs: usize,
+) -> Result<Vec<JointEstimate>, SimError> {
+    let qs: Vec<Vec<f64>> = poses(&opts.q0)
+        .into_iter()
+        .take(opts.id_poses.clamp(1, 3))
         .collect();
-    let tcps: Vec<TcpMeasurement<'_>> = tcp_data
-        .iter()
-        .map(|(pi, w, d)| TcpMeasurement {
-            q: &qs[*pi],
-            wrench: *w,
-            deflection: *d,
-            translation_only: true,
-        })
-        .collect();
+    let indexed: Vec<(usize, &Vec<f64>)> = qs.iter().enumerate().collect();
+    let readings = crate::jobs::parallel_map(&indexed, jobs, |&(i, q)| {
+        static_tests(arm, opts, q, opts.seed ^ (0x1D + i as u64))
+    })?
+    .into_iter()
+    .collect::<Result<Vec<_>, _>>()?;
+    let mut frames = Vec::new();
+    let mut tcps = Vec::new();
+    for (q, r) in qs.iter().zip(&readings) {
+        for (w, rots) in &r.rotations {
+            for (info, rot) in arm.springs.iter().zip(rots) {
+                frames.push(FrameMeasurement {
+                    q,
+                    wrench: *w,
+                    spring: info.index,
+                    rotation: *rot,
+                });
+            }
+        }
+        for (w, d) in &r.tcp {
+            tcps.push(TcpMeasurement {
+                q,
+                wrench: *w,
+                deflection: *d,
+                translation_only: false,
+            });
+        }
+    }
     let e = |e: deflect_core::BuildError| SimError::new(format!("identification: {e}"));
-    let by_frames = identify_from_frames(&guess, &frames, false).map_err(e)?;
-    let by_tcp = identify_from_tcp(&guess, &tcps, false).map_err(e)?;
-    Ok((0..JOINTS)
-        .map(|j| {
-            let (k_frames, se_frames) = stiffness_of(&by_frames, j);
-            let (k_tcp, se_tcp) = stiffness_of(&by_tcp, j);
-            JointEstimate {
-                joint: j,
-                k_true: arm.stiffness[j],
+    let by_frames = identify_from_frames(arm.model(), &frames, false).map_err(e)?;
+    let by_tcp = identify_from_tcp(arm.model(), &tcps, false).map_err(e)?;
+    let mut out = Vec::new();
+    for info in &arm.springs {
+        for (axis, &k_true) in info.k.iter().enumerate() {
+            if !k_true.is_finite() {
+                continue;
+            }
+            let (k_frames, se_frames) = stiffness_of(&by_frames, info.index, axis);
+            let (k_tcp, se_tcp) = stiffness_of(&by_tcp, info.index, axis);
+            out.push(JointEstimate {
+                spring: info.index,
+                axis,
+                label: format!("{} {}", info.label, ["x", "y", "z"][axis.min(2)]),
+                k_true,
                 k_frames,
                 se_frames,
                 k_tcp,
                 se_tcp,
-            }
-        })
-        .collect())
+            });
+        }
+    }
+    Ok(out)
 }
 
 /// Sensor identification from unloaded readings (each the mean of 50 noisy samples) at
-/// orientations reached by the arm's yaw and wrist joints.
+/// orientations reached by the base and wrist joints.
 pub fn identify_sensor_calibration(
+    arm: &MillingArm,
     opts: &MillingOptions,
 ) -> Result<(SensorCalibration, SensorEstimate), SimError> {
-    let arm = &opts.arm;
-    let model = vjm_model(arm, &arm.stiffness)?;
-    let mut data = Data::new(&model);
-    let s2t = arm.sensor_to_tcp();
+    let s2t = arm.sensor_to_tcp;
     let truth = opts.sensor.calibration(s2t);
     let mut noise = Noise::new(opts.seed ^ 0x5E);
-    let base = arm.ik(&Vector3::new(1.1, 0.0, 0.2));
     let mut orientations = Vec::new();
     let mut readings = Vec::new();
     for yaw in [-0.7, 0.0, 0.7] {
-        for wrist in [-1.2, -0.4, 0.4, 1.2] {
-            let q = [yaw, base[1], base[2], base[3] + wrist];
-            let tcp = vjm::forward(&model, &mut data, &q)
-                .map_err(|e| SimError::new(format!("sensor poses: {e}")))?;
+        for wrist in [
+            [0.0, 0.0, 0.0],
+            [0.8, 0.5, 0.0],
+            [-0.8, -0.5, 1.0],
+            [1.5, 0.3, -1.2],
+        ] {
+            let mut q = opts.q0.clone();
+            for (k, d) in [(0usize, yaw), (3, wrist[0]), (4, wrist[1]), (5, wrist[2])] {
+                if let Some(v) = q.get_mut(k) {
+                    *v += d;
+                }
+            }
+            let tcp = arm.forward(&q)?;
             let sensor = tcp * s2t.inverse();
             let n = 50;
             let mut mean = Vector6::zeros();

@@ -1,9 +1,10 @@
 //! Milling scenario for the online force-based compensation of Hähn and Weigold, "Hybrid
 //! compliance compensation for path accuracy enhancement in robot machining" (2020), sec.
-//! 2.2-2.6 and 3, on a 4-axis spatial flexible arm in rapier.
+//! 2.2-2.6 and 3, on their robot: the 6-axis KUKA KR 300 R2500 of `robots/` as a flexible arm
+//! in rapier (the serial testbed's [`crate::urdf_arm`]).
 //!
-//! * [`arm`]: the arm — geometry, its virtual-joint model ([`vjm_model`]) and the rapier
-//!   multibody with drive springs ([`FlexArm`]).
+//! * [`arm`]: the robot ([`MillingArm`]): the simulated arm, its sensor frame, the rigid pose
+//!   IK of the commanded path and the model rebuilt with identified stiffnesses.
 //! * [`sensor`]: the flange force/torque sensor with offsets, tool weight and noise.
 //! * [`identification`]: the stiffnesses from frame-pair rotations and TCP deflections under
 //!   static loads in rapier, and the sensor from unloaded readings at several orientations.
@@ -13,7 +14,7 @@
 //!   uncompensated, Cartesian compensation ([`deflect_core::compensation::step`], measured
 //!   forces only), compensation with pilot control (an offline force estimate leading the
 //!   real force), and Cartesian compensation without sensor calibration. The correction is
-//!   applied every control cycle through the arm's inverse kinematics; the robot answers a
+//!   applied every control cycle through the arm's pose inverse kinematics; the robot answers a
 //!   correction after a transport delay and a first-order servo lag. The compensator uses the
 //!   identified values.
 //! * [`output`]: summary table, CSV, JSON, MCAP log and plots.
@@ -24,7 +25,7 @@ pub mod output;
 pub mod scenario;
 pub mod sensor;
 
-pub use arm::{ArmParams, FlexArm, JOINTS, vjm_model};
+pub use arm::{MillingArm, SpringInfo};
 pub use identification::{
     JointEstimate, SensorEstimate, identify_sensor_calibration, identify_stiffness,
 };

@@ -30,7 +30,7 @@ pub fn table(r: &MillingResult) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "milling: 4-axis flexible arm (rapier), groove along +x at {:.0} mm/s, {:.1} s cut, \
+        "milling: KR 300 R2500 flexible arm (rapier), groove along +x at {:.0} mm/s, {:.1} s cut, \
          force [{:.0}, {:.0}, {:.0}] N (|F| = {:.0} N), cycle {:.1} ms, correction delay {} cycles \
          + {:.0} ms servo lag",
         o.feed * 1e3,
@@ -74,28 +74,42 @@ pub fn table(r: &MillingResult) -> String {
     }
     let _ = writeln!(
         s,
-        "\nstiffness identification ({} N static loads in rapier) [kN m/rad]",
-        o.id_load
+        "\nstiffness identification ({} N and {} N m static loads in rapier, {} poses) \
+         [kN m/rad]; n/a: not identifiable from these loads (the file's value is used)",
+        o.id_load,
+        0.25 * o.id_load,
+        o.id_poses.clamp(1, 3)
     );
     let _ = writeln!(
         s,
-        "joint | true    | frames (+- se)      | err %  | TCP (+- se)         | err %"
+        "spring axis  | true     | frames (+- se)        | err %   | TCP 6-D (+- se)        | err %"
     );
+    let k = |v: f64| {
+        if v.is_finite() {
+            format!("{:8.1}", v * 1e-3)
+        } else {
+            "     n/a".to_string()
+        }
+    };
+    let pct = |v: f64, t: f64| {
+        if v.is_finite() {
+            format!("{:+7.2}", (v / t - 1.0) * 100.0)
+        } else {
+            "    n/a".to_string()
+        }
+    };
     for e in &r.stiffness {
         let _ = writeln!(
             s,
-            "{:<5} | {:7.1} | {:7.1} (+- {:6.2}) | {:+6.2} | {:7.1} (+- {:6.2}) | {:+6.2}",
-            ["yaw", "q2", "q3", "q4"]
-                .get(e.joint)
-                .copied()
-                .unwrap_or("?"),
+            "{:<12} | {:8.1} | {} (+- {}) | {} | {} (+- {}) | {}",
+            e.label,
             e.k_true * 1e-3,
-            e.k_frames * 1e-3,
-            e.se_frames * 1e-3,
-            (e.k_frames / e.k_true - 1.0) * 100.0,
-            e.k_tcp * 1e-3,
-            e.se_tcp * 1e-3,
-            (e.k_tcp / e.k_true - 1.0) * 100.0
+            k(e.k_frames),
+            k(e.se_frames),
+            pct(e.k_frames, e.k_true),
+            k(e.k_tcp),
+            k(e.se_tcp),
+            pct(e.k_tcp, e.k_true)
         );
     }
     let c = &r.sensor;
@@ -155,12 +169,12 @@ pub fn csv(r: &MillingResult) -> String {
             m.exit_max_mm
         );
     }
-    s.push_str("\njoint,k_true,k_frames,se_frames,k_tcp,se_tcp\n");
+    s.push_str("\nspring,axis,label,k_true,k_frames,se_frames,k_tcp,se_tcp\n");
     for e in &r.stiffness {
         let _ = writeln!(
             s,
-            "{},{:.3},{:.3},{:.3},{:.3},{:.3}",
-            e.joint, e.k_true, e.k_frames, e.se_frames, e.k_tcp, e.se_tcp
+            "{},{},{},{:.3},{:.3},{:.3},{:.3},{:.3}",
+            e.spring, e.axis, e.label, e.k_true, e.k_frames, e.se_frames, e.k_tcp, e.se_tcp
         );
     }
     s
@@ -317,61 +331,60 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
     Ok(())
 }
 
-/// Identified vs true stiffness per joint (frames and TCP, with +- 2 se bars).
+/// Identified over true stiffness per virtual-joint axis (frame pairs and TCP, with +- 2 se
+/// bars); axes not identifiable are left out.
 pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
-    let root = canvas(path, (900, 560))?;
-    let kmax = r
+    let root = canvas(path, (1100, 560))?;
+    let ratio = |k: f64, t: f64| k / t;
+    let spread = r
         .stiffness
         .iter()
-        .flat_map(|e| [e.k_true, e.k_frames, e.k_tcp])
-        .filter(|k| k.is_finite())
-        .fold(1.0, f64::max)
-        * 1.2e-3;
+        .flat_map(|e| [ratio(e.k_frames, e.k_true), ratio(e.k_tcp, e.k_true)])
+        .filter(|v| v.is_finite())
+        .fold(0.02f64, |m, v| m.max((v - 1.0).abs()))
+        .min(1.0)
+        * 1.3;
+    let n = r.stiffness.len().max(1) as f64;
     let mut chart = new_chart(
         &root,
         CHART,
-        "joint stiffness: identified vs true",
-        -0.5f64..3.5f64,
-        0.0..kmax,
-        ("joint (0 = yaw, 1-3 = pitch)", "stiffness [kN m/rad]"),
+        "virtual-joint stiffness: identified / true",
+        -0.5f64..(n - 0.5),
+        (1.0 - spread)..(1.0 + spread),
+        (
+            "spring axis (chain order, see milling_summary.txt)",
+            "identified / true",
+        ),
     )?;
-    let true_pts: Vec<(f64, f64)> = r
-        .stiffness
-        .iter()
-        .map(|e| (e.joint as f64, e.k_true * 1e-3))
-        .collect();
     chart
-        .draw_series(true_pts.iter().map(|p| {
-            Rectangle::new(
-                [(p.0 - 0.3, 0.0), (p.0 + 0.3, p.1)],
-                BLACK.mix(0.15).filled(),
-            )
-        }))
-        .map_err(perr)?
-        .label("true")
-        .legend(|(x, y)| Rectangle::new([(x, y - 5), (x + 20, y + 5)], BLACK.mix(0.15).filled()));
+        .draw_series(LineSeries::new(
+            vec![(-0.5, 1.0), (n - 0.5, 1.0)],
+            BLACK.mix(0.5).stroke_width(1),
+        ))
+        .map_err(perr)?;
     for (dx, c, label, tcp) in [
-        (-0.1, BLUE, "frame pairs", false),
-        (0.1, RED, "TCP deflection", true),
+        (-0.12, BLUE, "frame pairs", false),
+        (0.12, RED, "TCP deflection (6-D)", true),
     ] {
         let pts: Vec<(f64, f64, f64)> = r
             .stiffness
             .iter()
-            .map(|e| {
+            .enumerate()
+            .map(|(i, e)| {
                 let (k, se) = if tcp {
                     (e.k_tcp, e.se_tcp)
                 } else {
                     (e.k_frames, e.se_frames)
                 };
-                (e.joint as f64 + dx, k * 1e-3, se * 1e-3)
+                (i as f64 + dx, k / e.k_true, se / e.k_true)
             })
-            .filter(|p| p.1.is_finite())
+            .filter(|p| p.1.is_finite() && (p.1 - 1.0).abs() <= spread)
             .collect();
         chart
-            .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 5, c.filled())))
+            .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 4, c.filled())))
             .map_err(perr)?
             .label(label)
-            .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+            .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
         chart
             .draw_series(pts.iter().filter(|p| p.2.is_finite()).map(|p| {
                 PathElement::new(

@@ -5,10 +5,10 @@
 
 use deflect_core::compensation::{self, CompensatorConfig, SensorCalibration};
 use deflect_core::vjm::{Model, Vector6};
-use nalgebra::Vector3;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector3};
 use serde::Serialize;
 
-use super::arm::{ArmParams, FlexArm, JOINTS, vjm_model};
+use super::arm::MillingArm;
 use super::identification::{
     JointEstimate, SensorEstimate, identify_sensor_calibration, identify_stiffness,
 };
@@ -16,16 +16,16 @@ use super::sensor::SensorParams;
 use crate::SimError;
 use crate::noise::Noise;
 use crate::robot::DT;
+use crate::urdf_arm::KR300_Q0;
 
 /// The milling scenario's settings.
 #[derive(Debug, Clone, Serialize)]
 pub struct MillingOptions {
-    /// The arm.
-    pub arm: ArmParams,
+    /// Start joints of the KR 300 \[rad\]: the groove starts at the TCP there and runs along
+    /// +x of the base with the tool's orientation held.
+    pub q0: Vec<f64>,
     /// The sensor.
     pub sensor: SensorParams,
-    /// Start of the groove (tool point) \[m\]; the groove runs along +x.
-    pub start: [f64; 3],
     /// Feed speed \[m/s\] (paper: 25 mm/s).
     pub feed: f64,
     /// Process force while cutting \[N\], base frame (paper: 546 N in the xy plane).
@@ -57,7 +57,8 @@ pub struct MillingOptions {
     pub pilot: (f64, f64),
     /// Physics step \[s\] (0.5 ms; tests use 2 ms).
     pub dt: f64,
-    /// Static test loads for the stiffness identification \[N\].
+    /// Static test loads for the stiffness identification: forces \[N\] along +-x, +-y, +-z
+    /// and moments of a quarter of it \[N m\] about them.
     pub id_load: f64,
     /// Number of poses for the stiffness identification (1..=3).
     pub id_poses: usize,
@@ -67,14 +68,15 @@ pub struct MillingOptions {
     pub id_noise: [f64; 2],
     /// Seed of all noise.
     pub seed: u64,
+    /// Worker threads (identification poses, runs); results do not depend on it.
+    pub jobs: usize,
 }
 
 impl Default for MillingOptions {
     fn default() -> Self {
         Self {
-            arm: ArmParams::default(),
+            q0: KR300_Q0.to_vec(),
             sensor: SensorParams::default(),
-            start: [1.05, -0.15, 0.1],
             feed: 0.025,
             force: [-386.1, 386.1, -60.0],
             settle: 0.1,
@@ -92,17 +94,17 @@ impl Default for MillingOptions {
             dt: DT,
             id_load: 800.0,
             id_poses: 3,
-            id_hold: 0.2,
+            id_hold: 0.25,
             id_noise: [2.0e-6, 2.0e-6],
             seed: 6,
+            jobs: 2,
         }
     }
 }
 
 impl MillingOptions {
-    /// A short scenario for tests (seconds in a debug build): 2 ms physics step, shorter
-    /// approach, cut and run-out, one identification pose with shorter holds, noise-free
-    /// identification.
+    /// A short scenario for tests: shorter approach, cut and run-out, one identification
+    /// pose with shorter holds, noise-free identification.
     pub fn short() -> Self {
         Self {
             settle: 0.02,
@@ -110,9 +112,7 @@ impl MillingOptions {
             approach: 0.1,
             cut: 0.35,
             runout: 0.2,
-            dt: 0.002,
             id_poses: 1,
-            id_hold: 0.12,
             id_noise: [0.0, 0.0],
             ..Self::default()
         }
@@ -133,10 +133,10 @@ impl MillingOptions {
         self.t_exit() + self.runout
     }
 
-    /// Nominal tool point and velocity at time `t`: standstill, a (1 - cos) ramp to the feed,
-    /// then constant feed along +x.
-    pub fn nominal(&self, t: f64) -> (Vector3<f64>, Vector3<f64>) {
-        let start = Vector3::from(self.start);
+    /// Nominal tool point and velocity at time `t` from `start`: standstill, a (1 - cos) ramp
+    /// to the feed, then constant feed along +x.
+    pub fn nominal(&self, start: &Vector3<f64>, t: f64) -> (Vector3<f64>, Vector3<f64>) {
+        let start = *start;
         let tm = t - self.settle;
         let (s, v) = if tm <= 0.0 {
             (0.0, 0.0)
@@ -208,8 +208,8 @@ pub struct Sample {
     pub actual: [f64; 3],
     /// Commanded tool point (nominal + correction) \[m\].
     pub commanded: [f64; 3],
-    /// Motor angles \[rad\].
-    pub q_motor: [f64; JOINTS],
+    /// Joint command \[rad\].
+    pub q_motor: Vec<f64>,
     /// True process force \[N\].
     pub force_true: [f64; 3],
     /// Raw sensor reading (sensor frame) \[N, N m\].
@@ -294,19 +294,21 @@ fn metrics(opts: &MillingOptions, samples: &[Sample]) -> Metrics {
     }
 }
 
-/// One run of the groove with `mode`, the compensator using `model` (identified stiffnesses)
-/// and `calibration` (identified sensor).
+/// One run of the groove with `mode` on `arm`, the compensator using `model` (identified
+/// stiffnesses) and `calibration` (identified sensor).
 pub fn run(
+    arm: &MillingArm,
     opts: &MillingOptions,
     mode: Mode,
     model: &Model,
     calibration: &SensorCalibration,
 ) -> Result<Run, SimError> {
-    let arm = &opts.arm;
-    let truth = opts.sensor.calibration(arm.sensor_to_tcp());
-    let (p0, _) = opts.nominal(0.0);
-    let q0 = arm.ik(&p0);
-    let mut sim = FlexArm::new(arm, &q0, 1.0, opts.dt)?;
+    let truth = opts.sensor.calibration(arm.sensor_to_tcp);
+    let start_pose = arm.forward(&opts.q0)?;
+    let start = start_pose.translation.vector;
+    let pose_at =
+        |p: &Vector3<f64>| Isometry3::from_parts(Translation3::from(*p), start_pose.rotation);
+    let mut sim = arm.sim(&opts.q0, 1.0, opts.dt)?;
     let mut comp = match mode {
         Mode::Uncompensated => None,
         Mode::Cartesian | Mode::Pilot | Mode::Uncalibrated => {
@@ -328,25 +330,29 @@ pub fn run(
     };
     let mut noise = Noise::new(opts.seed);
     let dt = opts.dt;
+    let dof = arm.dof();
     let sub = ((opts.cycle / dt).round() as usize).max(1);
     let cycles = (opts.t_end() / (sub as f64 * dt)).ceil() as usize;
+    // The nominal joints per physics step and the corrected target per cycle, each by the
+    // rigid pose IK warm-started from its last solution.
+    let (mut ik_nominal, mut ik_target) = (arm.ik_data(&opts.q0), arm.ik_data(&opts.q0));
     // Corrections (joint offsets) in flight to the servos, and the servo's lagged offset.
-    let mut queue: std::collections::VecDeque<[f64; JOINTS]> =
-        std::iter::repeat_n([0.0; JOINTS], opts.delay_cycles).collect();
-    let mut lagged = [0.0; JOINTS];
+    let mut queue: std::collections::VecDeque<Vec<f64>> =
+        std::iter::repeat_n(vec![0.0; dof], opts.delay_cycles).collect();
+    let mut lagged = vec![0.0; dof];
     let alpha = dt / (opts.servo_tau + dt);
-    let mut dq_target = [0.0; JOINTS];
+    let mut dq_target = vec![0.0; dof];
     let mut samples = Vec::with_capacity(cycles);
-    let mut q_motor = q0;
+    let mut q_cmd = opts.q0.clone();
     let mut step_index = 0usize;
     for c in 0..cycles {
         let t = c as f64 * sub as f64 * dt;
-        let (p_nom, v_nom) = opts.nominal(t);
-        let q_nom = arm.ik(&p_nom);
+        let (p_nom, v_nom) = opts.nominal(&start, t);
+        let q_nom = arm.ik(&mut ik_nominal, &pose_at(&p_nom))?;
         // The sensor is read at the start of the cycle.
         let f_true = opts.process_force(t);
-        let sensor = sim.sensor_pose();
-        let tcp = sim.tcp();
+        let sensor = arm.sensor_pose(&sim);
+        let tcp = sim.tcp_pose().translation.vector;
         let reading = opts
             .sensor
             .reading(&truth, &sensor, &tcp, &f_true, &mut noise, 1.0);
@@ -355,7 +361,7 @@ pub fn run(
             nominal: p_nom.into(),
             actual: tcp.into(),
             commanded: p_nom.into(),
-            q_motor,
+            q_motor: q_cmd.clone(),
             force_true: f_true.into(),
             force_measured: reading.into(),
             force_filtered: [0.0; 6],
@@ -367,29 +373,47 @@ pub fn run(
         if let Some((comp, data)) = comp.as_mut() {
             let f_est = opts.estimated_force(t);
             let est = Vector6::new(f_est.x, f_est.y, f_est.z, 0.0, 0.0, 0.0);
-            let out = compensation::step(comp, data, &q_motor, &reading, Some(&est), &v_nom)
+            let out = compensation::step(comp, data, &q_cmd, &reading, Some(&est), &v_nom)
                 .map_err(|e| SimError::new(format!("compensator step: {e}")))?;
-            let target = p_nom + out.correction.fixed_rows::<3>(0).into_owned();
-            let q_cmd = arm.ik(&target);
-            dq_target = core::array::from_fn(|j| q_cmd[j] - q_nom[j]);
-            sample.commanded = target.into();
+            // The commanded pose: the nominal one moved by the correction [dp; dr].
+            let dp: Vector3<f64> = out.correction.fixed_rows::<3>(0).into_owned();
+            let dr: Vector3<f64> = out.correction.fixed_rows::<3>(3).into_owned();
+            let target = Isometry3::from_parts(
+                Translation3::from(p_nom + dp),
+                UnitQuaternion::from_scaled_axis(dr) * start_pose.rotation,
+            );
+            let q_target = arm.ik(&mut ik_target, &target)?;
+            for ((d, a), b) in dq_target.iter_mut().zip(&q_target).zip(&q_nom) {
+                *d = a - b;
+            }
+            sample.commanded = (p_nom + dp).into();
             sample.force_filtered = out.measured_wrench.into();
             sample.force_used = out.wrench.into();
             sample.correction = out.correction.into();
             sample.pilot_weight = out.pilot_weight;
         }
         samples.push(sample);
-        queue.push_back(dq_target);
-        let dq_servo = queue.pop_front().unwrap_or([0.0; JOINTS]);
+        queue.push_back(dq_target.clone());
+        let dq_servo = queue.pop_front().unwrap_or_else(|| vec![0.0; dof]);
         for _ in 0..sub {
             let ts = step_index as f64 * dt;
-            let (p, _) = opts.nominal(ts);
-            let qn = arm.ik(&p);
-            for (((l, m), d), n) in lagged.iter_mut().zip(&mut q_motor).zip(&dq_servo).zip(&qn) {
+            let (p, _) = opts.nominal(&start, ts);
+            let qn = arm.ik(&mut ik_nominal, &pose_at(&p))?;
+            let q_prev = q_cmd.clone();
+            for (((l, m), d), n) in lagged.iter_mut().zip(&mut q_cmd).zip(&dq_servo).zip(&qn) {
                 *l += alpha * (d - *l);
                 *m = n + *l;
             }
-            sim.step(&q_motor, &opts.process_force(ts));
+            // Velocity feed-forward from the command's backward difference; the feed is slow
+            // and the corrections smooth, so no acceleration feed-forward.
+            let qd: Vec<f64> = q_cmd
+                .iter()
+                .zip(&q_prev)
+                .map(|(a, b)| (a - b) / dt)
+                .collect();
+            let f = opts.process_force(ts);
+            let w = Vector6::new(f.x, f.y, f.z, 0.0, 0.0, 0.0);
+            sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w));
             step_index += 1;
         }
     }
@@ -404,33 +428,34 @@ pub fn run(
 /// identified values (and a fourth, Cartesian compensation without sensor calibration).
 pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
     let start = std::time::Instant::now();
-    let stiffness = identify_stiffness(opts)?;
-    let mut k = [0.0; JOINTS];
-    for (dst, e) in k.iter_mut().zip(&stiffness) {
-        *dst = if e.k_frames.is_finite() && e.k_frames > 0.0 {
-            e.k_frames
-        } else {
-            e.k_true
-        };
-    }
-    let model = vjm_model(&opts.arm, &k)?;
-    let (calibration, sensor) = identify_sensor_calibration(opts)?;
-    let mut runs = Vec::new();
-    for mode in [
+    let arm = MillingArm::kr300()?;
+    let stiffness = identify_stiffness(&arm, opts, opts.jobs)?;
+    // The compensator's model: the frame-pair estimates (the file's value where an axis was
+    // not identifiable from the loads).
+    let identified: Vec<(usize, usize, f64)> = stiffness
+        .iter()
+        .map(|e| (e.spring, e.axis, e.k_frames))
+        .collect();
+    let model = arm.model_with(&identified)?;
+    let (calibration, sensor) = identify_sensor_calibration(&arm, opts)?;
+    let modes = [
         Mode::Uncompensated,
         Mode::Cartesian,
         Mode::Pilot,
         Mode::Uncalibrated,
-    ] {
-        runs.push(run(opts, mode, &model, &calibration)?);
-    }
+    ];
+    let runs = crate::jobs::parallel_map(&modes, opts.jobs, |&mode| {
+        run(&arm, opts, mode, &model, &calibration)
+    })?
+    .into_iter()
+    .collect::<Result<Vec<_>, _>>()?;
     Ok(MillingResult {
         options: opts.clone(),
         stiffness,
         sensor,
         runs,
         sim_seconds: opts.t_end() * 4.0
-            + opts.id_poses.clamp(1, 3) as f64 * 6.0 * (opts.id_hold + 0.03),
+            + opts.id_poses.clamp(1, 3) as f64 * 12.0 * (opts.id_hold + 0.03),
         wall_seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -10,18 +10,14 @@ use deflect_core::io::{stiffness, urdf};
 use deflect_core::vjm::{self, Data};
 use deflect_sim::SimError;
 use deflect_sim::serial_scene::{self, MotionParams, SerialOptions, output};
-use deflect_sim::urdf_arm::{ArmSpec, ServoParams, arm_spec};
+use deflect_sim::urdf_arm::{
+    ArmSpec, KR300_Q0, KR300_STIFFNESS, KR300_URDF, ServoParams, arm_spec,
+};
 use nalgebra::{Matrix3, Vector3};
 
 use super::input_file;
 use crate::cli::{CliError, ModelArg, SerialArgs};
 
-/// The KR 300 R2500 URDF of deflect's `robots/` (link masses are our estimates).
-const KR300_URDF: &str = include_str!("../../../../robots/kr300/kr300_r2500.urdf");
-/// Its stiffness file (Hähn and Weigold's identified values).
-const KR300_STIFFNESS: &str = include_str!("../../../../robots/kr300/kr300_r2500_stiffness.toml");
-/// The KR 300's start pose: the milling pose of the examples.
-const KR300_Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
 /// Largest input file read \[bytes\].
 const MAX_FILE: u64 = 16 << 20;
 /// Density of the payload cube \[kg/m^3\] (aluminium).

@@ -90,6 +90,8 @@ pub struct FlexSerialArm {
     actuated: Vec<usize>,
     /// Joint axis of each actuated joint in its body frame.
     axes: Vec<Vector3<f64>>,
+    /// Body index and attachment (in the previous body) of each virtual joint, chain order.
+    springs: Vec<(usize, Isometry3<f64>)>,
     q0: Vec<f64>,
     motors: Vec<Motor>,
     tcp: Isometry3<f64>,
@@ -185,8 +187,8 @@ impl FlexSerialArm {
         let mut world = new_world(Vector::ZERO, servo.dt);
         let mut parent = world.insert_body(RigidBodyBuilder::fixed());
         let mut at = Isometry3::identity();
-        let (mut bodies, mut joints, mut actuated, mut axes) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut bodies, mut joints, mut actuated, mut axes, mut spring_bodies) =
+            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let last = spec.bodies.len().saturating_sub(1);
         let mut qi = 0usize;
         for (index, b) in spec.bodies.iter().enumerate() {
@@ -237,6 +239,7 @@ impl FlexSerialArm {
                     )
                 }
                 Piece::Spring { k, .. } => {
+                    spring_bodies.push((index, b.attach));
                     let finite: Vec<usize> = (0..3).filter(|&a| k[a] < RIGID).collect();
                     let stiffest = finite.iter().map(|&a| k[a]).fold(0.0f64, f64::max);
                     let names = [ANG_X, ANG_Y, ANG_Z];
@@ -331,6 +334,7 @@ impl FlexSerialArm {
             joints,
             actuated,
             axes,
+            springs: spring_bodies,
             q0: q0.to_vec(),
             motors,
             tcp: spec.tcp,
@@ -374,6 +378,27 @@ impl FlexSerialArm {
             Some(b) => self.pose_of(*b) * self.tcp,
             None => self.tcp,
         }
+    }
+
+    /// The rotation across each virtual joint of the simulated arm (the bodies built for
+    /// springs with a finite stiffness, chain order) as a rotation vector in the spring frame
+    /// \[rad\]: what a frame-pair measurement on either side of it reads (Hähn and Weigold,
+    /// sec. 2.5).
+    pub fn spring_rotations(&self) -> Vec<Vector3<f64>> {
+        self.springs
+            .iter()
+            .map(|&(b, attach)| {
+                let parent = match b.checked_sub(1).and_then(|p| self.bodies.get(p)) {
+                    Some(h) => self.pose_of(*h),
+                    None => Isometry3::identity(),
+                };
+                let body = self
+                    .bodies
+                    .get(b)
+                    .map_or_else(Isometry3::identity, |h| self.pose_of(*h));
+                ((parent * attach).rotation.inverse() * body.rotation).scaled_axis()
+            })
+            .collect()
     }
 
     /// Joint angles and rates of the link side \[rad, rad/s\].
