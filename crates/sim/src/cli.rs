@@ -4,8 +4,10 @@
 //! ([`Command::check`]); the two kinds of errors and their exit codes ([`CliError`]).
 //!
 //! The ranges keep every accepted command within a few minutes of run time and a few hundred
-//! MB of memory. Release build, measured: `milling` at its largest cut, force and smallest
-//! cycle about 2 s and 30 MB; `contour` is bounded by the tracer's 4000-step limit per object
+//! MB of memory. Release build, measured on 2 cores: `milling` (the 16-body KR 300) at its
+//! largest cut, feed, force and smallest cycle about 1.5 min and 35 MB; `serial` with the
+//! defaults about 30 s and 17 MB (most of it the six static-compliance checks); `contour` is
+//! bounded by the tracer's 4000-step limit per object
 //! (about 0.7 M physics steps, under 10 s per object); `reproduce` with 50 fixed-point
 //! iterations about 2 s.
 
@@ -158,7 +160,8 @@ pub const JOBS: Range = Range::closed("--jobs", 1.0, 64.0, "");
 pub const FEED: Range = Range::closed("--feed", 0.1, 50.0, "mm/s");
 /// `milling --force` \[N\].
 pub const FORCE: Range = Range::closed("--force", 0.0, 2000.0, "N");
-/// `milling --cut` \[s\]: at most 4 x 5.8 s simulated at 0.5 ms plus the identification.
+/// `milling --cut` \[s\]: at most 4 x 6.2 s simulated at 0.5 ms plus the identification's
+/// 10 s, about 1.5 min on 2 cores.
 pub const CUT: Range = Range::closed("--cut", 0.01, 5.0, "s");
 /// `milling --rise-ms` \[ms\]: within the 0.4 s run-out.
 pub const RISE_MS: Range = Range::closed("--rise-ms", 0.1, 300.0, "ms");
