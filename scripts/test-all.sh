@@ -42,7 +42,19 @@ if [ ! -x "$VENV/bin/python" ]; then
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
 "$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19"
-"$VENV/bin/python" -m pip install --quiet ./crates/py
+# The wheel is built once (abi3, release) and installed from the file; a fresh venv with
+# nothing but the wheel (and numpy from its metadata) imports it: what `pip install
+# deflect-robotics` gives a user.
+rm -rf target/wheels
+# An older install under the distribution name `deflect` would shadow the import name.
+"$VENV/bin/python" -m pip uninstall --quiet -y deflect 2>/dev/null || true
+"$VENV/bin/python" -m maturin build --release --quiet -m crates/py/Cargo.toml -o target/wheels
+WHEEL=$(ls target/wheels/deflect_robotics-*-abi3-*.whl)
+"$VENV/bin/python" -m pip install --quiet --force-reinstall --no-deps "$WHEEL"
+rm -rf target/smoke-venv
+"$PY" -m venv target/smoke-venv
+target/smoke-venv/bin/python -m pip install --quiet "$WHEEL"
+target/smoke-venv/bin/python scripts/wheel_smoke.py
 "$VENV/bin/python" -m pytest -q crates/py/tests
 for ex in examples/[0-9][0-9]_*.py; do
   [ -e "$ex" ] || continue

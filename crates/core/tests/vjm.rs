@@ -542,3 +542,52 @@ proptest! {
         prop_assert!((d - lin).norm() <= 1e-3 * lin.norm() + 1e-15);
     }
 }
+
+#[test]
+fn a_model_rebuilt_from_its_elements_computes_bit_for_bit_the_same() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
+    let robot = deflect_core::SerialRobot::from_path(
+        format!("{dir}kr300_r2500.urdf"),
+        format!("{dir}kr300_r2500_stiffness.toml"),
+        "tcp",
+    )
+    .unwrap();
+    let model = &robot.model;
+    let rebuilt = model
+        .elements()
+        .iter()
+        .try_fold(ModelBuilder::new(), |b, e| b.element(*e))
+        .and_then(|b| b.build())
+        .unwrap();
+    assert_eq!(rebuilt.elements(), model.elements());
+    assert_eq!(rebuilt.mass_count(), 6);
+    let q = [0.3, -0.8, 1.2, 0.5, 0.9, -0.4];
+    let w = Vector6::new(-386.1, 386.1, -60.0, 12.0, -7.0, 3.0);
+    let (mut a, mut b) = (Data::new(model), Data::new(&rebuilt));
+    assert_eq!(
+        vjm::deflection(model, &mut a, &q, &w).unwrap(),
+        vjm::deflection(&rebuilt, &mut b, &q, &w).unwrap()
+    );
+    assert_eq!(
+        vjm::compliance(model, &mut a, &q).unwrap(),
+        vjm::compliance(&rebuilt, &mut b, &q).unwrap()
+    );
+    // A tampered element is refused, not normalized or clamped.
+    let long_axis = Element::Revolute {
+        axis: nalgebra::Unit::new_unchecked(Vector3::new(0.0, 0.0, 2.0)),
+        index: 0,
+    };
+    assert!(matches!(
+        ModelBuilder::new().element(long_axis),
+        Err(BuildError::InvalidParameter { value, .. }) if value == 2.0
+    ));
+    let negative = Element::Spring {
+        compliance: Vector3::new(1e-6, -1e-6, 0.0),
+        index: 0,
+        offset: Isometry3::identity(),
+    };
+    assert!(matches!(
+        ModelBuilder::new().element(negative),
+        Err(BuildError::NonPositiveStiffness { axis: 1, .. })
+    ));
+}

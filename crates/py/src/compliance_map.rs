@@ -289,6 +289,13 @@ impl ComplianceMap {
         })
     }
 
+    /// Pickling (and `copy.deepcopy`): the map's JSON (coefficients, grid and default query
+    /// options), an exact round trip.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (String,))> {
+        let rebuild = slf.get_type().getattr("from_json")?;
+        Ok((rebuild, (slf.get().to_json()?,)))
+    }
+
     /// The same map with other default options.
     #[pyo3(signature = (interpolation=None, out_of_grid=None))]
     fn with_options(

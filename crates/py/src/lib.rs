@@ -35,6 +35,7 @@ mod drivetrain;
 mod identification;
 mod mechanism;
 mod motion;
+mod pickle;
 mod pose_motion;
 mod vjm;
 

@@ -82,6 +82,23 @@ impl SerialRobot {
         self.inner.tip_link.clone()
     }
 
+    /// Pickling (and `copy.deepcopy`): the chain's elements, names and limits as plain Python
+    /// values; the copy computes bit for bit what the original does.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (crate::pickle::RobotState,))> {
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        Ok((rebuild, (crate::pickle::robot_state(&slf.get().inner),)))
+    }
+
+    /// The robot of a pickled state (see `__reduce__`), validated like a loaded one.
+    #[staticmethod]
+    fn _from_state(state: crate::pickle::RobotState) -> PyResult<Self> {
+        Ok(Self {
+            inner: crate::pickle::robot_of(state)?,
+        })
+    }
+
     /// Rigid TCP pose, a (4, 4) homogeneous matrix [m].
     fn forward<'py>(
         &self,

@@ -316,6 +316,77 @@ impl ModelBuilder {
         Ok(self)
     }
 
+    /// Appends `e` as it is, a model's own element ([`Model::elements`], e.g. of a model
+    /// saved and read back): validated like the other calls, joint, spring and mass indices
+    /// renumbered, and the values kept bit for bit (a unit axis is not normalized again, a
+    /// compliance not inverted twice), so that a rebuilt model computes exactly what the
+    /// original did. Rotations (fixed transforms, spring frames) and axes must be unit within
+    /// 1e-9; compliances 0 (rigid) or normal and positive.
+    pub fn element(self, e: Element) -> Result<Self, BuildError> {
+        let unit = |what: &'static str, norm: f64| {
+            if (norm - 1.0).abs() <= 1e-9 {
+                Ok(())
+            } else {
+                Err(BuildError::InvalidParameter {
+                    what,
+                    value: norm,
+                    expected: "unit length (within 1e-9)",
+                })
+            }
+        };
+        match e {
+            Element::Fixed(t) => {
+                unit(
+                    "fixed transform rotation (quaternion norm)",
+                    t.rotation.coords.norm(),
+                )?;
+                self.fixed(t)
+            }
+            Element::Revolute { axis, .. } | Element::Prismatic { axis, .. } => {
+                unit("joint axis (norm)", axis.norm())?;
+                let revolute = matches!(e, Element::Revolute { .. });
+                let mut b = self.joint(axis.into_inner(), revolute)?;
+                if let Some(
+                    Element::Revolute { axis: a, .. } | Element::Prismatic { axis: a, .. },
+                ) = b.elements.last_mut()
+                {
+                    *a = axis;
+                }
+                Ok(b)
+            }
+            Element::Spring {
+                compliance, offset, ..
+            } => {
+                unit(
+                    "spring frame rotation (quaternion norm)",
+                    offset.rotation.coords.norm(),
+                )?;
+                let mut k = [f64::INFINITY; 3];
+                for (axis, (&c, ki)) in compliance.iter().zip(k.iter_mut()).enumerate() {
+                    if c == 0.0 {
+                        continue;
+                    }
+                    if !(c.is_normal() && c > 0.0) {
+                        return Err(BuildError::NonPositiveStiffness {
+                            element: self.calls,
+                            axis,
+                            value: 1.0 / c,
+                        });
+                    }
+                    *ki = 1.0 / c;
+                }
+                let mut b = self.spring_at(offset, k)?;
+                if let Some(Element::Spring { compliance: c, .. }) = b.elements.last_mut() {
+                    *c = compliance;
+                }
+                Ok(b)
+            }
+            Element::Mass {
+                mass, com, inertia, ..
+            } => self.mass(mass, com, inertia),
+        }
+    }
+
     /// Finishes the model (and compiles it for the kernels).
     pub fn build(self) -> Result<Model, BuildError> {
         let mut ops: heapless::Vec<Op, MAX_ELEMENTS> = heapless::Vec::new();

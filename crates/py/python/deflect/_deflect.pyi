@@ -23,6 +23,11 @@ class ConvergenceError(DeflectError): ...
 class SerialRobot:
     """A serial robot with virtual joints (VJM paper, Eq. 1-9). SI units, base frame."""
 
+    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
+        """Pickling and copy.deepcopy: the chain as plain values, rebuilt bit for bit."""
+    @staticmethod
+    def _from_state(state: Any) -> "SerialRobot": ...
+
     @staticmethod
     def from_urdf(
         urdf_path: StrPath, stiffness_path: StrPath, tip_link: str, base_link: Optional[str] = None
@@ -132,6 +137,8 @@ class ComplianceMap:
         """Versioned JSON (format_version 1, SI units recorded)."""
     @staticmethod
     def from_json(text: str) -> "ComplianceMap": ...
+    def __reduce__(self) -> Tuple[Any, Tuple[str]]:
+        """Pickling and copy.deepcopy through the JSON (exact)."""
     def with_options(
         self, interpolation: Optional[str] = None, out_of_grid: Optional[str] = None
     ) -> "ComplianceMap": ...
