@@ -35,6 +35,13 @@ impl ParallelRobot2 {
             inner: CoreRobot2::new(link, half_width, min_sigma).map_err(build_err)?,
         })
     }
+    /// Pickling (and `copy.deepcopy`): the three constructor arguments, an exact round trip.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, pyo3::types::PyType>, (f64, f64, f64))> {
+        let r = &slf.get().inner;
+        Ok((slf.get_type(), (r.link(), r.half_width(), r.min_sigma())))
+    }
     /// Joints `q` [rad] that put C on `p` [m]; InputError out of reach, SingularError near a
     /// singularity.
     fn ik<'py>(

@@ -66,3 +66,11 @@ def test_compliance_map_round_trips_with_its_options():
         pickle.loads(pickle.dumps(cubic)).displacement(far, [10.0, 0.0]),
         cubic.displacement(far, [10.0, 0.0]),
     )
+
+
+def test_parallel_robot_round_trips():
+    robot = deflect.ParallelRobot2(link=0.16, half_width=0.085, min_sigma=0.01)
+    for other in [pickle.loads(pickle.dumps(robot)), copy.deepcopy(robot)]:
+        q = other.ik([0.2, 0.03])
+        np.testing.assert_array_equal(q, robot.ik([0.2, 0.03]))
+        np.testing.assert_array_equal(other.jacobian(q), robot.jacobian(q))
