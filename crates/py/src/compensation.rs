@@ -302,7 +302,8 @@ pub struct OnlineCompensator {
 #[pymethods]
 impl OnlineCompensator {
     #[new]
-    #[pyo3(signature = (robot, dt=0.004, calibration=None, lowpass_cutoff_hz=10.0, moving_average_window=5, pilot=Some((150.0, 0.08)), project_on_feed=true, max_correction=3.0e-3, max_rate=0.05, output="cartesian"))]
+    #[pyo3(signature = (robot, dt=0.004, calibration=None, lowpass_cutoff_hz=10.0, moving_average_window=5, pilot=Some((150.0, 0.08)), project_on_feed=true, max_correction=3.0e-3, max_rate=0.05, output="cartesian"),
+           text_signature = "(robot, dt=0.004, calibration=None, lowpass_cutoff_hz=10.0, moving_average_window=5, pilot=(150.0, 0.08), project_on_feed=True, max_correction=0.003, max_rate=0.05, output='cartesian')")]
     #[allow(clippy::too_many_arguments)] // reason: mirrors the Python keyword arguments
     fn new(
         robot: &SerialRobot,

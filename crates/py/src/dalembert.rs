@@ -75,7 +75,8 @@ impl DalembertCorrector {
     /// `mechanism` (a `ParallelRobot2`), `mass` m* [kg] (the paper tuned 5 kg); fixed-point
     /// `iterations` (a count) and `tolerance` [m] (finite, >= 0).
     #[new]
-    #[pyo3(signature = (compliance_map, mechanism, mass=dalembert::PAPER_MASS, iterations=0, tolerance=0.0))]
+    #[pyo3(signature = (compliance_map, mechanism, mass=dalembert::PAPER_MASS, iterations=0, tolerance=0.0),
+           text_signature = "(compliance_map, mechanism, mass=5.0, iterations=0, tolerance=0.0)")]
     fn new(
         compliance_map: &ComplianceMap,
         mechanism: &Bound<'_, PyAny>,

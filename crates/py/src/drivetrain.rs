@@ -108,7 +108,9 @@ impl DriveTrain {
     /// base z axis, (0, 0, -9.80665).
     #[new]
     #[pyo3(signature = (robot, stiffness, backlash=None, masses=None, gravity=None,
-                        torque_deadband=0.0, max_condition=dt::DEFAULT_MAX_CONDITION))]
+                        torque_deadband=0.0, max_condition=dt::DEFAULT_MAX_CONDITION),
+           text_signature = "(robot, stiffness, backlash=None, masses=None, gravity=None, \
+                             torque_deadband=0.0, max_condition=1000000.0)")]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
         robot: &SerialRobot,
@@ -310,7 +312,13 @@ impl ContourTracer {
                         stop_radius=None, clockwise=false, max_turn=std::f64::consts::FRAC_PI_4,
                         min_motion_fraction=0.25, jam_margin=0.8, min_step_fraction=0.1,
                         max_bisections=6, max_jam_steps=10,
-                        max_approach_steps=10_000, max_steps=100_000))]
+                        max_approach_steps=10_000, max_steps=100_000),
+           text_signature = "(stiffness, step, contact_force, jam_force, *, target_force=None, \
+                             approach_direction=(1.0, 0.0), approach_step=None, bias_samples=10, \
+                             stop_radius=None, clockwise=False, max_turn=0.7853981633974483, \
+                             min_motion_fraction=0.25, jam_margin=0.8, min_step_fraction=0.1, \
+                             max_bisections=6, max_jam_steps=10, max_approach_steps=10000, \
+                             max_steps=100000)")]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
         stiffness: &Bound<'_, PyAny>,

@@ -25,7 +25,8 @@ pub struct ParallelRobot2 {
 impl ParallelRobot2 {
     /// Paper geometry by default; `min_sigma` [m/rad] is the singularity threshold.
     #[new]
-    #[pyo3(signature = (link=0.150, half_width=0.090, min_sigma=deflect_core::mechanism::DEFAULT_MIN_SIGMA))]
+    #[pyo3(signature = (link=0.150, half_width=0.090, min_sigma=deflect_core::mechanism::DEFAULT_MIN_SIGMA),
+           text_signature = "(link=0.15, half_width=0.09, min_sigma=0.02)")]
     fn new(
         #[pyo3(from_py_with = args::real::link)] link: f64,
         #[pyo3(from_py_with = args::real::half_width)] half_width: f64,

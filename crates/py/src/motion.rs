@@ -530,7 +530,8 @@ impl Trajectory {
 /// of the arrays (at most 2^22 ticks, `InputError` beyond); `rate_hz=None` plans only (see
 /// `Trajectory.at`).
 #[pyfunction]
-#[pyo3(signature = (start, end, v_max, a_max, j_max, rate_hz=Some(DEFAULT_RATE_HZ)))]
+#[pyo3(signature = (start, end, v_max, a_max, j_max, rate_hz=Some(DEFAULT_RATE_HZ)),
+       text_signature = "(start, end, v_max, a_max, j_max, rate_hz=2000.0)")]
 fn plan_line(
     start: &Bound<'_, PyAny>,
     end: &Bound<'_, PyAny>,
@@ -561,7 +562,8 @@ fn plan_line(
 /// row `i` the `(v_max, a_max, j_max)` of the move from `points[i]` to `points[i + 1]` (then
 /// leave `v_max`, `a_max`, `j_max` out). Ticks and `rate_hz` as `plan_line`.
 #[pyfunction]
-#[pyo3(signature = (points, v_max=None, a_max=None, j_max=None, rate_hz=Some(DEFAULT_RATE_HZ), segment_limits=None))]
+#[pyo3(signature = (points, v_max=None, a_max=None, j_max=None, rate_hz=Some(DEFAULT_RATE_HZ), segment_limits=None),
+       text_signature = "(points, v_max=None, a_max=None, j_max=None, rate_hz=2000.0, segment_limits=None)")]
 fn plan_polyline(
     points: &Bound<'_, PyAny>,
     v_max: Option<&Bound<'_, PyAny>>,

@@ -267,7 +267,8 @@ fn limits(what: &str, [v, a, j]: [f64; 3]) -> PyResult<Limits> {
 /// [rad/s^2], jerk_max [rad/s^3])`, on one profile (the tighter part sets the pace). Ticks at
 /// `rate_hz` [Hz] (at most 2^22); `rate_hz=None` plans only.
 #[pyfunction]
-#[pyo3(signature = (start, end, linear, angular, rate_hz=Some(DEFAULT_RATE_HZ)))]
+#[pyo3(signature = (start, end, linear, angular, rate_hz=Some(DEFAULT_RATE_HZ)),
+       text_signature = "(start, end, linear, angular, rate_hz=2000.0)")]
 fn plan_pose(
     start: &Bound<'_, PyAny>,
     end: &Bound<'_, PyAny>,
