@@ -281,12 +281,28 @@ impl ComplianceMap {
         map_json::to_string(&self.inner).map_err(load_err)
     }
 
-    /// Loads a map saved by `to_json`.
+    /// Writes the map's JSON (see `to_json`) to the file `path`.
+    fn save_json(&self, path: std::path::PathBuf) -> PyResult<()> {
+        map_json::to_path(&self.inner, &path).map_err(load_err)
+    }
+
+    /// Loads a map saved by `to_json` / `save_json`: `source` is the JSON text (a `str`
+    /// whose first non-blank character is `{`) or a path (`str` or `os.PathLike`) to the file.
     #[staticmethod]
-    fn from_json(text: &str) -> PyResult<Self> {
-        Ok(Self {
-            inner: map_json::from_str(text).map_err(load_err)?,
-        })
+    fn from_json(source: &Bound<'_, PyAny>) -> PyResult<Self> {
+        let inner = match source.extract::<String>() {
+            Ok(text) if text.trim_start().starts_with('{') => map_json::from_str(&text),
+            Ok(path) => map_json::from_path(&path),
+            Err(_) => {
+                map_json::from_path(source.extract::<std::path::PathBuf>().map_err(|_| {
+                    InputError::new_err(
+                        "source: expected the JSON text or a path (str or os.PathLike)",
+                    )
+                })?)
+            }
+        }
+        .map_err(load_err)?;
+        Ok(Self { inner })
     }
 
     /// Pickling (and `copy.deepcopy`): the map's JSON (coefficients, grid and default query

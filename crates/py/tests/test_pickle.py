@@ -74,3 +74,15 @@ def test_parallel_robot_round_trips():
         q = other.ik([0.2, 0.03])
         np.testing.assert_array_equal(q, robot.ik([0.2, 0.03]))
         np.testing.assert_array_equal(other.jacobian(q), robot.jacobian(q))
+
+
+def test_from_json_takes_the_text_or_a_path(tmp_path):
+    cmap = deflect.ComplianceMap.from_csv(REPO / "data/paksoy2025_compliance_oc.csv")
+    path = tmp_path / "map.json"
+    cmap.save_json(path)
+    for source in [cmap.to_json(), "  \n" + cmap.to_json(), path, str(path)]:
+        assert deflect.ComplianceMap.from_json(source).to_json() == cmap.to_json()
+    with pytest.raises(deflect.LoadError, match="nonexistent"):
+        deflect.ComplianceMap.from_json(tmp_path / "nonexistent.json")
+    with pytest.raises(deflect.InputError, match="source"):
+        deflect.ComplianceMap.from_json(42)

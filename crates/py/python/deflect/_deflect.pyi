@@ -135,8 +135,11 @@ class ComplianceMap:
         """Static-test CSV: x, y, force_axis, force, dx, dy[, dz, rx, ry, rz]."""
     def to_json(self) -> str:
         """Versioned JSON (format_version 1, SI units recorded)."""
+    def save_json(self, path: StrPath) -> None:
+        """Writes to_json() to the file at path."""
     @staticmethod
-    def from_json(text: str) -> "ComplianceMap": ...
+    def from_json(source: Union[str, PathLike]) -> "ComplianceMap":
+        """JSON text (starting with '{') or a path to the file."""
     def __reduce__(self) -> Tuple[Any, Tuple[str]]:
         """Pickling and copy.deepcopy through the JSON (exact)."""
     def with_options(
