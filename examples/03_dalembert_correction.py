@@ -14,6 +14,6 @@ print("g   duration [ms]  ticks  max |correction| [mm]  max |F_D| [N]  clamped t
 for g in range(1, 6):
     traj = deflect.plan_line([0.222132, -0.075], [0.222132, 0.075], *deflect.paper_limits(g))
     out = corrector.correct(traj)  # GIL released, one row per 2 kHz tick
-    corr = np.linalg.norm(out.position - out.desired, axis=1).max() * 1e3
+    corr = np.linalg.norm(out.commanded - out.desired, axis=1).max() * 1e3
     force = np.linalg.norm(out.force, axis=1).max()
     print(f"{g}   {traj.duration * 1e3:13.1f}  {len(traj):5d}  {corr:21.4f}  {force:13.1f}  {len(out.flagged_ticks):13d}")

@@ -57,8 +57,8 @@ pub struct CorrectedPath {
     t: Py<PyArray1<f64>>,
     /// Desired (planned) points [m], (N, 2).
     desired: Py<PyArray2<f64>>,
-    /// Commanded points [m], (N, 2).
-    position: Py<PyArray2<f64>>,
+    /// Commanded points [m], (N, 2) (`step()['commanded']` per tick).
+    commanded: Py<PyArray2<f64>>,
     /// Joint commands [rad], (N, 2).
     joints: Py<PyArray2<f64>>,
     /// D'Alembert forces [N], (N, 2).
@@ -67,6 +67,16 @@ pub struct CorrectedPath {
     displacement: Py<PyArray2<f64>>,
     /// Ticks at which the map clamped or extrapolated.
     flagged_ticks: Vec<usize>,
+}
+
+#[pymethods]
+impl CorrectedPath {
+    /// The old name of `commanded` (kept so that existing code runs; `commanded` is the name
+    /// `step()` and `SerialDalembertCorrector` use).
+    #[getter]
+    fn position(&self, py: Python<'_>) -> Py<PyArray2<f64>> {
+        self.commanded.clone_ref(py)
+    }
 }
 
 #[pymethods]
@@ -185,7 +195,7 @@ impl DalembertCorrector {
         Ok(CorrectedPath {
             t: t.to_pyarray(py).unbind(),
             desired: desired.to_pyarray(py).unbind(),
-            position: position.to_pyarray(py).unbind(),
+            commanded: position.to_pyarray(py).unbind(),
             joints: joints.to_pyarray(py).unbind(),
             force: force.to_pyarray(py).unbind(),
             displacement: displacement.to_pyarray(py).unbind(),

@@ -28,7 +28,7 @@ def test_zero_map_leaves_path_unchanged(tmp_path):
     v, a, j = deflect.paper_limits(5)
     traj = deflect.plan_line([0.172132, 0.0], [0.272132, 0.0], v, a, j)
     out = corr.correct(traj)
-    np.testing.assert_array_equal(out.position, traj.position)
+    np.testing.assert_array_equal(out.commanded, traj.position)
     np.testing.assert_array_equal(out.joints[10], robot.ik(traj.position[10]))
 
 
@@ -52,16 +52,17 @@ def test_fixed_point_and_batch_equal_step():
     v, a, j = deflect.paper_limits(5)
     traj = deflect.plan_polyline([[0.19, -0.05], [0.25, 0.0], [0.19, 0.05], [0.19, -0.05]], v, a, j)
     out = corr.correct(traj)
-    assert out.position.shape == (len(traj), 2)
+    assert out.commanded.shape == (len(traj), 2)
+    np.testing.assert_array_equal(out.position, out.commanded)  # the old name still reads
     for i in range(0, len(traj), 97):
         t = corr.step(traj.position[i], traj.acceleration[i])
-        np.testing.assert_array_equal(t["commanded"], out.position[i])
+        np.testing.assert_array_equal(t["commanded"], out.commanded[i])
         np.testing.assert_array_equal(t["joints"], out.joints[i])
         # The map's own prediction at the command lands on the desired path.
-        reached = out.position[i] + cmap.displacement(out.position[i], out.force[i])
+        reached = out.commanded[i] + cmap.displacement(out.commanded[i], out.force[i])
         np.testing.assert_allclose(reached, traj.position[i], atol=1e-12)
     # Sub-millimetre corrections at 5 g with m* = 5 kg, force unit read as N.
-    corr_mm = np.linalg.norm(out.position - out.desired, axis=1).max() * 1e3
+    corr_mm = np.linalg.norm(out.commanded - out.desired, axis=1).max() * 1e3
     assert 0.01 < corr_mm < 2.0
 
 

@@ -298,11 +298,14 @@ class CorrectedPath:
     """Output of DalembertCorrector.correct: one row per tick."""
     t: FloatArray
     desired: FloatArray
-    position: FloatArray
+    commanded: FloatArray
     joints: FloatArray
     force: FloatArray
     displacement: FloatArray
     flagged_ticks: List[int]
+    @property
+    def position(self) -> FloatArray:
+        """The old name of ``commanded``."""
 
 class DalembertCorrector:
     """D'Alembert correction of the paper's five-bar from a compliance map; for a serial arm,
