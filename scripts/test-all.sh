@@ -56,6 +56,8 @@ rm -rf target/smoke-venv
 target/smoke-venv/bin/python -m pip install --quiet "$WHEEL"
 target/smoke-venv/bin/python scripts/wheel_smoke.py
 "$VENV/bin/python" -m pytest -q crates/py/tests
+# Every Python snippet of README.md runs as printed.
+"$VENV/bin/python" scripts/readme_snippets.py
 for ex in examples/[0-9][0-9]_*.py; do
   [ -e "$ex" ] || continue
   echo "-- $ex"
