@@ -41,7 +41,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19"
+"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19" "mypy>=1.18"
 # The wheel is built once (abi3, release) and installed from the file; a fresh venv with
 # nothing but the wheel (and numpy from its metadata) imports it: what `pip install
 # deflect-robotics` gives a user.
@@ -55,6 +55,8 @@ rm -rf target/smoke-venv
 "$PY" -m venv target/smoke-venv
 target/smoke-venv/bin/python -m pip install --quiet "$WHEEL"
 target/smoke-venv/bin/python scripts/wheel_smoke.py
+# The type stubs match the compiled module: every class, signature and default.
+"$VENV/bin/python" -m mypy.stubtest deflect
 "$VENV/bin/python" -m pytest -q crates/py/tests
 # Every Python snippet of README.md runs as printed.
 "$VENV/bin/python" scripts/readme_snippets.py
