@@ -83,6 +83,27 @@ impl SensorCalibration {
         Ok(Self { inner: c })
     }
 
+    /// Pickling and `copy.deepcopy`: every number of the calibration (the TCP pose as
+    /// translation and unit quaternion), an exact round trip validated again on the way back.
+    #[allow(clippy::type_complexity)] // reason: the pickle protocol's (callable, args) pair
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, (crate::pickle::CalibrationState,))> {
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        Ok((
+            rebuild,
+            (crate::pickle::calibration_state(&slf.get().inner),),
+        ))
+    }
+
+    /// The calibration of a pickled state (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(state: crate::pickle::CalibrationState) -> PyResult<Self> {
+        Ok(Self {
+            inner: crate::pickle::calibration_of(state)?,
+        })
+    }
+
     #[getter]
     fn force_offset<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.force_offset.as_slice().to_pyarray(py)
@@ -161,13 +182,27 @@ impl SensorCalibration {
 
 /// First-order low-pass on wrenches (6,), cut-off [Hz], sample time [s].
 #[pyclass(module = "deflect")]
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct LowPass {
     inner: CoreLowPass,
 }
 
 #[pymethods]
 impl LowPass {
+    /// Refused: a `LowPass` carries its filter state from tick to tick, which a copy in another
+    /// process could not continue; send its arguments and build one there. `copy.deepcopy`
+    /// copies the state exactly, within this process.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(crate::pickle::per_tick_state("LowPass", "its filter state"))
+    }
+    /// An exact copy, state included.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+    /// An exact copy, state included.
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
     #[new]
     fn new(
         #[pyo3(from_py_with = args::real::cutoff_hz)] cutoff_hz: f64,
@@ -203,13 +238,30 @@ impl LowPass {
 
 /// Moving average of the last `window` wrenches (window <= 64).
 #[pyclass(module = "deflect")]
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct MovingAverage {
     inner: CoreMovingAverage<MAX_AVERAGE_WINDOW>,
 }
 
 #[pymethods]
 impl MovingAverage {
+    /// Refused: a `MovingAverage` carries its window of samples from tick to tick, which a copy in another
+    /// process could not continue; send its arguments and build one there. `copy.deepcopy`
+    /// copies the state exactly, within this process.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(crate::pickle::per_tick_state(
+            "MovingAverage",
+            "its window of samples",
+        ))
+    }
+    /// An exact copy, state included.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+    /// An exact copy, state included.
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
     #[new]
     fn new(
         #[pyo3(from_py_with = args::count::window)] window: usize,
@@ -241,13 +293,30 @@ impl MovingAverage {
 
 /// Force pilot control (section 2.3): threshold [N], ramp [s], cycle time [s].
 #[pyclass(module = "deflect")]
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct PilotControl {
     inner: CorePilot,
 }
 
 #[pymethods]
 impl PilotControl {
+    /// Refused: a `PilotControl` carries its blend state from tick to tick, which a copy in another
+    /// process could not continue; send its arguments and build one there. `copy.deepcopy`
+    /// copies the state exactly, within this process.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(crate::pickle::per_tick_state(
+            "PilotControl",
+            "its blend state",
+        ))
+    }
+    /// An exact copy, state included.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+    /// An exact copy, state included.
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
     #[new]
     #[pyo3(signature = (threshold=150.0, ramp=0.08, dt=0.004))]
     fn new(
@@ -291,7 +360,7 @@ fn project_normal_to_feed<'py>(
 
 /// The online compensation chain for a `SerialRobot`.
 #[pyclass(module = "deflect")]
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct OnlineCompensator {
     /// The chain (the robot's, copied in) and the validated settings.
     model: compensation::Model,
@@ -301,6 +370,23 @@ pub struct OnlineCompensator {
 
 #[pymethods]
 impl OnlineCompensator {
+    /// Refused: a `OnlineCompensator` carries its filter, pilot and rate-limiter states from tick to tick, which a copy in another
+    /// process could not continue; send its arguments and build one there. `copy.deepcopy`
+    /// copies the state exactly, within this process.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(crate::pickle::per_tick_state(
+            "OnlineCompensator",
+            "its filter, pilot and rate-limiter states",
+        ))
+    }
+    /// An exact copy, state included.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+    /// An exact copy, state included.
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
     #[new]
     #[pyo3(signature = (robot, dt=0.004, calibration=None, lowpass_cutoff_hz=10.0, moving_average_window=5, pilot=Some((150.0, 0.08)), project_on_feed=true, max_correction=3.0e-3, max_rate=0.05, output="cartesian"),
            text_signature = "(robot, dt=0.004, calibration=None, lowpass_cutoff_hz=10.0, moving_average_window=5, pilot=(150.0, 0.08), project_on_feed=True, max_correction=0.003, max_rate=0.05, output='cartesian')")]

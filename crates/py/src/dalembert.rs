@@ -40,6 +40,8 @@ pub struct DalembertCorrector {
     /// The tick state (the last joints, the next IK seed); locked per call so that the class
     /// stays frozen and `correct` can run without the GIL.
     data: Mutex<Data>,
+    /// The constructor's arguments, for pickling.
+    config: Py<pyo3::types::PyTuple>,
 }
 
 impl DalembertCorrector {
@@ -88,7 +90,7 @@ impl DalembertCorrector {
     #[pyo3(signature = (compliance_map, mechanism, mass=dalembert::PAPER_MASS, iterations=0, tolerance=0.0),
            text_signature = "(compliance_map, mechanism, mass=5.0, iterations=0, tolerance=0.0)")]
     fn new(
-        compliance_map: &ComplianceMap,
+        compliance_map: &Bound<'_, ComplianceMap>,
         mechanism: &Bound<'_, PyAny>,
         #[pyo3(from_py_with = args::real::mass)] mass: f64,
         #[pyo3(from_py_with = args::count::iterations)] iterations: usize,
@@ -107,11 +109,34 @@ impl DalembertCorrector {
                 mechanism.get_type().name()?
             )));
         };
-        let model = Model::new(mechanism.get().inner, compliance_map.inner.clone(), mass)
-            .and_then(|m| m.with_fixed_point(iterations, tolerance))
-            .map_err(build_err)?;
+        let model = Model::new(
+            mechanism.get().inner,
+            compliance_map.get().inner.clone(),
+            mass,
+        )
+        .and_then(|m| m.with_fixed_point(iterations, tolerance))
+        .map_err(build_err)?;
         let data = Mutex::new(Data::new(&model));
-        Ok(Self { model, data })
+        let config = (compliance_map, mechanism, mass, iterations, tolerance)
+            .into_pyobject(compliance_map.py())?
+            .unbind();
+        Ok(Self {
+            model,
+            data,
+            config,
+        })
+    }
+
+    /// Pickling and `copy.deepcopy`: the configuration (the constructor's arguments, the map
+    /// and mechanism pickled with it). The tick state (the last joints) is not pickled: a
+    /// copy starts from its first tick, as a new corrector would.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, pyo3::types::PyType>,
+        Bound<'py, pyo3::types::PyTuple>,
+    ) {
+        (slf.get_type(), slf.get().config.bind(slf.py()).clone())
     }
 
     /// Mass parameter m* [kg].

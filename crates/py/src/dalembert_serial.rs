@@ -24,6 +24,14 @@ use crate::convert::{
 use crate::pose_motion::{PoseTrajectory, pose_ticks};
 use crate::vjm::SerialRobot;
 
+/// The Python name of a deflection model.
+fn model_name(d: Deflection) -> &'static str {
+    match d {
+        Deflection::Exact => "exact",
+        Deflection::Linearized => "linearized",
+    }
+}
+
 fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
     match o {
         None => Ok(Vector3::zeros()),
@@ -57,6 +65,8 @@ pub struct SerialDalembertCorrector {
     /// The tick state (the last joints, the next IK seed), locked per call.
     data: Mutex<SerialData>,
     joint_names: Vec<String>,
+    /// The constructor's arguments, as validated, for pickling.
+    config: Py<pyo3::types::PyTuple>,
 }
 
 impl SerialDalembertCorrector {
@@ -113,7 +123,7 @@ impl SerialDalembertCorrector {
     #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None, link_inertia=false, gravity=None))]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
-        robot: &SerialRobot,
+        robot: &Bound<'_, SerialRobot>,
         #[pyo3(from_py_with = args::real::mass)] mass: f64,
         com: Option<&Bound<'_, PyAny>>,
         inertia: Option<&Bound<'_, PyAny>>,
@@ -126,6 +136,8 @@ impl SerialDalembertCorrector {
         link_inertia: bool,
         gravity: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
+        let handle = robot;
+        let robot = robot.get();
         let chain = robot.inner.model.clone();
         let dof = chain.dof();
         let payload = Payload {
@@ -176,18 +188,55 @@ impl SerialDalembertCorrector {
             .and_then(|m| m.with_gravity(g))
             .map_err(build_err)?;
         let mut data = SerialData::new(&model);
-        if let Some(s) = seed {
-            let q = vector(s, "seed", dof)?;
-            if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-                return Err(InputError::new_err(format!("seed[{i}] is not finite")));
+        let seed = match seed {
+            Some(s) => {
+                let q = vector(s, "seed", dof)?;
+                if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                    return Err(InputError::new_err(format!("seed[{i}] is not finite")));
+                }
+                data.set_seed(&q);
+                Some(q)
             }
-            data.set_seed(&q);
-        }
+            None => None,
+        };
+        let p = &model.payload();
+        let inertia: [[f64; 3]; 3] = core::array::from_fn(|r| {
+            core::array::from_fn(|c| p.inertia.get((r, c)).copied().unwrap_or(f64::NAN))
+        });
+        let config = (
+            handle,
+            mass,
+            [p.com.x, p.com.y, p.com.z],
+            inertia,
+            model_name(model.deflection()),
+            limits,
+            max_iterations,
+            position_tolerance,
+            orientation_tolerance,
+            seed,
+            link_inertia,
+            [g.x, g.y, g.z],
+        )
+            .into_pyobject(handle.py())?
+            .unbind();
         Ok(Self {
             model,
             data: Mutex::new(data),
             joint_names: robot.inner.joint_names.clone(),
+            config,
         })
+    }
+
+    /// Pickling and `copy.deepcopy`: the configuration (the constructor's arguments as
+    /// validated, the robot pickled with it). The tick state (the last ticks' joints, the
+    /// IK's warm start) is not pickled: a copy starts from `seed`, as a new corrector would.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> (
+        Bound<'py, pyo3::types::PyType>,
+        Bound<'py, pyo3::types::PyTuple>,
+    ) {
+        (slf.get_type(), slf.get().config.bind(slf.py()).clone())
     }
 
     /// Number of joints.
@@ -218,10 +267,7 @@ impl SerialDalembertCorrector {
     /// Deflection model inverted: 'exact' or 'linearized'.
     #[getter]
     fn model(&self) -> &'static str {
-        match self.model.deflection() {
-            Deflection::Exact => "exact",
-            Deflection::Linearized => "linearized",
-        }
+        model_name(self.model.deflection())
     }
     /// The last tick's joints (the next tick's warm start), (dof,).
     #[getter]

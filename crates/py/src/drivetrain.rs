@@ -82,6 +82,8 @@ fn masses_arg(o: &Bound<'_, PyAny>) -> PyResult<Option<Vec<MassEntry>>> {
 pub struct DriveTrain {
     /// The drive train; it owns its kinematic chain.
     inner: dt::Model,
+    /// The robot it was built on, kept for pickling (its chain is `inner`'s).
+    robot: Py<SerialRobot>,
 }
 
 impl DriveTrain {
@@ -113,7 +115,7 @@ impl DriveTrain {
                              torque_deadband=0.0, max_condition=1000000.0)")]
     #[allow(clippy::too_many_arguments)] // reason: keyword arguments of the Python signature
     fn new(
-        robot: &SerialRobot,
+        robot: &Bound<'_, SerialRobot>,
         stiffness: &Bound<'_, PyAny>,
         backlash: Option<&Bound<'_, PyAny>>,
         #[pyo3(from_py_with = masses_arg)] masses: Option<Vec<MassEntry>>,
@@ -122,6 +124,7 @@ impl DriveTrain {
         #[pyo3(from_py_with = args::real::max_condition)] max_condition: f64,
     ) -> PyResult<Self> {
         // Values are validated by deflect-core's builders.
+        let (handle, robot) = (robot.clone().unbind(), robot.get());
         let k = vector_any(stiffness, "stiffness")?;
         let b = match backlash {
             Some(b) => vector_any(b, "backlash")?,
@@ -137,26 +140,74 @@ impl DriveTrain {
             .and_then(|d| d.with_torque_deadband(torque_deadband))
             .and_then(|d| d.with_max_condition(max_condition))
             .map_err(build_err)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            robot: handle,
+        })
+    }
+
+    /// Pickling and `copy.deepcopy`: the constructor arguments (robot, stiffness, backlash,
+    /// masses, gravity, torque deadband, condition limit) as plain values, an exact round
+    /// trip validated again on the way back.
+    #[allow(clippy::type_complexity)] // reason: the pickle protocol's (callable, args) pair
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, pyo3::types::PyType>,
+        (
+            Py<SerialRobot>,
+            Vec<f64>,
+            Vec<f64>,
+            Vec<(usize, f64, [f64; 3])>,
+            [f64; 3],
+            f64,
+            f64,
+        ),
+    )> {
+        let me = slf.get();
+        let m = &me.inner;
+        Ok((
+            slf.get_type(),
+            (
+                me.robot.clone_ref(slf.py()),
+                me.stiffness(),
+                me.backlash(),
+                me.masses(),
+                me.gravity(),
+                m.torque_deadband(),
+                m.max_condition(),
+            ),
+        ))
     }
 
     /// Stiffness and backlash from the `[[joint]]` entries of a TOML file (the robot's
     /// stiffness file or a sibling), masses from the URDF `<inertial>` elements.
     #[staticmethod]
     fn from_urdf(
-        robot: &SerialRobot,
+        robot: &Bound<'_, SerialRobot>,
         urdf_path: std::path::PathBuf,
         drive_path: std::path::PathBuf,
     ) -> PyResult<Self> {
-        let inner = io::drive::from_path(&robot.inner, urdf_path, drive_path).map_err(load_err)?;
-        Ok(Self { inner })
+        let inner =
+            io::drive::from_path(&robot.get().inner, urdf_path, drive_path).map_err(load_err)?;
+        Ok(Self {
+            inner,
+            robot: robot.clone().unbind(),
+        })
     }
 
     /// Same as `from_urdf`, from the files' texts.
     #[staticmethod]
-    fn from_strings(robot: &SerialRobot, urdf: &str, drive_toml: &str) -> PyResult<Self> {
-        let inner = io::drive::from_str(&robot.inner, urdf, drive_toml).map_err(load_err)?;
-        Ok(Self { inner })
+    fn from_strings(
+        robot: &Bound<'_, SerialRobot>,
+        urdf: &str,
+        drive_toml: &str,
+    ) -> PyResult<Self> {
+        let inner = io::drive::from_str(&robot.get().inner, urdf, drive_toml).map_err(load_err)?;
+        Ok(Self {
+            inner,
+            robot: robot.clone().unbind(),
+        })
     }
 
     /// Joint stiffnesses [N m/rad].
@@ -295,7 +346,7 @@ impl DriveTrain {
 /// force (xy, the force the tool exerts on the object, bias included) once the robot is at
 /// rest; it returns the next command and its state name.
 #[pyclass(module = "deflect")]
-#[derive(Debug)]
+#[derive(Debug, Clone)]
 pub struct ContourTracer {
     model: contour::Model,
     data: contour::Data,
@@ -304,6 +355,23 @@ pub struct ContourTracer {
 
 #[pymethods]
 impl ContourTracer {
+    /// Refused: a `ContourTracer` carries its tracing state (contact, bias, path so far) from tick to tick, which a copy in another
+    /// process could not continue; send its arguments and build one there. `copy.deepcopy`
+    /// copies the state exactly, within this process.
+    fn __reduce__(&self) -> PyResult<()> {
+        Err(crate::pickle::per_tick_state(
+            "ContourTracer",
+            "its tracing state (contact, bias, path so far)",
+        ))
+    }
+    /// An exact copy, state included.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Self {
+        self.clone()
+    }
+    /// An exact copy, state included.
+    fn __copy__(&self) -> Self {
+        self.clone()
+    }
     /// `stiffness` the (2, 2) xy stiffness [N/m]; `step` Delta r [m]; force window
     /// `contact_force < |F| < jam_force` [N]. Other settings as `TracerConfig` in Rust.
     #[new]

@@ -153,7 +153,7 @@ impl Plan {
 
 /// How a plan is limited: on the path (Euclidean norms), per coordinate, or per segment.
 #[derive(Debug, Clone)]
-enum LimitSpec {
+pub(crate) enum LimitSpec {
     Path(Limits),
     Axis([Vec<f64>; 3]),
     Segments(Vec<Limits>),
@@ -262,14 +262,31 @@ fn limit_spec(
 #[derive(Debug)]
 pub struct Trajectory {
     plan: Option<Plan>,
+    /// What it was made from, for pickling.
+    recipe: Recipe,
     dim: usize,
     duration: f64,
     rate_hz: Option<f64>,
     samples: OnceLock<Samples>,
 }
 
+/// What a trajectory was made from: pickling remakes it from these, bit for bit.
+#[derive(Debug, Clone)]
+pub(crate) enum Recipe {
+    /// `plan_line` / `plan_polyline`: the points (n, d) and the limits.
+    Planned {
+        points: Array2<f64>,
+        spec: LimitSpec,
+    },
+    /// `Trajectory.from_samples`: the positions (n, d) and accelerations, if given.
+    Sampled {
+        position: Array2<f64>,
+        acceleration: Option<Array2<f64>>,
+    },
+}
+
 impl Trajectory {
-    fn planned(plan: Plan, rate_hz: Option<f64>) -> PyResult<Self> {
+    fn planned(plan: Plan, recipe: Recipe, rate_hz: Option<f64>) -> PyResult<Self> {
         if let Some(r) = rate_hz {
             // Refuse a tick budget overrun now, not on first access.
             plan.sample_count(r).map_err(tick_err)?;
@@ -278,6 +295,7 @@ impl Trajectory {
             dim: plan.dim(),
             duration: plan.duration(),
             plan: Some(plan),
+            recipe,
             rate_hz,
             samples: OnceLock::new(),
         })
@@ -406,6 +424,10 @@ impl Trajectory {
         let duration = samples.t.last().copied().unwrap_or(0.0);
         Ok(Self {
             plan: None,
+            recipe: Recipe::Sampled {
+                position: p.clone(),
+                acceleration: a.clone(),
+            },
             dim: d,
             duration,
             rate_hz: Some(rate_hz),
@@ -443,7 +465,16 @@ impl Trajectory {
                 "this Trajectory was built from samples: it has no plan to sample again",
             ));
         };
-        Self::planned(plan.clone(), Some(rate_hz))
+        Self::planned(plan.clone(), self.recipe.clone(), Some(rate_hz))
+    }
+
+    /// Pickling and `copy.deepcopy`: planned trajectories are planned again from their
+    /// points and limits, sampled ones rebuilt from their samples; both bit for bit.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
+        let me = slf.get();
+        crate::pickle::trajectory_reduce(slf.py(), &me.recipe, me.rate_hz)
     }
 
     /// Tick times [s], shape (n,).
@@ -553,7 +584,8 @@ fn plan_line(
         ));
     }
     let spec = limit_spec(v_max, a_max, j_max, d)?;
-    Trajectory::planned(plan_dyn(pts.view(), &spec)?, rate_hz)
+    let plan = plan_dyn(pts.view(), &spec)?;
+    Trajectory::planned(plan, Recipe::Planned { points: pts, spec }, rate_hz)
 }
 
 /// Rest-to-rest moves through `points` (n, d), 2 <= n <= 32, 1 <= d <= 8, stopping at every
@@ -615,7 +647,12 @@ fn plan_polyline(
             &[points.nrows(), points.ncols()],
         ));
     }
-    Trajectory::planned(plan_dyn(points, &spec)?, rate_hz)
+    let plan = plan_dyn(points, &spec)?;
+    let recipe = Recipe::Planned {
+        points: points.to_owned(),
+        spec,
+    };
+    Trajectory::planned(plan, recipe, rate_hz)
 }
 
 /// Limits `(v_max, a_max, j_max)` that reproduce the paper's motions at `g_level` g (1..5).

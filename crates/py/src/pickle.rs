@@ -3,12 +3,18 @@
 //! back (a tampered state is an `InputError`, never a model the builders would refuse).
 
 use deflect_core::SerialRobot as CoreRobot;
+use deflect_core::compensation::SensorCalibration;
+use deflect_core::compensation::sensor::POLY_TERMS;
 use deflect_core::vjm::{Element, Model, ModelBuilder};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
+use numpy::ToPyArray;
+use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
+use pyo3::types::PyTuple;
 
 use crate::InputError;
 use crate::convert::build_err;
+use crate::motion::{LimitSpec, Recipe};
 
 /// Version of the state layout below.
 const VERSION: u32 = 1;
@@ -173,4 +179,131 @@ pub fn robot_of(state: RobotState) -> PyResult<CoreRobot> {
         base_link,
         tip_link,
     })
+}
+
+/// `(callable, args)` that remakes a trajectory of `recipe` sampled at `rate_hz`: the public
+/// `plan_polyline` (which is what `plan_line` plans with) or `Trajectory.from_samples`, so
+/// that the state is validated again on the way back.
+pub(crate) fn trajectory_reduce<'py>(
+    py: Python<'py>,
+    recipe: &Recipe,
+    rate_hz: Option<f64>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    let module = py.import("deflect._deflect")?;
+    let none = || py.None().into_bound(py);
+    match recipe {
+        Recipe::Planned { points, spec } => {
+            let (v, a, j, segments) = match spec {
+                LimitSpec::Path(l) => (
+                    l.v_max.into_bound_py_any(py)?,
+                    l.a_max.into_bound_py_any(py)?,
+                    l.j_max.into_bound_py_any(py)?,
+                    none(),
+                ),
+                LimitSpec::Axis([v, a, j]) => (
+                    v.clone().into_bound_py_any(py)?,
+                    a.clone().into_bound_py_any(py)?,
+                    j.clone().into_bound_py_any(py)?,
+                    none(),
+                ),
+                LimitSpec::Segments(ls) => {
+                    let rows: Vec<[f64; 3]> =
+                        ls.iter().map(|l| [l.v_max, l.a_max, l.j_max]).collect();
+                    (none(), none(), none(), rows.into_bound_py_any(py)?)
+                }
+            };
+            let args = [
+                points.to_pyarray(py).into_any(),
+                v,
+                a,
+                j,
+                rate_hz.into_bound_py_any(py)?,
+                segments,
+            ];
+            Ok((module.getattr("plan_polyline")?, PyTuple::new(py, args)?))
+        }
+        Recipe::Sampled {
+            position,
+            acceleration,
+        } => {
+            let args = [
+                position.to_pyarray(py).into_any(),
+                rate_hz.unwrap_or(f64::NAN).into_bound_py_any(py)?,
+                match acceleration {
+                    Some(a) => a.to_pyarray(py).into_any(),
+                    None => none(),
+                },
+            ];
+            let ctor = module.getattr("Trajectory")?.getattr("from_samples")?;
+            Ok((ctor, PyTuple::new(py, args)?))
+        }
+    }
+}
+
+/// The `TypeError` of `pickle.dumps` on an object with per-tick state.
+pub(crate) fn per_tick_state(class: &str, what: &str) -> PyErr {
+    pyo3::exceptions::PyTypeError::new_err(format!(
+        "cannot pickle a {class}: it carries {what} from tick to tick; pickle or send its \
+         constructor arguments and build a new {class} where it runs (copy.deepcopy copies \
+         it with its state within one process)"
+    ))
+}
+
+/// `(force_offset, moment_offset, weight, center_of_gravity, residual (6 x 15, row-major),
+/// TCP translation, TCP quaternion (x, y, z, w))` of a sensor calibration.
+pub type CalibrationState = (
+    [f64; 3],
+    [f64; 3],
+    f64,
+    [f64; 3],
+    Vec<f64>,
+    [f64; 3],
+    [f64; 4],
+);
+
+/// The pickled state of a sensor calibration.
+pub fn calibration_state(c: &SensorCalibration) -> CalibrationState {
+    let t = iso(&c.sensor_to_tcp);
+    let v3 = |v: &Vector3<f64>| [v.x, v.y, v.z];
+    (
+        v3(&c.force_offset),
+        v3(&c.moment_offset),
+        c.weight,
+        v3(&c.center_of_gravity),
+        c.residual.iter().flatten().copied().collect(),
+        [t[0], t[1], t[2]],
+        [t[3], t[4], t[5], t[6]],
+    )
+}
+
+/// The sensor calibration of a pickled state, validated by deflect-core (and its quaternion
+/// checked to be a unit one).
+pub fn calibration_of(state: CalibrationState) -> PyResult<SensorCalibration> {
+    let (f, m, weight, cog, residual, p, q) = state;
+    let norm = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if !(norm - 1.0).abs().le(&1e-12) {
+        return Err(InputError::new_err(format!(
+            "pickled SensorCalibration: the TCP quaternion has norm {norm}, expected 1"
+        )));
+    }
+    if residual.len() != 6 * POLY_TERMS {
+        return Err(InputError::new_err(format!(
+            "pickled SensorCalibration: residual has {} numbers, expected {}",
+            residual.len(),
+            6 * POLY_TERMS
+        )));
+    }
+    let mut c = SensorCalibration {
+        force_offset: Vector3::from(f),
+        moment_offset: Vector3::from(m),
+        weight,
+        center_of_gravity: Vector3::from(cog),
+        sensor_to_tcp: iso_of(&[p[0], p[1], p[2], q[0], q[1], q[2], q[3]]),
+        ..SensorCalibration::default()
+    };
+    for (row, src) in c.residual.iter_mut().zip(residual.chunks(POLY_TERMS)) {
+        row.copy_from_slice(src);
+    }
+    c.validate().map_err(build_err)?;
+    Ok(c)
 }

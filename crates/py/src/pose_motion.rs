@@ -16,8 +16,10 @@ use pyo3::types::PyDict;
 use crate::InputError;
 use crate::args;
 use crate::convert::{
-    build_err, float_array, iso_to_py, pose, put_pose, real, shape_error, tick_err, vector_any,
+    build_err, fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, real,
+    shape_error, tick_err, vector_any,
 };
+use nalgebra::Matrix4;
 
 /// Every tick of a pose motion, one row each.
 #[derive(Debug, Clone)]
@@ -81,17 +83,30 @@ pub(crate) fn pose_ticks(traj: &Core, rate_hz: f64) -> Result<Vec<PoseState>, Ti
 pub struct PoseTrajectory {
     pub(crate) plan: Core,
     pub(crate) rate_hz: Option<f64>,
+    /// `plan_pose`'s arguments, for pickling.
+    recipe: PoseRecipe,
     samples: OnceLock<PoseSamples>,
 }
 
+/// The arguments of `plan_pose` a pose trajectory was planned from: the 4 x 4 matrices as
+/// given (converting them to the planner's quaternions and back would not be exact).
+#[derive(Debug, Clone, Copy)]
+struct PoseRecipe {
+    start: Matrix4<f64>,
+    end: Matrix4<f64>,
+    linear: [f64; 3],
+    angular: [f64; 3],
+}
+
 impl PoseTrajectory {
-    fn new(plan: Core, rate_hz: Option<f64>) -> PyResult<Self> {
+    fn new(plan: Core, recipe: PoseRecipe, rate_hz: Option<f64>) -> PyResult<Self> {
         if let Some(r) = rate_hz {
             plan.sample_count(r).map_err(tick_err)?;
         }
         Ok(Self {
             plan,
             rate_hz,
+            recipe,
             samples: OnceLock::new(),
         })
     }
@@ -165,7 +180,37 @@ impl PoseTrajectory {
 
     /// The same plan with its ticks at `rate_hz` [Hz] (at most 2^22 ticks).
     fn sampled(&self, #[pyo3(from_py_with = args::real::rate_hz)] rate_hz: f64) -> PyResult<Self> {
-        Self::new(self.plan, Some(rate_hz))
+        Self::new(self.plan, self.recipe, Some(rate_hz))
+    }
+
+    /// Pickling and `copy.deepcopy`: `plan_pose` with the same arguments, planned again bit
+    /// for bit.
+    #[allow(clippy::type_complexity)] // reason: the pickle protocol's (callable, args) pair
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(
+        Bound<'py, PyAny>,
+        (
+            Bound<'py, PyArray2<f64>>,
+            Bound<'py, PyArray2<f64>>,
+            [f64; 3],
+            [f64; 3],
+            Option<f64>,
+        ),
+    )> {
+        let (py, me) = (slf.py(), slf.get());
+        let r = &me.recipe;
+        let f = py.import("deflect._deflect")?.getattr("plan_pose")?;
+        Ok((
+            f,
+            (
+                matrix_to_py(py, &r.start),
+                matrix_to_py(py, &r.end),
+                r.linear,
+                r.angular,
+                me.rate_hz,
+            ),
+        ))
     }
 
     /// Tick times [s], (n,).
@@ -276,12 +321,26 @@ fn plan_pose(
     #[pyo3(from_py_with = args::triple::angular)] angular: [f64; 3],
     #[pyo3(from_py_with = args::opt_real::rate_hz)] rate_hz: Option<f64>,
 ) -> PyResult<PoseTrajectory> {
-    let (s, e) = (pose(start, "start")?, pose(end, "end")?);
+    let (sm, em) = (
+        fixed_matrix::<4, 4>(start, "start")?,
+        fixed_matrix::<4, 4>(end, "end")?,
+    );
+    let (s, e) = (pose_of(&sm, "start")?, pose_of(&em, "end")?);
     let limits = PoseLimits {
         linear: limits("linear", linear)?,
         angular: limits("angular", angular)?,
     };
-    PoseTrajectory::new(Core::line(&s, &e, &limits).map_err(build_err)?, rate_hz)
+    let recipe = PoseRecipe {
+        start: sm,
+        end: em,
+        linear,
+        angular,
+    };
+    PoseTrajectory::new(
+        Core::line(&s, &e, &limits).map_err(build_err)?,
+        recipe,
+        rate_hz,
+    )
 }
 
 /// Adds the pose planner to the module.

@@ -86,3 +86,150 @@ def test_from_json_takes_the_text_or_a_path(tmp_path):
         deflect.ComplianceMap.from_json(tmp_path / "nonexistent.json")
     with pytest.raises(deflect.InputError, match="source"):
         deflect.ComplianceMap.from_json(42)
+
+
+CLONES = [lambda o: pickle.loads(pickle.dumps(o)), copy.deepcopy]
+
+
+@pytest.mark.parametrize("clone", CLONES)
+def test_drive_train_round_trips_with_its_robot(robots, clone):
+    kr300 = robots[0]
+    drive = deflect.DriveTrain(
+        kr300,
+        [1.0e7, 6.0e6, 4.0e6, 1.0e6, 8.0e5, 5.0e5],
+        [1e-4, 2e-4, 0.0, 0.0, 1e-4, 0.0],
+        masses=[(1, 120.0, (0.3, 0.0, 0.1)), (2, 60.0, (0.5, 0.02, 0.0))],
+        gravity=(0.0, 0.5, -9.8),
+        torque_deadband=2.0,
+        max_condition=1e5,
+    )
+    other = clone(drive)
+    for name in ["stiffness", "backlash", "masses", "gravity"]:
+        assert getattr(other, name) == getattr(drive, name), name
+    np.testing.assert_array_equal(other.gravity_torques(Q), drive.gravity_torques(Q))
+    np.testing.assert_array_equal(other.correct_joints(Q, W), drive.correct_joints(Q, W))
+    np.testing.assert_array_equal(other.cartesian_stiffness(Q), drive.cartesian_stiffness(Q))
+
+
+@pytest.mark.parametrize("clone", CLONES)
+def test_trajectories_round_trip_planned_or_sampled(clone):
+    pts = [[0.0, 0.0, 0.0], [0.1, 0.2, 0.0], [0.3, 0.0, 0.05]]
+    made = [
+        deflect.plan_line([0.0, 0.1], [0.2, -0.05], 1.0, 20.0, 400.0),
+        deflect.plan_line([0.0, 0.1], [0.2, -0.05], 1.0, 20.0, 400.0, rate_hz=None),
+        deflect.plan_polyline(pts, [1.0, 0.5, 0.2], 20.0, 400.0, rate_hz=1000.0),
+        deflect.plan_polyline(pts, segment_limits=[[1.0, 10.0, 100.0], [0.5, 20.0, 300.0]]),
+        deflect.plan_line([0.0, 0.1], [0.2, -0.05], 1.0, 20.0, 400.0).sampled(500.0),
+        deflect.Trajectory.from_samples(np.linspace(0.0, 1.0, 40) ** 3, 250.0),
+        deflect.Trajectory.from_samples(
+            np.c_[np.linspace(0, 1, 30), np.zeros(30)], 100.0, acceleration=np.ones((30, 2))
+        ),
+    ]
+    times = np.linspace(-0.1, 2.0, 17)
+    for traj in made:
+        other = clone(traj)
+        assert repr(other) == repr(traj)
+        assert (other.duration, other.dim, other.rate_hz) == (traj.duration, traj.dim, traj.rate_hz)
+        if traj.rate_hz is not None:
+            for name in ["t", "position", "velocity", "acceleration", "jerk"]:
+                np.testing.assert_array_equal(getattr(other, name), getattr(traj, name), name)
+        if traj.is_planned:
+            for k, v in traj.at(times).items():
+                np.testing.assert_array_equal(other.at(times)[k], v, k)
+
+
+@pytest.mark.parametrize("clone", CLONES)
+def test_pose_trajectory_round_trips(robots, clone):
+    ur5 = robots[1]
+    q0 = np.array([0.3, -1.2, 1.5, -1.9, -1.57, 0.4])
+    start = ur5.forward(q0)
+    end = ur5.forward(q0 + 0.2)
+    for rate in [2000.0, None]:
+        traj = deflect.plan_pose(start, end, (1.0, 30.0, 600.0), (2.0, 40.0, 800.0), rate_hz=rate)
+        other = clone(traj)
+        assert repr(other) == repr(traj)
+        np.testing.assert_array_equal(other.at(0.137)["pose"], traj.at(0.137)["pose"])
+        if rate is not None:
+            np.testing.assert_array_equal(other.pose, traj.pose)
+
+
+@pytest.mark.parametrize("clone", CLONES)
+def test_correctors_pickle_their_configuration_and_start_afresh(robots, clone):
+    cmap = deflect.ComplianceMap.from_csv(REPO / "data/paksoy2025_compliance_oc.csv")
+    five_bar = deflect.DalembertCorrector(cmap, deflect.ParallelRobot2(), 4.5, 3, 1e-9)
+    traj = deflect.plan_line([0.19, 0.0], [0.25, 0.0], *deflect.paper_limits(5))
+    a = five_bar.correct(traj)
+    other = clone(five_bar)
+    assert other.mass == five_bar.mass
+    np.testing.assert_array_equal(other.correct(traj).commanded, a.commanded)
+
+    ur5 = robots[1]
+    q0 = np.array([0.3, -1.2, 1.5, -1.9, -1.57, 0.4])
+    start = ur5.forward(q0)
+    end = start.copy()
+    end[:3, 3] += [0.1, -0.05, 0.02]
+    pose_traj = deflect.plan_pose(start, end, (1.0, 30.0, 600.0), (2.0, 40.0, 800.0))
+    serial = deflect.SerialDalembertCorrector(
+        ur5, 3.0, com=[0.0, 0.0, 0.05], inertia=np.diag([0.01, 0.02, 0.03]), seed=q0,
+        gravity=[0.0, 0.0, -9.80665], max_iterations=30,
+    )
+    fresh = clone(serial)
+    first = serial.correct(pose_traj)
+    # The copy made before any tick and the one made after both start from `seed`.
+    later = clone(serial)
+    for c in [fresh, later]:
+        assert (c.mass, c.model, c.dof, c.joint_names) == (
+            serial.mass, serial.model, serial.dof, serial.joint_names)
+        np.testing.assert_array_equal(c.gravity, serial.gravity)
+        np.testing.assert_array_equal(c.correct(pose_traj).joints, first.joints)
+
+
+@pytest.mark.parametrize("clone", CLONES)
+def test_sensor_calibration_round_trips(clone):
+    rng = np.random.default_rng(3)
+    tcp = np.eye(4)
+    tcp[:3, :3] = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    tcp[:3, 3] = [0.01, 0.0, 0.2]
+    cal = deflect.SensorCalibration(
+        force_offset=[1.0, -2.0, 3.0], moment_offset=[0.1, 0.2, -0.3], weight=45.0,
+        center_of_gravity=[0.0, 0.01, 0.08], residual=rng.normal(size=(6, 15)) * 1e-3,
+        sensor_to_tcp=tcp,
+    )
+    other = clone(cal)
+    for name in ["force_offset", "moment_offset", "center_of_gravity", "residual", "sensor_to_tcp"]:
+        np.testing.assert_array_equal(getattr(other, name), getattr(cal, name), name)
+    assert other.weight == cal.weight
+
+
+def test_a_tampered_calibration_state_is_refused():
+    rebuild, (state,) = deflect.SensorCalibration(weight=10.0).__reduce__()
+    f, m, w, cog, residual, p, q = state
+    with pytest.raises(deflect.InputError, match="quaternion"):
+        rebuild((f, m, w, cog, residual, p, (0.0, 0.0, 0.0, 2.0)))
+    with pytest.raises(deflect.InputError, match="weight"):
+        rebuild((f, m, -1.0, cog, residual, p, q))
+
+
+def test_per_tick_state_is_deep_copied_but_not_pickled(robots):
+    x = np.array([1.0, 2.0, 3.0, 0.1, 0.2, 0.3])
+    made = [
+        (deflect.LowPass(10.0, 0.004), lambda o: o.step(x)),
+        (deflect.MovingAverage(4, 0.004), lambda o: o.step(x)),
+        (deflect.PilotControl(), lambda o: o.step(x * 100, x)),
+        (
+            deflect.OnlineCompensator(robots[0], project_on_feed=False, max_rate=1.0),
+            lambda o: o.step(Q, x * 100)["correction"],
+        ),
+    ]
+    for obj, tick in made:
+        tick(obj)
+        twin = copy.deepcopy(obj)
+        for _ in range(3):
+            np.testing.assert_array_equal(tick(twin), tick(obj))
+        name = type(obj).__name__
+        with pytest.raises(TypeError, match=f"cannot pickle a {name}: it carries"):
+            pickle.dumps(obj)
+    tracer = deflect.ContourTracer(4e4 * np.eye(2), 1.5e-3, 1.5, 30.0, bias_samples=3)
+    with pytest.raises(TypeError, match="cannot pickle a ContourTracer"):
+        pickle.dumps(tracer)
+    assert copy.deepcopy(tracer).state == tracer.state

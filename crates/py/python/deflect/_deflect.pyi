@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension ``deflect._deflect``."""
 
 from os import PathLike
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union, final
+from typing import Any, Dict, List, NoReturn, Optional, Sequence, Tuple, Union, final
 
 from typing_extensions import Self
 
@@ -232,6 +232,9 @@ _Limit = Union[float, _ArrayLike]
 class Trajectory:
     """A motion in 1..=8 coordinates: a plan (exact at any t) with its ticks at ``rate_hz``
     (computed on first access; ``rate_hz`` None: plan only), or the user's own samples."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and ``copy.deepcopy``: planned again from its points and limits, or
+        rebuilt from its samples (exact)."""
     @staticmethod
     def from_samples(
         position: _ArrayLike, rate_hz: float, acceleration: Optional[_ArrayLike] = None
@@ -285,6 +288,8 @@ def paper_limits(g_level: int) -> Tuple[float, float, float]:
 @final
 class PoseTrajectory:
     """A 6-D rest-to-rest pose motion: straight line and a turn about a fixed axis, synchronised."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and ``copy.deepcopy``: ``plan_pose`` with the same arguments (exact)."""
     def at(self, t: Union[float, _ArrayLike]) -> Dict[str, Any]:
         """t, pose (4, 4), velocity, acceleration, angular_velocity, angular_acceleration."""
     def sampled(self, rate_hz: float) -> "PoseTrajectory": ...
@@ -356,6 +361,8 @@ class CorrectedPath:
 class DalembertCorrector:
     """D'Alembert correction of the paper's five-bar from a compliance map; for a serial arm,
     ``SerialDalembertCorrector``."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and ``copy.deepcopy``: its configuration; the copy starts from its first tick."""
     def __new__(
         cls,
         compliance_map: ComplianceMap,
@@ -388,6 +395,8 @@ class CorrectedPoses:
 @final
 class SerialDalembertCorrector:
     """The 6-D D'Alembert corrector for a serial arm (a SerialRobot with >= 6 joints)."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and ``copy.deepcopy``: its configuration; the copy starts from ``seed``."""
     def __new__(
         cls,
         robot: SerialRobot,
@@ -436,6 +445,10 @@ class SerialDalembertCorrector:
 @final
 class SensorCalibration:
     """Force/torque sensor calibration (VJM paper Eq. 12-20); SI units, sensor frame."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
+        """Pickling and ``copy.deepcopy``: every number, exact, validated on the way back."""
+    @staticmethod
+    def _from_state(state: Any) -> "SensorCalibration": ...
     def __new__(
         cls,
         force_offset: Optional[_ArrayLike] = None,
@@ -466,6 +479,12 @@ class SensorCalibration:
 
 @final
 class LowPass:
+    def __reduce__(self) -> NoReturn:
+        """``TypeError``: the per-tick state does not pickle; send the constructor's arguments."""
+    def __copy__(self) -> Self:
+        """An exact copy, state included."""
+    def __deepcopy__(self, memo: Any, /) -> Self:
+        """An exact copy, state included."""
     def __new__(
         cls, cutoff_hz: float, dt: float) -> Self: ...
     def step(self, x: _ArrayLike) -> _FloatArray: ...
@@ -479,6 +498,12 @@ class LowPass:
 
 @final
 class MovingAverage:
+    def __reduce__(self) -> NoReturn:
+        """``TypeError``: the per-tick state does not pickle; send the constructor's arguments."""
+    def __copy__(self) -> Self:
+        """An exact copy, state included."""
+    def __deepcopy__(self, memo: Any, /) -> Self:
+        """An exact copy, state included."""
     def __new__(
         cls, window: int, dt: float) -> Self: ...
     def step(self, x: _ArrayLike) -> _FloatArray: ...
@@ -490,6 +515,12 @@ class MovingAverage:
 
 @final
 class PilotControl:
+    def __reduce__(self) -> NoReturn:
+        """``TypeError``: the per-tick state does not pickle; send the constructor's arguments."""
+    def __copy__(self) -> Self:
+        """An exact copy, state included."""
+    def __deepcopy__(self, memo: Any, /) -> Self:
+        """An exact copy, state included."""
     def __new__(
         cls, threshold: float = 150.0, ramp: float = 0.08, dt: float = 0.004) -> Self: ...
     def step(self, measured: _ArrayLike, estimated: _ArrayLike) -> _FloatArray: ...
@@ -502,6 +533,12 @@ def project_normal_to_feed(r: _ArrayLike, v: _ArrayLike) -> Tuple[_FloatArray, b
 
 @final
 class OnlineCompensator:
+    def __reduce__(self) -> NoReturn:
+        """``TypeError``: the per-tick state does not pickle; send the constructor's arguments."""
+    def __copy__(self) -> Self:
+        """An exact copy, state included."""
+    def __deepcopy__(self, memo: Any, /) -> Self:
+        """An exact copy, state included."""
     def __new__(
         cls,
         robot: SerialRobot,
@@ -544,6 +581,8 @@ def identify_sensor(
 class DriveTrain:
     """Drive-train errors of a serial robot (contour-tracking paper, Eq. 3-13). Wrenches are the
     wrench the tool exerts on the environment (base frame); torques are drive torques."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and ``copy.deepcopy``: its constructor's arguments, the robot with them (exact)."""
     def __new__(
         cls,
         robot: SerialRobot,
@@ -579,6 +618,12 @@ class DriveTrain:
 @final
 class ContourTracer:
     """Force-feedback contour tracing (Figures 3-4): step(position, force) -> (command, state)."""
+    def __reduce__(self) -> NoReturn:
+        """``TypeError``: the per-tick state does not pickle; send the constructor's arguments."""
+    def __copy__(self) -> Self:
+        """An exact copy, state included."""
+    def __deepcopy__(self, memo: Any, /) -> Self:
+        """An exact copy, state included."""
     def __new__(
         cls,
         stiffness: _ArrayLike,
