@@ -5,12 +5,9 @@
 
 use std::sync::OnceLock;
 
-use deflect_core::TickError;
-use deflect_core::motion::{
-    AxisLimits, DEFAULT_RATE_HZ, Limits, SampledTrajectory, State, Trajectory as CoreTraj,
-};
+use deflect_core::motion::{DEFAULT_RATE_HZ, Limits, SampledTrajectory};
 use nalgebra::SVector;
-use numpy::ndarray::{Array1, Array2, ArrayView2};
+use numpy::ndarray::{Array2, ArrayView2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -25,35 +22,10 @@ use crate::convert::{
 /// Most coordinates of a planned or sampled motion (joint vectors of up to 8 joints).
 pub const MAX_DIM: usize = 8;
 
-/// A plan in `N` coordinates, `N` known at run time.
-#[derive(Debug, Clone)]
-#[allow(clippy::large_enum_variant)] // reason: one plan per Python object, never in arrays
-pub(crate) enum Plan {
-    D1(CoreTraj<1>),
-    D2(CoreTraj<2>),
-    D3(CoreTraj<3>),
-    D4(CoreTraj<4>),
-    D5(CoreTraj<5>),
-    D6(CoreTraj<6>),
-    D7(CoreTraj<7>),
-    D8(CoreTraj<8>),
-}
+mod plan;
 
-/// Runs `$body` with `$t` bound to the plan of whatever dimension `$plan` holds.
-macro_rules! with_plan {
-    ($plan:expr, $t:ident => $body:expr) => {
-        match $plan {
-            Plan::D1($t) => $body,
-            Plan::D2($t) => $body,
-            Plan::D3($t) => $body,
-            Plan::D4($t) => $body,
-            Plan::D5($t) => $body,
-            Plan::D6($t) => $body,
-            Plan::D7($t) => $body,
-            Plan::D8($t) => $body,
-        }
-    };
-}
+pub(crate) use plan::{LimitSpec, Plan, Samples};
+use plan::{limit_spec, plan_dyn};
 
 /// Calls `$f::<N>($($arg),*)` for the run-time dimension `$d` (1..=8); `$else` for any
 /// other dimension.
@@ -71,184 +43,6 @@ macro_rules! dispatch_dim {
             _ => $else,
         }
     };
-}
-
-/// Every tick of a trajectory, one row each.
-#[derive(Debug, Clone)]
-pub(crate) struct Samples {
-    pub(crate) t: Array1<f64>,
-    pub(crate) position: Array2<f64>,
-    pub(crate) velocity: Array2<f64>,
-    pub(crate) acceleration: Array2<f64>,
-    pub(crate) jerk: Array2<f64>,
-}
-
-impl Samples {
-    fn zeros(n: usize, d: usize) -> Self {
-        Self {
-            t: Array1::zeros(n),
-            position: Array2::zeros((n, d)),
-            velocity: Array2::zeros((n, d)),
-            acceleration: Array2::zeros((n, d)),
-            jerk: Array2::zeros((n, d)),
-        }
-    }
-
-    fn set<const N: usize>(&mut self, i: usize, s: &State<N>) {
-        if let Some(t) = self.t.get_mut(i) {
-            *t = s.t;
-        }
-        for (arr, v) in [
-            (&mut self.position, &s.position),
-            (&mut self.velocity, &s.velocity),
-            (&mut self.acceleration, &s.acceleration),
-            (&mut self.jerk, &s.jerk),
-        ] {
-            arr.row_mut(i)
-                .iter_mut()
-                .zip(v.iter())
-                .for_each(|(d, x)| *d = *x);
-        }
-    }
-}
-
-/// Every tick of `traj` at `rate_hz`. The count comes first from deflect-core's
-/// [`CoreTraj::sample_count`], which refuses more than `deflect_core::motion::MAX_SAMPLES`
-/// ticks before anything is allocated.
-fn sample_plan<const N: usize>(traj: &CoreTraj<N>, rate_hz: f64) -> Result<Samples, TickError> {
-    let n = traj.sample_count(rate_hz)?;
-    let mut out = Samples::zeros(n, N);
-    for (i, s) in traj.ticks(rate_hz)?.enumerate().take(n) {
-        out.set(i, &s);
-    }
-    Ok(out)
-}
-
-/// The states of `traj` at `times`.
-fn eval_plan<const N: usize>(traj: &CoreTraj<N>, times: &[f64]) -> Result<Samples, TickError> {
-    let mut out = Samples::zeros(times.len(), N);
-    for (i, &t) in times.iter().enumerate() {
-        out.set(i, &traj.sample(t)?);
-    }
-    Ok(out)
-}
-
-impl Plan {
-    fn dim(&self) -> usize {
-        with_plan!(self, p => p.start().len())
-    }
-    fn duration(&self) -> f64 {
-        with_plan!(self, p => p.duration())
-    }
-    fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
-        with_plan!(self, p => p.sample_count(rate_hz))
-    }
-    fn sample(&self, rate_hz: f64) -> Result<Samples, TickError> {
-        with_plan!(self, p => sample_plan(p, rate_hz))
-    }
-    fn eval(&self, times: &[f64]) -> Result<Samples, TickError> {
-        with_plan!(self, p => eval_plan(p, times))
-    }
-}
-
-/// How a plan is limited: on the path (Euclidean norms), per coordinate, or per segment.
-#[derive(Debug, Clone)]
-pub(crate) enum LimitSpec {
-    Path(Limits),
-    Axis([Vec<f64>; 3]),
-    Segments(Vec<Limits>),
-}
-
-fn plan_points<const N: usize>(
-    points: &ArrayView2<'_, f64>,
-    spec: &LimitSpec,
-) -> PyResult<CoreTraj<N>> {
-    let pts: Vec<SVector<f64, N>> = points
-        .rows()
-        .into_iter()
-        .map(|r| SVector::<f64, N>::from_iterator(r.iter().copied()))
-        .collect();
-    match spec {
-        LimitSpec::Path(l) => CoreTraj::polyline(&pts, l),
-        LimitSpec::Segments(l) => CoreTraj::polyline_with_limits(&pts, l),
-        LimitSpec::Axis([v, a, j]) => CoreTraj::polyline_axis_limits(
-            &pts,
-            &AxisLimits {
-                v_max: SVector::from_column_slice(v),
-                a_max: SVector::from_column_slice(a),
-                j_max: SVector::from_column_slice(j),
-            },
-        ),
-    }
-    .map_err(build_err)
-}
-
-fn plan_dyn(points: ArrayView2<'_, f64>, spec: &LimitSpec) -> PyResult<Plan> {
-    let p = &points;
-    Ok(match points.ncols() {
-        1 => Plan::D1(plan_points::<1>(p, spec)?),
-        2 => Plan::D2(plan_points::<2>(p, spec)?),
-        3 => Plan::D3(plan_points::<3>(p, spec)?),
-        4 => Plan::D4(plan_points::<4>(p, spec)?),
-        5 => Plan::D5(plan_points::<5>(p, spec)?),
-        6 => Plan::D6(plan_points::<6>(p, spec)?),
-        7 => Plan::D7(plan_points::<7>(p, spec)?),
-        8 => Plan::D8(plan_points::<8>(p, spec)?),
-        _ => {
-            return Err(shape_error(
-                "points",
-                &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
-                points.shape(),
-            ));
-        }
-    })
-}
-
-/// One of `v_max`, `a_max`, `j_max`: a real number, or one per coordinate (`d` of them).
-enum LimitArg {
-    Scalar(f64),
-    Axis(Vec<f64>),
-}
-
-fn limit_arg(o: &Bound<'_, PyAny>, what: &str, d: usize) -> PyResult<LimitArg> {
-    let a = float_array(o, what)?;
-    match a.ndim() {
-        0 => Ok(LimitArg::Scalar(real(o, what)?)),
-        1 => Ok(LimitArg::Axis(vector(o, what, d)?)),
-        _ => Err(shape_error(
-            what,
-            &format!("a real number or ({d},)"),
-            a.shape(),
-        )),
-    }
-}
-
-/// The limits from the `v_max`, `a_max`, `j_max` arguments: path limits if all three are
-/// numbers, per-coordinate limits (numbers broadcast) if any is an array.
-fn limit_spec(
-    v_max: &Bound<'_, PyAny>,
-    a_max: &Bound<'_, PyAny>,
-    j_max: &Bound<'_, PyAny>,
-    d: usize,
-) -> PyResult<LimitSpec> {
-    let args = [
-        limit_arg(v_max, "v_max", d)?,
-        limit_arg(a_max, "a_max", d)?,
-        limit_arg(j_max, "j_max", d)?,
-    ];
-    if let [
-        LimitArg::Scalar(v),
-        LimitArg::Scalar(a),
-        LimitArg::Scalar(j),
-    ] = args
-    {
-        return Ok(LimitSpec::Path(Limits::new(v, a, j).map_err(build_err)?));
-    }
-    let [v, a, j] = args.map(|x| match x {
-        LimitArg::Scalar(s) => vec![s; d],
-        LimitArg::Axis(v) => v,
-    });
-    Ok(LimitSpec::Axis([v, a, j]))
 }
 
 /// A planned or sampled motion in 1..=8 coordinates, SI units.
