@@ -171,6 +171,8 @@ pub const CYCLE_MS: Range = Range::closed("--cycle-ms", 0.5, 20.0, "ms");
 pub const LEAD_MS: Range = Range::closed("--lead-ms", 0.0, 500.0, "ms");
 /// `milling --estimate-error`.
 pub const ESTIMATE_ERROR: Range = Range::closed("--estimate-error", -1.0, 1.0, "");
+/// `milling --id-poses`: poses of the stiffness identification.
+pub const ID_POSES: Range = Range::closed("--id-poses", 1.0, 3.0, "");
 /// `contour --step-mm` \[mm\].
 pub const STEP_MM: Range = Range::closed("--step-mm", 0.2, 20.0, "mm");
 /// `contour --target-force` \[N\]: strictly between the tracer's contact and jam forces.
@@ -219,7 +221,8 @@ pub enum Command {
     /// The whole pipeline: static tests, fit, all motions at 1-5 g for OC/NC x GU/GL, with and
     /// without correction; tables, CSV/JSON, MCAP and plots.
     Reproduce(ReproduceArgs),
-    /// Simulated static tests (15 nodes x 2 axes x 49..245 N), written as CSV (mm, N).
+    /// Simulated static tests (15 nodes x 2 axes x 49..245 N), written as CSV (columns
+    /// x_mm, y_mm, force_axis, force_N, dx_mm, dy_mm).
     StaticTest {
         /// Mechanism.
         #[arg(long, value_enum, default_value_t = Mech::Oc)]
@@ -231,8 +234,9 @@ pub enum Command {
         /// Mechanism (for fresh static tests and the held-out tests).
         #[arg(long, value_enum, default_value_t = Mech::Oc)]
         mechanism: Mech,
-        /// Static-test CSV written by `static-test` (columns x, y \[mm\], force_axis, force \[N\],
-        /// dx, dy \[mm\]); a regular file of at most 16 MiB.
+        /// Static-test CSV written by `static-test` (columns x_mm, y_mm, force_axis, force_N,
+        /// dx_mm, dy_mm; the older header x, y, force_axis, force, dx, dy is read in mm and N);
+        /// a regular file of at most 16 MiB.
         #[arg(long)]
         input: Option<PathBuf>,
     },
@@ -412,6 +416,11 @@ pub struct MillingArgs {
     /// Seed of the sensor and measurement noise.
     #[arg(long, default_value_t = 6)]
     pub seed: u64,
+    #[arg(long, default_value_t = 3, help = ID_POSES.help(
+        "Poses of the stiffness identification's static tests (each about 3.4 s simulated)",
+        "Fewer poses: a faster run, fewer identifiable axes"
+    ))]
+    pub id_poses: usize,
 }
 
 // Arguments of `reproduce` (help texts with their ranges in the `help` attributes).
@@ -582,7 +591,8 @@ impl MillingArgs {
             )));
         }
         LEAD_MS.check(self.lead_ms)?;
-        ESTIMATE_ERROR.check(self.estimate_error)
+        ESTIMATE_ERROR.check(self.estimate_error)?;
+        ID_POSES.check_int(count(self.id_poses))
     }
 }
 

@@ -26,10 +26,12 @@
 pub mod analysis;
 pub mod contour_scene;
 pub mod jobs;
+pub mod mcap_log;
 pub mod milling;
 pub mod noise;
 pub mod output;
 pub mod pipeline;
+pub mod plot_style;
 pub mod rapier_util;
 pub mod report;
 pub mod robot;

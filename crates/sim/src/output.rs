@@ -1,187 +1,30 @@
-//! Outputs: summary table (text, CSV, JSON), MCAP log (JSON messages with JSON schemas, for
-//! Foxglove and the Python `mcap` reader) and PNG plots.
+//! Outputs of `reproduce` and `run`: summary table (text, CSV, JSON), MCAP log (the
+//! convention of [`crate::mcap_log`]) and PNG plots (the style of [`crate::plot_style`]).
 
-use std::collections::BTreeMap;
 use std::fmt::Write as _;
-use std::fs::File;
-use std::io::BufWriter;
-use std::ops::Range;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use mcap::records::MessageHeader;
-use plotters::coord::Shift;
-use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use serde_json::json;
 
-use crate::pipeline::{Motion, RunResult, Sample};
+use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, poses_in_frame, scene_update};
+use crate::pipeline::{Motion, RunResult};
+use crate::plot_style::{
+    CHART, Entry, Role, Swatch, canvas, color, config_role, config_words, draw_legend, figure,
+    line, new_chart, padded_range, perr, present,
+};
 use crate::{SimError, write_file};
 
-/// Topics written for each run (prefixed by the run's name in multi-run logs).
-pub const TOPICS: [&str; 5] = [
+/// Topics written for each run, as `/<scenario>/<run>/<topic>` (`crates/sim/README.md`).
+pub const TOPICS: [&str; 7] = [
     "desired",
     "commanded",
     "actual",
     "dalembert_force",
     "joints",
+    "tcp_pose",
+    "paths",
 ];
-
-fn point_schema(title: &str, unit: &str, z: bool) -> serde_json::Value {
-    let mut props = json!({
-        "timestamp": stamp_schema(),
-        "run": {"type": "string"},
-        "x": {"type": "number", "description": unit},
-        "y": {"type": "number", "description": unit},
-    });
-    if z {
-        props["z"] = json!({"type": "number", "description": unit});
-    }
-    json!({"title": title, "type": "object", "properties": props})
-}
-
-fn schemas() -> [(String, serde_json::Value); 5] {
-    [
-        (
-            "deflect.DesiredPoint".into(),
-            point_schema("desired tool point", "m", false),
-        ),
-        (
-            "deflect.CommandedPoint".into(),
-            point_schema("commanded tool point", "m", false),
-        ),
-        (
-            "deflect.ActualPoint".into(),
-            point_schema("actual tool point", "m", true),
-        ),
-        (
-            "deflect.DalembertForce".into(),
-            point_schema("D'Alembert force -m* a", "N", false),
-        ),
-        (
-            "deflect.Joints".into(),
-            json!({"title": "joint angles", "type": "object", "properties": {
-                "timestamp": stamp_schema(),
-                "run": {"type": "string"},
-                "command": {"type": "array", "items": {"type": "number"}, "description": "rad"},
-                "motor": {"type": "array", "items": {"type": "number"}, "description": "rad"},
-                "link": {"type": "array", "items": {"type": "number"}, "description": "rad"}
-            }}),
-        ),
-    ]
-}
-
-/// Log time `t` \[s\] in nanoseconds.
-fn nanos(t: f64) -> u64 {
-    (t * 1e9).round() as u64
-}
-
-/// A message timestamp `{"sec", "nsec"}` for time `t` \[s\].
-pub(crate) fn stamp(t: f64) -> serde_json::Value {
-    let ns = nanos(t);
-    json!({"sec": ns / 1_000_000_000, "nsec": ns % 1_000_000_000})
-}
-
-/// The JSON schema of a [`stamp`].
-pub(crate) fn stamp_schema() -> serde_json::Value {
-    json!({"type": "object", "properties": {"sec": {"type": "integer"}, "nsec": {"type": "integer"}}})
-}
-
-/// An MCAP file of JSON messages with JSON schemas (zstd chunks), shared by the scenarios.
-pub(crate) struct McapLog {
-    w: mcap::Writer<BufWriter<File>>,
-    count: usize,
-    path: PathBuf,
-}
-
-impl McapLog {
-    /// Creates the file at `path`.
-    pub(crate) fn create(path: &Path) -> Result<Self, SimError> {
-        let err = |e: &dyn std::fmt::Display| SimError::file(path, "create the MCAP log", e);
-        let file = File::create(path).map_err(|e| err(&e))?;
-        Ok(Self {
-            w: mcap::Writer::new(BufWriter::new(file)).map_err(|e| err(&e))?,
-            count: 0,
-            path: path.to_path_buf(),
-        })
-    }
-
-    /// An MCAP error naming the file.
-    fn err(&self, e: mcap::McapError) -> SimError {
-        SimError::file(&self.path, "write the MCAP log", e)
-    }
-
-    /// Adds a JSON schema named `name`; returns its id.
-    pub(crate) fn add_schema(
-        &mut self,
-        name: &str,
-        schema: &serde_json::Value,
-    ) -> Result<u16, SimError> {
-        self.w
-            .add_schema(
-                name,
-                "jsonschema",
-                serde_json::to_string(schema)?.as_bytes(),
-            )
-            .map_err(|e| self.err(e))
-    }
-
-    /// Adds a JSON channel on `topic` with one metadata entry `key: value`; returns its id.
-    pub(crate) fn add_channel(
-        &mut self,
-        schema: u16,
-        topic: &str,
-        key: &str,
-        value: &str,
-    ) -> Result<u16, SimError> {
-        let mut meta = BTreeMap::new();
-        meta.insert(key.to_string(), value.to_string());
-        self.w
-            .add_channel(schema, topic, "json", &meta)
-            .map_err(|e| self.err(e))
-    }
-
-    /// Writes `msg` on `channel` with sequence number `seq`, logged and published at `t` \[s\].
-    pub(crate) fn write(
-        &mut self,
-        channel: u16,
-        seq: u32,
-        t: f64,
-        msg: &serde_json::Value,
-    ) -> Result<(), SimError> {
-        let ns = nanos(t);
-        let header = MessageHeader {
-            channel_id: channel,
-            sequence: seq,
-            log_time: ns,
-            publish_time: ns,
-        };
-        let data = serde_json::to_string(msg)?;
-        if let Err(e) = self.w.write_to_known_channel(&header, data.as_bytes()) {
-            return Err(self.err(e));
-        }
-        self.count += 1;
-        Ok(())
-    }
-
-    /// Finishes the file; returns the number of messages written.
-    pub(crate) fn finish(mut self) -> Result<usize, SimError> {
-        if let Err(e) = self.w.finish() {
-            return Err(self.err(e));
-        }
-        Ok(self.count)
-    }
-}
-
-fn messages(run: &str, s: &Sample, t: f64) -> [serde_json::Value; 5] {
-    let ts = stamp(t);
-    [
-        json!({"timestamp": ts, "run": run, "x": s.desired[0], "y": s.desired[1]}),
-        json!({"timestamp": ts, "run": run, "x": s.commanded[0], "y": s.commanded[1]}),
-        json!({"timestamp": ts, "run": run, "x": s.actual[0], "y": s.actual[1], "z": s.actual[2]}),
-        json!({"timestamp": ts, "run": run, "x": s.force[0], "y": s.force[1]}),
-        json!({"timestamp": ts, "run": run, "command": s.q_cmd, "motor": s.q_motor, "link": s.q_link}),
-    ]
-}
 
 /// A run's name for topics and files: "oc_gu_y-line_5g_corr".
 pub fn run_name(r: &RunResult) -> String {
@@ -194,40 +37,98 @@ pub fn run_name(r: &RunResult) -> String {
     )
 }
 
-/// Writes `runs` into one MCAP file (zstd chunks). With `prefix_topics`, each run gets its own
-/// topics `/<run>/<topic>`; otherwise the topics are `/<topic>` (single-run logs). Runs follow
-/// each other in log time.
-pub fn write_mcap(
-    path: &Path,
-    runs: &[&RunResult],
-    prefix_topics: bool,
-) -> Result<usize, SimError> {
-    let mut log = McapLog::create(path)?;
-    let mut schema_ids = Vec::new();
-    for (name, s) in schemas() {
-        schema_ids.push(log.add_schema(&name, &s)?);
+/// A motion in words with its size: "y-line (150 mm along y)".
+pub fn motion_words(m: Motion) -> &'static str {
+    match m {
+        Motion::XLine => "x-line (100 mm along x at y = 0)",
+        Motion::YLine => "y-line (150 mm along y at x = 222.132 mm)",
+        Motion::Triangle => "triangle (legs of 63.6 mm, baseline along y at x = 197.132 mm)",
     }
-    let mut offset = 0.0;
+}
+
+/// What a run was, for its `deflect.run` metadata record.
+fn run_info(scenario: &str, r: &RunResult) -> RunInfo {
+    RunInfo {
+        scenario: scenario.to_string(),
+        run: run_name(r),
+        robot: format!(
+            "2-DoF planar parallel robot of Paksoy, Dede and Kiper (2025) in rapier: {}",
+            config_words(&r.config)
+        ),
+        motion: motion_words(r.motion).to_string(),
+        acceleration: format!(
+            "{} g peak ({:.2} m/s^2), the paper's durations",
+            r.g,
+            f64::from(r.g) * deflect_core::units::STANDARD_GRAVITY
+        ),
+        correction: if r.corrected {
+            format!(
+                "D'Alembert correction (m* = {} kg, compliance map fitted from the simulated static tests)",
+                r.mass
+            )
+        } else {
+            "none".to_string()
+        },
+        options: json!({"config": r.config, "motion": r.motion.label(), "g": r.g,
+                        "corrected": r.corrected, "mass_kg": r.mass}),
+    }
+}
+
+/// Writes `runs` of `scenario` ("reproduce", "run") into one MCAP file following the
+/// convention of [`crate::mcap_log`]: topics `/<scenario>/<run>/<topic>` ([`TOPICS`]), every
+/// run from t = 0, a `deflect.run` metadata record per run. Planar points carry the tool
+/// point's height at rest as `z`. Returns the number of messages.
+pub fn write_mcap(path: &Path, scenario: &str, runs: &[&RunResult]) -> Result<usize, SimError> {
+    let mut log = McapLog::create(path)?;
     for r in runs {
-        let name = run_name(r);
-        let mut channels = Vec::new();
-        for (topic, schema) in TOPICS.iter().zip(&schema_ids) {
-            let full = if prefix_topics {
-                format!("/{name}/{topic}")
-            } else {
-                format!("/{topic}")
-            };
-            channels.push(log.add_channel(*schema, &full, "run", &name)?);
+        let info = run_info(scenario, r);
+        log.run_metadata(&info)?;
+        let prefix = info.prefix();
+        let name = info.run.as_str();
+        let kinds = [
+            Kind::Point,
+            Kind::Point,
+            Kind::Point,
+            Kind::Force,
+            Kind::JointState,
+            Kind::PosesInFrame,
+            Kind::SceneUpdate,
+        ];
+        let mut ch = [0u16; 7];
+        for ((c, topic), kind) in ch.iter_mut().zip(TOPICS).zip(kinds) {
+            *c = log.channel(&prefix, topic, kind)?;
         }
-        let mut last = 0.0;
-        for (seq, s) in (0u32..).zip(&r.samples) {
-            let t = offset + s.t;
-            for (ch, msg) in channels.iter().zip(messages(&name, s, t)) {
-                log.write(*ch, seq, t, &msg)?;
+        let z0 = r.samples.first().map_or(0.0, |s| s.actual[2]);
+        let plane = |p: &[f64; 2]| [p[0], p[1], z0];
+        let lines = [
+            Line {
+                id: format!("{name}/desired"),
+                points: r.samples.iter().map(|s| plane(&s.desired)).collect(),
+                rgb: color(Role::Desired).rgb(),
+                closed: false,
+            },
+            Line {
+                id: format!("{name}/actual"),
+                points: r.samples.iter().map(|s| s.actual).collect(),
+                rgb: color(config_role(&r.config)).rgb(),
+                closed: false,
+            },
+        ];
+        log.write(ch[6], 0.0, &scene_update(0.0, &lines))?;
+        for s in &r.samples {
+            let t = s.t;
+            let msgs = [
+                mcap_log::point(name, t, plane(&s.desired)),
+                mcap_log::point(name, t, plane(&s.commanded)),
+                mcap_log::point(name, t, s.actual),
+                mcap_log::force(name, t, [s.force[0], s.force[1], 0.0]),
+                mcap_log::joints(name, t, &s.q_cmd, &s.q_motor, &s.q_link),
+                poses_in_frame(t, s.actual, IDENTITY),
+            ];
+            for (c, m) in ch.iter().zip(&msgs) {
+                log.write(*c, t, m)?;
             }
-            last = s.t;
         }
-        offset += last + 0.1;
     }
     log.finish()
 }
@@ -235,7 +136,7 @@ pub fn write_mcap(
 /// CSV of all runs' metrics.
 pub fn summary_csv(runs: &[RunResult]) -> String {
     let mut s = String::from(
-        "config,motion,g,corrected,mass_kg,length_dev_mm,area_mm2,max_dev_mm,rms_dev_mm,max_track_mm,rms_track_mm\n",
+        "config,motion,peak_acceleration_g,corrected,mass_kg,length_dev_mm,area_mm2,max_dev_mm,rms_dev_mm,max_track_mm,rms_track_mm\n",
     );
     for r in runs {
         let m = &r.metrics;
@@ -258,123 +159,6 @@ pub fn summary_csv(runs: &[RunResult]) -> String {
     s
 }
 
-const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-
-/// Registers the embedded font for plotters (once).
-pub(crate) fn register_font() {
-    use std::sync::Once;
-    static ONCE: Once = Once::new();
-    ONCE.call_once(|| {
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, FONT);
-    });
-}
-
-/// A plotting error as a [`SimError`].
-pub(crate) fn perr<E: std::fmt::Display>(e: E) -> SimError {
-    SimError::new(format!("plot: {e}"))
-}
-
-/// A PNG canvas of `size` pixels at `path`, filled white (font registered).
-pub(crate) fn canvas(
-    path: &Path,
-    size: (u32, u32),
-) -> Result<DrawingArea<BitMapBackend<'_>, Shift>, SimError> {
-    register_font();
-    let root = BitMapBackend::new(path, size).into_drawing_area();
-    root.fill(&WHITE).map_err(perr)?;
-    Ok(root)
-}
-
-/// Writes the PNG of `root` to `path` (the file it was created on); the error names the file.
-pub(crate) fn present(
-    root: &DrawingArea<BitMapBackend<'_>, Shift>,
-    path: &Path,
-) -> Result<(), SimError> {
-    root.present()
-        .map_err(|e| SimError::file(path, "write the PNG plot", e))
-}
-
-/// A 2-D chart of `f64` axes as the scenarios draw them.
-pub(crate) type Chart<'a, 'b> =
-    ChartContext<'a, BitMapBackend<'b>, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
-
-/// Font sizes and label areas of a chart.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct ChartStyle {
-    /// Caption font size.
-    pub caption: u32,
-    /// X and y label area sizes.
-    pub label_areas: (u32, u32),
-    /// Axis label font size.
-    pub labels: u32,
-}
-
-/// The usual style: caption 22, label areas 45 x 70, labels 15.
-pub(crate) const CHART: ChartStyle = ChartStyle {
-    caption: 22,
-    label_areas: (45, 70),
-    labels: 15,
-};
-
-/// A chart on `area` with a caption, axis ranges `x`, `y` and axis descriptions `desc`
-/// (mesh drawn).
-pub(crate) fn new_chart<'a, 'b>(
-    area: &'a DrawingArea<BitMapBackend<'b>, Shift>,
-    style: ChartStyle,
-    caption: &str,
-    x: Range<f64>,
-    y: Range<f64>,
-    desc: (&str, &str),
-) -> Result<Chart<'a, 'b>, SimError> {
-    let mut chart = ChartBuilder::on(area)
-        .caption(caption, ("sans-serif", style.caption))
-        .margin(12)
-        .x_label_area_size(style.label_areas.0)
-        .y_label_area_size(style.label_areas.1)
-        .build_cartesian_2d(x, y)
-        .map_err(perr)?;
-    chart
-        .configure_mesh()
-        .x_desc(desc.0)
-        .y_desc(desc.1)
-        .label_style(("sans-serif", style.labels))
-        .draw()
-        .map_err(perr)?;
-    Ok(chart)
-}
-
-/// Draws a line of `width` in color `c` with a legend entry `label`.
-pub(crate) fn labelled_line(
-    chart: &mut Chart<'_, '_>,
-    pts: impl IntoIterator<Item = (f64, f64)>,
-    c: RGBColor,
-    width: u32,
-    label: impl Into<String>,
-) -> Result<(), SimError> {
-    chart
-        .draw_series(LineSeries::new(pts, c.stroke_width(width)))
-        .map_err(perr)?
-        .label(label)
-        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width)));
-    Ok(())
-}
-
-/// Draws the legend box (upper right, white at `opacity`, font size `font`).
-pub(crate) fn legend<'a, 'b: 'a>(
-    chart: &mut Chart<'a, 'b>,
-    opacity: f64,
-    font: u32,
-) -> Result<(), SimError> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .background_style(WHITE.mix(opacity))
-        .border_style(BLACK)
-        .label_font(("sans-serif", font))
-        .draw()
-        .map_err(perr)
-}
-
 /// Writes `<stem>.txt`, `<stem>.csv` and `<stem>.json` (pretty JSON of `json`) into `out`.
 pub fn write_summary<T: serde::Serialize + ?Sized>(
     out: &Path,
@@ -393,91 +177,167 @@ pub fn write_summary<T: serde::Serialize + ?Sized>(
     Ok(())
 }
 
-/// Path plot of runs of one motion: deviation across the path (mm, magnified) against the
-/// position along it, one curve per run.
-pub fn plot_paths(path: &Path, title: &str, runs: &[&RunResult]) -> Result<(), SimError> {
-    let root = canvas(path, (1000, 620))?;
+/// Signed distance \[m\] of `p` from the polyline `pts`: to the nearest segment, positive to
+/// the left of its direction.
+pub fn polyline_distance(pts: &[nalgebra::Vector2<f64>], p: &nalgebra::Vector2<f64>) -> f64 {
+    let mut best = (f64::INFINITY, 0.0);
+    for w in pts.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let d = b - a;
+        let len2 = d.norm_squared().max(f64::MIN_POSITIVE);
+        let u = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
+        let dist = (p - (a + d * u)).norm();
+        if dist < best.0 {
+            let side = (d.x * (p.y - a.y) - d.y * (p.x - a.x)).signum();
+            best = (dist, side * dist);
+        }
+    }
+    best.1
+}
+
+/// The legend entry and line style of a parallel-robot run: the configuration's colour,
+/// dashed thin uncorrected, solid thick corrected.
+fn run_style(r: &RunResult, with_g: bool) -> (Entry, u32, bool) {
+    let g = if with_g {
+        format!(" {} g", r.g)
+    } else {
+        String::new()
+    };
+    let label = format!(
+        "{}{g}, {}",
+        config_words(&r.config),
+        if r.corrected {
+            "corrected"
+        } else {
+            "uncorrected"
+        }
+    );
+    let swatch = if r.corrected {
+        Swatch::Line(3)
+    } else {
+        Swatch::Dashed(2)
+    };
+    let width = if r.corrected { 3 } else { 2 };
+    (
+        Entry::new(label, config_role(&r.config), swatch),
+        width,
+        !r.corrected,
+    )
+}
+
+/// Whether the runs are uncorrected, corrected or both, in words.
+fn correction_words<'a>(runs: impl IntoIterator<Item = &'a RunResult>) -> &'static str {
+    let (mut off, mut on) = (false, false);
+    for r in runs {
+        off |= !r.corrected;
+        on |= r.corrected;
+    }
+    match (off, on) {
+        (true, true) => "with and without correction",
+        (false, true) => "with correction",
+        _ => "without correction",
+    }
+}
+
+/// The title of a path plot: robot (when one), motion, acceleration and correction in words,
+/// e.g. "NC robot, lower head: triangle at 5 g, with and without correction".
+pub fn paths_title(runs: &[&RunResult]) -> String {
+    let Some(first) = runs.first() else {
+        return String::new();
+    };
+    let one_config = runs.iter().all(|r| r.config == first.config);
+    let robot = if one_config {
+        config_words(&first.config)
+    } else {
+        "OC and NC robots, upper and lower heads".to_string()
+    };
+    format!(
+        "{robot}: {} at {} g, {}; deviation across the path",
+        first.motion.label(),
+        first.g,
+        correction_words(runs.iter().copied())
+    )
+}
+
+/// Path plot of runs of one motion: the tool point's signed distance from the desired path
+/// (all legs) against time over the whole run, one curve per run; grey lines where a new
+/// leg is commanded.
+pub fn plot_paths(path: &Path, runs: &[&RunResult]) -> Result<(), SimError> {
+    let root = canvas(path, (1200, 620))?;
     let Some(first) = runs.first() else {
         return Ok(());
     };
     let pts = first.motion.points();
-    let (a, b) = (pts[0], pts[1]);
-    let dir = (b - a).normalize();
-    let along_across = |s: &Sample| {
-        let r = nalgebra::Vector2::new(s.actual[0], s.actual[1]) - a;
-        (r.dot(&dir) * 1e3, (-r.x * dir.y + r.y * dir.x) * 1e3)
-    };
-    let seg0 = |s: &&Sample| s.segment == 0;
-    let mut vmax: f64 = 0.05;
-    let mut umin: f64 = 0.0;
-    let mut umax: f64 = (b - a).norm() * 1e3;
-    for r in runs {
-        for s in r.samples.iter().filter(seg0) {
-            let (u, v) = along_across(s);
-            vmax = vmax.max(v.abs());
-            umin = umin.min(u);
-            umax = umax.max(u);
-        }
-    }
+    let series: Vec<Vec<(f64, f64)>> = runs
+        .iter()
+        .map(|r| {
+            r.samples
+                .iter()
+                .map(|s| {
+                    let p = nalgebra::Vector2::new(s.actual[0], s.actual[1]);
+                    (s.t, polyline_distance(&pts, &p) * 1e3)
+                })
+                .collect()
+        })
+        .collect();
+    let styles: Vec<(Entry, u32, bool)> = runs.iter().map(|r| run_style(r, false)).collect();
+    let mut entries: Vec<Entry> = styles.iter().map(|s| s.0.clone()).collect();
+    entries.push(Entry::new(
+        "new leg commanded",
+        Role::Guide,
+        Swatch::Line(1),
+    ));
+    let (plot, legend) = figure(&root, &paths_title(runs), CHART.caption, &entries)?;
+    let x = padded_range(series.iter().flatten().map(|p| p.0), 0.01, 0.01);
+    let y = padded_range(
+        series.iter().flatten().map(|p| p.1).chain([0.0]),
+        0.06,
+        0.01,
+    );
     let mut chart = new_chart(
-        &root,
+        &plot,
         CHART,
-        title,
-        umin - 2.0..umax + 2.0,
-        -vmax * 1.1..vmax * 1.1,
-        ("along the first segment [mm]", "across [mm]"),
+        x,
+        y.clone(),
+        (
+            "time since the motion start [s]",
+            "distance from the desired path, + left of travel [mm]",
+        ),
     )?;
-    let colors = [RED, BLUE, GREEN, MAGENTA, CYAN, BLACK];
-    let mut configs: Vec<&str> = Vec::new();
-    for r in runs {
-        if !configs.contains(&r.config.as_str()) {
-            configs.push(&r.config);
-        }
+    let legs: Vec<f64> = first
+        .samples
+        .windows(2)
+        .filter(|w| w[1].segment != w[0].segment)
+        .map(|w| w[1].t)
+        .collect();
+    for t in legs {
+        line(
+            &mut chart,
+            vec![(t, y.start), (t, y.end)],
+            color(Role::Guide),
+            1,
+            false,
+        )?;
     }
-    for r in runs {
-        let k = configs.iter().position(|c| *c == r.config).unwrap_or(0);
-        let c = colors[k % colors.len()];
-        let width = if r.corrected { 3 } else { 1 };
-        let series: Vec<(f64, f64)> = r.samples.iter().filter(seg0).map(along_across).collect();
-        let label = format!(
-            "{} {}g {}",
-            r.config,
-            r.g,
-            if r.corrected {
-                "corrected"
-            } else {
-                "uncorrected"
-            }
-        );
-        labelled_line(&mut chart, series, c, width, label)?;
+    for (s, (e, width, dashed)) in series.into_iter().zip(&styles) {
+        line(&mut chart, s, e.color, *width, *dashed)?;
     }
-    legend(&mut chart, 0.8, 15)?;
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }
 
-/// Max path deviation (or tracking error for the x-line) against acceleration, per
-/// configuration, uncorrected (dashed-looking thin) and corrected (thick).
+/// Max path deviation against acceleration, per configuration (its colour), uncorrected
+/// (dashed) and corrected (solid).
 pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Result<(), SimError> {
-    let root = canvas(path, (1000, 620))?;
+    let root = canvas(path, (1200, 620))?;
     let sel: Vec<&RunResult> = runs.iter().filter(|r| r.motion == motion).collect();
     let metric = |r: &RunResult| r.metrics.max_dev_mm;
-    let ymax = sel.iter().map(|r| metric(r)).fold(0.01, f64::max) * 1.1;
-    let mut chart = new_chart(
-        &root,
-        CHART,
-        &format!("{}: max path deviation vs acceleration", motion.label()),
-        0.8f64..5.2f64,
-        0.0..ymax,
-        ("peak acceleration [g]", "max deviation [mm]"),
-    )?;
     let mut configs: Vec<String> = sel.iter().map(|r| r.config.clone()).collect();
-    configs.dedup();
     configs.sort();
     configs.dedup();
-    let colors = [RED, BLUE, GREEN, MAGENTA];
-    for (k, cfg) in configs.iter().enumerate() {
-        let c = colors[k % colors.len()];
+    let mut curves = Vec::new();
+    for cfg in &configs {
         for corrected in [false, true] {
             let mut pts: Vec<(f64, f64)> = sel
                 .iter()
@@ -485,22 +345,45 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
                 .map(|r| (f64::from(r.g), metric(r)))
                 .collect();
             pts.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let width = if corrected { 3 } else { 1 };
-            let label = format!(
-                "{cfg} {}",
-                if corrected {
-                    "corrected"
-                } else {
-                    "uncorrected"
-                }
-            );
-            labelled_line(&mut chart, pts.clone(), c, width, label)?;
-            chart
-                .draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))
-                .map_err(perr)?;
+            if let Some(r) = sel
+                .iter()
+                .find(|r| &r.config == cfg && r.corrected == corrected)
+            {
+                curves.push((run_style(r, false), pts));
+            }
         }
     }
-    legend(&mut chart, 0.8, 14)?;
+    let entries: Vec<Entry> = curves.iter().map(|c| c.0.0.clone()).collect();
+    let title = format!(
+        "{}: max path deviation against peak acceleration, OC and NC robots, {}",
+        motion_words(motion),
+        correction_words(sel.iter().copied())
+    );
+    let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
+    let x = padded_range(
+        curves.iter().flat_map(|c| c.1.iter().map(|p| p.0)),
+        0.06,
+        1.0,
+    );
+    let ymax = curves
+        .iter()
+        .flat_map(|c| c.1.iter().map(|p| p.1))
+        .fold(0.01, f64::max);
+    let mut chart = new_chart(
+        &plot,
+        CHART,
+        x,
+        0.0..ymax * 1.08,
+        ("peak acceleration [g]", "max path deviation [mm]"),
+    )?;
+    for ((e, width, dashed), pts) in &curves {
+        line(&mut chart, pts.clone(), e.color, *width, *dashed)?;
+        let c = e.color;
+        chart
+            .draw_series(pts.iter().map(|p| Circle::new(*p, 4, c.filled())))
+            .map_err(perr)?;
+    }
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }

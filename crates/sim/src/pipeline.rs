@@ -157,18 +157,23 @@ pub fn map_options() -> QueryOptions {
     }
 }
 
-/// Prediction errors of a map on held-out data.
+/// Prediction errors of a map on held-out data (JSON keys with their unit: `loo_rms_y_m`, ...).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct HeldOut {
     /// Leave-one-grid-line-out RMS error (deflect-core), along y, bilinear \[m\].
+    #[serde(rename = "loo_rms_y_m")]
     pub loo_rms_y: f64,
     /// Same along x \[m\].
+    #[serde(rename = "loo_rms_x_m")]
     pub loo_rms_x: f64,
     /// Static tests at the 8 cell centres (245 N along x and y): RMS error of the map \[m\].
+    #[serde(rename = "centre_rms_m")]
     pub centre_rms: f64,
     /// Worst error at the cell centres \[m\].
+    #[serde(rename = "centre_max_m")]
     pub centre_max: f64,
     /// RMS displacement there (for scale) \[m\].
+    #[serde(rename = "centre_rms_displacement_m")]
     pub centre_rms_displacement: f64,
 }
 

@@ -17,7 +17,16 @@ fn ranged() -> [(&'static str, Vec<Range>); 5] {
         ("run", vec![G_LEVEL, MASS]),
         (
             "milling",
-            vec![FEED, FORCE, CUT, RISE_MS, CYCLE_MS, LEAD_MS, ESTIMATE_ERROR],
+            vec![
+                FEED,
+                FORCE,
+                CUT,
+                RISE_MS,
+                CYCLE_MS,
+                LEAD_MS,
+                ESTIMATE_ERROR,
+                ID_POSES,
+            ],
         ),
         ("contour", vec![STEP_MM, TARGET_FORCE, NOISE, JOBS]),
         (

@@ -7,13 +7,13 @@ use std::path::Path;
 
 use nalgebra::Vector2;
 use plotters::prelude::*;
-use serde_json::json;
 
-use super::{ContourRun, Sample};
+use super::{ContourRun, Sample, TraceOptions};
 use crate::SimError;
-use crate::output::{
-    ChartStyle, McapLog, canvas, labelled_line, legend, new_chart, present, stamp, stamp_schema,
-    write_summary,
+use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
+use crate::output::write_summary;
+use crate::plot_style::{
+    ChartStyle, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, present,
 };
 use crate::report::reduction;
 
@@ -109,128 +109,187 @@ pub fn summary_csv(runs: &[ContourRun]) -> String {
     s
 }
 
-fn point_schema(title: &str, unit: &str) -> serde_json::Value {
-    json!({"title": title, "type": "object", "properties": {
-        "timestamp": stamp_schema(),
-        "shape": {"type": "string"},
-        "state": {"type": "string"},
-        "x": {"type": "number", "description": unit},
-        "y": {"type": "number", "description": unit},
-    }})
-}
-
-/// Topics per shape, under `/contour/<shape>/`.
-pub const TOPICS: [&str; 6] = [
-    "command",
-    "tool_actual",
-    "recorded_raw",
-    "recorded_compensated",
-    "force",
-    "joints",
+/// Topics per shape, as `/contour/<shape>/<topic>`, and their message types; the recorded
+/// points only at contact samples.
+pub const TOPICS: [(&str, Kind); 11] = [
+    ("command", Kind::Point),
+    ("tool_actual", Kind::Point),
+    ("recorded_raw", Kind::Point),
+    ("recorded_compensated", Kind::Point),
+    ("force", Kind::Force),
+    ("force_sensed", Kind::Force),
+    ("force_true", Kind::Force),
+    ("joints", Kind::JointState),
+    ("state", Kind::TracerState),
+    ("tcp_pose", Kind::PosesInFrame),
+    ("paths", Kind::SceneUpdate),
 ];
 
-fn messages(shape: &str, s: &Sample, t: f64) -> [Option<serde_json::Value>; 6] {
-    let ts = stamp(t);
-    let pt = |p: &[f64; 2]| json!({"timestamp": ts, "shape": shape, "state": s.state, "x": p[0], "y": p[1]});
+/// Planar point or force with z = 0.
+fn p3(p: &[f64; 2]) -> [f64; 3] {
+    [p[0], p[1], 0.0]
+}
+
+fn messages(shape: &str, s: &Sample, t: f64) -> [Option<serde_json::Value>; 10] {
     [
-        Some(pt(&s.command)),
-        Some(pt(&s.tool_actual)),
-        s.raw.as_ref().map(pt),
-        s.compensated.as_ref().map(pt),
-        Some(
-            json!({"timestamp": ts, "shape": shape, "state": s.state, "x": s.force[0], "y": s.force[1],
-            "sensed_x": s.force_sensed[0], "sensed_y": s.force_sensed[1],
-            "true_x": s.force_true[0], "true_y": s.force_true[1]}),
-        ),
-        Some(json!({"timestamp": ts, "shape": shape, "motor": s.q_motor, "link": s.q_link})),
+        Some(mcap_log::point(shape, t, p3(&s.command))),
+        Some(mcap_log::point(shape, t, p3(&s.tool_actual))),
+        s.raw.as_ref().map(|p| mcap_log::point(shape, t, p3(p))),
+        s.compensated
+            .as_ref()
+            .map(|p| mcap_log::point(shape, t, p3(p))),
+        Some(mcap_log::force(shape, t, p3(&s.force))),
+        Some(mcap_log::force(shape, t, p3(&s.force_sensed))),
+        Some(mcap_log::force(shape, t, p3(&s.force_true))),
+        // The motors are ideal position servos: the reading is the command.
+        Some(mcap_log::joints(
+            shape, t, &s.q_motor, &s.q_motor, &s.q_link,
+        )),
+        Some(mcap_log::tracer_state(shape, t, s.state)),
+        Some(mcap_log::poses_in_frame(t, p3(&s.tool_actual), IDENTITY)),
     ]
 }
 
-/// Writes every run into one MCAP file, topics `/contour/<shape>/<topic>`; shapes follow each
-/// other in log time. Returns the number of messages.
-pub fn write_mcap(path: &Path, runs: &[ContourRun]) -> Result<usize, SimError> {
-    let mut log = McapLog::create(path)?;
-    let schemas = [
-        (
-            "deflect.ContourCommand",
-            point_schema("commanded tool point (motor side)", "m"),
+fn run_info(r: &ContourRun, o: &TraceOptions) -> RunInfo {
+    RunInfo {
+        scenario: "contour".into(),
+        run: r.name.clone(),
+        robot: format!(
+            "planar 2R arm in rapier (links {} / {} m), compliant backlashed joints, penalty \
+             contact at the tool point",
+            o.arm.lengths[0], o.arm.lengths[1]
         ),
-        (
-            "deflect.ContourToolActual",
-            point_schema("true tool point (simulation)", "m"),
+        motion: format!(
+            "counter-clockwise force-feedback contour tracing of the {} (perimeter {:.1} mm), \
+             step {:.2} mm, target force {:.1} N",
+            r.name,
+            r.perimeter * 1e3,
+            o.step * 1e3,
+            o.target_force
         ),
-        (
-            "deflect.ContourRecordedRaw",
-            point_schema("recovered contour point, FK of the motor readings", "m"),
+        acceleration: format!(
+            "quasi-static: position steps ramped over {:.0} ms, then {:.0} ms settling",
+            o.ramp * 1e3,
+            o.settle * 1e3
         ),
-        (
-            "deflect.ContourRecordedCompensated",
-            point_schema("recovered contour point, Eq. 10 compensated", "m"),
-        ),
-        (
-            "deflect.ContourForce",
-            json!({"title": "force the tool exerts on the object [N]", "type": "object", "properties": {
-                "timestamp": stamp_schema(), "shape": {"type": "string"}, "state": {"type": "string"},
-                "x": {"type": "number", "description": "bias removed, N"}, "y": {"type": "number", "description": "bias removed, N"},
-                "sensed_x": {"type": "number"}, "sensed_y": {"type": "number"},
-                "true_x": {"type": "number"}, "true_y": {"type": "number"}}}),
-        ),
-        (
-            "deflect.ContourJoints",
-            json!({"title": "joint angles [rad]", "type": "object", "properties": {
-                "timestamp": stamp_schema(), "shape": {"type": "string"},
-                "motor": {"type": "array", "items": {"type": "number"}},
-                "link": {"type": "array", "items": {"type": "number"}}}}),
-        ),
-    ];
-    let mut ids = Vec::new();
-    for (name, s) in &schemas {
-        ids.push(log.add_schema(name, s)?);
+        correction: "none on the arm; the shape is recovered raw (FK of the motor readings) \
+                     and compensated (Eq. 10), both logged"
+            .into(),
+        options: serde_json::to_value(o).unwrap_or_default(),
     }
-    let mut offset = 0.0;
+}
+
+/// Writes every run into one MCAP file by the convention of [`crate::mcap_log`]: topics
+/// `/contour/<shape>/<topic>` ([`TOPICS`]), each shape's log time from its first reading
+/// (t = 0), a `deflect.run` metadata record per shape. Returns the number of messages.
+pub fn write_mcap(path: &Path, runs: &[ContourRun], o: &TraceOptions) -> Result<usize, SimError> {
+    let mut log = McapLog::create(path)?;
     for r in runs {
+        let info = run_info(r, o);
+        log.run_metadata(&info)?;
+        let prefix = info.prefix();
         let mut channels = Vec::new();
-        for (topic, id) in TOPICS.iter().zip(&ids) {
-            channels.push(log.add_channel(
-                *id,
-                &format!("/contour/{}/{topic}", r.name),
-                "shape",
-                &r.name,
-            )?);
+        for (topic, kind) in TOPICS {
+            channels.push(log.channel(&prefix, topic, kind)?);
         }
-        let mut last = 0.0;
-        for (seq, s) in (0u32..).zip(&r.samples) {
-            let t = offset + s.t;
-            for (ch, msg) in channels.iter().zip(messages(&r.name, s, t)) {
+        let name = r.name.as_str();
+        let outline = r.outline.polyline();
+        let lines = [
+            Line {
+                id: format!("{name}/outline"),
+                points: outline.iter().map(|p| [p.x, p.y, 0.0]).collect(),
+                rgb: color(Role::Desired).rgb(),
+                closed: true,
+            },
+            Line {
+                id: format!("{name}/tool_actual"),
+                points: r.samples.iter().map(|s| p3(&s.tool_actual)).collect(),
+                rgb: color(Role::Guide).rgb(),
+                closed: false,
+            },
+            Line {
+                id: format!("{name}/recorded_raw"),
+                points: r
+                    .samples
+                    .iter()
+                    .filter_map(|s| s.raw.as_ref())
+                    .map(p3)
+                    .collect(),
+                rgb: color(Role::Uncorrected).rgb(),
+                closed: false,
+            },
+            Line {
+                id: format!("{name}/recorded_compensated"),
+                points: r
+                    .samples
+                    .iter()
+                    .filter_map(|s| s.compensated.as_ref())
+                    .map(p3)
+                    .collect(),
+                rgb: color(Role::Corrected).rgb(),
+                closed: false,
+            },
+        ];
+        if let Some(ch) = channels.last() {
+            log.write(*ch, 0.0, &scene_update(0.0, &lines))?;
+        }
+        let t0 = r.samples.first().map_or(0.0, |s| s.t);
+        for s in &r.samples {
+            let t = s.t - t0;
+            for (ch, msg) in channels.iter().zip(messages(name, s, t)) {
                 let Some(msg) = msg else { continue };
-                log.write(*ch, seq, t, &msg)?;
+                log.write(*ch, t, &msg)?;
             }
-            last = s.t;
         }
-        offset += last + 1.0;
     }
     log.finish()
 }
 
-/// One PNG per run: left the true outline (black), the raw (red) and compensated (blue)
-/// recovered contours in mm, right the signed distance of each recorded point to the outline.
+/// An object's name in words: "l_shape" -> "L-shaped object", "circle" -> "circle".
+fn shape_words(name: &str) -> String {
+    match name {
+        "l_shape" => "L-shaped object".to_string(),
+        other => other.replace('_', " "),
+    }
+}
+
+/// One PNG per run: left the true outline, the raw and compensated recovered contours in mm
+/// (equal scales), right the signed distance of each recorded point to the outline; the
+/// legend in a column on the right.
 pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     let root = canvas(path, (1500, 700))?;
-    let (left, right) = root.split_horizontally(700);
     let mm = |p: &Vector2<f64>| (p.x * 1e3, p.y * 1e3);
     let outline: Vec<(f64, f64)> = r.outline.polyline().iter().map(mm).collect();
-    let raw: Vec<(f64, f64)> = r
-        .samples
-        .iter()
-        .filter_map(|s| s.raw)
-        .map(|p| (p[0] * 1e3, p[1] * 1e3))
-        .collect();
-    let comp: Vec<(f64, f64)> = r
-        .samples
-        .iter()
-        .filter_map(|s| s.compensated)
-        .map(|p| (p[0] * 1e3, p[1] * 1e3))
-        .collect();
+    let recorded = |f: fn(&Sample) -> Option<[f64; 2]>| -> Vec<(f64, f64)> {
+        r.samples
+            .iter()
+            .filter_map(f)
+            .map(|p| (p[0] * 1e3, p[1] * 1e3))
+            .collect()
+    };
+    let raw = recorded(|s| s.raw);
+    let comp = recorded(|s| s.compensated);
+    let entries = [
+        Entry::new("true outline", Role::Desired, Swatch::Line(2)),
+        Entry::new(
+            format!("raw (FK of the motor readings): RMS {:.3} mm", r.raw.rms_mm),
+            Role::Uncorrected,
+            Swatch::Line(2),
+        ),
+        Entry::new(
+            format!("compensated (Eq. 10): RMS {:.4} mm", r.compensated.rms_mm),
+            Role::Corrected,
+            Swatch::Line(2),
+        ),
+    ];
+    let title = format!(
+        "2R arm with compliant, backlashed joints tracing the {} by force feedback: recovered \
+         contour, raw and compensated",
+        shape_words(&r.name)
+    );
+    let (plot, legend) = figure(&root, &title, 20, &entries)?;
+    let (pw, _) = plot.dim_in_pixel();
+    let (left, right) = plot.split_horizontally(pw * 45 / 100);
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
@@ -247,27 +306,27 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     let half = 0.5 * (x1 - x0).max(y1 - y0) + 8.0;
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
     let style = ChartStyle {
-        caption: 22,
+        caption: 16,
         label_areas: (40, 55),
         labels: 14,
     };
+    let left = left
+        .titled("contour in the plane", ("sans-serif", style.caption))
+        .map_err(crate::plot_style::perr)?;
     let mut chart = new_chart(
         &left,
         style,
-        &format!("{}: recovered contour", r.name),
         cx - half..cx + half,
         cy - half..cy + half,
         ("x [mm]", "y [mm]"),
     )?;
-    let series = [
-        (outline.clone(), BLACK, "true outline"),
-        (raw.clone(), RED, "raw (motor readings)"),
-        (comp.clone(), BLUE, "compensated (Eq. 10)"),
-    ];
-    for (pts, c, label) in series {
-        labelled_line(&mut chart, pts, c, 2, label)?;
+    for (pts, role) in [
+        (outline, Role::Desired),
+        (raw.clone(), Role::Uncorrected),
+        (comp.clone(), Role::Corrected),
+    ] {
+        line(&mut chart, pts, color(role), 2, false)?;
     }
-    legend(&mut chart, 0.85, 14)?;
 
     let dist = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
         pts.iter()
@@ -286,37 +345,44 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
         .chain(&dcomp)
         .map(|p| p.1.abs())
         .fold(0.05, f64::max)
-        * 1.1;
+        * 1.06;
     let n = raw.len().max(2) as f64;
     let style = ChartStyle {
-        caption: 20,
+        caption: 16,
         label_areas: (40, 60),
         labels: 14,
     };
+    let right = right
+        .titled(
+            "distance of each recorded point to the outline",
+            ("sans-serif", style.caption),
+        )
+        .map_err(crate::plot_style::perr)?;
     let mut chart = new_chart(
         &right,
         style,
-        &format!(
-            "distance to the outline: raw RMS {:.3} mm, compensated RMS {:.4} mm",
-            r.raw.rms_mm, r.compensated.rms_mm
-        ),
         0.0..n,
         -lim..lim,
-        ("contact sample", "signed distance (+ outside) [mm]"),
+        ("contact sample [count]", "signed distance, + outside [mm]"),
     )?;
-    for (pts, c, label) in [(draw, RED, "raw"), (dcomp, BLUE, "compensated")] {
-        labelled_line(&mut chart, pts, c, 2, label)?;
+    for (pts, role) in [(draw, Role::Uncorrected), (dcomp, Role::Corrected)] {
+        line(&mut chart, pts, color(role), 2, false)?;
     }
-    legend(&mut chart, 0.85, 14)?;
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }
 
 /// Writes `contour_summary.{txt,csv,json}`, `contour.mcap` and `contour_<shape>.png` into
 /// `out`; returns the number of MCAP messages.
-pub fn write_all(out: &Path, runs: &[ContourRun], table: &str) -> Result<usize, SimError> {
+pub fn write_all(
+    out: &Path,
+    runs: &[ContourRun],
+    table: &str,
+    opts: &TraceOptions,
+) -> Result<usize, SimError> {
     write_summary(out, "contour_summary", table, &summary_csv(runs), runs)?;
-    let n = write_mcap(&out.join("contour.mcap"), runs)?;
+    let n = write_mcap(&out.join("contour.mcap"), runs, opts)?;
     for r in runs {
         plot_run(&out.join(format!("contour_{}.png", r.name)), r)?;
     }

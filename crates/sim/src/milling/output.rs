@@ -6,23 +6,14 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde_json::json;
 
-use super::{MillingResult, Sample};
+use super::{MillingOptions, MillingResult, Mode, Sample};
 use crate::SimError;
-use crate::output::{
-    CHART, McapLog, canvas, labelled_line, legend, new_chart, perr, present, stamp, stamp_schema,
-    write_summary,
+use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
+use crate::output::write_summary;
+use crate::plot_style::{
+    CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
+    present,
 };
-
-/// Topics written per run, as `/milling/<run>/<topic>`.
-pub const TOPICS: [&str; 7] = [
-    "nominal",
-    "actual",
-    "commanded",
-    "force_measured",
-    "force_filtered",
-    "correction",
-    "error",
-];
 
 /// The summary table printed on stdout and written to `milling_summary.txt`.
 pub fn table(r: &MillingResult) -> String {
@@ -169,7 +160,10 @@ pub fn csv(r: &MillingResult) -> String {
             m.exit_max_mm
         );
     }
-    s.push_str("\nspring,axis,label,k_true,k_frames,se_frames,k_tcp,se_tcp\n");
+    s.push_str(
+        "\nspring,axis,label,k_true_N_m_per_rad,k_frames_N_m_per_rad,se_frames_N_m_per_rad,\
+         k_tcp_N_m_per_rad,se_tcp_N_m_per_rad\n",
+    );
     for e in &r.stiffness {
         let _ = writeln!(
             s,
@@ -192,91 +186,133 @@ pub fn json(r: &MillingResult) -> serde_json::Value {
     })
 }
 
-fn schema(title: &str, fields: &[(&str, &str)]) -> serde_json::Value {
-    let mut props = json!({
-        "timestamp": stamp_schema(),
-        "run": {"type": "string"},
-    });
-    for (f, unit) in fields {
-        props[*f] = json!({"type": "number", "description": unit});
-    }
-    json!({"title": title, "type": "object", "properties": props})
-}
-
-const XYZ: [&str; 3] = ["x", "y", "z"];
-const WRENCH: [&str; 6] = ["fx", "fy", "fz", "mx", "my", "mz"];
-const TWIST: [&str; 6] = ["x", "y", "z", "rx", "ry", "rz"];
-
-fn fields(topic: &str) -> Vec<(&'static str, &'static str)> {
-    match topic {
-        "nominal" | "actual" | "commanded" => XYZ.iter().map(|f| (*f, "m")).collect(),
-        "force_measured" | "force_filtered" => WRENCH
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (*f, if i < 3 { "N" } else { "N m" }))
-            .collect(),
-        "correction" => TWIST
-            .iter()
-            .enumerate()
-            .map(|(i, f)| (*f, if i < 3 { "m" } else { "rad" }))
-            .collect(),
-        _ => vec![
-            ("error_mm", "mm"),
-            ("pilot_weight", "1"),
-            ("force_true_norm", "N"),
-        ],
+/// The run's mode as a plot role (its colour in every figure).
+fn role(mode: Mode) -> Role {
+    match mode {
+        Mode::Uncompensated => Role::Uncorrected,
+        Mode::Cartesian => Role::Corrected,
+        Mode::Pilot => Role::Pilot,
+        Mode::Uncalibrated => Role::Uncalibrated,
     }
 }
 
-fn message(topic: &str, run: &str, s: &Sample) -> serde_json::Value {
-    let mut m = json!({"timestamp": stamp(s.t), "run": run});
-    let put = |m: &mut serde_json::Value, names: &[&str], v: &[f64]| {
-        for (n, x) in names.iter().zip(v) {
-            m[*n] = json!(x);
-        }
-    };
-    match topic {
-        "nominal" => put(&mut m, &XYZ, &s.nominal),
-        "actual" => put(&mut m, &XYZ, &s.actual),
-        "commanded" => put(&mut m, &XYZ, &s.commanded),
-        "force_measured" => put(&mut m, &WRENCH, &s.force_measured),
-        "force_filtered" => put(&mut m, &WRENCH, &s.force_filtered),
-        "correction" => put(&mut m, &TWIST, &s.correction),
-        _ => {
-            let f = nalgebra::Vector3::from(s.force_true).norm();
-            put(
-                &mut m,
-                &["error_mm", "pilot_weight", "force_true_norm"],
-                &[s.error_mm, s.pilot_weight, f],
-            );
-        }
+/// The compensation of `mode` in words.
+fn mode_words(mode: Mode, o: &MillingOptions) -> String {
+    match mode {
+        Mode::Uncompensated => "none".to_string(),
+        Mode::Cartesian => "online Cartesian compensation (Hähn and Weigold 2020) from the \
+                            measured forces, pilot control off"
+            .to_string(),
+        Mode::Pilot => format!(
+            "online Cartesian compensation with pilot control ({:.0} N, {:.0} ms) from an offline \
+             force estimate leading by {:.0} ms, {:+.0} % off",
+            o.pilot.0,
+            o.pilot.1 * 1e3,
+            o.estimate_lead * 1e3,
+            o.estimate_error * 100.0
+        ),
+        Mode::Uncalibrated => "online Cartesian compensation without sensor calibration \
+                               (offsets and tool weight taken for process force)"
+            .to_string(),
     }
-    m
 }
 
-/// Writes the runs to `path`, topics `/milling/<run>/<topic>`; all runs share the
-/// scenario's time axis. Returns the number of messages.
+fn run_info(r: &MillingResult, mode: Mode) -> RunInfo {
+    let o = &r.options;
+    RunInfo {
+        scenario: "milling".into(),
+        run: mode.label().into(),
+        robot: "KUKA KR 300 R2500 (robots/ URDF and stiffness file) as a flexible arm in rapier: \
+                6 servo joints, 10 virtual joints"
+            .into(),
+        motion: format!(
+            "groove along +x of the base at {:.1} mm/s with the tool's orientation held: {:.2} s \
+             standstill, {:.2} s approach, {:.2} s cut, {:.2} s run-out; process force \
+             [{:.0}, {:.0}, {:.0}] N at the TCP while cutting",
+            o.feed * 1e3,
+            o.settle,
+            o.approach,
+            o.cut,
+            o.runout,
+            o.force[0],
+            o.force[1],
+            o.force[2]
+        ),
+        acceleration: format!(
+            "(1 - cos) ramp to the feed in {:.2} s, peak {:.3} m/s^2",
+            o.ramp,
+            core::f64::consts::FRAC_PI_2 * o.feed / o.ramp.max(1e-9)
+        ),
+        correction: mode_words(mode, o),
+        options: serde_json::to_value(o).unwrap_or_default(),
+    }
+}
+
+/// Topics per run, as `/milling/<run>/<topic>`, and their message types.
+pub const TOPICS: [(&str, Kind); 11] = [
+    ("nominal", Kind::Point),
+    ("actual", Kind::Point),
+    ("commanded", Kind::Point),
+    ("force_measured", Kind::Wrench),
+    ("force_filtered", Kind::Wrench),
+    ("process_force", Kind::Force),
+    ("correction", Kind::Displacement),
+    ("error", Kind::PathError),
+    ("pilot", Kind::PilotControl),
+    ("tcp_pose", Kind::PosesInFrame),
+    ("paths", Kind::SceneUpdate),
+];
+
+fn messages(run: &str, s: &Sample) -> [serde_json::Value; 10] {
+    let t = s.t;
+    [
+        mcap_log::point(run, t, s.nominal),
+        mcap_log::point(run, t, s.actual),
+        mcap_log::point(run, t, s.commanded),
+        mcap_log::wrench(run, t, &s.force_measured),
+        mcap_log::wrench(run, t, &s.force_filtered),
+        mcap_log::force(run, t, s.force_true),
+        mcap_log::displacement(run, t, &s.correction),
+        mcap_log::path_error(run, t, s.error_mm * 1e-3),
+        mcap_log::pilot(run, t, s.pilot_weight),
+        mcap_log::poses_in_frame(t, s.actual, IDENTITY),
+    ]
+}
+
+/// Writes the runs to `path` by the convention of [`crate::mcap_log`]: topics
+/// `/milling/<run>/<topic>` ([`TOPICS`]), every run from t = 0, SI units (the path error in
+/// m), a `deflect.run` metadata record per run. Returns the number of messages.
 pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
     let mut log = McapLog::create(path)?;
-    let mut schema_ids = Vec::new();
-    for topic in TOPICS {
-        let s = schema(&format!("milling {topic}"), &fields(topic));
-        schema_ids.push(log.add_schema(&format!("deflect.milling.{topic}"), &s)?);
-    }
     for run in &r.runs {
+        let info = run_info(r, run.mode);
+        log.run_metadata(&info)?;
+        let prefix = info.prefix();
         let name = run.mode.label();
         let mut channels = Vec::new();
-        for (topic, schema) in TOPICS.iter().zip(&schema_ids) {
-            channels.push(log.add_channel(
-                *schema,
-                &format!("/milling/{name}/{topic}"),
-                "run",
-                name,
-            )?);
+        for (topic, kind) in TOPICS {
+            channels.push(log.channel(&prefix, topic, kind)?);
         }
-        for (seq, s) in (0u32..).zip(&run.samples) {
-            for (topic, ch) in TOPICS.iter().zip(&channels) {
-                log.write(*ch, seq, s.t, &message(topic, name, s))?;
+        let lines = [
+            Line {
+                id: format!("{name}/nominal"),
+                points: run.samples.iter().map(|s| s.nominal).collect(),
+                rgb: color(Role::Desired).rgb(),
+                closed: false,
+            },
+            Line {
+                id: format!("{name}/actual"),
+                points: run.samples.iter().map(|s| s.actual).collect(),
+                rgb: color(role(run.mode)).rgb(),
+                closed: false,
+            },
+        ];
+        if let Some(ch) = channels.last() {
+            log.write(*ch, 0.0, &scene_update(0.0, &lines))?;
+        }
+        for s in &run.samples {
+            for (ch, msg) in channels.iter().zip(messages(name, s)) {
+                log.write(*ch, s.t, &msg)?;
             }
         }
     }
@@ -285,89 +321,197 @@ pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
 
 /// Path error against time for the runs, with the cutter entry and exit marked.
 pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
-    let root = canvas(path, (1100, 620))?;
-    let t_end = r.options.t_end();
+    let root = canvas(path, (1250, 620))?;
+    let o = &r.options;
+    let mut entries: Vec<Entry> = r
+        .runs
+        .iter()
+        .map(|run| {
+            let m = &run.metrics;
+            Entry::new(
+                format!(
+                    "{}: max {:.2} mm, RMS {:.2} mm",
+                    run.mode.label(),
+                    m.max_mm,
+                    m.rms_mm
+                ),
+                role(run.mode),
+                Swatch::Line(2),
+            )
+        })
+        .collect();
+    entries.push(Entry::new(
+        "cutter entry and exit",
+        Role::Guide,
+        Swatch::Line(1),
+    ));
+    let title = format!(
+        "KR 300 R2500 milling a groove at {:.0} mm/s, {:.0} N process force: path error across \
+         the feed, uncompensated and compensated",
+        o.feed * 1e3,
+        nalgebra::Vector3::from(o.force).norm()
+    );
+    let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
+    let x = padded_range(
+        r.runs.iter().flat_map(|x| x.samples.iter().map(|s| s.t)),
+        0.01,
+        0.01,
+    );
     let ymax = r
         .runs
         .iter()
         .flat_map(|x| x.samples.iter().map(|s| s.error_mm))
         .fold(0.1, f64::max)
-        * 1.1;
+        * 1.06;
     let mut chart = new_chart(
-        &root,
+        &plot,
         CHART,
-        "milling: tool-point deviation across the feed",
-        0.0..t_end,
+        x,
         0.0..ymax,
-        ("time [s]", "path error [mm]"),
+        (
+            "time since the run's start [s]",
+            "path error across the feed [mm]",
+        ),
     )?;
-    for t in [r.options.t_entry(), r.options.t_exit()] {
-        chart
-            .draw_series(LineSeries::new(
-                vec![(t, 0.0), (t, ymax)],
-                BLACK.mix(0.4).stroke_width(1),
-            ))
-            .map_err(perr)?;
-    }
-    let colors = [RED, BLUE, GREEN, MAGENTA];
-    for (run, c) in r.runs.iter().zip(colors) {
-        let m = &run.metrics;
-        let label = format!(
-            "{}: max {:.2} mm, RMS {:.2} mm",
-            run.mode.label(),
-            m.max_mm,
-            m.rms_mm
-        );
-        labelled_line(
+    for t in [o.t_entry(), o.t_exit()] {
+        line(
             &mut chart,
-            run.samples.iter().map(|s| (s.t, s.error_mm)),
-            c,
-            2,
-            label,
+            vec![(t, 0.0), (t, ymax)],
+            color(Role::Guide),
+            1,
+            false,
         )?;
     }
-    legend(&mut chart, 0.8, 15)?;
+    for run in &r.runs {
+        let pts = run.samples.iter().map(|s| (s.t, s.error_mm)).collect();
+        line(&mut chart, pts, color(role(run.mode)), 2, false)?;
+    }
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }
 
-/// Identified over true stiffness per virtual-joint axis (frame pairs and TCP, with +- 2 se
-/// bars); axes not identifiable are left out.
-pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
-    let root = canvas(path, (1100, 560))?;
-    let ratio = |k: f64, t: f64| k / t;
-    let spread = r
-        .stiffness
+/// The 95 % confidence factor of a normal estimate: identified value +- 1.96 standard errors.
+pub const CI95: f64 = 1.96;
+
+/// One panel of [`plot_stiffness`]: identified / true per axis with 95 % confidence bars
+/// (capped; a bar beyond the axis ends in an arrow), unidentifiable axes as crosses at 1.
+fn stiffness_panel(
+    area: &crate::plot_style::Area<'_>,
+    caption: &str,
+    pts: &[(f64, f64, f64)],
+    n: f64,
+    role: Role,
+) -> Result<(), SimError> {
+    let area = area
+        .titled(caption, ("sans-serif", 16))
+        .map_err(crate::plot_style::perr)?;
+    let ok: Vec<&(f64, f64, f64)> = pts.iter().filter(|p| p.1.is_finite()).collect();
+    let half = |p: &(f64, f64, f64)| if p.2.is_finite() { CI95 * p.2 } else { 0.0 };
+    // Every estimate and bar, but bars 100x the value would hide the estimates: the axis
+    // stops at 3 times the estimates' spread about 1 (then arrows mark the longer bars).
+    let spread = ok.iter().map(|p| (p.1 - 1.0).abs()).fold(0.005, f64::max);
+    let reach = ok
         .iter()
-        .flat_map(|e| [ratio(e.k_frames, e.k_true), ratio(e.k_tcp, e.k_true)])
-        .filter(|v| v.is_finite())
-        .fold(0.02f64, |m, v| m.max((v - 1.0).abs()))
-        .min(1.0)
-        * 1.3;
-    let n = r.stiffness.len().max(1) as f64;
+        .map(|p| (p.1 - 1.0).abs() + half(p))
+        .fold(spread, f64::max)
+        .min(3.0 * spread + 0.02);
+    let y = (1.0 - 1.08 * reach)..(1.0 + 1.08 * reach);
     let mut chart = new_chart(
-        &root,
+        &area,
         CHART,
-        "virtual-joint stiffness: identified / true",
-        -0.5f64..(n - 0.5),
-        (1.0 - spread)..(1.0 + spread),
+        -0.5..(n - 0.5),
+        y.clone(),
         (
             "spring axis (chain order, see milling_summary.txt)",
-            "identified / true",
+            "identified / true [1]",
         ),
     )?;
+    let c = color(role);
+    line(
+        &mut chart,
+        vec![(-0.5, 1.0), (n - 0.5, 1.0)],
+        color(Role::Guide),
+        1,
+        false,
+    )?;
+    let perr = crate::plot_style::perr;
+    for p in &ok {
+        let (lo, hi) = (p.1 - half(p), p.1 + half(p));
+        let (a, b) = (lo.max(y.start), hi.min(y.end));
+        chart
+            .draw_series(std::iter::once(PathElement::new(
+                vec![(p.0, a), (p.0, b)],
+                c.stroke_width(2),
+            )))
+            .map_err(perr)?;
+        for (v, clipped, up) in [(a, lo < y.start, false), (b, hi > y.end, true)] {
+            if clipped {
+                let d = 0.03 * (y.end - y.start);
+                let base = if up { v - d } else { v + d };
+                chart
+                    .draw_series(std::iter::once(Polygon::new(
+                        vec![(p.0 - 0.2, base), (p.0 + 0.2, base), (p.0, v)],
+                        c.filled(),
+                    )))
+                    .map_err(perr)?;
+            } else {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        vec![(p.0 - 0.2, v), (p.0 + 0.2, v)],
+                        c.stroke_width(2),
+                    )))
+                    .map_err(perr)?;
+            }
+        }
+    }
     chart
-        .draw_series(LineSeries::new(
-            vec![(-0.5, 1.0), (n - 0.5, 1.0)],
-            BLACK.mix(0.5).stroke_width(1),
-        ))
+        .draw_series(
+            ok.iter()
+                .map(|p| Circle::new((p.0, p.1.clamp(y.start, y.end)), 4, c.filled())),
+        )
         .map_err(perr)?;
-    for (dx, c, label, tcp) in [
-        (-0.12, BLUE, "frame pairs", false),
-        (0.12, RED, "TCP deflection (6-D)", true),
-    ] {
-        let pts: Vec<(f64, f64, f64)> = r
-            .stiffness
+    chart
+        .draw_series(
+            pts.iter()
+                .filter(|p| !p.1.is_finite())
+                .map(|p| Cross::new((p.0, 1.0), 5, color(Role::Guide).stroke_width(2))),
+        )
+        .map_err(perr)?;
+    Ok(())
+}
+
+/// Identified over true stiffness per virtual-joint axis, frame pairs (top) and 6-D TCP
+/// deflections (bottom), each with its 95 % confidence interval (+- 1.96 standard errors of
+/// the least-squares identification, from its residuals).
+pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
+    let root = canvas(path, (1250, 820))?;
+    let entries = [
+        Entry::new(
+            "frame pairs: identified / true",
+            Role::FramePairs,
+            Swatch::Marker,
+        ),
+        Entry::new(
+            "TCP 6-D: identified / true",
+            Role::TcpDeflection,
+            Swatch::Marker,
+        ),
+        Entry::new("bars: 95 % CI (+- 1.96 se)", Role::Guide, Swatch::Line(2)),
+        Entry::new("arrow: bar beyond the axis", Role::Guide, Swatch::Marker),
+        Entry::new("cross: not identifiable", Role::Guide, Swatch::Marker),
+        Entry::new("line: true value (1)", Role::Guide, Swatch::Line(1)),
+    ];
+    let title = format!(
+        "KR 300 R2500: virtual-joint stiffness identified from static loads ({:.0} N, {} \
+         pose(s)) over the true value",
+        r.options.id_load,
+        r.options.id_poses.clamp(1, 3)
+    );
+    let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
+    let n = r.stiffness.len().max(1) as f64;
+    let pts = |tcp: bool| -> Vec<(f64, f64, f64)> {
+        r.stiffness
             .iter()
             .enumerate()
             .map(|(i, e)| {
@@ -376,25 +520,27 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
                 } else {
                     (e.k_frames, e.se_frames)
                 };
-                (i as f64 + dx, k / e.k_true, se / e.k_true)
+                (i as f64, k / e.k_true, se / e.k_true)
             })
-            .filter(|p| p.1.is_finite() && (p.1 - 1.0).abs() <= spread)
-            .collect();
-        chart
-            .draw_series(pts.iter().map(|p| Circle::new((p.0, p.1), 4, c.filled())))
-            .map_err(perr)?
-            .label(label)
-            .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
-        chart
-            .draw_series(pts.iter().filter(|p| p.2.is_finite()).map(|p| {
-                PathElement::new(
-                    vec![(p.0, p.1 - 2.0 * p.2), (p.0, p.1 + 2.0 * p.2)],
-                    c.stroke_width(2),
-                )
-            }))
-            .map_err(perr)?;
-    }
-    legend(&mut chart, 0.8, 15)?;
+            .collect()
+    };
+    let (_, ph) = plot.dim_in_pixel();
+    let (top, bottom) = plot.split_vertically(ph / 2);
+    stiffness_panel(
+        &top,
+        "frame-pair rotations across each virtual joint (used by the compensator)",
+        &pts(false),
+        n,
+        Role::FramePairs,
+    )?;
+    stiffness_panel(
+        &bottom,
+        "6-D TCP deflections only (springs in series are hard to tell apart)",
+        &pts(true),
+        n,
+        Role::TcpDeflection,
+    )?;
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }

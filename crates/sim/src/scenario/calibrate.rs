@@ -12,18 +12,34 @@ use deflect_sim::robot::{Constraint, Head, RobotParams};
 use deflect_sim::{SimError, write_file};
 use indicatif::ProgressBar;
 
-/// The static-test readings as CSV (mm, N), the columns `static-test` writes and `fit` reads.
+/// The header of the static-test CSV: units in the column names.
+pub const STATIC_HEADER: &str = "x_mm,y_mm,force_axis,force_N,dx_mm,dy_mm";
+
+/// `v` rounded to `decimals` and written without float noise or a negative zero:
+/// -75.00000000000001 -> "-75", 172.132 -> "172.132".
+pub fn plain(v: f64, decimals: i32) -> String {
+    let k = 10f64.powi(decimals);
+    let r = (v * k).round() / k;
+    if r == 0.0 {
+        "0".to_string()
+    } else {
+        format!("{r}")
+    }
+}
+
+/// The static-test readings as CSV ([`STATIC_HEADER`]: mm, N), the columns `static-test`
+/// writes and `fit` reads; positions to 1 nm, forces to 1 uN, displacements to 1e-9 mm.
 pub fn static_csv(readings: &[StaticReading]) -> String {
-    let mut s = String::from("x,y,force_axis,force,dx,dy\n");
+    let mut s = format!("{STATIC_HEADER}\n");
     for r in readings {
         s.push_str(&format!(
-            "{},{},{},{},{:e},{:e}\n",
-            r.x * 1e3,
-            r.y * 1e3,
+            "{},{},{},{},{},{}\n",
+            plain(r.x * 1e3, 6),
+            plain(r.y * 1e3, 6),
             if r.axis == 0 { "x" } else { "y" },
-            r.force,
-            r.d[0] * 1e3,
-            r.d[1] * 1e3,
+            plain(r.force, 6),
+            plain(r.d[0] * 1e3, 9),
+            plain(r.d[1] * 1e3, 9),
         ));
     }
     s

@@ -39,7 +39,7 @@ pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
         a.jobs.max(1),
         sim / wall
     );
-    let n = output::write_all(out, &runs, &table)?;
+    let n = output::write_all(out, &runs, &table, &opts)?;
     say!(
         "wrote {0}/contour_summary.{{txt,csv,json}}, {0}/contour.mcap ({n} messages), {0}/contour_<shape>.png",
         out.display()

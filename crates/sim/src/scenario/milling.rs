@@ -21,6 +21,7 @@ pub fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
     opts.estimate_lead = a.lead_ms * 1e-3;
     opts.estimate_error = a.estimate_error;
     opts.seed = a.seed;
+    opts.id_poses = a.id_poses;
     let r = milling::milling(&opts)?;
     let table = output::table(&r);
     put!("{table}");

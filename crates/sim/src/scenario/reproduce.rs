@@ -148,7 +148,7 @@ fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimE
     output::write_summary(out, "summary", table, &output::summary_csv(runs), runs)?;
     let gmax = runs.iter().map(|r| r.g).max().unwrap_or(5);
     let top: Vec<&RunResult> = runs.iter().filter(|r| r.g == gmax).collect();
-    output::write_mcap(&out.join("reproduce.mcap"), &top, true)?;
+    output::write_mcap(&out.join("reproduce.mcap"), "reproduce", &top)?;
     for motion in [Motion::XLine, Motion::YLine, Motion::Triangle] {
         let sel: Vec<&RunResult> = top.iter().copied().filter(|r| r.motion == motion).collect();
         if sel.is_empty() {
@@ -156,11 +156,6 @@ fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimE
         }
         output::plot_paths(
             &out.join(format!("paths_{}_{}g.png", motion.label(), gmax)),
-            &format!(
-                "{} at {} g: tool path across the line",
-                motion.label(),
-                gmax
-            ),
             &sel,
         )?;
         output::plot_error_vs_g(

@@ -57,8 +57,9 @@ pub fn load_map(path: &Path) -> Result<LoadedMap, CliError> {
             kind: "compliance map JSON",
         })
     } else {
-        const WHAT: &str = "static-test CSV written by `static-test` (columns x, y \
-                            [mm], force_axis, force [N], dx, dy [mm]; a JSON map starts with `{`)";
+        const WHAT: &str = "static-test CSV written by `static-test` (columns x_mm, y_mm, \
+                            force_axis, force_N, dx_mm, dy_mm, or the older x, y, force_axis, \
+                            force, dx, dy in mm and N; a JSON map starts with `{`)";
         let map = super::fit::fit_csv(path).map_err(|e| load_error("--map", path, WHAT, e))?;
         Ok(LoadedMap {
             map,
@@ -141,8 +142,8 @@ pub fn run_one(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(),
         args.g
     );
     let mcap_path = out.join(format!("{name}.mcap"));
-    let n = output::write_mcap(&mcap_path, &refs, runs.len() > 1)?;
-    output::plot_paths(&out.join(format!("{name}.png")), &name, &refs)?;
+    let n = output::write_mcap(&mcap_path, "run", &refs)?;
+    output::plot_paths(&out.join(format!("{name}.png")), &refs)?;
     write_file(
         &out.join(format!("{name}.json")),
         "the runs JSON",
@@ -203,6 +204,26 @@ mod tests {
         fitted.map.displacement(p, &f, &mut b).unwrap();
         assert!(a[1].abs() > 1e-4, "{a:?}");
         assert_eq!(a, b);
+        // The header with units (what `static-test` writes) and in metres give the same map.
+        let units = dir.join("units.csv");
+        let text = static_table().replacen(
+            "x,y,force_axis,force,dx,dy",
+            super::super::calibrate::STATIC_HEADER,
+            1,
+        );
+        std::fs::write(&units, text).unwrap();
+        let with_units = load_map(&units).unwrap();
+        let mut c = [0.0; 2];
+        with_units.map.displacement(p, &f, &mut c).unwrap();
+        assert_eq!(a, c);
+        let (h, unit) =
+            super::super::fit::unit_header("x_m,y_m,force_axis,force_N,dx_m,dy_m").unwrap();
+        assert_eq!(
+            h,
+            "x,y,force,axis".replace("force,axis", "force_axis,force,dx,dy")
+        );
+        assert_eq!(unit, deflect_core::units::LengthUnit::Metre);
+        assert!(super::super::fit::unit_header("x,y,force_axis,force,dx,dy").is_none());
         let _ = std::fs::remove_dir_all(&dir);
     }
 }

@@ -5,18 +5,16 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use plotters::prelude::*;
-use serde_json::json;
 
-use super::{PathKind, SerialResult, SerialRun, SerialSample};
+use super::{PathKind, SerialResult, SerialRun};
 use crate::SimError;
-use crate::output::{
-    CHART, McapLog, canvas, labelled_line, legend, new_chart, present, stamp, stamp_schema,
-    write_summary,
+use crate::mcap_log::{self, Kind, Line, McapLog, RunInfo, scene_update};
+use crate::output::write_summary;
+use crate::plot_style::{
+    CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
+    present,
 };
 use crate::report::reduction;
-
-/// Topics written per run, as `/serial/<path>_<corrected|uncorrected>/<topic>`.
-pub const TOPICS: [&str; 4] = ["desired", "actual", "commanded", "wrench"];
 
 fn run_label(r: &SerialRun) -> String {
     format!(
@@ -152,79 +150,131 @@ pub fn csv(r: &SerialResult) -> String {
     s
 }
 
-fn pose_schema(title: &str) -> serde_json::Value {
-    let mut props = json!({"timestamp": stamp_schema(), "run": {"type": "string"}});
-    for f in ["x", "y", "z"] {
-        props[f] = json!({"type": "number", "description": "m"});
-    }
-    for f in ["qw", "qx", "qy", "qz"] {
-        props[f] = json!({"type": "number", "description": "unit quaternion"});
-    }
-    json!({"title": title, "type": "object", "properties": props})
+/// `[w, x, y, z]` -> `[x, y, z, w]`.
+fn xyzw(q: &[f64]) -> [f64; 4] {
+    [q[1], q[2], q[3], q[0]]
 }
 
-fn wrench_schema() -> serde_json::Value {
-    let mut props = json!({"timestamp": stamp_schema(), "run": {"type": "string"}});
-    for (i, f) in ["fx", "fy", "fz", "mx", "my", "mz"].iter().enumerate() {
-        props[*f] = json!({"type": "number", "description": if i < 3 { "N" } else { "N m" }});
-    }
-    json!({"title": "inertial wrench the corrector cancels", "type": "object", "properties": props})
+fn position(p: &[f64]) -> [f64; 3] {
+    [p[0], p[1], p[2]]
 }
 
-fn message(topic: &str, run: &str, s: &SerialSample) -> serde_json::Value {
-    let mut m = json!({"timestamp": stamp(s.t), "run": run});
-    let put = |m: &mut serde_json::Value, names: &[&str], v: &[f64]| {
-        for (n, x) in names.iter().zip(v) {
-            m[*n] = json!(x);
-        }
+fn run_info(r: &SerialResult, run: &SerialRun) -> RunInfo {
+    let o = &r.options;
+    let m = &o.motion;
+    let motion = match run.path {
+        PathKind::Line => format!(
+            "line ({:.0}, {:.0}, {:.0}) mm with a {:.2} rad turn about the vertical, rest to rest",
+            300.0 * m.scale,
+            200.0 * m.scale,
+            -100.0 * m.scale,
+            m.turn
+        ),
+        PathKind::Circle => format!(
+            "horizontal circle of radius {:.0} mm with a {:.2} rad turn, rest to rest",
+            150.0 * m.scale,
+            m.turn
+        ),
     };
-    const POSE: [&str; 7] = ["x", "y", "z", "qw", "qx", "qy", "qz"];
-    match topic {
-        "desired" => put(&mut m, &POSE, &s.desired),
-        "actual" => put(&mut m, &POSE, &s.actual),
-        "commanded" => put(&mut m, &POSE[..3], &s.commanded),
-        _ => put(&mut m, &["fx", "fy", "fz", "mx", "my", "mz"], &s.wrench),
+    RunInfo {
+        scenario: "serial".into(),
+        run: run_label(run),
+        robot: format!(
+            "{} as a flexible arm in rapier ({} bodies), payload {:.1} kg",
+            o.robot, r.bodies, o.payload.mass
+        ),
+        motion,
+        acceleration: format!(
+            "{} g peak ({:.2} m/s^2), jerk-limited (ramp {:.0} ms), v_max {:.2} m/s",
+            m.g,
+            m.g * deflect_core::units::STANDARD_GRAVITY,
+            m.ramp * 1e3,
+            m.v_max
+        ),
+        correction: if run.corrected {
+            format!(
+                "deflect-core's 6-D D'Alembert corrector for serial arms, cancelling the {}",
+                if o.link_inertia {
+                    "payload's and the links' inertial loads"
+                } else {
+                    "payload's inertial wrench only"
+                }
+            )
+        } else {
+            "none".into()
+        },
+        options: serde_json::to_value(o).unwrap_or_default(),
     }
-    m
 }
 
-/// Writes every run to `path`; all runs share the time axis from t = 0. Returns the number
-/// of messages.
+/// Topics per run, as `/serial/<path>_<corrected|uncorrected>/<topic>`, and their types.
+pub const TOPICS: [(&str, Kind); 6] = [
+    ("desired", Kind::Pose),
+    ("actual", Kind::Pose),
+    ("commanded", Kind::Point),
+    ("wrench", Kind::Wrench),
+    ("tcp_pose", Kind::PosesInFrame),
+    ("paths", Kind::SceneUpdate),
+];
+
+/// Writes every run to `path` by the convention of [`crate::mcap_log`]: topics
+/// `/serial/<run>/<topic>` ([`TOPICS`]), every run from t = 0, a `deflect.run` metadata
+/// record per run. Returns the number of messages.
 pub fn write_mcap(path: &Path, r: &SerialResult) -> Result<usize, SimError> {
     let mut log = McapLog::create(path)?;
-    let pose = log.add_schema("deflect.serial.Pose", &pose_schema("TCP pose"))?;
-    let wrench = log.add_schema("deflect.serial.Wrench", &wrench_schema())?;
     for run in &r.runs {
-        let name = run_label(run);
+        let info = run_info(r, run);
+        log.run_metadata(&info)?;
+        let prefix = info.prefix();
+        let name = info.run.as_str();
         let mut channels = Vec::new();
-        for topic in TOPICS {
-            let schema = if topic == "wrench" { wrench } else { pose };
-            channels.push(log.add_channel(
-                schema,
-                &format!("/serial/{name}/{topic}"),
-                "run",
-                &name,
-            )?);
+        for (topic, kind) in TOPICS {
+            channels.push(log.channel(&prefix, topic, kind)?);
         }
-        for (seq, s) in (0u32..).zip(&run.samples) {
-            for (topic, ch) in TOPICS.iter().zip(&channels) {
-                log.write(*ch, seq, s.t, &message(topic, &name, s))?;
+        let role = if run.corrected {
+            Role::Corrected
+        } else {
+            Role::Uncorrected
+        };
+        let lines = [
+            Line {
+                id: format!("{name}/desired"),
+                points: run.samples.iter().map(|s| position(&s.desired)).collect(),
+                rgb: color(Role::Desired).rgb(),
+                closed: false,
+            },
+            Line {
+                id: format!("{name}/actual"),
+                points: run.samples.iter().map(|s| position(&s.actual)).collect(),
+                rgb: color(role).rgb(),
+                closed: false,
+            },
+        ];
+        if let Some(ch) = channels.last() {
+            log.write(*ch, 0.0, &scene_update(0.0, &lines))?;
+        }
+        for s in &run.samples {
+            let t = s.t;
+            let (d, a) = (&s.desired, &s.actual);
+            let msgs = [
+                mcap_log::pose(name, t, position(d), xyzw(&d[3..])),
+                mcap_log::pose(name, t, position(a), xyzw(&a[3..])),
+                mcap_log::point(name, t, s.commanded),
+                mcap_log::wrench(name, t, &s.wrench),
+                mcap_log::poses_in_frame(t, position(a), xyzw(&a[3..])),
+            ];
+            for (ch, msg) in channels.iter().zip(&msgs) {
+                log.write(*ch, t, msg)?;
             }
         }
     }
     log.finish()
 }
 
-/// Path error (top) and orientation error (bottom) against time, one curve per run.
+/// Path error (top) and orientation error (bottom) against time, one curve per run: colour
+/// uncorrected / corrected, solid line, dashed circle; the legend in a column on the right.
 pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
-    let root = canvas(path, (1100, 900))?;
-    let (top, bottom) = root.split_vertically(450);
-    let t_end = r
-        .runs
-        .iter()
-        .map(|x| x.duration)
-        .fold(0.1, f64::max)
-        .max(0.1);
+    let root = canvas(path, (1250, 900))?;
     let start = |run: &SerialRun| {
         let p = run.samples.first().map(|s| s.desired).unwrap_or_default();
         super::pose_of(&p)
@@ -250,51 +300,77 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
             })
             .collect()
     };
-    let colors = [
-        (PathKind::Line, false, RED),
-        (PathKind::Line, true, BLUE),
-        (PathKind::Circle, false, MAGENTA),
-        (PathKind::Circle, true, GREEN),
+    let order = [
+        (PathKind::Line, false),
+        (PathKind::Line, true),
+        (PathKind::Circle, false),
+        (PathKind::Circle, true),
     ];
+    let runs: Vec<&SerialRun> = order.iter().filter_map(|&(p, c)| find(r, p, c)).collect();
+    let style = |run: &SerialRun| {
+        let role = if run.corrected {
+            Role::Corrected
+        } else {
+            Role::Uncorrected
+        };
+        let dashed = run.path == PathKind::Circle;
+        (role, dashed)
+    };
+    let entries: Vec<Entry> = runs
+        .iter()
+        .map(|run| {
+            let (role, dashed) = style(run);
+            let m = &run.metrics;
+            Entry::new(
+                format!(
+                    "{}: path max {:.3} mm, rot. max {:.2} mrad",
+                    run_label(run).replace('_', ", "),
+                    m.path_max_mm,
+                    m.rot_max_mrad
+                ),
+                role,
+                if dashed {
+                    Swatch::Dashed(2)
+                } else {
+                    Swatch::Line(2)
+                },
+            )
+        })
+        .collect();
+    let o = &r.options;
+    let title = format!(
+        "{} carrying {:.0} kg: line and circle at {} g peak, with and without the D'Alembert \
+         correction",
+        o.robot, o.payload.mass, o.motion.g
+    );
+    let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
+    let (_, h) = plot.dim_in_pixel();
+    let (top, bottom) = plot.split_vertically(h / 2);
     for (area, rot) in [(&top, false), (&bottom, true)] {
-        let ymax = r
-            .runs
-            .iter()
-            .flat_map(|x| series(x, rot).into_iter().map(|p| p.1))
-            .fold(1e-3, f64::max)
-            * 1.35;
+        let all: Vec<Vec<(f64, f64)>> = runs.iter().map(|x| series(x, rot)).collect();
+        let ymax = all.iter().flatten().map(|p| p.1).fold(1e-3, f64::max) * 1.06;
+        let x = padded_range(all.iter().flatten().map(|p| p.0), 0.01, 0.01);
         let (caption, unit) = if rot {
             ("orientation error", "orientation error [mrad]")
         } else {
             ("distance from the planned path", "path deviation [mm]")
         };
+        let area = area
+            .titled(caption, ("sans-serif", 16))
+            .map_err(crate::plot_style::perr)?;
         let mut chart = new_chart(
-            area,
+            &area,
             CHART,
-            &format!("{}: {caption}", r.options.robot),
-            0.0..t_end,
+            x,
             0.0..ymax,
-            ("time [s]", unit),
+            ("time since the motion start [s]", unit),
         )?;
-        for &(p, c, color) in &colors {
-            if let Some(run) = find(r, p, c) {
-                let m = &run.metrics;
-                let (mx, rms) = if rot {
-                    (m.rot_max_mrad, m.rot_rms_mrad)
-                } else {
-                    (m.path_max_mm, m.path_rms_mm)
-                };
-                labelled_line(
-                    &mut chart,
-                    series(run, rot),
-                    color,
-                    if c { 2 } else { 1 },
-                    format!("{}: max {mx:.3}, RMS {rms:.3}", run_label(run)),
-                )?;
-            }
+        for (run, pts) in runs.iter().zip(all) {
+            let (role, dashed) = style(run);
+            line(&mut chart, pts, color(role), 2, dashed)?;
         }
-        legend(&mut chart, 0.85, 14)?;
     }
+    draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
 }
