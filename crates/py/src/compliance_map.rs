@@ -16,7 +16,8 @@ use pyo3::types::{PyDict, PyList};
 use crate::InputError;
 use crate::args;
 use crate::convert::{
-    build_err, indices, load_err, matrix, shape_error, tick_err, tick_err_at, vector_any,
+    batch_pair, build_err, indices, load_err, matrix, shape_error, tick_err, tick_err_at,
+    vector_any,
 };
 
 /// Batches of at least this many rows use several threads.
@@ -352,8 +353,10 @@ impl ComplianceMap {
     }
 
     /// Displacements (N, n_displacement) [m] for positions `P` (N, 2) or (N, 3) [m] (z
-    /// ignored) and forces `F` (N, n_force) [N]. Runs without the GIL, on several threads for
-    /// N >= 20000. With
+    /// ignored) and forces `F` (N, n_force) [N]; either may be a single row ((2,), (n_force,)
+    /// or one-row 2-D) that broadcasts over the other's rows, as in numpy (a displacement
+    /// field under one load, or one point under many loads). float64 C-contiguous arrays are
+    /// read in place. Runs without the GIL, on several threads for N >= 20000. With
     /// `out_of_grid="error"` the first row outside the grid raises `InputError`.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
     #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None))]
@@ -367,23 +370,23 @@ impl ComplianceMap {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let o = self.options(interpolation, out_of_grid)?;
         let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
-        let pm = matrix(P, "P", None, None)?;
-        let p = pm.as_array();
-        let n = p.nrows();
-        if p.ncols() != 2 && p.ncols() != 3 {
-            return Err(shape_error("P", "(N, 2) or (N, 3)", p.shape()));
-        }
-        let fm = matrix(F, "F", Some(n), Some(nf))?;
-        let f = fm.as_array();
+        let (n, pm, fm) = batch_pair((P, "P", &[2, 3]), (F, "F", &[nf]))?;
+        let (p, f) = (pm.as_array(), fm.as_array());
+        let pc = p.ncols();
         let map = &self.inner;
         let out = py.detach(|| -> Result<Vec<f64>, BatchFailure> {
+            // A broadcast row is repeated once here; a float64 C-contiguous (N, k) argument
+            // is read in place (`as_standard_layout` borrows it).
+            let (Some(p), Some(f)) = (p.broadcast((n, pc)), f.broadcast((n, nf))) else {
+                return Err(BatchFailure::Internal("rows do not broadcast"));
+            };
             let (p, f) = (p.as_standard_layout(), f.as_standard_layout());
             let (Some(ps), Some(fs)) = (p.as_slice(), f.as_slice()) else {
                 return Err(BatchFailure::Internal("arrays not contiguous"));
             };
             let view = map.view();
             let mut out = vec![0.0; n * nd];
-            let pc = p.ncols().max(1);
+            let pc = pc.max(1);
             // Large batches are split over the available cores (at most 8 threads).
             let threads = if n >= PARALLEL_MIN_ROWS {
                 std::thread::available_parallelism().map_or(1, |t| t.get().min(8))

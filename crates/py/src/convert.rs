@@ -231,6 +231,59 @@ pub fn matrix<'py>(
     readonly(&a2, what)
 }
 
+/// One argument of a batch, (rows, k) with `k` one of `cols`: rows (N, k), or a single row
+/// (k,) (returned as (1, k)) that numpy's broadcasting repeats for every row of the others.
+fn batch_arg<'py>(
+    o: &Bound<'py, PyAny>,
+    what: &str,
+    cols: &[usize],
+) -> PyResult<PyReadonlyArray2<'py, f64>> {
+    let a = float_array(o, what)?;
+    let shape = a.shape().to_vec();
+    let expected = || {
+        let k = cols
+            .iter()
+            .map(|c| c.to_string())
+            .collect::<Vec<_>>()
+            .join(" or ");
+        format!("(N, {k}) or ({k},)")
+    };
+    let a = match shape.as_slice() {
+        [k] if cols.contains(k) => a.reshape(vec![1, *k])?,
+        [_, k] if cols.contains(k) => a,
+        _ => return Err(shape_error(what, &expected(), &shape)),
+    };
+    readonly(&a.cast_into::<PyArray2<f64>>()?, what)
+}
+
+/// Two batch arguments under numpy's broadcasting rule for the row axis: each is (N, k) or a
+/// single row (k,); the row counts must be equal or one of them 1. Returns the common row
+/// count. Neither array is copied here: a float64 C-contiguous argument is read in place.
+pub fn batch_pair<'py>(
+    a: (&Bound<'py, PyAny>, &str, &[usize]),
+    b: (&Bound<'py, PyAny>, &str, &[usize]),
+) -> PyResult<(
+    usize,
+    PyReadonlyArray2<'py, f64>,
+    PyReadonlyArray2<'py, f64>,
+)> {
+    let (x, y) = (batch_arg(a.0, a.1, a.2)?, batch_arg(b.0, b.1, b.2)?);
+    let (nx, ny) = (x.as_array().nrows(), y.as_array().nrows());
+    let n = match (nx, ny) {
+        _ if nx == ny => nx,
+        (_, 1) => nx,
+        (1, _) => ny,
+        _ => {
+            return Err(InputError::new_err(format!(
+                "{} has {nx} rows and {} has {ny}: batch arguments broadcast when their row \
+                 counts are equal or one of them has a single row",
+                a.1, b.1
+            )));
+        }
+    };
+    Ok((n, x, y))
+}
+
 /// Checks that every entry of a matrix is finite; names the first one that is not.
 pub fn check_finite_matrix(what: &str, m: &ArrayView2<'_, f64>) -> PyResult<()> {
     for ((i, j), v) in m.indexed_iter() {

@@ -3,14 +3,14 @@
 use deflect_core::SerialRobot as CoreRobot;
 use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
-use numpy::ndarray::{Array1, Array2};
-use numpy::{PyArray1, PyArray2, ToPyArray};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
 use crate::convert::{
-    iso_to_py, load_err, matrix, matrix_to_py, pose, tick_err, tick_err_at, vector, vector6,
+    batch_pair, iso_to_py, load_err, matrix_to_py, pose, tick_err, tick_err_at, vector, vector6,
 };
 
 /// A serial robot with virtual joints (VJM paper, Eq. 1-9). All arrays are SI, base frame.
@@ -252,8 +252,10 @@ impl SerialRobot {
         Ok(c.dq.get(..model.dof()).unwrap_or(&[]).to_pyarray(py))
     }
 
-    /// Deflections of many loaded poses at once: `Q` (N, dof), `W` (N, 6) -> (N, 6). Runs
-    /// without the GIL.
+    /// Deflections of many loaded poses at once: `Q` (N, dof), `W` (N, 6) -> (N, 6) [m, rad];
+    /// either may be a single row ((dof,) or (6,)) that broadcasts over the other's rows, as
+    /// in numpy (one pose under many wrenches, one wrench over many poses). float64
+    /// C-contiguous arrays are read in place. Runs without the GIL.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
     fn deflection_batch<'py>(
         &self,
@@ -262,13 +264,15 @@ impl SerialRobot {
         W: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = matrix(Q, "Q", None, Some(model.dof()))?;
-        let q = q.as_array();
-        let n = q.nrows();
-        let w = matrix(W, "W", Some(n), Some(6))?;
-        let w = w.as_array();
+        let dof = model.dof();
+        let (n, qm, wm) = batch_pair((Q, "Q", &[dof]), (W, "W", &[6]))?;
+        let (q, w) = (qm.as_array(), wm.as_array());
         let out = py.detach(
             || -> Result<Array2<f64>, (usize, deflect_core::TickError)> {
+                // Rows are read in place; a single row broadcasts (stride 0).
+                let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
+                    return Ok(Array2::zeros((0, 6)));
+                };
                 let mut data = Data::new(model);
                 let mut out = Array2::zeros((n, 6));
                 let mut qi = vec![0.0; model.dof()];
@@ -276,13 +280,17 @@ impl SerialRobot {
                     qi.iter_mut().zip(qrow.iter()).for_each(|(d, s)| *d = *s);
                     let wi = Vector6::from_iterator(wrow.iter().copied());
                     let d = vjm::deflection(model, &mut data, &qi, &wi).map_err(|e| (i, e))?;
-                    out.row_mut(i).assign(&Array1::from_iter(d.iter().copied()));
+                    out.row_mut(i)
+                        .iter_mut()
+                        .zip(d.iter())
+                        .for_each(|(o, x)| *o = *x);
                 }
                 Ok(out)
             },
         );
         let out = out.map_err(|(i, e)| tick_err_at(format_args!("row {i}"), e))?;
-        Ok(out.to_pyarray(py))
+        // The result array becomes the numpy array's buffer (no copy).
+        Ok(out.into_pyarray(py))
     }
 
     fn __repr__(&self) -> String {

@@ -344,8 +344,8 @@ def test_bad_argument_types_raise_input_error_naming_the_argument(kr300):
     # Wrong shapes: the expected and the received shape.
     msg = refused(deflect.InputError, kr300.deflection, np.zeros((2, 3)), w)
     assert "expected shape (6,)" in msg and "got (2, 3)" in msg
-    msg = refused(deflect.InputError, kr300.deflection_batch, np.zeros((3, 6)), np.zeros(6))
-    assert "W: expected shape (3, 6)" in msg and "got (6,)" in msg
+    msg = refused(deflect.InputError, kr300.deflection_batch, np.zeros((3, 6)), np.zeros(5))
+    assert "W: expected shape (N, 6) or (6,)" in msg and "got (5,)" in msg
     msg = refused(deflect.InputError, deflect.commanded_pose, np.eye(3), np.zeros(6))
     assert "target: expected shape (4, 4)" in msg and "got (3, 3)" in msg
     msg = refused(deflect.InputError, deflect.identify_sensor, np.zeros((2, 3)), np.zeros((2, 6)))

@@ -105,7 +105,8 @@ class SerialRobot:
         and >= 0 (``InputError`` otherwise); ``ConvergenceError`` when the residual stays above
         ``tolerance`` (the message says whether the iteration stalled at its fixed point)."""
     def deflection_batch(self, Q: _ArrayLike, W: _ArrayLike) -> _FloatArray:
-        """(N, dof), (N, 6) -> (N, 6); releases the GIL."""
+        """(N, dof), (N, 6) -> (N, 6) [m, rad]; a single row of either broadcasts over the
+        other's rows. float64 C-contiguous input is read in place; the GIL is released."""
     def equilibrium(
         self, q: _ArrayLike, wrench: _ArrayLike, max_iterations: int = 20, tolerance: float = 1e-12
     ) -> _FloatArray:
@@ -201,7 +202,9 @@ class ComplianceMap:
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
     ) -> _FloatArray:
-        """(N, 2|3), (N, n_force) -> (N, n_displacement); releases the GIL."""
+        """(N, 2|3) [m], (N, n_force) [N] -> (N, n_displacement) [m]; a single row of either
+        broadcasts over the other's rows. float64 C-contiguous input is read in place; the
+        GIL is released."""
     def cross_validate(self, forces: _ArrayLike, axis: str = "y") -> Dict[str, Any]:
         """Leave-one-node-out RMS [m] of bilinear vs bicubic."""
     @property

@@ -1,0 +1,113 @@
+"""numpy habits: array-likes of any real dtype convert once, float64 C-contiguous input is read
+in place (no copy), batch arguments broadcast a single row as numpy does, and wrong shapes name
+the argument, the expected and the received shape.
+
+Copies are counted with tracemalloc, which sees every allocation numpy makes (deflect's own
+outputs are Rust buffers handed to numpy, not traced): an input that is converted shows up as
+a peak of its float64 size, one read in place as (almost) nothing."""
+
+import tracemalloc
+
+import numpy as np
+import pytest
+
+import deflect
+from conftest import KR300_TOML, KR300_URDF, REPO
+
+N = 100_000
+RNG = np.random.default_rng(11)
+
+
+@pytest.fixture(scope="module")
+def cmap():
+    return deflect.ComplianceMap.from_csv(REPO / "data/paksoy2025_compliance_oc.csv")
+
+
+@pytest.fixture(scope="module")
+def kr300():
+    return deflect.SerialRobot.from_urdf(KR300_URDF, KR300_TOML, "tcp")
+
+
+def points(n=N):
+    return np.c_[RNG.uniform(0.18, 0.26, n), RNG.uniform(-0.07, 0.07, n)]
+
+
+def traced_peak(f, *args):
+    tracemalloc.start()
+    try:
+        out = f(*args)
+        return tracemalloc.get_traced_memory()[1], out
+    finally:
+        tracemalloc.stop()
+
+
+def test_float64_c_contiguous_batches_are_read_without_a_copy(cmap, kr300):
+    p, f = points(), RNG.uniform(-200.0, 200.0, (N, 2))
+    peak, out = traced_peak(cmap.displacement_batch, p, f)
+    assert out.shape == (N, 2)
+    assert peak < 0.01 * (p.nbytes + f.nbytes), peak
+    # The same data as float32 is converted, once: one float64 copy of each argument.
+    p32, f32 = p.astype(np.float32), f.astype(np.float32)
+    peak32, out32 = traced_peak(cmap.displacement_batch, p32, f32)
+    assert p.nbytes + f.nbytes <= peak32 < 1.1 * (p.nbytes + f.nbytes), peak32
+    np.testing.assert_array_equal(out32, cmap.displacement_batch(p32.astype(float), f32.astype(float)))
+
+    q = RNG.uniform(-1.0, 1.0, (20_000, 6))
+    w = RNG.uniform(-300.0, 300.0, (20_000, 6))
+    peak, d = traced_peak(kr300.deflection_batch, q, w)
+    assert d.shape == (20_000, 6)
+    assert peak < 0.01 * (q.nbytes + w.nbytes), peak
+
+
+def test_batches_broadcast_a_single_row(cmap, kr300):
+    p, f = points(1000), RNG.uniform(-200.0, 200.0, (1000, 2))
+    one_force = f[0]
+    expected = cmap.displacement_batch(p, np.tile(one_force, (1000, 1)))
+    np.testing.assert_array_equal(cmap.displacement_batch(p, one_force), expected)
+    np.testing.assert_array_equal(cmap.displacement_batch(p, [one_force]), expected)
+    np.testing.assert_array_equal(cmap.displacement_batch(p, tuple(one_force)), expected)
+    one_point = p[3]
+    np.testing.assert_array_equal(
+        cmap.displacement_batch(one_point, f), cmap.displacement_batch(np.tile(one_point, (1000, 1)), f)
+    )
+    for i in [0, 500, 999]:
+        np.testing.assert_array_equal(expected[i], cmap.displacement(p[i], one_force))
+
+    q = RNG.uniform(-1.0, 1.0, (50, 6))
+    w = RNG.uniform(-300.0, 300.0, 6)
+    np.testing.assert_array_equal(kr300.deflection_batch(q, w), kr300.deflection_batch(q, np.tile(w, (50, 1))))
+    np.testing.assert_array_equal(kr300.deflection_batch(q[0], [w, 2 * w])[1], kr300.deflection(q[0], 2 * w))
+
+
+def test_non_contiguous_and_integer_inputs_give_the_same_numbers(cmap, kr300):
+    p = points(2000)
+    f = np.round(RNG.uniform(-200.0, 200.0, (2000, 2)))
+    ref = cmap.displacement_batch(p, f)
+    np.testing.assert_array_equal(cmap.displacement_batch(np.asfortranarray(p), f), ref)
+    np.testing.assert_array_equal(cmap.displacement_batch(p, f.astype(np.int32)), ref)
+    wide = np.zeros((2000, 4))
+    wide[:, ::2] = p
+    np.testing.assert_array_equal(cmap.displacement_batch(wide[:, ::2], f), ref)
+    np.testing.assert_array_equal(cmap.displacement_batch(p.tolist(), f.tolist()), ref)
+    q = np.zeros((4, 6))
+    np.testing.assert_array_equal(
+        kr300.deflection_batch(q, np.ones((4, 6), dtype=np.int64) * 100),
+        kr300.deflection_batch(q, np.full((4, 6), 100.0)),
+    )
+
+
+@pytest.mark.parametrize(
+    "call, match",
+    [
+        (lambda m, r: m.displacement_batch(np.zeros((5, 2)), np.zeros((3, 2))), "P has 5 rows and F has 3"),
+        (lambda m, r: m.displacement_batch(np.zeros((5, 4)), np.zeros((5, 2))), r"P: expected .*\(N, 2 or 3\).*got \(5, 4\)"),
+        (lambda m, r: m.displacement_batch(np.zeros((5, 2)), np.zeros((5, 2, 1))), r"F: expected .*got \(5, 2, 1\)"),
+        (lambda m, r: m.displacement_batch(np.zeros((5, 2), complex), np.zeros((5, 2))), "P: .*complex"),
+        (lambda m, r: m.displacement_batch(np.zeros((5, 2), object), np.zeros((5, 2))), "P: .*object"),
+        (lambda m, r: r.deflection_batch(np.zeros((4, 6)), np.zeros((3, 6))), "Q has 4 rows and W has 3"),
+        (lambda m, r: r.deflection_batch(np.zeros((4, 5)), np.zeros((4, 6))), r"Q: expected .*\(N, 6\).*got \(4, 5\)"),
+    ],
+)
+def test_wrong_batches_name_the_argument_and_both_shapes(cmap, kr300, call, match):
+    with pytest.raises(deflect.InputError, match=match):
+        call(cmap, kr300)
