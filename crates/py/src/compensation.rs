@@ -104,22 +104,27 @@ impl SensorCalibration {
         })
     }
 
+    /// Internal force offset `F_SI` (3,) [N], sensor frame (Eq. 12).
     #[getter]
     fn force_offset<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.force_offset.as_slice().to_pyarray(py)
     }
+    /// Internal moment offset `M_SI` (3,) [N m], sensor frame (Eq. 12).
     #[getter]
     fn moment_offset<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.moment_offset.as_slice().to_pyarray(py)
     }
+    /// Weight of everything beyond the sensor `G` [N] (gravity along -z of the base).
     #[getter]
     fn weight(&self) -> f64 {
         self.inner.weight
     }
+    /// Centre of gravity `r_G` (3,) [m], sensor frame (Eq. 13).
     #[getter]
     fn center_of_gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.inner.center_of_gravity.as_slice().to_pyarray(py)
     }
+    /// Residual-offset polynomial coefficients (6, 15), one row per wrench component (Eq. 17).
     #[getter]
     fn residual<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
         let flat: Vec<f64> = self.inner.residual.iter().flatten().copied().collect();
@@ -127,6 +132,7 @@ impl SensorCalibration {
             .unwrap_or_else(|_| Array2::zeros((6, POLY_TERMS)))
             .to_pyarray(py)
     }
+    /// Pose of the TCP in the sensor frame `^S T_TCP`, (4, 4).
     #[getter]
     fn sensor_to_tcp<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray2<f64>> {
         iso_to_py(py, &self.inner.sensor_to_tcp)
@@ -212,6 +218,7 @@ impl LowPass {
             .map(|inner| Self { inner })
             .map_err(build_err)
     }
+    /// Filters one wrench sample `x` (6,) [N, N m]; returns the filtered wrench (6,).
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -219,18 +226,22 @@ impl LowPass {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(out6(py, &self.inner.step(&v6(x, "x")?)))
     }
+    /// Smoothing factor of the first-order filter, `dt / (dt + 1 / (2 pi f_c))`.
     #[getter]
     fn alpha(&self) -> f64 {
         self.inner.alpha()
     }
+    /// Phase delay at low frequency [samples].
     #[getter]
     fn delay_samples(&self) -> f64 {
         self.inner.delay_samples()
     }
+    /// Phase delay at low frequency [s].
     #[getter]
     fn delay_seconds(&self) -> f64 {
         self.inner.delay_seconds()
     }
+    /// Forgets the filter state: the next sample starts it afresh.
     fn reset(&mut self) {
         self.inner.reset()
     }
@@ -271,6 +282,7 @@ impl MovingAverage {
             .map(|inner| Self { inner })
             .map_err(build_err)
     }
+    /// Averages one wrench sample `x` (6,) [N, N m] over the window; returns (6,).
     fn step<'py>(
         &mut self,
         py: Python<'py>,
@@ -278,14 +290,17 @@ impl MovingAverage {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         Ok(out6(py, &self.inner.step(&v6(x, "x")?)))
     }
+    /// Delay of the window, `(window - 1) / 2` [samples].
     #[getter]
     fn delay_samples(&self) -> f64 {
         self.inner.delay_samples()
     }
+    /// Delay of the window [s].
     #[getter]
     fn delay_seconds(&self) -> f64 {
         self.inner.delay_seconds()
     }
+    /// Empties the window.
     fn reset(&mut self) {
         self.inner.reset()
     }
@@ -338,10 +353,12 @@ impl PilotControl {
         let (m, e) = (v6(measured, "measured")?, v6(estimated, "estimated")?);
         Ok(out6(py, &self.inner.step(&m, &e)))
     }
+    /// Current weight of the measured wrench in the blend, 0..1.
     #[getter]
     fn weight(&self) -> f64 {
         self.inner.weight()
     }
+    /// Back to the start: the estimate alone, weight 0.
     fn reset(&mut self) {
         self.inner.reset()
     }
@@ -481,6 +498,7 @@ impl OnlineCompensator {
         Ok(d)
     }
 
+    /// Forgets the filter, pilot and rate-limiter states (a new process step).
     fn reset(&mut self) {
         self.data.reset()
     }

@@ -46,3 +46,24 @@ def test_shown_defaults_are_the_used_ones():
     assert tracer["max_turn"].default == np.pi / 4
     assert tracer["approach_direction"].default == (1.0, 0.0)
     assert inspect.signature(deflect.OnlineCompensator).parameters["pilot"].default == (150.0, 0.08)
+
+
+def test_every_public_object_has_a_docstring():
+    """help() shows something for every public class, function, method and property."""
+    import inspect
+
+    missing = []
+    for name in deflect.__all__:
+        obj = getattr(deflect, name)
+        if name == "__version__":
+            continue
+        if not (obj.__doc__ or "").strip():
+            missing.append(name)
+        if inspect.isclass(obj) and not issubclass(obj, Exception):
+            for member, raw in vars(obj).items():
+                if member.startswith("_"):
+                    continue
+                doc = getattr(obj, member).__doc__ if isinstance(raw, staticmethod) else raw.__doc__
+                if not (doc or "").strip() or doc == type(raw).__doc__:
+                    missing.append(f"{name}.{member}")
+    assert missing == []
