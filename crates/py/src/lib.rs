@@ -26,6 +26,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 mod args;
+mod batch;
 mod compensation;
 mod compliance_map;
 mod convert;

@@ -4,13 +4,16 @@ use deflect_core::SerialRobot as CoreRobot;
 use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
 use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
+use numpy::{IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayDyn, ToPyArray};
+
+use crate::batch::{self, BatchFailure};
 use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
 use crate::convert::{
-    batch_pair, iso_to_py, load_err, matrix_to_py, pose, tick_err, tick_err_at, vector, vector6,
+    batch_pair, iso_to_py, load_err, matrix, matrix_to_py, pose, tick_err, tick_err_at, vector,
+    vector6,
 };
 
 /// A serial robot with virtual joints (VJM paper, Eq. 1-9). All arrays are SI, base frame.
@@ -267,30 +270,93 @@ impl SerialRobot {
         let dof = model.dof();
         let (n, qm, wm) = batch_pair((Q, "Q", &[dof]), (W, "W", &[6]))?;
         let (q, w) = (qm.as_array(), wm.as_array());
-        let out = py.detach(
-            || -> Result<Array2<f64>, (usize, deflect_core::TickError)> {
-                // Rows are read in place; a single row broadcasts (stride 0).
-                let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
-                    return Ok(Array2::zeros((0, 6)));
-                };
-                let mut data = Data::new(model);
-                let mut out = Array2::zeros((n, 6));
-                let mut qi = vec![0.0; model.dof()];
-                for (i, (qrow, wrow)) in q.rows().into_iter().zip(w.rows()).enumerate() {
-                    qi.iter_mut().zip(qrow.iter()).for_each(|(d, s)| *d = *s);
-                    let wi = Vector6::from_iterator(wrow.iter().copied());
-                    let d = vjm::deflection(model, &mut data, &qi, &wi).map_err(|e| (i, e))?;
-                    out.row_mut(i)
-                        .iter_mut()
-                        .zip(d.iter())
-                        .for_each(|(o, x)| *o = *x);
-                }
-                Ok(out)
-            },
-        );
-        let out = out.map_err(|(i, e)| tick_err_at(format_args!("row {i}"), e))?;
-        // The result array becomes the numpy array's buffer (no copy).
-        Ok(out.into_pyarray(py))
+        let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
+            return Err(InputError::new_err("Q and W: rows do not broadcast"));
+        };
+        // Rows are read in place (a single row broadcasts with stride 0), on every core for
+        // large batches; the result buffer becomes the numpy array's (no copy).
+        let mut out = vec![0.0; n * 6];
+        py.detach(|| {
+            batch::rows(
+                &mut out,
+                6,
+                || (Data::new(model), vec![0.0; dof]),
+                |i, (data, qi), o| {
+                    copy_row(qi, q.row(i).iter());
+                    let wi = Vector6::from_iterator(w.row(i).iter().copied());
+                    let d = vjm::deflection(model, data, qi, &wi)?;
+                    o.copy_from_slice(d.as_slice());
+                    Ok(())
+                },
+            )
+        })
+        .map_err(batch_err)?;
+        rows_to_py(py, out, &[n, 6])
+    }
+
+    /// Rigid TCP poses of many joint vectors: `Q` (N, dof) -> (N, 4, 4). float64
+    /// C-contiguous input is read in place; runs without the GIL, on every core for large
+    /// batches.
+    #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    fn forward_batch<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let model = &self.inner.model;
+        let dof = model.dof();
+        let qm = matrix(Q, "Q", None, Some(dof))?;
+        let q = qm.as_array();
+        let n = q.nrows();
+        let mut out = vec![0.0; n * 16];
+        py.detach(|| {
+            batch::rows(
+                &mut out,
+                16,
+                || (Data::new(model), vec![0.0; dof]),
+                |i, (data, qi), o| {
+                    copy_row(qi, q.row(i).iter());
+                    let t = vjm::forward(model, data, qi)?.to_homogeneous();
+                    // Row-major 4 x 4: the transpose's column-major storage.
+                    o.copy_from_slice(t.transpose().as_slice());
+                    Ok(())
+                },
+            )
+        })
+        .map_err(batch_err)?;
+        rows_to_py(py, out, &[n, 4, 4])
+    }
+
+    /// Cartesian compliances of many joint vectors: `Q` (N, dof) -> (N, 6, 6), as
+    /// `compliance`. float64 C-contiguous input is read in place; runs without the GIL, on
+    /// every core for large batches.
+    #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    fn compliance_batch<'py>(
+        &self,
+        py: Python<'py>,
+        Q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
+        let model = &self.inner.model;
+        let dof = model.dof();
+        let qm = matrix(Q, "Q", None, Some(dof))?;
+        let q = qm.as_array();
+        let n = q.nrows();
+        let mut out = vec![0.0; n * 36];
+        py.detach(|| {
+            batch::rows(
+                &mut out,
+                36,
+                || (Data::new(model), vec![0.0; dof]),
+                |i, (data, qi), o| {
+                    copy_row(qi, q.row(i).iter());
+                    let c = vjm::compliance(model, data, qi)?;
+                    o.copy_from_slice(c.transpose().as_slice());
+                    Ok(())
+                },
+            )
+        })
+        .map_err(batch_err)?;
+        rows_to_py(py, out, &[n, 6, 6])
     }
 
     fn __repr__(&self) -> String {
@@ -322,4 +388,33 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<SerialRobot>()?;
     m.add_function(wrap_pyfunction!(commanded_pose, m)?)?;
     Ok(())
+}
+
+/// Copies a row of an array view into a joint-vector buffer.
+fn copy_row<'a>(dst: &mut [f64], src: impl Iterator<Item = &'a f64>) {
+    dst.iter_mut().zip(src).for_each(|(d, s)| *d = *s);
+}
+
+/// A batch failure as the exception the single call would raise, naming the row.
+fn batch_err(e: BatchFailure) -> PyErr {
+    match e {
+        BatchFailure::Row(i, e) => tick_err_at(format_args!("row {i}"), e),
+        BatchFailure::Panicked => InputError::new_err("internal: a batch worker thread panicked"),
+    }
+}
+
+/// `out` as a numpy array of `shape`, its buffer handed over (no copy).
+fn rows_to_py<'py, D>(
+    py: Python<'py>,
+    out: Vec<f64>,
+    shape: &[usize],
+) -> PyResult<Bound<'py, PyArray<f64, D>>>
+where
+    D: numpy::ndarray::Dimension,
+{
+    let a = numpy::ndarray::ArrayD::from_shape_vec(shape.to_vec(), out)
+        .map_err(|e| InputError::new_err(format!("internal: {e}")))?
+        .into_dimensionality::<D>()
+        .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
+    Ok(a.into_pyarray(py))
 }

@@ -111,3 +111,24 @@ def test_non_contiguous_and_integer_inputs_give_the_same_numbers(cmap, kr300):
 def test_wrong_batches_name_the_argument_and_both_shapes(cmap, kr300, call, match):
     with pytest.raises(deflect.InputError, match=match):
         call(cmap, kr300)
+
+
+def test_batches_on_every_core_match_the_single_calls(kr300):
+    n = 5000  # above the threading threshold (2048 rows)
+    q = RNG.uniform(-1.0, 1.0, (n, 6))
+    w = RNG.uniform(-300.0, 300.0, (n, 6))
+    d = kr300.deflection_batch(q, w)
+    f = kr300.forward_batch(q)
+    c = kr300.compliance_batch(q)
+    assert d.shape == (n, 6) and f.shape == (n, 4, 4) and c.shape == (n, 6, 6)
+    for i in [0, 1, 2499, 2500, 4999]:
+        np.testing.assert_array_equal(d[i], kr300.deflection(q[i], w[i]))
+        np.testing.assert_array_equal(f[i], kr300.forward(q[i]))
+        np.testing.assert_array_equal(c[i], kr300.compliance(q[i]))
+    # The first failing row is named, whichever thread met it.
+    q[4000, 2] = np.nan
+    q[3000, 1] = np.inf
+    for call in [lambda: kr300.deflection_batch(q, w), lambda: kr300.forward_batch(q),
+                 lambda: kr300.compliance_batch(q)]:
+        with pytest.raises(deflect.InputError, match="row 3000"):
+            call()

@@ -104,9 +104,14 @@ class SerialRobot:
         """(dof,) axis-specific correction. ``max_iterations`` 0..=256 and ``tolerance`` finite
         and >= 0 (``InputError`` otherwise); ``ConvergenceError`` when the residual stays above
         ``tolerance`` (the message says whether the iteration stalled at its fixed point)."""
+    def forward_batch(self, Q: _ArrayLike) -> _FloatArray:
+        """(N, dof) -> (N, 4, 4) rigid TCP poses; GIL released, every core for N >= 2048."""
+    def compliance_batch(self, Q: _ArrayLike) -> _FloatArray:
+        """(N, dof) -> (N, 6, 6) compliances; GIL released, every core for N >= 2048."""
     def deflection_batch(self, Q: _ArrayLike, W: _ArrayLike) -> _FloatArray:
         """(N, dof), (N, 6) -> (N, 6) [m, rad]; a single row of either broadcasts over the
-        other's rows. float64 C-contiguous input is read in place; the GIL is released."""
+        other's rows. float64 C-contiguous input is read in place; the GIL is released and
+        batches of N >= 2048 rows run on every core."""
     def equilibrium(
         self, q: _ArrayLike, wrench: _ArrayLike, max_iterations: int = 20, tolerance: float = 1e-12
     ) -> _FloatArray:
