@@ -1,0 +1,241 @@
+"""deflect against its peers, back to back in one process: ratios and agreement.
+
+Run by hand on a quiet machine (not a test: nothing here asserts a time):
+
+    .venv/bin/pip install pin scipy ruckig example-robot-data   # once
+    .venv/bin/python benches/peers.py [--quick]
+
+Each pair computes the same thing on the same inputs, and the table gives the median time per
+call (or per point / row), the deflect/peer ratio (< 1: deflect is faster) and the largest
+difference between the two results:
+
+- UR5 compliance and deflection (example-robot-data's UR5, deflect's `robots/ur5` springs):
+  Pinocchio's frame placements and joint frames plus numpy for the spring Jacobian
+  (three rotations per joint: the drive's axis and two bending axes; the springs as extra
+  joints) and `J K^-1 J^T w`, against `SerialRobot.compliance` + `@ w`, and per row in batches;
+- compliance map (Paksoy, Dede and Kiper 2025, Eq. 9-14, OC map): scipy's
+  RegularGridInterpolator (linear, and cubic: a different C1/C2 interpolant, so its agreement is
+  the gap between two smooth fits, not a check) on the 8 coefficient fields, against
+  `ComplianceMap.displacement` and `displacement_batch`;
+- jerk-limited motion: ruckig's `calculate` (plan only) and `calculate` + `at_time` per tick at
+  2 kHz, against `plan_line(..., rate_hz=None)` and `plan_line(...)` + `position`, on a 1-D move
+  (deflect limits the path, ruckig each axis: in one coordinate both solve the same problem).
+"""
+
+import argparse
+import pathlib
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import deflect
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def median_time(fn, repeats, inner=1):
+    """Median seconds per call of `fn` over `repeats` samples of `inner` calls each."""
+    fn()  # warm up (first-call imports, caches)
+    samples = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        for _ in range(inner):
+            fn()
+        samples.append((time.perf_counter() - t0) / inner)
+    return statistics.median(samples)
+
+
+def row(name, t_deflect, t_peer, unit_scale, unit, agreement):
+    ratio = t_deflect / t_peer
+    print(
+        f"{name:<44} {t_deflect * unit_scale:>10.3f} {t_peer * unit_scale:>10.3f} {unit:<8}"
+        f" {ratio:>7.3f}  {1 / ratio:>7.1f}x  "
+        + ("n/a (exact vs linear model)" if agreement is None else f"{agreement:.1e}")
+    )
+
+
+def ur5_urdf():
+    from importlib import metadata
+
+    dist = metadata.distribution("example-robot-data")
+    return pathlib.Path(
+        dist.locate_file("cmeel.prefix/share/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf")
+    )
+
+
+def springs_of(toml_path):
+    """(joint name, [k_axis, k_bend1, k_bend2]) per `[[virtual_joint]]` of a stiffness file."""
+    import tomllib
+
+    with open(toml_path, "rb") as f:
+        return [(v["joint"], v["k"]) for v in tomllib.load(f)["virtual_joint"]]
+
+
+class PinocchioCompliance:
+    """C = J_s K^-1 J_s^T at the tool frame, J_s the twists of the virtual joints' rotations.
+
+    Each spring sits in its joint's frame with its first axis along the joint axis: its three
+    rotations are that axis and two unit vectors normal to it (any pair: the two bending
+    stiffnesses are equal in the UR5 file, and checked so)."""
+
+    def __init__(self, urdf, toml_path, tip):
+        import pinocchio as pin
+
+        self.pin = pin
+        self.model = pin.buildModelFromUrdf(str(urdf))
+        self.data = self.model.createData()
+        self.tip = self.model.getFrameId(tip)
+        springs = springs_of(toml_path)
+        self.joint_ids = [self.model.getJointId(name) for name, _ in springs]
+        k = np.array([s[1] for s in springs], dtype=float)
+        assert np.all(k[:, 1] == k[:, 2]), "bending stiffnesses must be equal for this reference"
+        # 1/k per column, columns in the joint frame's x, y, z order (the drive axis gets the
+        # torsional compliance, the two others the bending one).
+        inv = []
+        for jid, kj in zip(self.joint_ids, k):
+            ax = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}[
+                self.model.joints[jid].shortname()]
+            inv.extend(1.0 / kj[0] if c == ax else 1.0 / kj[1] for c in range(3))
+        self.inv_k = np.array(inv)
+
+    def compliance(self, q):
+        pin = self.pin
+        pin.forwardKinematics(self.model, self.data, q)
+        p = pin.updateFramePlacement(self.model, self.data, self.tip).translation
+        frames = [self.data.oMi[j] for j in self.joint_ids]
+        # Rows of R^T are the frame axes in the base frame: 3 rotation axes per spring.
+        axes = np.concatenate([m.rotation.T for m in frames])
+        levers = np.repeat([p - m.translation for m in frames], 3, axis=0)
+        j = np.concatenate([np.cross(axes, levers), axes], axis=1).T
+        return (j * self.inv_k) @ j.T
+
+
+def bench_vjm(args):
+    urdf, toml = ur5_urdf(), ROOT / "robots/ur5/ur5_stiffness.toml"
+    robot = deflect.SerialRobot.from_urdf(urdf, toml, "tool0")
+    peer = PinocchioCompliance(urdf, toml, "tool0")
+    rng = np.random.default_rng(1)
+    q = rng.uniform(-2.0, 2.0, 6)
+    w = np.array([30.0, -20.0, 50.0, 2.0, -1.0, 0.5])
+
+    c_d, c_p = robot.compliance(q), peer.compliance(q)
+    agree_c = np.abs(c_d - c_p).max() / np.abs(c_p).max()
+    t_d = median_time(lambda: robot.compliance(q) @ w, args.repeats, args.inner)
+    t_p = median_time(lambda: peer.compliance(q) @ w, args.repeats, args.inner)
+    row("UR5 compliance + C w, one call", t_d, t_p, 1e6, "us", agree_c)
+
+    n = args.rows
+    qs = rng.uniform(-2.0, 2.0, (n, 6))
+    ws = rng.uniform(-50.0, 50.0, (n, 6))
+    d_batch = robot.compliance_batch(qs) @ ws[:, :, None]
+    ref = np.array([peer.compliance(qs[i]) @ ws[i] for i in range(min(n, 200))])
+    agree_b = np.abs(d_batch[: len(ref), :, 0] - ref).max() / np.abs(ref).max()
+    t_d = median_time(lambda: robot.compliance_batch(qs), max(3, args.repeats // 10)) / n
+    t_p = median_time(lambda: [peer.compliance(x) for x in qs[:2000]], 3) / 2000
+    row(f"UR5 compliance, batch of {n} (per row)", t_d, t_p, 1e6, "us", agree_b)
+    t_d = median_time(lambda: robot.deflection_batch(qs, ws), max(3, args.repeats // 10)) / n
+    row(f"UR5 deflection_batch of {n} (per row) vs C w", t_d, t_p, 1e6, "us", None)
+
+
+def bench_map(args):
+    from scipy.interpolate import RegularGridInterpolator
+
+    m = deflect.ComplianceMap.from_csv(ROOT / "data/paksoy2025_compliance_oc.csv")
+    rng = np.random.default_rng(0)
+    n = args.points
+    p = np.column_stack([rng.uniform(m.x[0], m.x[-1], n), rng.uniform(m.y[0], m.y[-1], n)])
+    f = rng.uniform(-250.0, 250.0, (n, 2))
+    nx, ny = len(m.x), len(m.y)
+    fields = np.concatenate([m.slopes.reshape(nx, ny, 4), m.offsets.reshape(nx, ny, 4)], axis=2)
+
+    def scipy_of(rgi):
+        def run(pp, ff):
+            c = rgi(pp)
+            s = c[:, :4].reshape(-1, 2, 2)
+            o = c[:, 4:].reshape(-1, 2, 2)
+            return np.einsum("ndf,nf->nd", s, ff) + o.sum(axis=2)
+        return run
+
+    for method, interp in [("linear", "bilinear"), ("cubic", "bicubic")]:
+        if method == "cubic" and min(nx, ny) < 4:
+            print(f"{'map ' + method:<44} skipped: scipy's cubic needs 4 nodes per axis, the "
+                  f"grid has {nx} x {ny}")
+            continue
+        peer = scipy_of(RegularGridInterpolator((m.x, m.y), fields, method=method))
+        d = m.displacement_batch(p, f, interpolation=interp)
+        agree = np.abs(d - peer(p, f)).max() / np.abs(d).max()
+        t_d = median_time(lambda: m.displacement_batch(p, f, interpolation=interp), args.repeats)
+        t_p = median_time(lambda: peer(p, f), max(3, args.repeats // 4))
+        row(f"map {interp} vs RGI {method}, batch of {n} (per pt)", t_d / n, t_p / n, 1e9, "ns", agree)
+        p1, f1 = p[0], f[0]
+        t_d = median_time(lambda: m.displacement(p1, f1, interpolation=interp), args.repeats, args.inner)
+        t_p = median_time(lambda: peer(p1[None], f1[None]), args.repeats, max(1, args.inner // 20))
+        row(f"map {interp} vs RGI {method}, one query", t_d, t_p, 1e6, "us",
+            np.abs(m.displacement(p1, f1, interpolation=interp) - peer(p1[None], f1[None])[0]).max()
+            / np.abs(d).max())
+
+
+def bench_motion(args):
+    import ruckig
+
+    v, a, j = 1.2, 25.0, 600.0
+    start, end = 0.05, 0.35
+
+    def ruckig_plan():
+        otg = ruckig.Ruckig(1)
+        inp = ruckig.InputParameter(1)
+        inp.current_position, inp.target_position = [start], [end]
+        inp.current_velocity = inp.current_acceleration = [0.0]
+        inp.target_velocity = inp.target_acceleration = [0.0]
+        inp.max_velocity, inp.max_acceleration, inp.max_jerk = [v], [a], [j]
+        traj = ruckig.Trajectory(1)
+        otg.calculate(inp, traj)
+        return traj
+
+    def ruckig_sampled():
+        traj = ruckig_plan()
+        dt = 1.0 / 2000.0
+        k = int(np.floor(traj.duration / dt)) + 1
+        return [traj.at_time(i * dt)[0][0] for i in range(k)]
+
+    plan = deflect.plan_line([start], [end], v, a, j, rate_hz=None)
+    peer = ruckig_plan()
+    agree = abs(plan.duration - peer.duration) / peer.duration
+    t_d = median_time(lambda: deflect.plan_line([start], [end], v, a, j, rate_hz=None),
+                      args.repeats, args.inner)
+    t_p = median_time(ruckig_plan, args.repeats, args.inner)
+    row("1-D jerk-limited plan only (duration)", t_d, t_p, 1e6, "us", agree)
+
+    sampled = deflect.plan_line([start], [end], v, a, j).position[:, 0]
+    ref = np.array(ruckig_sampled())
+    k = min(len(sampled), len(ref))
+    agree = np.abs(sampled[:k] - ref[:k]).max() / (end - start)
+    t_d = median_time(lambda: deflect.plan_line([start], [end], v, a, j).position,
+                      max(5, args.repeats // 5))
+    t_p = median_time(ruckig_sampled, max(5, args.repeats // 5))
+    row(f"1-D plan + {len(sampled)} ticks at 2 kHz", t_d, t_p, 1e6, "us", agree)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
+    args = ap.parse_args()
+    args.repeats = 5 if args.quick else 41
+    args.inner = 20 if args.quick else 200
+    args.rows = 2_000 if args.quick else 20_000
+    args.points = 10_000 if args.quick else 100_000
+    print(f"deflect {deflect.__version__}, numpy {np.__version__}, Python {sys.version.split()[0]}")
+    print(f"{'pair':<44} {'deflect':>10} {'peer':>10} {'unit':<8} {'ratio':>7}  {'speedup':>8}  "
+          "max rel diff")
+    for bench in (bench_vjm, bench_map, bench_motion):
+        try:
+            bench(args)
+        except ImportError as e:
+            print(f"{bench.__name__}: skipped, {e.name} is not installed (pip install pin scipy "
+                  "ruckig example-robot-data)")
+
+
+if __name__ == "__main__":
+    main()
