@@ -16,13 +16,13 @@ use deflect_core::{BuildError, LoadError as CoreLoadError, TickError};
 use nalgebra::{Isometry3, Matrix3, Matrix4, UnitQuaternion};
 use numpy::ndarray::{Array2, ArrayView2};
 use numpy::{
-    PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
+    PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
     PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods, ToPyArray,
 };
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
-use pyo3::types::{PyFloat, PyInt};
+use pyo3::types::{PyFloat, PyInt, PyList, PyTuple};
 
 use crate::{ConvergenceError, InputError, LoadError, SingularError};
 
@@ -164,8 +164,35 @@ pub fn array_dyn<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyA
     readonly(&float_array(o, what)?, what)
 }
 
+/// The numbers of a float64 1-D numpy array, a list or a tuple of Python floats and ints,
+/// read directly (the common per-call inputs: no numpy round trip). `None` for anything
+/// else, which then goes through numpy's conversion and its checks.
+fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
+    if let Ok(a) = o.cast::<PyArray1<f64>>() {
+        let r = a.try_readonly().ok()?;
+        return r.as_slice().ok().map(<[f64]>::to_vec);
+    }
+    let number = |x: Bound<'_, PyAny>| -> Option<f64> {
+        if x.is_exact_instance_of::<PyFloat>() || x.is_exact_instance_of::<PyInt>() {
+            x.extract::<f64>().ok()
+        } else {
+            None
+        }
+    };
+    if let Ok(l) = o.cast::<PyList>() {
+        return l.iter().map(number).collect();
+    }
+    if let Ok(t) = o.cast::<PyTuple>() {
+        return t.iter().map(number).collect();
+    }
+    None
+}
+
 /// `o` as a 1-D float array of any length, copied.
 pub fn vector_any(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+    if let Some(v) = fast_vector(o) {
+        return Ok(v);
+    }
     let a = array_dyn(o, what)?;
     let v = a.as_array();
     if v.ndim() != 1 {
@@ -177,6 +204,9 @@ pub fn vector_any(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
 /// `o` as a 1-D float array of exactly `n` entries, copied (no finiteness check: the core
 /// call checks and names what it refuses).
 pub fn vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> {
+    if let Some(v) = fast_vector(o).filter(|v| v.len() == n) {
+        return Ok(v);
+    }
     let a = array_dyn(o, what)?;
     let v = a.as_array();
     if v.shape() != [n] {

@@ -1,5 +1,7 @@
 //! `deflect.SerialRobot`: the virtual-joint model of deflect-core.
 
+use std::sync::{Mutex, MutexGuard, PoisonError};
+
 use deflect_core::SerialRobot as CoreRobot;
 use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
@@ -21,6 +23,22 @@ use crate::convert::{
 #[derive(Debug)]
 pub struct SerialRobot {
     pub(crate) inner: CoreRobot,
+    /// The workspace of single calls (batches give each thread its own): allocated once,
+    /// locked per call so that the class stays frozen.
+    data: Mutex<Data>,
+}
+
+impl SerialRobot {
+    pub(crate) fn new(inner: CoreRobot) -> Self {
+        let data = Mutex::new(Data::new(&inner.model));
+        Self { inner, data }
+    }
+
+    fn data(&self) -> MutexGuard<'_, Data> {
+        // A poisoned lock only means another call failed mid-call; the workspace is
+        // overwritten by every call.
+        self.data.lock().unwrap_or_else(PoisonError::into_inner)
+    }
 }
 
 #[pymethods]
@@ -37,7 +55,7 @@ impl SerialRobot {
     ) -> PyResult<Self> {
         let inner = io::urdf::from_path(&urdf_path, &stiffness_path, base_link, tip_link)
             .map_err(load_err)?;
-        Ok(Self { inner })
+        Ok(Self::new(inner))
     }
 
     /// Same as `from_urdf`, from the files' texts; the chain runs from `base_link` (default:
@@ -51,7 +69,7 @@ impl SerialRobot {
         base_link: Option<&str>,
     ) -> PyResult<Self> {
         let inner = io::urdf::from_str(urdf, stiffness, base_link, tip_link).map_err(load_err)?;
-        Ok(Self { inner })
+        Ok(Self::new(inner))
     }
 
     /// Number of actuated joints.
@@ -97,9 +115,7 @@ impl SerialRobot {
     /// The robot of a pickled state (see `__reduce__`), validated like a loaded one.
     #[staticmethod]
     fn _from_state(state: crate::pickle::RobotState) -> PyResult<Self> {
-        Ok(Self {
-            inner: crate::pickle::robot_of(state)?,
-        })
+        Ok(Self::new(crate::pickle::robot_of(state)?))
     }
 
     /// Rigid TCP pose, a (4, 4) homogeneous matrix [m].
@@ -110,7 +126,7 @@ impl SerialRobot {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
-        let t = vjm::forward(model, &mut Data::new(model), &q).map_err(tick_err)?;
+        let t = vjm::forward(model, &mut self.data(), &q).map_err(tick_err)?;
         Ok(iso_to_py(py, &t))
     }
 
@@ -125,7 +141,7 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let d = vjm::deflection(model, &mut Data::new(model), &q, &w).map_err(tick_err)?;
+        let d = vjm::deflection(model, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(d.as_slice().to_pyarray(py))
     }
 
@@ -153,8 +169,7 @@ impl SerialRobot {
             max_iterations,
             tolerance,
         };
-        let e =
-            vjm::equilibrium(model, &mut Data::new(model), &q, &w, &options).map_err(tick_err)?;
+        let e = vjm::equilibrium(model, &mut self.data(), &q, &w, &options).map_err(tick_err)?;
         Ok(e.deflection.as_slice().to_pyarray(py))
     }
 
@@ -169,7 +184,7 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let mut data = Data::new(model);
+        let mut data = self.data();
         vjm::deflection(model, &mut data, &q, &w).map_err(tick_err)?;
         let n = model.spring_count();
         let flat: Vec<f64> = data
@@ -192,7 +207,7 @@ impl SerialRobot {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
-        let c = vjm::compliance(model, &mut Data::new(model), &q).map_err(tick_err)?;
+        let c = vjm::compliance(model, &mut self.data(), &q).map_err(tick_err)?;
         Ok(matrix_to_py(py, &c))
     }
 
@@ -204,7 +219,7 @@ impl SerialRobot {
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
-        let mut data = Data::new(model);
+        let mut data = self.data();
         vjm::joint_jacobian(model, &mut data, &q).map_err(tick_err)?;
         let j = &data.jacobian;
         Ok(Array2::from_shape_fn((6, model.dof()), |ij| {
@@ -231,15 +246,8 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let c = vjm::joint_correction(
-            model,
-            &mut Data::new(model),
-            &q,
-            &w,
-            max_iterations,
-            tolerance,
-        )
-        .map_err(tick_err)?;
+        let c = vjm::joint_correction(model, &mut self.data(), &q, &w, max_iterations, tolerance)
+            .map_err(tick_err)?;
         if !c.converged {
             let why = if c.stalled {
                 "stalled: a step no longer lowers the residual (least-squares fixed point)"

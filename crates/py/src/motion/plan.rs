@@ -180,6 +180,11 @@ enum LimitArg {
 }
 
 fn limit_arg(o: &Bound<'_, PyAny>, what: &str, d: usize) -> PyResult<LimitArg> {
+    if o.is_exact_instance_of::<pyo3::types::PyFloat>()
+        || o.is_exact_instance_of::<pyo3::types::PyInt>()
+    {
+        return Ok(LimitArg::Scalar(real(o, what)?));
+    }
     let a = float_array(o, what)?;
     match a.ndim() {
         0 => Ok(LimitArg::Scalar(real(o, what)?)),
