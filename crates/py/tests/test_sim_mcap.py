@@ -1,7 +1,7 @@
 """Every MCAP log deflect-sim writes follows one convention (crates/sim/README.md, "MCAP logs").
 
 Runs the release binary (`cargo run --release -p deflect-sim -- ...`) for every scenario with
-small, fast settings, all at once (about 20 s on 2 cores, most of it the KR 300 scenes), and
+small, fast settings, all at once (about 30 s on 2 cores, most of it the KR 300 scenes), and
 reads each log back with the official `mcap` reader:
 
 * schema names are `deflect.<Type>` or `foxglove.<Type>`; a name means the same fields in
@@ -57,11 +57,16 @@ def logs(tmp_path_factory):
         cwd=REPO, capture_output=True, text=True, timeout=1800,
     )
     assert build.returncode == 0, build.stderr
+    meta = subprocess.run(
+        ["cargo", "metadata", "--format-version", "1", "--no-deps"],
+        cwd=REPO, capture_output=True, text=True, timeout=600, check=True,
+    )
+    binary = pathlib.Path(json.loads(meta.stdout)["target_directory"]) / "release" / "deflect-sim"
     procs = {}
     for name, (args, _) in SCENARIOS.items():
         out = tmp_path_factory.mktemp(name)
-        cmd = ["cargo", "run", "--release", "--quiet", "-p", "deflect-sim", "--", *args,
-               "--out", str(out)]
+        # The binary `cargo run --release -p deflect-sim` runs, built once above.
+        cmd = [str(binary), *args, "--out", str(out)]
         procs[name] = (out, subprocess.Popen(cmd, cwd=REPO, stdout=subprocess.PIPE,
                                              stderr=subprocess.PIPE, text=True))
     result = {}
@@ -162,7 +167,8 @@ def test_one_time_base_every_run_from_zero(logs):
         for _, topic, t, d in log.messages:
             assert t >= last.get(topic, 0), (name, topic)
             last[topic] = t
-            ts = d["timestamp"]
+            # foxglove.SceneUpdate: the entities' timestamps.
+            ts = d["timestamp"] if "timestamp" in d else d["entities"][0]["timestamp"]
             assert 0 <= ts["nsec"] < 1_000_000_000
             assert ts["sec"] * 1_000_000_000 + ts["nsec"] == t, (name, topic)
             run = topic.rsplit("/", 1)[0]

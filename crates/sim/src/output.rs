@@ -177,8 +177,9 @@ pub fn write_summary<T: serde::Serialize + ?Sized>(
     Ok(())
 }
 
-/// Signed distance \[m\] of `p` from the polyline `pts`: to the nearest segment, positive to
-/// the left of its direction.
+/// Deviation \[m\] of `p` across the polyline `pts`: its signed distance from the line of
+/// the nearest segment, positive to the left of the direction of travel (overshoot beyond a
+/// segment's end along it does not count, as in the paper's path deviation).
 pub fn polyline_distance(pts: &[nalgebra::Vector2<f64>], p: &nalgebra::Vector2<f64>) -> f64 {
     let mut best = (f64::INFINITY, 0.0);
     for w in pts.windows(2) {
@@ -188,8 +189,8 @@ pub fn polyline_distance(pts: &[nalgebra::Vector2<f64>], p: &nalgebra::Vector2<f
         let u = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
         let dist = (p - (a + d * u)).norm();
         if dist < best.0 {
-            let side = (d.x * (p.y - a.y) - d.y * (p.x - a.x)).signum();
-            best = (dist, side * dist);
+            let across = (d.x * (p.y - a.y) - d.y * (p.x - a.x)) / len2.sqrt();
+            best = (dist, across);
         }
     }
     best.1
@@ -259,9 +260,9 @@ pub fn paths_title(runs: &[&RunResult]) -> String {
     )
 }
 
-/// Path plot of runs of one motion: the tool point's signed distance from the desired path
-/// (all legs) against time over the whole run, one curve per run; grey lines where a new
-/// leg is commanded.
+/// Path plot of runs of one motion: the tool point's deviation across the desired path
+/// ([`polyline_distance`], all legs) against time over the whole run, one curve per run;
+/// dashed grey lines where a new leg is commanded.
 pub fn plot_paths(path: &Path, runs: &[&RunResult]) -> Result<(), SimError> {
     let root = canvas(path, (1200, 620))?;
     let Some(first) = runs.first() else {
@@ -285,7 +286,7 @@ pub fn plot_paths(path: &Path, runs: &[&RunResult]) -> Result<(), SimError> {
     entries.push(Entry::new(
         "new leg commanded",
         Role::Guide,
-        Swatch::Line(1),
+        Swatch::Dashed(1),
     ));
     let (plot, legend) = figure(&root, &paths_title(runs), CHART.caption, &entries)?;
     let x = padded_range(series.iter().flatten().map(|p| p.0), 0.01, 0.01);
@@ -301,7 +302,7 @@ pub fn plot_paths(path: &Path, runs: &[&RunResult]) -> Result<(), SimError> {
         y.clone(),
         (
             "time since the motion start [s]",
-            "distance from the desired path, + left of travel [mm]",
+            "deviation across the path, + left of travel [mm]",
         ),
     )?;
     let legs: Vec<f64> = first
@@ -316,7 +317,7 @@ pub fn plot_paths(path: &Path, runs: &[&RunResult]) -> Result<(), SimError> {
             vec![(t, y.start), (t, y.end)],
             color(Role::Guide),
             1,
-            false,
+            true,
         )?;
     }
     for (s, (e, width, dashed)) in series.into_iter().zip(&styles) {
@@ -356,7 +357,7 @@ pub fn plot_error_vs_g(path: &Path, motion: Motion, runs: &[RunResult]) -> Resul
     let entries: Vec<Entry> = curves.iter().map(|c| c.0.0.clone()).collect();
     let title = format!(
         "{}: max path deviation against peak acceleration, OC and NC robots, {}",
-        motion_words(motion),
+        motion.label(),
         correction_words(sel.iter().copied())
     );
     let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
@@ -400,6 +401,26 @@ mod tests {
         std::fs::create_dir_all(&d).unwrap();
         std::fs::write(d.join("a_file"), "").unwrap();
         d
+    }
+
+    #[test]
+    fn distance_from_the_path_is_signed_and_covers_every_leg() {
+        use nalgebra::Vector2;
+        let tri = Motion::Triangle.points();
+        // On a vertex, on the second leg, left and right of the first leg.
+        assert!(polyline_distance(&tri, &tri[1]).abs() < 1e-15);
+        let mid = (tri[1] + tri[2]) * 0.5;
+        assert!(polyline_distance(&tri, &mid).abs() < 1e-15);
+        let line = [Vector2::new(0.0, 0.0), Vector2::new(1.0, 0.0)];
+        assert_eq!(polyline_distance(&line, &Vector2::new(0.5, 0.25)), 0.25);
+        assert_eq!(polyline_distance(&line, &Vector2::new(0.5, -0.25)), -0.25);
+        // Overshoot along the line beyond its end is not a deviation across it.
+        assert_eq!(polyline_distance(&line, &Vector2::new(1.5, 0.125)), 0.125);
+        assert_eq!(config_words("NC GL"), "NC robot, lower head");
+        assert_eq!(
+            motion_words(Motion::XLine),
+            "x-line (100 mm along x at y = 0)"
+        );
     }
 
     #[test]

@@ -37,7 +37,7 @@ pub enum Role {
     FramePairs,
     /// Identified from 6-D TCP deflections.
     TcpDeflection,
-    /// Guide lines (leg changes, cutter entry and exit, ratio 1): not data.
+    /// Guide lines (leg changes, cutter entry and exit, ratio 1), drawn dashed: not data.
     Guide,
 }
 
@@ -55,7 +55,7 @@ pub fn color(role: Role) -> RGBColor {
         Role::NcLower => RGBColor(136, 34, 85),
         Role::FramePairs => RGBColor(68, 170, 153),
         Role::TcpDeflection => RGBColor(140, 86, 75),
-        Role::Guide => RGBColor(185, 185, 185),
+        Role::Guide => RGBColor(90, 90, 90),
     }
 }
 
@@ -145,6 +145,12 @@ pub enum Swatch {
     Dashed(u32),
     /// A filled circle.
     Marker,
+    /// A cross.
+    Cross,
+    /// A filled triangle pointing up.
+    Arrow,
+    /// A vertical error bar with caps.
+    Bar,
 }
 
 /// One legend entry.
@@ -239,6 +245,28 @@ pub fn draw_legend(area: &Area<'_>, entries: &[Entry]) -> Result<(), SimError> {
             Swatch::Marker => area
                 .draw(&Circle::new(((x0 + x1) / 2, y), 4, e.color.filled()))
                 .map_err(perr)?,
+            Swatch::Cross => area
+                .draw(&Cross::new(((x0 + x1) / 2, y), 5, e.color.stroke_width(2)))
+                .map_err(perr)?,
+            Swatch::Arrow => {
+                let c = (x0 + x1) / 2;
+                area.draw(&Polygon::new(
+                    vec![(c - 6, y + 5), (c + 6, y + 5), (c, y - 6)],
+                    e.color.filled(),
+                ))
+                .map_err(perr)?;
+            }
+            Swatch::Bar => {
+                let c = (x0 + x1) / 2;
+                for pts in [
+                    vec![(c, y - 8), (c, y + 8)],
+                    vec![(c - 5, y - 8), (c + 5, y - 8)],
+                    vec![(c - 5, y + 8), (c + 5, y + 8)],
+                ] {
+                    area.draw(&PathElement::new(pts, e.color.stroke_width(2)))
+                        .map_err(perr)?;
+                }
+            }
         }
         area.draw(&Text::new(
             e.label.clone(),

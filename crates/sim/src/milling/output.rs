@@ -343,7 +343,7 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
     entries.push(Entry::new(
         "cutter entry and exit",
         Role::Guide,
-        Swatch::Line(1),
+        Swatch::Dashed(1),
     ));
     let title = format!(
         "KR 300 R2500 milling a groove at {:.0} mm/s, {:.0} N process force: path error across \
@@ -379,7 +379,7 @@ pub fn plot_error(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             vec![(t, 0.0), (t, ymax)],
             color(Role::Guide),
             1,
-            false,
+            true,
         )?;
     }
     for run in &r.runs {
@@ -497,16 +497,25 @@ pub fn plot_stiffness(path: &Path, r: &MillingResult) -> Result<(), SimError> {
             Role::TcpDeflection,
             Swatch::Marker,
         ),
-        Entry::new("bars: 95 % CI (+- 1.96 se)", Role::Guide, Swatch::Line(2)),
-        Entry::new("arrow: bar beyond the axis", Role::Guide, Swatch::Marker),
-        Entry::new("cross: not identifiable", Role::Guide, Swatch::Marker),
-        Entry::new("line: true value (1)", Role::Guide, Swatch::Line(1)),
+        Entry::new(
+            "95 % confidence interval (+- 1.96 se)",
+            Role::Guide,
+            Swatch::Bar,
+        ),
+        Entry::new("interval beyond the axis", Role::Guide, Swatch::Arrow),
+        Entry::new(
+            "not identifiable from the loads",
+            Role::Guide,
+            Swatch::Cross,
+        ),
+        Entry::new("true value (ratio 1)", Role::Guide, Swatch::Dashed(1)),
     ];
+    let poses = r.options.id_poses.clamp(1, 3);
     let title = format!(
-        "KR 300 R2500: virtual-joint stiffness identified from static loads ({:.0} N, {} \
-         pose(s)) over the true value",
+        "KR 300 R2500: virtual-joint stiffness identified from static loads ({:.0} N, {poses} \
+         pose{}) over the true value",
         r.options.id_load,
-        r.options.id_poses.clamp(1, 3)
+        if poses == 1 { "" } else { "s" }
     );
     let (plot, legend) = figure(&root, &title, CHART.caption, &entries)?;
     let n = r.stiffness.len().max(1) as f64;
