@@ -11,7 +11,6 @@
 //! (about 0.7 M physics steps, under 10 s per object); `reproduce` with 50 fixed-point
 //! iterations about 2 s.
 
-use std::fmt;
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
@@ -54,149 +53,9 @@ impl From<SimError> for CliError {
     }
 }
 
-/// The documented range of a numeric flag: `[min, max]` (`(min, max)` if `open`), with its
-/// unit. Shown in the flag's `--help` ([`Range::help`]) and checked before any work
-/// ([`Range::check`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Range {
-    /// The flag, `--cut`.
-    pub flag: &'static str,
-    /// Smallest value.
-    pub min: f64,
-    /// Largest value.
-    pub max: f64,
-    /// Both ends excluded.
-    pub open: bool,
-    /// Unit ("" if none).
-    pub unit: &'static str,
-}
-
-impl Range {
-    /// `[min, max]` in `unit`.
-    const fn closed(flag: &'static str, min: f64, max: f64, unit: &'static str) -> Self {
-        Self {
-            flag,
-            min,
-            max,
-            open: false,
-            unit,
-        }
-    }
-
-    /// The range as written in help and errors: "[0.01, 5] s", "(1.5, 30) N", "[1, 64]".
-    pub fn text(&self) -> String {
-        let (l, r) = if self.open { ('(', ')') } else { ('[', ']') };
-        let unit = if self.unit.is_empty() {
-            String::new()
-        } else {
-            format!(" {}", self.unit)
-        };
-        format!("{l}{}, {}{r}{unit}", self.min, self.max)
-    }
-
-    /// The help of the flag: "`what`. Range: <text>. `more`."
-    pub fn help(&self, what: &str, more: &str) -> String {
-        let more = if more.is_empty() {
-            String::new()
-        } else {
-            format!(" {more}.")
-        };
-        format!("{what}. Range: {}.{more}", self.text())
-    }
-
-    /// Whether `v` is in the range (NaN is not).
-    pub fn contains(&self, v: f64) -> bool {
-        if self.open {
-            v > self.min && v < self.max
-        } else {
-            v >= self.min && v <= self.max
-        }
-    }
-
-    /// `v` in the range, or the usage error "--flag v is out of range: allowed <text>".
-    pub fn check(&self, v: f64) -> Result<(), CliError> {
-        self.check_shown(v, &shown(v))
-    }
-
-    /// [`Range::check`] of an integer flag (shown as given; u64 -> f64 rounds only above
-    /// 2^53, far outside every integer range here).
-    pub fn check_int(&self, v: impl Into<u64> + Copy + fmt::Display) -> Result<(), CliError> {
-        self.check_shown(v.into() as f64, &v.to_string())
-    }
-
-    fn check_shown(&self, v: f64, shown: &str) -> Result<(), CliError> {
-        if self.contains(v) {
-            Ok(())
-        } else {
-            Err(CliError::Usage(format!(
-                "{} {shown} is out of range: allowed {}",
-                self.flag,
-                self.text()
-            )))
-        }
-    }
-}
-
-/// A float as the errors show it: plain, or in exponent form when very large or small.
-fn shown(v: f64) -> String {
-    let a = v.abs();
-    if v.is_finite() && a != 0.0 && !(1e-4..1e6).contains(&a) {
-        format!("{v:e}")
-    } else {
-        format!("{v}")
-    }
-}
-
-/// `reproduce --mass`, `run --mass` \[kg\].
-pub const MASS: Range = Range::closed("--mass", 0.0, 50.0, "kg");
-/// `reproduce --g` (each level), `run --g`.
-pub const G_LEVEL: Range = Range::closed("--g", 1.0, 5.0, "g");
-/// `reproduce --fixed-point`.
-pub const FIXED_POINT: Range = Range::closed("--fixed-point", 0.0, 50.0, "");
-/// `reproduce --jobs`, `contour --jobs`: 0 is refused (it used to mean 1).
-pub const JOBS: Range = Range::closed("--jobs", 1.0, 64.0, "");
-/// `milling --feed` \[mm/s\]: with the longest cut the groove stays within 300 mm, well inside
-/// the arm's reach.
-pub const FEED: Range = Range::closed("--feed", 0.1, 50.0, "mm/s");
-/// `milling --force` \[N\].
-pub const FORCE: Range = Range::closed("--force", 0.0, 2000.0, "N");
-/// `milling --cut` \[s\]: at most 4 x 6.2 s simulated at 0.5 ms plus the identification's
-/// 10 s, about 1.5 min on 2 cores.
-pub const CUT: Range = Range::closed("--cut", 0.01, 5.0, "s");
-/// `milling --rise-ms` \[ms\]: within the 0.4 s run-out.
-pub const RISE_MS: Range = Range::closed("--rise-ms", 0.1, 300.0, "ms");
-/// `milling --cycle-ms` \[ms\], also a multiple of the 0.5 ms physics step.
-pub const CYCLE_MS: Range = Range::closed("--cycle-ms", 0.5, 20.0, "ms");
-/// `milling --lead-ms` \[ms\].
-pub const LEAD_MS: Range = Range::closed("--lead-ms", 0.0, 500.0, "ms");
-/// `milling --estimate-error`.
-pub const ESTIMATE_ERROR: Range = Range::closed("--estimate-error", -1.0, 1.0, "");
-/// `milling --id-poses`: poses of the stiffness identification.
-pub const ID_POSES: Range = Range::closed("--id-poses", 1.0, 3.0, "");
-/// `contour --step-mm` \[mm\].
-pub const STEP_MM: Range = Range::closed("--step-mm", 0.2, 20.0, "mm");
-/// `contour --target-force` \[N\]: strictly between the tracer's contact and jam forces.
-pub const TARGET_FORCE: Range = Range {
-    flag: "--target-force",
-    min: 1.5,
-    max: 30.0,
-    open: true,
-    unit: "N",
-};
-/// `contour --noise` \[N\].
-pub const NOISE: Range = Range::closed("--noise", 0.0, 5.0, "N");
-/// `serial --g`: peak acceleration of the motions.
-pub const SERIAL_G: Range = Range::closed("--g", 0.05, 5.0, "g");
-/// `serial --payload-mass` \[kg\].
-pub const PAYLOAD_MASS: Range = Range::closed("--payload-mass", 0.0, 2000.0, "kg");
-/// `serial --scale` \[m\]: the line is `(0.3, 0.2, -0.1) scale`, the circle's radius `0.15 scale`.
-pub const SCALE: Range = Range::closed("--scale", 0.01, 3.0, "m");
-/// `serial --v-max` \[m/s\].
-pub const V_MAX: Range = Range::closed("--v-max", 0.01, 10.0, "m/s");
-/// `serial --ramp` \[s\]: time to ramp the acceleration up (sets the jerk).
-pub const RAMP: Range = Range::closed("--ramp", 0.005, 1.0, "s");
-/// `serial --turn` \[rad\]: turn about the vertical over a motion.
-pub const TURN: Range = Range::closed("--turn", 0.0, 3.0, "rad");
+/// The ranges of the numeric flags (in `cli/range.rs`).
+mod range;
+pub use range::*;
 
 // The command line.
 #[derive(Parser, Debug)]
