@@ -76,6 +76,7 @@ pub mod identification;
 pub mod io;
 pub mod mechanism;
 pub mod motion;
+pub mod posture;
 #[cfg(feature = "std")]
 pub mod robot;
 pub mod units;

@@ -1,0 +1,239 @@
+//! Stiffness-optimal posture on the shipped KR 300: the refined optimum agrees with a brute
+//! scan at 0.1 degree, every reported posture reaches the task, and unreachable angles are
+//! reported as such (NaN, never a zero deflection).
+
+use deflect_core::SerialRobot;
+use deflect_core::TickError;
+use deflect_core::posture::{self, AnglePoint, Measure, PostureOptions, Reach};
+use deflect_core::vjm::{self, Data, Vector6};
+use nalgebra::{Unit, Vector3};
+
+const Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+/// The milling wrench of the VJM paper's test (Hähn and Weigold, sec. 3): 386.1 N in -x and
+/// +y, 60 N in -z.
+const WRENCH: [f64; 6] = [-386.1, 386.1, -60.0, 0.0, 0.0, 0.0];
+
+fn kr300() -> SerialRobot {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
+    SerialRobot::from_path(
+        format!("{dir}kr300_r2500.urdf"),
+        format!("{dir}kr300_r2500_stiffness.toml"),
+        "tcp",
+    )
+    .unwrap()
+}
+
+/// The task of the posture Q0: its TCP position and tool (z) axis.
+fn task(robot: &SerialRobot) -> (Vector3<f64>, Vector3<f64>) {
+    let t = vjm::forward(&robot.model, &mut Data::new(&robot.model), &Q0).unwrap();
+    (t.translation.vector, t.rotation * Vector3::z())
+}
+
+fn degrees(from: f64, to: f64, step: f64) -> Vec<f64> {
+    let n = ((to - from) / step).round() as usize;
+    (0..=n)
+        .map(|k| (from + k as f64 * step).to_radians())
+        .collect()
+}
+
+fn run(
+    robot: &SerialRobot,
+    position: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    angles: &[f64],
+    options: &PostureOptions,
+) -> (Vec<AnglePoint>, posture::SweepSummary) {
+    let mut data = Data::new(&robot.model);
+    let mut out = vec![AnglePoint::default(); angles.len()];
+    let s = posture::sweep(
+        &robot.model,
+        &mut data,
+        &robot.joint_limits,
+        position,
+        axis,
+        &Vector6::from_column_slice(&WRENCH),
+        angles,
+        &Q0,
+        options,
+        &mut out,
+    )
+    .unwrap();
+    (out, s)
+}
+
+#[test]
+fn the_refined_optimum_agrees_with_a_brute_scan_at_a_tenth_of_a_degree() {
+    let robot = kr300();
+    let (p, z) = task(&robot);
+    let coarse = degrees(-90.0, 90.0, 5.0);
+    let (out, s) = run(&robot, &p, &z, &coarse, &PostureOptions::default());
+    assert!(s.reachable > 20, "{} reachable", s.reachable);
+    let best = s.best.unwrap();
+    let sampled = out[s.best_index.unwrap()];
+    assert!(best.measure <= sampled.measure);
+    // Brute force: 0.1 degree over the bracket the refinement searched, no refinement.
+    let centre = sampled.angle.to_degrees();
+    let fine = degrees(centre - 5.0, centre + 5.0, 0.1);
+    let plain = PostureOptions {
+        refine: false,
+        ..PostureOptions::default()
+    };
+    let (scan, _) = run(&robot, &p, &z, &fine, &plain);
+    let brute = scan
+        .iter()
+        .filter(|a| a.reach == Reach::Reachable)
+        .min_by(|a, b| a.measure.total_cmp(&b.measure))
+        .unwrap();
+    assert!(
+        (best.angle - brute.angle).abs() <= 0.1f64.to_radians() + 1e-9,
+        "refined {} deg, brute {} deg",
+        best.angle.to_degrees(),
+        brute.angle.to_degrees()
+    );
+    assert!(best.measure <= brute.measure + 1e-12);
+    // The worst reachable angle deflects more, and the spread is worth choosing for.
+    let worst = out[s.worst_index.unwrap()];
+    assert!(
+        worst.measure > 1.05 * best.measure,
+        "{} vs {}",
+        worst.measure,
+        best.measure
+    );
+}
+
+#[test]
+fn every_posture_reaches_the_task_and_its_deflection_is_the_models() {
+    let robot = kr300();
+    let (p, z) = task(&robot);
+    let (out, _) = run(
+        &robot,
+        &p,
+        &z,
+        &degrees(-60.0, 60.0, 10.0),
+        &PostureOptions::default(),
+    );
+    let mut data = Data::new(&robot.model);
+    for a in out.iter().filter(|a| a.reach == Reach::Reachable) {
+        let q = &a.q[..6];
+        let t = vjm::forward(&robot.model, &mut data, q).unwrap();
+        assert!((t.translation.vector - p).norm() < 1e-7);
+        assert!((t.rotation * Vector3::z() - z).norm() < 1e-7);
+        // Its x axis is the convention's, turned by the angle.
+        let want = posture::tool_orientation(&Unit::new_normalize(z), a.angle);
+        assert!(t.rotation.angle_to(&want) < 1e-7);
+        let d = vjm::deflection(
+            &robot.model,
+            &mut data,
+            q,
+            &Vector6::from_column_slice(&WRENCH),
+        )
+        .unwrap();
+        assert_eq!(d, a.deflection);
+        assert_eq!(a.measure, d.fixed_rows::<3>(0).norm());
+        for (v, (lo, hi)) in q.iter().zip(&robot.joint_limits) {
+            assert!(lo <= v && v <= hi);
+        }
+    }
+}
+
+#[test]
+fn measures_by_hand() {
+    let d = Vector6::new(3e-4, -4e-4, 1e-4, 1e-3, 0.0, 0.0);
+    assert!((Measure::Norm.of(&d) - (26e-8f64).sqrt()).abs() < 1e-18);
+    assert_eq!(Measure::Max.of(&d), 4e-4);
+    let along =
+        Measure::along(&[Vector3::new(2.0, 0.0, 0.0), Vector3::new(0.0, 0.0, -1.0)]).unwrap();
+    assert_eq!(along.of(&d), 3e-4);
+    assert!(Measure::along(&[]).is_none());
+    assert!(Measure::along(&[Vector3::zeros()]).is_none());
+}
+
+#[test]
+fn unreachable_angles_are_reported_never_as_zeros() {
+    let robot = kr300();
+    let (_, z) = task(&robot);
+    let far = Vector3::new(10.0, 0.0, 1.0);
+    let (out, s) = run(
+        &robot,
+        &far,
+        &z,
+        &degrees(-30.0, 30.0, 10.0),
+        &PostureOptions::default(),
+    );
+    assert_eq!(s.reachable, 0);
+    assert!(s.best.is_none() && s.best_index.is_none() && s.worst_index.is_none());
+    for a in &out {
+        assert_eq!(a.reach, Reach::OutOfReach);
+        assert!(a.measure.is_nan() && a.deflection.iter().all(|v| v.is_nan()));
+    }
+    // Joint limits pinned around Q0's wrist: turning the tool needs the wrist, so most
+    // angles are refused as joint-limit violations, the original one stays.
+    let mut pinned = kr300();
+    pinned.joint_limits[5] = (Q0[5] - 0.01, Q0[5] + 0.01);
+    pinned.joint_limits[3] = (Q0[3] - 0.01, Q0[3] + 0.01);
+    let (p, z) = task(&pinned);
+    let (out, s) = run(
+        &pinned,
+        &p,
+        &z,
+        &degrees(-180.0, 175.0, 5.0),
+        &PostureOptions::default(),
+    );
+    assert!(out.iter().any(|a| a.reach == Reach::JointLimit));
+    assert!(
+        s.reachable >= 1 && s.reachable < out.len() / 2,
+        "{}",
+        s.reachable
+    );
+}
+
+#[test]
+fn bad_inputs_are_statuses() {
+    let robot = kr300();
+    let (p, z) = task(&robot);
+    let mut data = Data::new(&robot.model);
+    let w = Vector6::from_column_slice(&WRENCH);
+    let mut out = vec![AnglePoint::default(); 4];
+    let o = PostureOptions::default();
+    let angles = [0.0, 0.1, 0.2, 0.3];
+    let call = |data: &mut Data,
+                axis: &Vector3<f64>,
+                seeds: &[f64],
+                angles: &[f64],
+                out: &mut [AnglePoint]| {
+        posture::sweep(
+            &robot.model,
+            data,
+            &robot.joint_limits,
+            &p,
+            axis,
+            &w,
+            angles,
+            seeds,
+            &o,
+            out,
+        )
+    };
+    assert!(matches!(
+        call(&mut data, &Vector3::zeros(), &Q0, &angles, &mut out),
+        Err(TickError::InvalidArgument { .. })
+    ));
+    assert!(matches!(
+        call(&mut data, &z, &Q0[..5], &angles, &mut out),
+        Err(TickError::WrongLength { what: "seeds", .. })
+    ));
+    assert!(matches!(
+        call(&mut data, &z, &Q0, &[0.0, f64::NAN, 0.2, 0.3], &mut out),
+        Err(TickError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        call(&mut data, &z, &Q0, &angles, &mut out[..2]),
+        Err(TickError::WrongLength { what: "output", .. })
+    ));
+    let too_many = vec![0.0; posture::MAX_ANGLES + 1];
+    let mut big = vec![AnglePoint::default(); too_many.len()];
+    assert!(matches!(
+        call(&mut data, &z, &Q0, &too_many, &mut big),
+        Err(TickError::WrongLength { what: "angles", .. })
+    ));
+}
