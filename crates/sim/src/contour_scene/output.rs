@@ -313,11 +313,21 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     let left = left
         .titled("contour in the plane", ("sans-serif", style.caption))
         .map_err(crate::plot_style::perr)?;
+    // Equal scales: the ranges in the proportions of the plotting area (the panel less its
+    // label areas and 12 px margins).
+    let (lw, lh) = left.dim_in_pixel();
+    let aw = f64::from(lw.saturating_sub(style.label_areas.1 + 24).max(1));
+    let ah = f64::from(lh.saturating_sub(style.label_areas.0 + 24).max(1));
+    let (hx, hy) = if aw > ah {
+        (half * aw / ah, half)
+    } else {
+        (half, half * ah / aw)
+    };
     let mut chart = new_chart(
         &left,
         style,
-        cx - half..cx + half,
-        cy - half..cy + half,
+        cx - hx..cx + hx,
+        cy - hy..cy + hy,
         ("x [mm]", "y [mm]"),
     )?;
     for (pts, role) in [
