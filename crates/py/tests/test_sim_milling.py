@@ -15,7 +15,9 @@ import mcap.reader as mcap_reader  # installed by scripts/test-all.sh
 
 REPO = pathlib.Path(__file__).resolve().parents[3]
 RUNS = ["uncompensated", "cartesian", "pilot", "uncalibrated"]
-TOPICS = ["nominal", "actual", "commanded", "force_measured", "force_filtered", "correction", "error"]
+# Every topic is logged every control cycle but `paths` (one foxglove.SceneUpdate at t = 0).
+TOPICS = ["nominal", "actual", "commanded", "force_measured", "force_filtered", "process_force",
+          "correction", "error", "pilot", "tcp_pose", "paths"]
 
 
 @pytest.fixture(scope="module")
@@ -54,8 +56,8 @@ def test_channels_and_counts(out_dir):
     n = counts["/milling/pilot/actual"]
     # 0.1 + 0.2 + 0.3 + 0.4 + 0.4 s at 4 ms.
     assert 340 < n < 360, counts
-    assert all(c == n for c in counts.values()), counts
-    assert summary.statistics.message_count == len(RUNS) * len(TOPICS) * n
+    assert all(c == (1 if t.endswith("/paths") else n) for t, c in counts.items()), counts
+    assert summary.statistics.message_count == len(RUNS) * ((len(TOPICS) - 1) * n + 1)
 
 
 def test_runs(out_dir):
@@ -64,7 +66,8 @@ def test_runs(out_dir):
     for topic, msg, d in msgs:
         run, name = topic.split("/")[2:4]
         if name == "error":
-            err[run].append((msg.log_time, d["error_mm"]))
+            # deflect.PathError: the distance in metres.
+            err[run].append((msg.log_time, d["distance"] * 1e3))
         if name in ("force_measured", "force_filtered"):
             assert set(d) >= {"timestamp", "run", "fx", "fy", "fz", "mx", "my", "mz"}
     peak = {r: max(e for _, e in v) for r, v in err.items()}
