@@ -41,7 +41,7 @@ if [ ! -x "$VENV/bin/python" ]; then
   "$PY" -m venv "$VENV"
 fi
 "$VENV/bin/python" -m pip install --quiet --upgrade pip
-"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19" "mypy>=1.18"
+"$VENV/bin/python" -m pip install --quiet "maturin>=1.9,<2" numpy scipy pytest hypothesis mcap "example-robot-data>=4" "ruckig>=0.19" "mypy>=1.18" "dask[distributed]" ray
 # The wheel is built once (abi3, release) and installed from the file; a fresh venv with
 # nothing but the wheel (and numpy from its metadata) imports it: what `pip install
 # deflect-robotics` gives a user.

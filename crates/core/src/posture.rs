@@ -367,11 +367,29 @@ fn refine(
     i: usize,
     best: AnglePoint,
 ) -> AnglePoint {
-    let before = i
-        .checked_sub(1)
-        .and_then(|k| out.get(k))
-        .map_or(best.angle, |p| p.angle);
-    let after = out.get(i + 1).map_or(best.angle, |p| p.angle);
+    // A sweep over the full turn is a circle: its first and last angles are neighbours.
+    let turn = core::f64::consts::TAU;
+    let (first, last) = match (out.first(), out.last()) {
+        (Some(f), Some(l)) => (f.angle, l.angle),
+        _ => return best,
+    };
+    let step = match (out.first(), out.get(1)) {
+        (Some(a), Some(b)) => (b.angle - a.angle).abs(),
+        _ => 0.0,
+    };
+    let full = step > 0.0 && (last - first).abs() >= turn - 1.5 * step;
+    // The direction the sweep runs in (+1 increasing angles, -1 decreasing).
+    let dir = (last - first).signum();
+    let before = match i.checked_sub(1).and_then(|k| out.get(k)) {
+        Some(p) => p.angle,
+        None if full => last - dir * turn,
+        None => best.angle,
+    };
+    let after = match out.get(i + 1) {
+        Some(p) => p.angle,
+        None if full => first + dir * turn,
+        None => best.angle,
+    };
     let (mut a, mut b) = (before.min(after), before.max(after));
     if b - a <= 0.0 {
         return best;
@@ -404,6 +422,13 @@ fn refine(
     match found {
         Some(mut f) if f.measure < best.measure => {
             f.seed = best.seed;
+            // Back into the sweep's own range when the search crossed one of its ends.
+            let (lo, hi) = (first.min(last), first.max(last));
+            if full && f.angle < lo - 0.5 * step {
+                f.angle += turn;
+            } else if full && f.angle > hi + 0.5 * step {
+                f.angle -= turn;
+            }
             f
         }
         _ => best,

@@ -18,20 +18,22 @@ pub enum BatchFailure {
     Panicked,
 }
 
-/// Threads for `n` rows: one below [`PARALLEL_MIN_ROWS`], else every available core (at
-/// most [`MAX_THREADS`]).
-pub fn threads_for(n: usize) -> usize {
-    if n < PARALLEL_MIN_ROWS {
+/// Threads for `n` rows: one below `min_rows`, else every available core (at most
+/// [`MAX_THREADS`], at most one per row).
+pub fn threads_for(n: usize, min_rows: usize) -> usize {
+    if n < min_rows.max(2) {
         return 1;
     }
-    std::thread::available_parallelism().map_or(1, |t| t.get().min(MAX_THREADS))
+    std::thread::available_parallelism().map_or(1, |t| t.get().min(MAX_THREADS).min(n))
 }
 
 /// Fills `out` (n rows of `width` numbers) by `row(i, workspace, out_row)` for every row
-/// `i`, each thread with its own `workspace()`.
+/// `i`, each thread with its own `workspace()`, on several threads from `min_rows` rows
+/// ([`PARALLEL_MIN_ROWS`] for rows of a microsecond; fewer for costlier rows).
 pub fn rows<W, M, F>(
     out: &mut [f64],
     width: usize,
+    min_rows: usize,
     workspace: M,
     row: F,
 ) -> Result<(), BatchFailure>
@@ -41,7 +43,7 @@ where
 {
     let width = width.max(1);
     let n = out.len() / width;
-    let threads = threads_for(n);
+    let threads = threads_for(n, min_rows);
     let chunk_rows = n.div_ceil(threads).max(1);
     let run = |first: usize, chunk: &mut [f64]| -> Result<(), BatchFailure> {
         let mut w = workspace();

@@ -38,6 +38,7 @@ mod mechanism;
 mod motion;
 mod pickle;
 mod pose_motion;
+mod posture;
 mod vjm;
 
 create_exception!(
@@ -90,5 +91,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     dalembert_serial::register(m)?;
     pose_motion::register(m)?;
     drivetrain::register(m)?;
+    posture::register(m)?;
     Ok(())
 }

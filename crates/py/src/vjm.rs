@@ -288,6 +288,7 @@ impl SerialRobot {
             batch::rows(
                 &mut out,
                 6,
+                batch::PARALLEL_MIN_ROWS,
                 || (Data::new(model), vec![0.0; dof]),
                 |i, (data, qi), o| {
                     copy_row(qi, q.row(i).iter());
@@ -321,6 +322,7 @@ impl SerialRobot {
             batch::rows(
                 &mut out,
                 16,
+                batch::PARALLEL_MIN_ROWS,
                 || (Data::new(model), vec![0.0; dof]),
                 |i, (data, qi), o| {
                     copy_row(qi, q.row(i).iter());
@@ -354,6 +356,7 @@ impl SerialRobot {
             batch::rows(
                 &mut out,
                 36,
+                batch::PARALLEL_MIN_ROWS,
                 || (Data::new(model), vec![0.0; dof]),
                 |i, (data, qi), o| {
                     copy_row(qi, q.row(i).iter());

@@ -31,6 +31,7 @@ from ._deflect import (
     plan_polyline,
     plan_pose,
     PoseTrajectory,
+    posture_sweep,
     project_normal_to_feed,
     SensorCalibration,
     SerialDalembertCorrector,
@@ -39,6 +40,7 @@ from ._deflect import (
     Trajectory,
     __version__,
 )
+from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
 
 __all__ = [
     "commanded_pose",
@@ -67,6 +69,7 @@ __all__ = [
     "plan_polyline",
     "plan_pose",
     "PoseTrajectory",
+    "posture_sweep",
     "project_normal_to_feed",
     "SensorCalibration",
     "SerialDalembertCorrector",
@@ -74,4 +77,8 @@ __all__ = [
     "SingularError",
     "Trajectory",
     "__version__",
+    "atlas",
+    "AtlasResult",
+    "ChunkError",
+    "RayExecutor",
 ]

@@ -43,6 +43,8 @@ __all__ = [
     "ContourTracer",
     "edge_direction",
     "edge_contact_force",
+    "posture_sweep",
+    "_atlas_chunk",
 ]
 
 _ArrayLike = npt.ArrayLike
@@ -676,3 +678,32 @@ def edge_direction(stiffness: _ArrayLike, step: _ArrayLike, force: _ArrayLike) -
     """Eq. 21: the edge angle from a commanded step and the steady-state force."""
 def edge_contact_force(stiffness: _ArrayLike, step: _ArrayLike, edge_angle: float) -> _FloatArray:
     """Eq. 16-20: the contact force of a step blocked by an edge."""
+
+def posture_sweep(
+    robot: SerialRobot,
+    position: _ArrayLike,
+    tool_axis: _ArrayLike,
+    wrench: _ArrayLike,
+    *,
+    angles: Optional[_ArrayLike] = None,
+    seeds: Optional[_ArrayLike] = None,
+    measure: Union[None, str, _ArrayLike] = None,
+    refine: bool = True,
+    min_sigma: float = 0.001,
+) -> Dict[str, Any]:
+    """The rotation about the tool axis that deflects least: per angle [rad] the reach, the
+    measure [m], the deflection (n, 6) [m, rad] and the joints (n, dof); ``best`` (or None),
+    ``best_index``, ``worst_index``."""
+
+def _atlas_chunk(
+    robot: SerialRobot,
+    positions: _ArrayLike,
+    tool_axes: _ArrayLike,
+    wrenches: _ArrayLike,
+    angles: Optional[_ArrayLike] = None,
+    seeds: Optional[_ArrayLike] = None,
+    measure: Union[None, str, _ArrayLike] = None,
+    refine: bool = True,
+    min_sigma: float = 0.001,
+) -> _FloatArray:
+    """One chunk of ``deflect.atlas``: (N, 10 + dof + 39) rows."""
