@@ -138,12 +138,20 @@ pub struct PostureOptions {
     pub refine: bool,
 }
 
+/// IK iterations per angle by default: the first angle of a sweep (and the first after an
+/// unreachable stretch) starts from afar; the others, warm-started, take 2-3.
+pub const SWEEP_IK_ITERATIONS: usize = 64;
+
 impl Default for PostureOptions {
-    /// Norm of the deflection, default IK (1e-8 m / 1e-8 rad, margin 1e-3), refined.
+    /// Norm of the deflection, the default IK (1e-8 m / 1e-8 rad, margin 1e-3) with
+    /// [`SWEEP_IK_ITERATIONS`] iterations, refined.
     fn default() -> Self {
         Self {
             measure: Measure::Norm,
-            ik: PoseIkOptions::default(),
+            ik: PoseIkOptions {
+                max_iterations: SWEEP_IK_ITERATIONS,
+                ..PoseIkOptions::default()
+            },
             refine: true,
         }
     }

@@ -17,10 +17,6 @@ use crate::batch::{self, BatchFailure};
 use crate::convert::{batch_pair, matrix, tick_err, tick_err_at, vector, vector_any};
 use crate::vjm::SerialRobot;
 
-/// IK iterations per angle: the first angle of a task starts from the seed (possibly far),
-/// the others from the angle before (2-3 iterations).
-const IK_ITERATIONS: usize = 64;
-
 /// Columns of one atlas row before the joints: reachable, reachable angles, best angle, best
 /// measure, best deflection (6).
 const HEAD: usize = 10;
@@ -98,9 +94,8 @@ fn settings(
         }
     };
     let ik = PoseIkOptions {
-        max_iterations: IK_ITERATIONS,
         min_sigma,
-        ..PoseIkOptions::default()
+        ..PostureOptions::default().ik
     };
     ik.validate().map_err(crate::convert::build_err)?;
     Ok(Settings {
