@@ -113,7 +113,9 @@ def _run_chunk(*args: Any, **kwargs: Any) -> np.ndarray:
 def _as_executor(executor: Any) -> Executor:
     """A Dask ``Client`` gives its executor; anything with ``submit`` is used as it is."""
     if hasattr(executor, "get_executor") and not isinstance(executor, Executor):
-        return executor.get_executor()
+        # Every call computes (Dask would otherwise hand back an earlier call's futures for
+        # equal arguments, a cache the caller did not ask for).
+        return executor.get_executor(pure=False)
     if not hasattr(executor, "submit"):
         raise TypeError(
             f"executor: expected a concurrent.futures.Executor, a dask.distributed.Client or "
