@@ -108,7 +108,9 @@ class PinocchioCompliance:
         # Rows of R^T are the frame axes in the base frame: 3 rotation axes per spring.
         axes = np.concatenate([m.rotation.T for m in frames])
         levers = np.repeat([p - m.translation for m in frames], 3, axis=0)
-        j = np.concatenate([np.cross(axes, levers), axes], axis=1).T
+        # u x r written out (np.cross costs ~35 us here, more than everything else).
+        lin = axes[:, [1, 2, 0]] * levers[:, [2, 0, 1]] - axes[:, [2, 0, 1]] * levers[:, [1, 2, 0]]
+        j = np.concatenate([lin, axes], axis=1).T
         return (j * self.inv_k) @ j.T
 
 
