@@ -4,7 +4,7 @@
 //! the rotation `theta` about the tool axis. The compliance, and so the deflection under a
 //! process wrench, changes with it; choosing it is a known lever in robot machining (the
 //! papers compensate the deflection the posture gives; this picks the posture that deflects
-//! least). [`sweep`] solves the 6-D pose IK ([`mechanism::pose_ik`], the same solver the
+//! least). [`sweep`] solves the 6-D pose IK ([`mechanism::pose_ik()`], the same solver the
 //! serial D'Alembert corrector uses) for every angle of a sweep, warm-started from the angle
 //! before, from one or several seeds (one per IK branch the caller wants explored), keeps the
 //! solutions inside the joint limits and away from singularities, evaluates the exact
@@ -36,7 +36,7 @@ pub const MAX_DIRECTIONS: usize = 3;
 /// a 2 degree bracket below 1e-6 degrees.
 const REFINE_ITERATIONS: usize = 24;
 
-/// What "deflects least" means. All act on the translational deflection `dp` [m] of the
+/// What "deflects least" means. All act on the translational deflection `dp` \[m\] of the
 /// TCP, base frame.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Measure {
