@@ -181,3 +181,29 @@ def test_atlas_result_pickles(ur5, tasks):
     p, axis = tasks
     a = deflect.atlas(ur5, p[:3], axis, WRENCH, angles=ANGLES, seeds=Q0)
     same(pickle.loads(pickle.dumps(a)), a)
+
+
+def test_the_cli_atlas_is_the_python_atlas(tmp_path):
+    """`deflect-sim atlas` (release binary) writes the same numbers as deflect.atlas."""
+    import subprocess
+
+    out = tmp_path / "atlas"
+    cmd = ["cargo", "run", "--release", "--quiet", "-p", "deflect-sim", "--", "atlas",
+           "--region", "1.5:1.9:3,-0.3:0.3:3,0.2", "--angle-step", "15", "--out", str(out)]
+    res = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=1800)
+    assert res.returncode == 0, res.stderr
+    z = np.load(out / "atlas.npz")
+    kr300 = deflect.SerialRobot.from_urdf(KR300_URDF, KR300_TOML, "tcp")
+    xs = 1.5 + (1.9 - 1.5) / 2 * np.arange(3)
+    ys = -0.3 + (0.3 - -0.3) / 2 * np.arange(3)
+    np.testing.assert_array_equal(z["x"], xs)
+    np.testing.assert_array_equal(z["y"], ys)
+    X, Y = np.meshgrid(xs, ys, indexing="ij")
+    a = deflect.atlas(kr300, np.c_[X.ravel(), Y.ravel(), np.full(9, 0.2)], [0.0, 0.0, -1.0],
+                      [-386.1, 386.1, 0, 0, 0, 0], angles=z["angles"],
+                      seeds=[0.0, -0.9, 1.4, 0.0, 1.0708, 0.0])
+    np.testing.assert_array_equal(z["angles"], np.radians(-180.0 + 15.0 * np.arange(24)))
+    np.testing.assert_array_equal(z["best_measure"].ravel(), a.best_measure)
+    np.testing.assert_array_equal(z["best_angle"].ravel(), a.best_angle)
+    np.testing.assert_array_equal(z["best_q"].reshape(9, 6), a.best_q)
+    np.testing.assert_array_equal(z["reachable"].ravel() == 1.0, a.reachable)

@@ -24,6 +24,7 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 pub mod analysis;
+pub mod atlas;
 pub mod contour_scene;
 pub mod jobs;
 pub mod mcap_log;

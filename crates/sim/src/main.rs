@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use scenario::{contour, fit, milling, reproduce, run, serial, static_test};
+use scenario::{atlas, contour, fit, milling, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -54,6 +54,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Serial(a) => Some(serial::load(a)?),
         _ => None,
     };
+    let atlas_task = match command {
+        Command::Atlas(a) => Some(atlas::load(a)?),
+        _ => None,
+    };
     scenario::prepare_out(out)?;
     match command {
         Command::Reproduce(a) => reproduce::reproduce(a, out),
@@ -66,6 +70,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         },
         Command::Milling(a) => milling::milling_cmd(a, out),
         Command::Contour(a) => contour::contour_cmd(a, out),
+        Command::Atlas(a) => match &atlas_task {
+            Some(t) => atlas::atlas_cmd(a, t, out),
+            None => Err(deflect_sim::SimError::new("atlas: inputs not loaded")),
+        },
     }
     .map_err(CliError::from)
 }

@@ -148,3 +148,8 @@ pub const V_MAX: Range = Range::closed("--v-max", 0.01, 10.0, "m/s");
 pub const RAMP: Range = Range::closed("--ramp", 0.005, 1.0, "s");
 /// `serial --turn` \[rad\]: turn about the vertical over a motion.
 pub const TURN: Range = Range::closed("--turn", 0.0, 3.0, "rad");
+/// `atlas --region`: grid points per axis (at most 100 x 100 points x 3600 angles, about a
+/// minute on 2 cores).
+pub const ATLAS_POINTS: Range = Range::closed("--region", 1.0, 100.0, "points per axis");
+/// `atlas --angle-step` \[deg\].
+pub const ANGLE_STEP: Range = Range::closed("--angle-step", 0.1, 90.0, "deg");

@@ -26,6 +26,7 @@ macro_rules! put {
     };
 }
 
+pub mod atlas;
 pub mod calibrate;
 pub mod contour;
 pub mod fit;

@@ -34,7 +34,7 @@ pub struct SerialInput {
 
 /// Reads a text file of `flag` (regular, at most 16 MiB): a usage error naming the flag and
 /// the file otherwise.
-fn read_text(flag: &str, path: &Path, expected: &str) -> Result<String, CliError> {
+pub(crate) fn read_text(flag: &str, path: &Path, expected: &str) -> Result<String, CliError> {
     input_file(flag, path, expected)?;
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     if len > MAX_FILE {
@@ -53,7 +53,7 @@ fn read_text(flag: &str, path: &Path, expected: &str) -> Result<String, CliError
 
 /// The deepest leaf link of the URDF (the default tip); an error naming the candidates if two
 /// are equally deep.
-fn deepest_leaf(robot: &urdf_rs::Robot, base: Option<&str>) -> Result<String, String> {
+pub(crate) fn deepest_leaf(robot: &urdf_rs::Robot, base: Option<&str>) -> Result<String, String> {
     let parent_of = |link: &str| {
         robot
             .joints

@@ -1,0 +1,140 @@
+//! `atlas`: the workspace compliance atlas of [`deflect_sim::atlas`] on the built-in KR 300
+//! or on the user's URDF and stiffness file. [`load`] reads and checks everything before any
+//! work; [`atlas_cmd`] runs, prints the summary and writes `atlas.npz` and `atlas.png`.
+
+use std::path::Path;
+use std::time::Instant;
+
+use deflect_core::SerialRobot;
+use deflect_core::io::urdf;
+use deflect_sim::SimError;
+use deflect_sim::atlas::{self, AtlasTask};
+use deflect_sim::jobs::progress;
+use deflect_sim::urdf_arm::{KR300_Q0, KR300_STIFFNESS, KR300_URDF};
+use nalgebra::Vector3;
+
+use super::serial::{deepest_leaf, read_text};
+use super::stdout;
+use crate::cli::{AtlasArgs, CliError};
+
+/// Reads the robot, checks the seed, builds the task.
+pub fn load(a: &AtlasArgs) -> Result<AtlasTask, CliError> {
+    const URDF: &str = "robot URDF";
+    const STIFF: &str = "stiffness TOML (deflect's virtual-joint format)";
+    let builtin = a.urdf.is_none();
+    let (urdf_text, stiff_text) = match (&a.urdf, &a.stiffness) {
+        (Some(u), Some(s)) => (
+            read_text("--urdf", u, URDF)?,
+            read_text("--stiffness", s, STIFF)?,
+        ),
+        _ => (KR300_URDF.to_string(), KR300_STIFFNESS.to_string()),
+    };
+    let name = a
+        .urdf
+        .as_ref()
+        .map_or("the built-in KR 300 URDF".to_string(), |p| {
+            format!("--urdf {}", p.display())
+        });
+    let parsed = urdf::parse(&urdf_text)
+        .map_err(|e| CliError::Failure(format!("{name}: not a valid {URDF}: {e}")))?;
+    let tip = match (&a.tip, builtin) {
+        (Some(t), _) => t.clone(),
+        (None, true) => "tcp".to_string(),
+        (None, false) => deepest_leaf(&parsed, a.base.as_deref())
+            .map_err(|e| CliError::Usage(format!("--tip: {e}")))?,
+    };
+    let robot = SerialRobot::from_str(&urdf_text, &stiff_text, a.base.as_deref(), &tip)
+        .map_err(|e| CliError::Failure(format!("{name}, tip {tip}: {e}")))?;
+    let dof = robot.model.dof();
+    if dof < 6 {
+        return Err(CliError::Usage(format!(
+            "{name}, tip {tip}: {dof} joints; the atlas needs at least 6 (a TCP position and \
+             tool axis leave one rotation free only on a 6-axis arm)"
+        )));
+    }
+    let seed = match (&a.seed, builtin) {
+        (Some(q), _) => q.clone(),
+        (None, true) => KR300_Q0.to_vec(),
+        (None, false) => robot
+            .joint_limits
+            .iter()
+            .map(|(l, h)| 0.5 * (l + h))
+            .collect(),
+    };
+    if seed.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--seed: {} values; expected {dof}, one per joint of {name}",
+            seed.len()
+        )));
+    }
+    let (xa, ya, z) = a.region()?;
+    let n = (360.0 / a.angle_step).round().max(1.0) as usize;
+    let angles = (0..n)
+        .map(|k| (-180.0 + a.angle_step * k as f64).to_radians())
+        .filter(|t| *t < std::f64::consts::PI)
+        .collect();
+    Ok(AtlasTask {
+        robot,
+        name: if builtin {
+            "KR 300 R2500".to_string()
+        } else {
+            parsed.name.clone()
+        },
+        xs: xa.points(),
+        ys: ya.points(),
+        z,
+        tool_axis: Vector3::from_column_slice(&a.tool_axis),
+        wrench: deflect_core::vjm::Vector6::from_column_slice(&a.wrench),
+        angles,
+        seed,
+    })
+}
+
+/// Runs the atlas and writes its files.
+pub fn atlas_cmd(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimError> {
+    let t0 = Instant::now();
+    let bar = progress(task.xs.len(), "atlas rows");
+    let points = atlas::compute(task, a.jobs, &bar)?;
+    bar.finish_and_clear();
+    let wall = t0.elapsed().as_secs_f64();
+    let evaluations = points.len() * task.angles.len();
+    let reachable = points.iter().filter(|p| p.reachable_angles > 0).count();
+    let npz = out.join("atlas.npz");
+    atlas::write_npz(&npz, task, &points)?;
+    let png = out.join("atlas.png");
+    atlas::plot_heat_map(&png, task, &points)?;
+    stdout(format_args!(
+        "atlas: {}, {} points x {} angles on {} thread(s) in {wall:.2} s ({:.0} pose \
+         evaluations/s)\n{}\nreachable points: {reachable} of {}\n",
+        task.name,
+        points.len(),
+        task.angles.len(),
+        a.jobs,
+        evaluations as f64 / wall.max(1e-9),
+        atlas::title(task),
+        points.len()
+    ))?;
+    let ny = task.ys.len().max(1);
+    let best = points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| p.best_measure.is_finite())
+        .min_by(|x, y| x.1.best_measure.total_cmp(&y.1.best_measure));
+    match best {
+        Some((k, p)) => stdout(format_args!(
+            "best placement: x = {:.3} m, y = {:.3} m: |dp| = {:.3} mm at {:.2} deg about the \
+             tool axis (worst angle there: {:.3} mm)\n",
+            task.xs.get(k / ny).copied().unwrap_or(f64::NAN),
+            task.ys.get(k % ny).copied().unwrap_or(f64::NAN),
+            p.best_measure * 1e3,
+            p.best_angle.to_degrees(),
+            p.worst_measure * 1e3
+        ))?,
+        None => stdout(format_args!("no point of the region is reachable\n"))?,
+    }
+    stdout(format_args!(
+        "outputs: {}, {}\n",
+        npz.display(),
+        png.display()
+    ))
+}
