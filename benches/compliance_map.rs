@@ -29,6 +29,75 @@ fn maps() -> (ComplianceMap, ComplianceMap) {
     (oc, uneven)
 }
 
+/// A hand-written 2 x 2 bilinear lookup on an evenly spaced grid: the floor a controller
+/// author would write in C++ (no input checks, positions assumed inside).
+struct Hand {
+    x0: f64,
+    y0: f64,
+    inv_dx: f64,
+    inv_dy: f64,
+    ny: usize,
+    last_i: usize,
+    last_j: usize,
+    /// Per node: s_xx, s_xy, s_yx, s_yy, offset sum x, offset sum y.
+    node: Vec<[f64; 6]>,
+}
+
+impl Hand {
+    fn new(map: &ComplianceMap) -> Self {
+        let (x, y) = (map.x(), map.y());
+        let (nx, ny) = (x.len(), y.len());
+        let node = (0..nx * ny)
+            .map(|n| {
+                let s = &map.slopes()[n * 4..n * 4 + 4];
+                let o = &map.offsets()[n * 4..n * 4 + 4];
+                [s[0], s[1], s[2], s[3], o[0] + o[1], o[2] + o[3]]
+            })
+            .collect();
+        Self {
+            x0: x[0],
+            y0: y[0],
+            inv_dx: (nx - 1) as f64 / (x[nx - 1] - x[0]),
+            inv_dy: (ny - 1) as f64 / (y[ny - 1] - y[0]),
+            ny,
+            last_i: nx - 2,
+            last_j: ny - 2,
+            node,
+        }
+    }
+
+    #[inline(always)]
+    fn query(&self, p: [f64; 2], f: [f64; 2]) -> [f64; 2] {
+        let u = (p[0] - self.x0) * self.inv_dx;
+        let v = (p[1] - self.y0) * self.inv_dy;
+        let i = (u as usize).min(self.last_i);
+        let j = (v as usize).min(self.last_j);
+        let (tx, ty) = (u - i as f64, v - j as f64);
+        let n = i * self.ny + j;
+        let val = |c: &[f64; 6]| {
+            [
+                c[0] * f[0] + c[1] * f[1] + c[4],
+                c[2] * f[0] + c[3] * f[1] + c[5],
+            ]
+        };
+        let (a, b) = (val(&self.node[n]), val(&self.node[n + 1]));
+        let (c, d) = (
+            val(&self.node[n + self.ny]),
+            val(&self.node[n + self.ny + 1]),
+        );
+        let w = [
+            (1.0 - tx) * (1.0 - ty),
+            (1.0 - tx) * ty,
+            tx * (1.0 - ty),
+            tx * ty,
+        ];
+        [
+            w[0] * a[0] + w[1] * b[0] + w[2] * c[0] + w[3] * d[0],
+            w[0] * a[1] + w[1] * b[1] + w[2] * c[1] + w[3] * d[1],
+        ]
+    }
+}
+
 fn bench(c: &mut Criterion) {
     let (even, uneven) = maps();
     let points: Vec<([f64; 2], [f64; 2])> = (0..1024)
@@ -47,6 +116,17 @@ fn bench(c: &mut Criterion) {
         })
         .collect();
     let mut group = c.benchmark_group("compliance_map");
+    // What this CPU can do: the hand-written lookup of a C++ controller (uniform 2 x 2 map,
+    // no checks, no out-of-grid policy), timed the same way, for same-run ratios.
+    let hand = Hand::new(&even);
+    let mut k = 0usize;
+    group.bench_function("reference_hand/even", |b| {
+        b.iter(|| {
+            k = (k + 1) & 1023;
+            let (p, f) = points.get(k).copied().unwrap_or_default();
+            black_box(hand.query(black_box(p), black_box(f)))
+        })
+    });
     for (name, map) in [("even", &even), ("uneven", &uneven)] {
         for method in [Interpolation::Bilinear, Interpolation::Bicubic] {
             let options = QueryOptions {
@@ -87,6 +167,19 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    group.bench_function("batch_1e5/reference_hand/even", |b| {
+        b.iter(|| {
+            for ((p, f), o) in pos
+                .chunks_exact(2)
+                .zip(force.chunks_exact(2))
+                .zip(out.chunks_exact_mut(2))
+            {
+                let r = hand.query([p[0], p[1]], [f[0], f[1]]);
+                o.copy_from_slice(&r);
+            }
+            black_box(&out);
+        })
+    });
     group.finish();
 }
 

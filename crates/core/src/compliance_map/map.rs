@@ -20,6 +20,9 @@ pub struct ComplianceMap {
     n_disp: usize,
     slopes: Vec<f64>,
     offsets: Vec<f64>,
+    /// Slopes and offset sums node by node, the layout the query kernels read (derived
+    /// from `slopes` and `offsets` at build).
+    packed: Vec<f64>,
     options: QueryOptions,
     fit: Option<Vec<NodeFit>>,
 }
@@ -37,6 +40,7 @@ impl ComplianceMap {
     ) -> Result<Self, BuildError> {
         let v = ComplianceMapView::new(&x, &y, n_force, n_displacement, &slopes, &offsets)?;
         let (x_inv_step, y_inv_step) = (v.x.inv_step, v.y.inv_step);
+        let packed = super::kernel::pack(n_displacement, n_force, &slopes, &offsets);
         Ok(Self {
             x,
             y,
@@ -46,6 +50,7 @@ impl ComplianceMap {
             n_disp: n_displacement,
             slopes,
             offsets,
+            packed,
             options: QueryOptions::default(),
             fit: None,
         })
@@ -67,6 +72,7 @@ impl ComplianceMap {
             n_disp: self.n_disp,
             slopes: &self.slopes,
             offsets: &self.offsets,
+            packed: &self.packed,
             options: self.options,
         }
     }

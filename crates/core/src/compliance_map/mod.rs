@@ -43,6 +43,7 @@
 
 mod grid;
 mod interp;
+mod kernel;
 mod view;
 
 #[cfg(feature = "alloc")]

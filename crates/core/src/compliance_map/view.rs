@@ -16,6 +16,10 @@ pub struct ComplianceMapView<'a> {
     pub(super) n_disp: usize,
     pub(super) slopes: &'a [f64],
     pub(super) offsets: &'a [f64],
+    /// The coefficients again, node by node in the packed layout of the kernels (slopes,
+    /// then offset sums), when the owner built them; empty for a view over plain tables,
+    /// which sums the offsets per query instead (same results, bit for bit).
+    pub(super) packed: &'a [f64],
     pub(super) options: QueryOptions,
 }
 
@@ -84,6 +88,7 @@ impl<'a> ComplianceMapView<'a> {
             n_disp: n_displacement,
             slopes,
             offsets,
+            packed: &[],
             options: QueryOptions::default(),
         })
     }

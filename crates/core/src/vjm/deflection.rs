@@ -2,7 +2,7 @@
 //! Cartesian compliance. Every function here is allocation-free, bounded by the chain length
 //! and panic-free.
 
-use nalgebra::{Isometry3, Matrix6, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
 use super::model::Op;
 use super::{Data, Model, Vector6};
@@ -163,11 +163,27 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
     frame
 }
 
+/// The rigid TCP pose alone: the joints with the fixed transforms between them folded at
+/// build (springs and masses do not move the rigid chain), one composition per joint.
+fn tcp_pass(model: &Model, q: &[f64]) -> Isometry3<f64> {
+    let mut frame = Isometry3::identity();
+    for step in model.tcp_chain.iter() {
+        frame *= step.pre;
+        let qi = q.get(step.index).copied().unwrap_or(0.0);
+        if step.revolute {
+            frame.rotation *= UnitQuaternion::from_axis_angle(&step.axis, qi);
+        } else {
+            frame.translation.vector += frame.rotation * (step.axis.into_inner() * qi);
+        }
+    }
+    frame * model.tcp_tail
+}
+
 /// Rigid TCP pose in the base frame (Eq. 2 with i = 0). `q` \[rad or m\], length
 /// [`Model::dof`]. Also stored in `data.tcp`.
 pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f64>, TickError> {
     check_q(model, data, q)?;
-    let tcp = rigid_pass(model, data, q);
+    let tcp = tcp_pass(model, q);
     check_output("tcp translation", tcp.translation.vector.as_slice())?;
     data.tcp = tcp;
     Ok(tcp)
@@ -329,7 +345,11 @@ pub fn deflection_and_jacobian(
 pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f64>, TickError> {
     check_q(model, data, q)?;
     let tcp = rigid_pass(model, data, q);
-    let mut c = Matrix6::zeros();
+    // Per spring with world axes R and compliances c, lever r from its origin to the TCP and
+    // S = [r]x: the columns [u_a x r; u_a] of J_s give the blocks A = R diag(c) R^T
+    // (rotation), -S A (translation-rotation) and S A S^T = -(S A) S (translation), summed
+    // over springs: a third of the multiplications of the 6 x 6 outer products.
+    let (mut c_vv, mut c_vw, mut c_ww) = (Matrix3::zeros(), Matrix3::zeros(), Matrix3::zeros());
     for op in model.ops.iter() {
         let Op::Spring {
             compliance, index, ..
@@ -341,17 +361,28 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
             continue;
         };
         let r = tcp.translation.vector - f.translation.vector;
-        let rot = f.rotation.to_rotation_matrix();
-        for (a, &ca) in compliance.iter().enumerate() {
-            if ca == 0.0 {
-                continue;
-            }
-            let u: Vector3<f64> = rot.matrix().column(a).into_owned();
-            let lin = u.cross(&r);
-            let col = Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z);
-            c += (col * col.transpose()) * ca;
-        }
+        let rot = f.rotation.to_rotation_matrix().into_inner();
+        let rc = Matrix3::from_columns(&[
+            rot.column(0) * compliance.x,
+            rot.column(1) * compliance.y,
+            rot.column(2) * compliance.z,
+        ]);
+        let a = rc * rot.transpose();
+        let sa = r.cross_matrix() * a;
+        c_ww += a;
+        c_vw -= sa;
+        c_vv -= sa * r.cross_matrix();
     }
+    // Symmetric to the bit, as the sum of outer products it replaces.
+    let (c_vv, c_ww) = (
+        (c_vv + c_vv.transpose()) * 0.5,
+        (c_ww + c_ww.transpose()) * 0.5,
+    );
+    let mut c = Matrix6::zeros();
+    c.fixed_view_mut::<3, 3>(0, 0).copy_from(&c_vv);
+    c.fixed_view_mut::<3, 3>(0, 3).copy_from(&c_vw);
+    c.fixed_view_mut::<3, 3>(3, 0).copy_from(&c_vw.transpose());
+    c.fixed_view_mut::<3, 3>(3, 3).copy_from(&c_ww);
     data.tcp = tcp;
     data.compliance = c;
     check_output("compliance", c.as_slice())?;

@@ -91,12 +91,26 @@ pub(crate) enum Op {
     },
 }
 
+/// One actuated joint of the chain with springs and masses taken out: what the rigid TCP
+/// pose alone needs ([`super::forward`]), every fixed transform before it folded into `pre`.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct TcpStep {
+    pub pre: Isometry3<f64>,
+    pub axis: Unit<Vector3<f64>>,
+    pub revolute: bool,
+    pub index: usize,
+}
+
 /// An immutable serial chain with virtual joints, built once by [`ModelBuilder`] or loaded by
 /// [`crate::SerialRobot`]. Holds no heap memory, so it can live in a static on a controller.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Model {
     pub(crate) elements: heapless::Vec<Element, MAX_ELEMENTS>,
     pub(crate) ops: heapless::Vec<Op, MAX_ELEMENTS>,
+    /// The joints alone, fixed transforms folded across the springs and masses between them.
+    pub(crate) tcp_chain: heapless::Vec<TcpStep, MAX_DOF>,
+    /// The fixed transform after the last joint.
+    pub(crate) tcp_tail: Isometry3<f64>,
     pub(crate) dof: usize,
     pub(crate) springs: usize,
     pub(crate) masses: usize,
@@ -448,9 +462,34 @@ impl ModelBuilder {
         if let Some(p) = pending {
             ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
         }
+        // Springs and masses leave the rigid chain as it is: without them, the fixed
+        // transforms between two joints fold into one.
+        let mut tcp_chain: heapless::Vec<TcpStep, MAX_DOF> = heapless::Vec::new();
+        let mut tail = Isometry3::identity();
+        for e in &self.elements {
+            match *e {
+                Element::Fixed(t) => tail *= t,
+                Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
+                    let step = TcpStep {
+                        pre: core::mem::replace(&mut tail, Isometry3::identity()),
+                        axis,
+                        revolute: matches!(e, Element::Revolute { .. }),
+                        index,
+                    };
+                    tcp_chain.push(step).map_err(|_| BuildError::Capacity {
+                        what: "joints",
+                        capacity: MAX_DOF,
+                        got: MAX_DOF + 1,
+                    })?;
+                }
+                Element::Spring { .. } | Element::Mass { .. } => {}
+            }
+        }
         Ok(Model {
             elements: self.elements,
             ops,
+            tcp_chain,
+            tcp_tail: tail,
             dof: self.dof,
             springs: self.springs,
             masses: self.masses,

@@ -1,0 +1,213 @@
+//! The arithmetic of a query: node values (Eq. 9-10) blended with 2-D weights (Eq. 14, or the
+//! cubic Hermite option), with kernels specialised for the common axis counts.
+//!
+//! Every path — single query, batch, the fixed-size kernels, the generic one, the packed and
+//! the plain coefficient layout — computes each node value as
+//! `v[d] = (sum_f slope[d][f] * F[f]) + (sum_f offset[d][f])` and the result as
+//! `out[d] = sum_n w_n * v_n[d]`, in the same order, so they agree bit for bit.
+//!
+//! Packed layout (built by the owning [`super::ComplianceMap`]): per node, the `nd * nf`
+//! slopes then the `nd` offset sums, nodes in the order `i * ny + j`. The two nodes of a cell
+//! that share `i` are adjacent, so a bilinear query reads two contiguous runs of
+//! `2 * nd * (nf + 1)` values (96 bytes, two cache lines or fewer, for the paper's 2 x 2).
+
+use super::ComplianceMapView;
+use super::MAX_AXES;
+
+/// Values per node in the packed layout.
+#[inline(always)]
+pub(crate) const fn packed_block(n_disp: usize, n_force: usize) -> usize {
+    n_disp * (n_force + 1)
+}
+
+/// Sum of one displacement axis' offsets over the force axes, in the kernels' order.
+#[inline(always)]
+fn offset_sum(offsets: &[f64]) -> f64 {
+    offsets.iter().fold(0.0, |a, o| a + o)
+}
+
+/// Packs plain `slopes` and `offsets` (layout of [`ComplianceMapView`]) node by node into
+/// `out` (`nodes * packed_block(nd, nf)` values).
+#[cfg(feature = "alloc")]
+pub(crate) fn pack(
+    n_disp: usize,
+    n_force: usize,
+    slopes: &[f64],
+    offsets: &[f64],
+) -> alloc::vec::Vec<f64> {
+    let block = n_disp * n_force;
+    let nodes = slopes.len().checked_div(block).unwrap_or(0);
+    let mut out = alloc::vec::Vec::with_capacity(nodes * packed_block(n_disp, n_force));
+    for (s, o) in slopes.chunks_exact(block).zip(offsets.chunks_exact(block)) {
+        out.extend_from_slice(s);
+        out.extend(o.chunks_exact(n_force).map(offset_sum));
+    }
+    out
+}
+
+impl ComplianceMapView<'_> {
+    /// Node `node`'s displacement under `f` (Eq. 9-10), fixed sizes.
+    #[inline(always)]
+    fn node_value<const ND: usize, const NF: usize>(
+        &self,
+        node: usize,
+        f: &[f64; NF],
+    ) -> [f64; ND] {
+        let mut v = [0.0; ND];
+        let line =
+            |s_row: &[f64]| -> f64 { s_row.iter().zip(f).fold(0.0, |a, (s, fk)| a + s * fk) };
+        if self.packed.is_empty() {
+            let start = node * ND * NF;
+            let (Some(s), Some(o)) = (
+                self.slopes.get(start..start + ND * NF),
+                self.offsets.get(start..start + ND * NF),
+            ) else {
+                return v; // unreachable for a validated view
+            };
+            for ((v_d, s_row), o_row) in
+                v.iter_mut().zip(s.chunks_exact(NF)).zip(o.chunks_exact(NF))
+            {
+                *v_d = line(s_row) + offset_sum(o_row);
+            }
+        } else {
+            let b = packed_block(ND, NF);
+            let Some(blk) = self.packed.get(node * b..node * b + b) else {
+                return v; // unreachable for a validated view
+            };
+            let (s, o) = blk.split_at(ND * NF);
+            for ((v_d, s_row), o_d) in v.iter_mut().zip(s.chunks_exact(NF)).zip(o) {
+                *v_d = line(s_row) + o_d;
+            }
+        }
+        v
+    }
+
+    /// [`Self::node_value`] for run-time sizes, into the first `nd` entries of the result.
+    #[inline]
+    fn node_value_dyn(&self, node: usize, f: &[f64]) -> [f64; MAX_AXES] {
+        let (nd, nf) = (self.n_disp, self.n_force);
+        let mut v = [0.0; MAX_AXES];
+        let line =
+            |s_row: &[f64]| -> f64 { s_row.iter().zip(f).fold(0.0, |a, (s, fk)| a + s * fk) };
+        if self.packed.is_empty() {
+            let start = node * nd * nf;
+            let (Some(s), Some(o)) = (
+                self.slopes.get(start..start + nd * nf),
+                self.offsets.get(start..start + nd * nf),
+            ) else {
+                return v;
+            };
+            for ((v_d, s_row), o_row) in
+                v.iter_mut().zip(s.chunks_exact(nf)).zip(o.chunks_exact(nf))
+            {
+                *v_d = line(s_row) + offset_sum(o_row);
+            }
+        } else {
+            let b = packed_block(nd, nf);
+            let Some(blk) = self.packed.get(node * b..node * b + b) else {
+                return v;
+            };
+            let (s, o) = blk.split_at(nd * nf);
+            for ((v_d, s_row), o_d) in v.iter_mut().zip(s.chunks_exact(nf)).zip(o) {
+                *v_d = line(s_row) + o_d;
+            }
+        }
+        v
+    }
+
+    /// `sum_n w_n * v_n` over the given nodes, fixed sizes.
+    #[inline(always)]
+    pub(super) fn blend_fixed<const ND: usize, const NF: usize>(
+        &self,
+        nodes: &[usize],
+        weights: &[f64],
+        f: &[f64; NF],
+    ) -> [f64; ND] {
+        let mut acc = [0.0; ND];
+        for (node, w) in nodes.iter().zip(weights) {
+            let v = self.node_value::<ND, NF>(*node, f);
+            for (a, v_d) in acc.iter_mut().zip(&v) {
+                *a += w * v_d;
+            }
+        }
+        acc
+    }
+
+    /// The blend for any sizes into `out` (`nd` entries), dispatching to the fixed kernels
+    /// for the common shapes (the paper's 2 x 2, 3-D, 6-D).
+    #[inline(always)]
+    pub(super) fn blend(&self, nodes: &[usize], weights: &[f64], force: &[f64], out: &mut [f64]) {
+        macro_rules! fixed {
+            ($nd:literal, $nf:literal) => {
+                if let (Ok(f), Ok(o)) = (
+                    <&[f64; $nf]>::try_from(force),
+                    <&mut [f64; $nd]>::try_from(&mut *out),
+                ) {
+                    *o = self.blend_fixed::<$nd, $nf>(nodes, weights, f);
+                    return;
+                }
+            };
+        }
+        match (self.n_disp, self.n_force) {
+            (2, 2) => fixed!(2, 2),
+            (3, 3) => fixed!(3, 3),
+            (6, 6) => fixed!(6, 6),
+            (2, 1) => fixed!(2, 1),
+            (3, 1) => fixed!(3, 1),
+            (6, 1) => fixed!(6, 1),
+            _ => {}
+        }
+        let mut acc = [0.0; MAX_AXES];
+        for (node, w) in nodes.iter().zip(weights) {
+            let v = self.node_value_dyn(*node, force);
+            for (a, v_d) in acc.iter_mut().zip(&v).take(self.n_disp) {
+                *a += w * v_d;
+            }
+        }
+        out.iter_mut().zip(&acc).for_each(|(o, a)| *o = *a);
+    }
+
+    /// Bilinear weights and nodes of cell `(i, j)` at local coordinates `(tx, ty)` (Eq. 14:
+    /// `(x2 - x)(y2 - y)`, `(x2 - x)(y - y1)`, ... over `(x2 - x1)(y2 - y1)`).
+    #[inline(always)]
+    pub(super) fn bilinear_stencil(
+        &self,
+        i: usize,
+        j: usize,
+        tx: f64,
+        ty: f64,
+    ) -> ([usize; 4], [f64; 4]) {
+        let ny = self.y.nodes.len();
+        let n00 = i * ny + j;
+        let (ux, uy) = (1.0 - tx, 1.0 - ty);
+        (
+            [n00, n00 + 1, n00 + ny, n00 + ny + 1],
+            [ux * uy, ux * ty, tx * uy, tx * ty],
+        )
+    }
+
+    /// The bilinear query for finite input inside the grid, fixed sizes: `None` when the
+    /// position is outside or any input is not finite, so the caller takes the general path
+    /// (which names the error or applies the out-of-grid policy). Gives the same bits as
+    /// the general path.
+    #[inline(always)]
+    pub(super) fn bilinear_inside<const ND: usize, const NF: usize>(
+        &self,
+        [px, py]: [f64; 2],
+        f: &[f64; NF],
+    ) -> Option<[f64; ND]> {
+        // NaN and infinities make this NaN; finite values make it exactly 0.
+        let probe = f.iter().fold(px * 0.0 + py * 0.0, |a, v| a + v * 0.0);
+        let inside = px >= self.x.first()
+            && px <= self.x.last()
+            && py >= self.y.first()
+            && py <= self.y.last();
+        if probe != 0.0 || !inside {
+            return None;
+        }
+        let (i, tx) = self.x.cell_t_inside(px);
+        let (j, ty) = self.y.cell_t_inside(py);
+        let (nodes, weights) = self.bilinear_stencil(i, j, tx, ty);
+        Some(self.blend_fixed::<ND, NF>(&nodes, &weights, f))
+    }
+}
