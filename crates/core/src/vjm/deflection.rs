@@ -4,7 +4,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
-use super::model::Op;
+use super::model::{Op, Pass};
 use super::{Data, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 
@@ -125,42 +125,33 @@ fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64> {
 /// (before their own motion), which every kernel below reads.
 fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
     let mut frame = Isometry3::identity();
-    for op in model.ops.iter() {
-        match op {
-            Op::Fixed(f) => frame *= f,
-            Op::Joint {
-                pre,
-                axis,
-                revolute,
-                index,
-            } => {
-                let i = *index;
-                frame *= pre;
+    for p in model.pass.iter() {
+        match p {
+            Pass::Joint(step) => {
+                let i = step.index;
+                frame *= step.pre;
+                let u = frame.rotation * step.axis.into_inner();
                 if let (Some(a), Some(o)) =
                     (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
                 {
-                    *a = frame.rotation * axis.into_inner();
+                    *a = u;
                     *o = frame.translation.vector;
                 }
                 let qi = q.get(i).copied().unwrap_or(0.0);
-                if *revolute {
-                    frame.rotation *= UnitQuaternion::from_axis_angle(axis, qi);
+                if step.revolute {
+                    frame.rotation *= UnitQuaternion::from_axis_angle(&step.axis, qi);
                 } else {
-                    frame.translation.vector += frame.rotation * (axis.into_inner() * qi);
+                    frame.translation.vector += u * qi;
                 }
             }
-            Op::Spring { offset, index, .. } => {
+            Pass::Spring { local, index } => {
                 if let Some(slot) = data.spring_frames.get_mut(*index) {
-                    *slot = match offset {
-                        Some(o) => frame * o,
-                        None => frame,
-                    };
+                    *slot = frame * local;
                 }
             }
-            Op::Mass { .. } => {}
         }
     }
-    frame
+    frame * model.tcp_tail
 }
 
 /// The rigid TCP pose alone: the joints with the fixed transforms between them folded at

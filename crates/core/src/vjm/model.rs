@@ -101,6 +101,15 @@ pub(crate) struct TcpStep {
     pub index: usize,
 }
 
+/// The rigid pass compiled at build: the joints with the fixed transforms between them
+/// folded (across springs and masses), and each spring's frame relative to the frame after
+/// the joint before it, so every spring costs one composition and the chain one per joint.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Pass {
+    Joint(TcpStep),
+    Spring { local: Isometry3<f64>, index: usize },
+}
+
 /// An immutable serial chain with virtual joints, built once by [`ModelBuilder`] or loaded by
 /// [`crate::SerialRobot`]. Holds no heap memory, so it can live in a static on a controller.
 #[derive(Debug, Clone, PartialEq)]
@@ -109,6 +118,8 @@ pub struct Model {
     pub(crate) ops: heapless::Vec<Op, MAX_ELEMENTS>,
     /// The joints alone, fixed transforms folded across the springs and masses between them.
     pub(crate) tcp_chain: heapless::Vec<TcpStep, MAX_DOF>,
+    /// Joints and springs for the pass that also places the springs.
+    pub(crate) pass: heapless::Vec<Pass, MAX_ELEMENTS>,
     /// The fixed transform after the last joint.
     pub(crate) tcp_tail: Isometry3<f64>,
     pub(crate) dof: usize,
@@ -465,6 +476,7 @@ impl ModelBuilder {
         // Springs and masses leave the rigid chain as it is: without them, the fixed
         // transforms between two joints fold into one.
         let mut tcp_chain: heapless::Vec<TcpStep, MAX_DOF> = heapless::Vec::new();
+        let mut pass: heapless::Vec<Pass, MAX_ELEMENTS> = heapless::Vec::new();
         let mut tail = Isometry3::identity();
         for e in &self.elements {
             match *e {
@@ -476,19 +488,28 @@ impl ModelBuilder {
                         revolute: matches!(e, Element::Revolute { .. }),
                         index,
                     };
+                    pass.push(Pass::Joint(step.clone())).map_err(|_| capacity)?;
                     tcp_chain.push(step).map_err(|_| BuildError::Capacity {
                         what: "joints",
                         capacity: MAX_DOF,
                         got: MAX_DOF + 1,
                     })?;
                 }
-                Element::Spring { .. } | Element::Mass { .. } => {}
+                Element::Spring { offset, index, .. } => {
+                    pass.push(Pass::Spring {
+                        local: tail * offset,
+                        index,
+                    })
+                    .map_err(|_| capacity)?;
+                }
+                Element::Mass { .. } => {}
             }
         }
         Ok(Model {
             elements: self.elements,
             ops,
             tcp_chain,
+            pass,
             tcp_tail: tail,
             dof: self.dof,
             springs: self.springs,
