@@ -145,6 +145,21 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    // A displacement field at a fixed load (`ComplianceMap::field`): position-only queries.
+    let field = match even.field(&[-120.0, 245.25]) {
+        Ok(f) => f,
+        Err(e) => panic!("{e}"),
+    };
+    let mut k = 0usize;
+    let mut fout = [0.0; 2];
+    group.bench_function("field/Bilinear/even", |b| {
+        b.iter(|| {
+            k = (k + 1) & 1023;
+            let (p, _) = points.get(k).copied().unwrap_or_default();
+            let s = field.displacement(black_box(p), &mut fout);
+            black_box((s, fout))
+        })
+    });
     // 1e5 queries in one allocation-free batch call (the path the Python binding uses).
     let n = 100_000;
     let mut pos = Vec::with_capacity(2 * n);

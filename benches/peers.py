@@ -10,9 +10,9 @@ call (or per point / row), the deflect/peer ratio (< 1: deflect is faster) and t
 difference between the two results:
 
 - UR5 compliance and deflection (example-robot-data's UR5, deflect's `robots/ur5` springs):
-  Pinocchio's frame placements and joint frames plus numpy for the spring Jacobian
-  (three rotations per joint: the drive's axis and two bending axes; the springs as extra
-  joints) and `J K^-1 J^T w`, against `SerialRobot.compliance` + `@ w`, and per row in batches;
+  Pinocchio with the springs as extra joints (three revolute joints per spring: the drive's
+  axis and two bending axes), one `computeFrameJacobian` and `J K^-1 J^T w` in numpy, against
+  `SerialRobot.linear_deflection` (and `compliance`), and per row in batches;
 - compliance map (Paksoy, Dede and Kiper 2025, Eq. 9-14, OC map): scipy's
   RegularGridInterpolator (linear, and cubic: a different C1/C2 interpolant, so its agreement is
   the gap between two smooth fits, not a check) on the 8 coefficient fields, against
@@ -23,14 +23,19 @@ difference between the two results:
 """
 
 import argparse
+import os
 import pathlib
 import statistics
 import sys
 import time
 
-import numpy as np
+# OpenBLAS's worker threads spin after each matrix product and take a core from the
+# threaded batches measured next; neither side's timed work uses BLAS threads.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
-import deflect
+import numpy as np  # noqa: E402
+
+import deflect  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -74,43 +79,53 @@ def springs_of(toml_path):
 
 
 class PinocchioCompliance:
-    """C = J_s K^-1 J_s^T at the tool frame, J_s the twists of the virtual joints' rotations.
+    """C = J_s K^-1 J_s^T at the tool frame with the springs as extra Pinocchio joints.
 
-    Each spring sits in its joint's frame with its first axis along the joint axis: its three
-    rotations are that axis and two unit vectors normal to it (any pair: the two bending
-    stiffnesses are equal in the UR5 file, and checked so)."""
+    Each spring becomes three revolute joints RX, RY, RZ at zero angle, right after its
+    actuated joint and in that joint's frame (the spring frame of the stiffness file, whose
+    first axis is the joint axis), and the joints after it hang from the spring. One
+    `computeFrameJacobian` (LOCAL_WORLD_ALIGNED) then gives every spring column: both
+    libraries compute the same thing, in compiled code."""
 
     def __init__(self, urdf, toml_path, tip):
         import pinocchio as pin
 
         self.pin = pin
-        self.model = pin.buildModelFromUrdf(str(urdf))
-        self.data = self.model.createData()
-        self.tip = self.model.getFrameId(tip)
-        springs = springs_of(toml_path)
-        self.joint_ids = [self.model.getJointId(name) for name, _ in springs]
-        k = np.array([s[1] for s in springs], dtype=float)
+        src = pin.buildModelFromUrdf(str(urdf))
+        springs = dict(springs_of(toml_path))
+        k = np.array(list(springs.values()), dtype=float)
         assert np.all(k[:, 1] == k[:, 2]), "bending stiffnesses must be equal for this reference"
-        # 1/k per column, columns in the joint frame's x, y, z order (the drive axis gets the
-        # torsional compliance, the two others the bending one).
-        inv = []
-        for jid, kj in zip(self.joint_ids, k):
-            ax = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}[
-                self.model.joints[jid].shortname()]
-            inv.extend(1.0 / kj[0] if c == ax else 1.0 / kj[1] for c in range(3))
-        self.inv_k = np.array(inv)
+        m = pin.Model()
+        hang = {0: 0}  # source joint -> the new joint its children hang from
+        spring_joints, inv_k, q_pairs = [], [], []
+        for jid in range(1, src.njoints):
+            joint, name = src.joints[jid], src.names[jid]
+            new = m.addJoint(hang[src.parents[jid]], joint, src.jointPlacements[jid], name)
+            q_pairs.append((joint.idx_q, new))
+            hang[jid] = new
+            if name not in springs:
+                continue
+            kj = springs[name]
+            ax = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}[joint.shortname()]
+            for c, jm in enumerate([pin.JointModelRX(), pin.JointModelRY(), pin.JointModelRZ()]):
+                hang[jid] = m.addJoint(hang[jid], jm, pin.SE3.Identity(), f"{name}_spring_{c}")
+                spring_joints.append(hang[jid])
+                # The drive axis gets the torsional compliance, the two others the bending one.
+                inv_k.append(1.0 / (kj[0] if c == ax else kj[1]))
+        f = src.frames[src.getFrameId(tip)]
+        self.tip = m.addFrame(pin.Frame(tip, hang[f.parentJoint], f.placement, pin.FrameType.OP_FRAME))
+        self.model, self.data = m, m.createData()
+        self.cols = np.array([m.joints[j].idx_v for j in spring_joints])
+        self.inv_k = np.array(inv_k)
+        self.src_q = np.array([s for s, _ in q_pairs])
+        self.dst_q = np.array([m.joints[n].idx_q for _, n in q_pairs])
+        self.q = pin.neutral(m)  # spring angles stay 0
 
     def compliance(self, q):
-        pin = self.pin
-        pin.forwardKinematics(self.model, self.data, q)
-        p = pin.updateFramePlacement(self.model, self.data, self.tip).translation
-        frames = [self.data.oMi[j] for j in self.joint_ids]
-        # Rows of R^T are the frame axes in the base frame: 3 rotation axes per spring.
-        axes = np.concatenate([m.rotation.T for m in frames])
-        levers = np.repeat([p - m.translation for m in frames], 3, axis=0)
-        # u x r written out (np.cross costs ~35 us here, more than everything else).
-        lin = axes[:, [1, 2, 0]] * levers[:, [2, 0, 1]] - axes[:, [2, 0, 1]] * levers[:, [1, 2, 0]]
-        j = np.concatenate([lin, axes], axis=1).T
+        self.q[self.dst_q] = q[self.src_q]
+        j = self.pin.computeFrameJacobian(
+            self.model, self.data, self.q, self.tip, self.pin.LOCAL_WORLD_ALIGNED
+        )[:, self.cols]
         return (j * self.inv_k) @ j.T
 
 
@@ -124,9 +139,12 @@ def bench_vjm(args):
 
     c_d, c_p = robot.compliance(q), peer.compliance(q)
     agree_c = np.abs(c_d - c_p).max() / np.abs(c_p).max()
-    t_d = median_time(lambda: robot.compliance(q) @ w, args.repeats, args.inner)
+    t_d = median_time(lambda: robot.linear_deflection(q, w), args.repeats, args.inner)
     t_p = median_time(lambda: peer.compliance(q) @ w, args.repeats, args.inner)
-    row("UR5 compliance + C w, one call", t_d, t_p, 1e6, "us", agree_c)
+    row("UR5 compliance + C w (linear_deflection)", t_d, t_p, 1e6, "us", agree_c)
+    t_d = median_time(lambda: robot.compliance(q), args.repeats, args.inner)
+    t_p = median_time(lambda: peer.compliance(q), args.repeats, args.inner)
+    row("UR5 compliance (6, 6)", t_d, t_p, 1e6, "us", agree_c)
 
     n = args.rows
     qs = rng.uniform(-2.0, 2.0, (n, 6))

@@ -999,3 +999,152 @@ fn batch_equals_single_bit_for_bit() {
         );
     }
 }
+
+/// The owning map's packed coefficient layout (slopes, then offset sums, node by node) and a
+/// borrowed view over the plain tables give the same bits, for the fixed-size kernels (2 x 2,
+/// 3 x 3, 6 x 6) and the generic one (3 x 2), every interpolation and out-of-grid policy,
+/// single queries and batches; and both equal Eq. 9-10 summed by hand at the nodes.
+#[test]
+fn packed_and_plain_layouts_agree_bit_for_bit() {
+    let x = vec![0.0, 0.1, 0.25, 0.3];
+    let y = vec![-0.2, -0.1, 0.0, 0.1, 0.2];
+    for (nd, nf) in [(2, 2), (3, 3), (6, 6), (3, 2), (1, 4)] {
+        let n = x.len() * y.len() * nd * nf;
+        let coef = |k: usize, s: f64| ((k as f64 * s).sin() * 1e-6) + 1e-7;
+        let slopes: Vec<f64> = (0..n).map(|k| coef(k, 0.37)).collect();
+        let offsets: Vec<f64> = (0..n).map(|k| coef(k, 1.91) * 1e-3).collect();
+        let map = ComplianceMap::new(
+            x.clone(),
+            y.clone(),
+            nf,
+            nd,
+            slopes.clone(),
+            offsets.clone(),
+        )
+        .unwrap();
+        let plain = ComplianceMapView::new(&x, &y, nf, nd, &slopes, &offsets).unwrap();
+        let packed = map.view();
+        let force: Vec<f64> = (0..nf).map(|f| 100.0 * (f as f64 + 1.0) - 150.0).collect();
+        // Nodes: Eq. 9-10 by hand.
+        for (i, xi) in x.iter().enumerate() {
+            for (j, yj) in y.iter().enumerate() {
+                let mut out = vec![0.0; nd];
+                packed.displacement([*xi, *yj], &force, &mut out).unwrap();
+                for (d, o) in out.iter().enumerate() {
+                    let want: f64 = (0..nf)
+                        .map(|f| map.slope(i, j, d, f).unwrap() * force[f])
+                        .sum::<f64>()
+                        + (0..nf)
+                            .map(|f| map.offset(i, j, d, f).unwrap())
+                            .sum::<f64>();
+                    assert!(
+                        (o - want).abs() <= 1e-15 * want.abs().max(1e-12),
+                        "{nd}x{nf}"
+                    );
+                }
+            }
+        }
+        let points: Vec<[f64; 2]> = (0..200)
+            .map(|k| {
+                let t = k as f64 * 0.618_033_988_749_895;
+                [-0.05 + 0.4 * t.fract(), -0.25 + 0.5 * (t * 1.7).fract()]
+            })
+            .chain([[0.1, 0.0], [0.3, 0.2], [0.0, -0.2], [0.25, -0.1]])
+            .collect();
+        for interpolation in [Interpolation::Bilinear, Interpolation::Bicubic] {
+            for out_of_grid in [OutOfGrid::Error, OutOfGrid::Clamp, OutOfGrid::Extrapolate] {
+                let o = opts(interpolation, out_of_grid);
+                let flat_p: Vec<f64> = points.iter().flatten().copied().collect();
+                let flat_f: Vec<f64> = points.iter().flat_map(|_| force.clone()).collect();
+                for p in &points {
+                    let (mut a, mut b) = (vec![0.0; nd], vec![0.0; nd]);
+                    let ra = packed.displacement_with(*p, &force, &mut a, o);
+                    let rb = plain.displacement_with(*p, &force, &mut b, o);
+                    assert_eq!(ra, rb);
+                    if ra.is_ok() {
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&a), bits(&b), "{nd}x{nf} {p:?} {o:?}");
+                    }
+                }
+                if out_of_grid != OutOfGrid::Error {
+                    let (mut a, mut b) =
+                        (vec![0.0; nd * points.len()], vec![0.0; nd * points.len()]);
+                    packed
+                        .displacement_batch(&flat_p, 2, &flat_f, &mut a, o)
+                        .unwrap();
+                    plain
+                        .displacement_batch(&flat_p, 2, &flat_f, &mut b, o)
+                        .unwrap();
+                    for (k, p) in points.iter().enumerate() {
+                        let mut s = vec![0.0; nd];
+                        packed.displacement_with(*p, &force, &mut s, o).unwrap();
+                        for d in 0..nd {
+                            assert_eq!(a[k * nd + d].to_bits(), s[d].to_bits());
+                            assert_eq!(b[k * nd + d].to_bits(), s[d].to_bits());
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// A displacement field at a fixed load gives the map's displacement under that load (the
+/// same node values blended the same way), inside and out, single and batched; bad loads
+/// are refused at build.
+#[test]
+fn displacement_field_equals_the_map_at_its_load() {
+    let map = paper(OC);
+    let force = [-120.0, 245.25];
+    let field = map.field(&force).unwrap();
+    assert_eq!(field.force(), &force);
+    assert_eq!(field.n_displacement(), 2);
+    for interpolation in [Interpolation::Bilinear, Interpolation::Bicubic] {
+        for out_of_grid in [OutOfGrid::Error, OutOfGrid::Clamp, OutOfGrid::Extrapolate] {
+            let o = opts(interpolation, out_of_grid);
+            let mut flat = Vec::new();
+            for k in 0..300 {
+                let t = k as f64 * 0.618_033_988_749_895;
+                let p = [0.15 + 0.15 * t.fract(), -0.09 + 0.18 * (t * 1.3).fract()];
+                flat.extend_from_slice(&p);
+                let (mut a, mut b) = ([0.0; 2], [0.0; 2]);
+                let ra = field.displacement_with(p, &mut a, o);
+                let rb = map.displacement_with(p, &force, &mut b, o);
+                assert_eq!(ra, rb, "{p:?} {o:?}");
+                if ra.is_ok() {
+                    assert_eq!(a, b, "{p:?} {o:?}");
+                }
+            }
+            if out_of_grid != OutOfGrid::Error {
+                let mut out = vec![0.0; flat.len()];
+                field.displacement_batch(&flat, 2, &mut out, o).unwrap();
+                for (p, d) in flat.chunks(2).zip(out.chunks(2)) {
+                    let mut b = [0.0; 2];
+                    map.displacement_with([p[0], p[1]], &force, &mut b, o)
+                        .unwrap();
+                    assert_eq!(d, b);
+                }
+            }
+        }
+    }
+    assert!(matches!(
+        map.field(&[1.0]),
+        Err(BuildError::WrongLength {
+            what: "force",
+            expected: 2,
+            got: 1
+        })
+    ));
+    assert!(matches!(
+        map.field(&[1.0, f64::NAN]),
+        Err(BuildError::NonFinite {
+            what: "force",
+            index: 1
+        })
+    ));
+    let mut out = [0.0; 2];
+    assert!(matches!(
+        field.displacement([0.5, 0.0], &mut out),
+        Err(TickError::OutOfGrid { axis: 0, .. })
+    ));
+}

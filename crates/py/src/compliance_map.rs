@@ -3,8 +3,8 @@
 
 use deflect_core::TickError;
 use deflect_core::compliance_map::{
-    self as cm, ComplianceMap as CoreMap, FitOptions, HoldOutAxis, Interpolation, Measurement,
-    OutOfGrid, QueryOptions,
+    self as cm, ComplianceMap as CoreMap, FitOptions, HoldOutAxis, Interpolation, MAX_AXES,
+    Measurement, OutOfGrid, QueryOptions,
 };
 use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
@@ -313,6 +313,16 @@ impl ComplianceMap {
         Ok((rebuild, (slf.get().to_json()?,)))
     }
 
+    /// The displacement field under the fixed `force` (n_force,) [N]: every node's
+    /// displacement computed once, for position-only queries (`DisplacementField`).
+    /// `InputError` for a wrong length or a non-finite force.
+    fn field(
+        slf: &Bound<'_, Self>,
+        force: &Bound<'_, PyAny>,
+    ) -> PyResult<crate::field::DisplacementField> {
+        crate::field::DisplacementField::build(slf, force)
+    }
+
     /// The same map with other default options.
     #[pyo3(signature = (interpolation=None, out_of_grid=None))]
     fn with_options(
@@ -345,11 +355,16 @@ impl ComplianceMap {
             other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
         };
         let f = vector_any(force, "force")?;
-        let mut out = vec![0.0; self.inner.n_displacement()];
+        let mut buf = [0.0; MAX_AXES];
+        let out = buf
+            .get_mut(..self.inner.n_displacement())
+            .unwrap_or(&mut []);
         self.inner
-            .displacement_with(p, &f, &mut out, o)
+            .displacement_with(p, &f, out, o)
             .map_err(tick_err)?;
-        Ok(out.into_pyarray(py))
+        // A new numpy-owned array with the values copied: cheaper than handing over a Rust
+        // buffer for a few entries.
+        Ok(PyArray1::from_slice(py, out))
     }
 
     /// Displacements (N, n_displacement) [m] for positions `P` (N, 2) or (N, 3) [m] (z

@@ -33,6 +33,7 @@ mod convert;
 mod dalembert;
 mod dalembert_serial;
 mod drivetrain;
+mod field;
 mod identification;
 mod mechanism;
 mod motion;
@@ -85,6 +86,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     compensation::register(m)?;
     identification::register(m)?;
     compliance_map::register(m)?;
+    field::register(m)?;
     motion::register(m)?;
     mechanism::register(m)?;
     dalembert::register(m)?;

@@ -211,6 +211,21 @@ impl SerialRobot {
         Ok(matrix_to_py(py, &c))
     }
 
+    /// Linearized deflection `compliance(q) @ wrench`, (6,) [m, rad], in one call (the
+    /// first-order term of `deflection`).
+    fn linear_deflection<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+        wrench: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let model = &self.inner.model;
+        let q = vector(q, "q", model.dof())?;
+        let w = vector6(wrench, "wrench")?;
+        let d = vjm::linear_deflection(model, &mut self.data(), &q, &w).map_err(tick_err)?;
+        Ok(d.as_slice().to_pyarray(py))
+    }
+
     /// Actuated-joint Jacobian of the rigid TCP, (6, dof), rows `[v; w]`, base frame.
     fn joint_jacobian<'py>(
         &self,

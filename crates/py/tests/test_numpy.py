@@ -132,3 +132,41 @@ def test_batches_on_every_core_match_the_single_calls(kr300):
                  lambda: kr300.compliance_batch(q)]:
         with pytest.raises(deflect.InputError, match="row 3000"):
             call()
+
+
+def test_displacement_field_is_the_map_at_a_fixed_load(cmap):
+    """ComplianceMap.field(force): position-only queries equal to the map under that load,
+    single and batched, pickled exactly; bad loads raise InputError naming the force."""
+    import copy
+    import pickle
+
+    force = np.array([-120.0, 245.25])
+    field = cmap.field(force)
+    assert isinstance(field, deflect.DisplacementField)
+    np.testing.assert_array_equal(field.force, force)
+    P = points(5000)
+    np.testing.assert_array_equal(field.displacement_batch(P), cmap.displacement_batch(P, force))
+    for p in P[:50]:
+        np.testing.assert_array_equal(field.displacement(p), cmap.displacement(p, force))
+    # Node values are Eq. 9-10 at the nodes.
+    s, o = cmap.slopes, cmap.offsets
+    np.testing.assert_allclose(field.node_values, s @ force + o.sum(axis=3), rtol=1e-14, atol=1e-18)
+    for back in (pickle.loads(pickle.dumps(field)), copy.deepcopy(field)):
+        np.testing.assert_array_equal(back.displacement_batch(P), field.displacement_batch(P))
+    with pytest.raises(deflect.InputError, match="force"):
+        cmap.field([1.0])
+    with pytest.raises(deflect.InputError, match="force"):
+        cmap.field([1.0, np.nan])
+    with pytest.raises(deflect.InputError, match="x"):
+        field.displacement([0.5, 0.0])
+
+
+def test_linear_deflection_is_compliance_times_wrench(kr300):
+    q = np.array([0.1, -0.9, 1.4, 0.2, 1.07, -0.3])
+    w = np.array([-386.1, 386.1, 20.0, 1.0, -2.0, 0.5])
+    # numpy and nalgebra sum the product in other orders: equal to an ulp or two.
+    np.testing.assert_allclose(kr300.linear_deflection(q, w), kr300.compliance(q) @ w, rtol=1e-15, atol=1e-21)
+    # Lists of numpy scalars (float subclasses) read like floats.
+    np.testing.assert_array_equal(kr300.linear_deflection(list(q), list(w)), kr300.linear_deflection(q, w))
+    with pytest.raises(deflect.InputError, match="wrench"):
+        kr300.linear_deflection(q, [0.0, 0.0, np.inf, 0.0, 0.0, 0.0])

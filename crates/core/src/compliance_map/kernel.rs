@@ -84,7 +84,7 @@ impl ComplianceMapView<'_> {
 
     /// [`Self::node_value`] for run-time sizes, into the first `nd` entries of the result.
     #[inline]
-    fn node_value_dyn(&self, node: usize, f: &[f64]) -> [f64; MAX_AXES] {
+    pub(super) fn node_value_dyn(&self, node: usize, f: &[f64]) -> [f64; MAX_AXES] {
         let (nd, nf) = (self.n_disp, self.n_force);
         let mut v = [0.0; MAX_AXES];
         let line =

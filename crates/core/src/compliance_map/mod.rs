@@ -49,12 +49,16 @@ mod view;
 #[cfg(feature = "alloc")]
 mod cross_validation;
 #[cfg(feature = "alloc")]
+mod field;
+#[cfg(feature = "alloc")]
 mod fit;
 #[cfg(feature = "alloc")]
 mod map;
 
 #[cfg(feature = "alloc")]
 pub use cross_validation::{CrossValidation, HeldOutNode, HoldOutAxis, leave_one_node_out};
+#[cfg(feature = "alloc")]
+pub use field::DisplacementField;
 #[cfg(feature = "std")]
 pub(crate) use fit::grid_of;
 #[cfg(feature = "alloc")]

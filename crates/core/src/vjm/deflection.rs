@@ -380,6 +380,22 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
     Ok(c)
 }
 
+/// The linearized deflection `C(q) w` \[m, rad\] under the TCP wrench `[F; M]` \[N, N m\]
+/// (base frame): [`compliance`] times the wrench in one call, the first-order term of
+/// [`deflection`]. Also fills `data.compliance` and `data.tcp`.
+pub fn linear_deflection(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    wrench: &Vector6,
+) -> Result<Vector6, TickError> {
+    check_finite("wrench", wrench.as_slice())?;
+    let c = compliance(model, data, q)?;
+    let d = c * wrench;
+    check_output("deflection", d.as_slice())?;
+    Ok(d)
+}
+
 /// Fills `data.jacobian` with the actuated-joint Jacobian of the rigid TCP, rows
 /// `[v; w]` in the base frame, and `data.tcp` with the rigid pose. Columns past the model's
 /// dof are zero.

@@ -22,6 +22,7 @@ pub use correction::{
 pub(crate) use deflection::rotation_vector;
 pub use deflection::{
     MAX_SPRING_ANGLE, compliance, deflection, deflection_and_jacobian, forward, joint_jacobian,
+    linear_deflection,
 };
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};

@@ -7,6 +7,7 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 from ._deflect import (
     commanded_pose,
     ComplianceMap,
+    DisplacementField,
     ContourTracer,
     ConvergenceError,
     CorrectedPath,
@@ -45,6 +46,7 @@ from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
 __all__ = [
     "commanded_pose",
     "ComplianceMap",
+    "DisplacementField",
     "ContourTracer",
     "ConvergenceError",
     "CorrectedPath",

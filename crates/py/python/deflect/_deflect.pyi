@@ -28,6 +28,7 @@ __all__ = [
     "identify_stiffness_from_frames",
     "identify_sensor",
     "ComplianceMap",
+    "DisplacementField",
     "Trajectory",
     "plan_line",
     "plan_polyline",
@@ -98,6 +99,8 @@ class SerialRobot:
         """(n_springs, 3) elastic angles [rad] (Eq. 7)."""
     def compliance(self, q: _ArrayLike) -> _FloatArray:
         """(6, 6) Cartesian compliance of the linearized model."""
+    def linear_deflection(self, q: _ArrayLike, wrench: _ArrayLike) -> _FloatArray:
+        """(6,) linearized deflection compliance(q) @ wrench [m, rad], one call."""
     def joint_jacobian(self, q: _ArrayLike) -> _FloatArray:
         """(6, dof) actuated-joint Jacobian, rows [v; w]."""
     def joint_correction(
@@ -235,6 +238,29 @@ class ComplianceMap:
     @property
     def offsets(self) -> _FloatArray:
         """(nx, ny, n_displacement, n_force) [m]."""
+    def field(self, force: _ArrayLike) -> "DisplacementField":
+        """The displacement field under a fixed force (n_force,) [N]: node values computed once."""
+
+@final
+class DisplacementField:
+    """A ComplianceMap evaluated once at a fixed load: position-only queries that equal
+    ``map.displacement(position, force)``. Built by ``ComplianceMap.field(force)``."""
+
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling and copy.deepcopy as ``map.field(force)`` (exact)."""
+    def displacement(self, position: _ArrayLike) -> _FloatArray:
+        """(n_displacement,) [m] at (x, y) [m]."""
+    def displacement_batch(self, P: _ArrayLike) -> _FloatArray:
+        """(N, 2) or (N, 3) positions [m] -> (N, n_displacement) [m]; GIL released."""
+    @property
+    def force(self) -> _FloatArray:
+        """The load (n_force,) [N]."""
+    @property
+    def node_values(self) -> _FloatArray:
+        """(nx, ny, n_displacement) [m] node displacements under the load."""
+    @property
+    def map(self) -> ComplianceMap:
+        """The map the field was computed from."""
 
 _Limit = Union[float, _ArrayLike]
 

@@ -1,0 +1,142 @@
+//! `DisplacementField`: a compliance map evaluated once at a fixed load.
+
+use deflect_core::compliance_map::{DisplacementField as CoreField, MAX_AXES};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
+use pyo3::prelude::*;
+
+use crate::InputError;
+use crate::compliance_map::ComplianceMap;
+use crate::convert::{build_err, matrix, shape_error, tick_err, tick_err_at, vector_any};
+
+/// What a pickled field is rebuilt from: its map and its load.
+type FieldState = (Py<ComplianceMap>, Vec<f64>);
+
+/// The displacement field of a `ComplianceMap` under one fixed load
+/// (`ComplianceMap.field(force)`): the node displacements (Eq. 9-10 of Paksoy, Dede and
+/// Kiper 2025) computed once, so queries take a position only and blend them with the map's
+/// options. Equals `map.displacement(position, force)`.
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct DisplacementField {
+    inner: CoreField,
+    map: Py<ComplianceMap>,
+}
+
+impl DisplacementField {
+    /// `map.field(force)`, for `ComplianceMap.field`.
+    pub(crate) fn build(
+        map: &Bound<'_, ComplianceMap>,
+        force: &Bound<'_, PyAny>,
+    ) -> PyResult<Self> {
+        let f = vector_any(force, "force")?;
+        let inner = map.get().inner.field(&f).map_err(build_err)?;
+        Ok(Self {
+            inner,
+            map: map.clone().unbind(),
+        })
+    }
+}
+
+#[pymethods]
+impl DisplacementField {
+    /// Displacement (n_displacement,) [m] at `position` (x, y) [m] (a 3rd entry is ignored).
+    fn displacement<'py>(
+        &self,
+        py: Python<'py>,
+        position: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = match vector_any(position, "position")?.as_slice() {
+            &[x, y] | &[x, y, _] => [x, y],
+            other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
+        };
+        let mut buf = [0.0; MAX_AXES];
+        let out = buf
+            .get_mut(..self.inner.n_displacement())
+            .unwrap_or(&mut []);
+        self.inner.displacement(p, out).map_err(tick_err)?;
+        Ok(PyArray1::from_slice(py, out))
+    }
+
+    /// Displacements (N, n_displacement) [m] at positions `P` (N, 2) or (N, 3) [m]; float64
+    /// C-contiguous input is read in place, the GIL is released.
+    #[allow(non_snake_case)] // reason: matrix name as in the documented Python signature
+    fn displacement_batch<'py>(
+        &self,
+        py: Python<'py>,
+        P: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let pm = matrix(P, "P", None, None)?;
+        let p = pm.as_array();
+        let (n, pc) = p.dim();
+        if pc != 2 && pc != 3 {
+            return Err(shape_error("P", "(N, 2) or (N, 3)", &[n, pc]));
+        }
+        let nd = self.inner.n_displacement();
+        let field = &self.inner;
+        let out = py.detach(|| {
+            let p = p.as_standard_layout();
+            let mut out = vec![0.0; n * nd];
+            let r = field.displacement_batch(
+                p.as_slice().unwrap_or(&[]),
+                pc,
+                &mut out,
+                field.options(),
+            );
+            r.map(|_| out)
+        });
+        let out = out.map_err(|e| tick_err_at(format_args!("row {}", e.row), e.error))?;
+        let a =
+            Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py))
+    }
+
+    /// The load (n_force,) [N] the field was computed for.
+    #[getter]
+    fn force<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.inner.force().to_pyarray(py)
+    }
+
+    /// Node displacements (nx, ny, n_displacement) [m] under the load.
+    #[getter]
+    fn node_values<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let shape = (
+            self.inner.x().len(),
+            self.inner.y().len(),
+            self.inner.n_displacement(),
+        );
+        let a = numpy::ndarray::Array3::from_shape_vec(shape, self.inner.node_values().to_vec())
+            .map_err(|e| InputError::new_err(e.to_string()))?;
+        Ok(a.into_pyarray(py).into_any())
+    }
+
+    /// The map the field was computed from.
+    #[getter]
+    fn map(&self, py: Python<'_>) -> Py<ComplianceMap> {
+        self.map.clone_ref(py)
+    }
+
+    /// Pickling: rebuilt as `map.field(force)` (an exact round trip).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, FieldState)> {
+        let rebuild = py.get_type::<ComplianceMap>().getattr("field")?;
+        Ok((
+            rebuild,
+            (self.map.clone_ref(py), self.inner.force().to_vec()),
+        ))
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "DisplacementField(grid={}x{}, n_displacement={}, force={:?})",
+            self.inner.x().len(),
+            self.inner.y().len(),
+            self.inner.n_displacement(),
+            self.inner.force()
+        )
+    }
+}
+
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<DisplacementField>()?;
+    Ok(())
+}
