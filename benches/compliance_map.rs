@@ -145,6 +145,38 @@ fn bench(c: &mut Criterion) {
             });
         }
     }
+    // 1024 single queries back to back through the per-query API (what a loop over
+    // `displacement` costs per call without the harness's per-iteration overhead).
+    group.throughput(criterion::Throughput::Elements(1024));
+    let bilinear = QueryOptions {
+        interpolation: Interpolation::Bilinear,
+        out_of_grid: OutOfGrid::Error,
+    };
+    group.bench_function("single_x1024/Bilinear/even", |b| {
+        b.iter(|| {
+            let mut acc = [0.0; 2];
+            let mut out = [0.0; 2];
+            for (p, f) in &points {
+                if even.displacement_with(*p, f, &mut out, bilinear).is_ok() {
+                    acc[0] += out[0];
+                    acc[1] += out[1];
+                }
+            }
+            black_box(acc)
+        })
+    });
+    group.bench_function("single_x1024/reference_hand/even", |b| {
+        b.iter(|| {
+            let mut acc = [0.0; 2];
+            for (p, f) in &points {
+                let r = hand.query(*p, *f);
+                acc[0] += r[0];
+                acc[1] += r[1];
+            }
+            black_box(acc)
+        })
+    });
+    group.throughput(criterion::Throughput::Elements(1));
     // A displacement field at a fixed load (`ComplianceMap::field`): position-only queries.
     let field = match even.field(&[-120.0, 245.25]) {
         Ok(f) => f,
