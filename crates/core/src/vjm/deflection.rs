@@ -127,7 +127,10 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
     let mut frame = Isometry3::identity();
     for p in model.pass.iter() {
         match p {
-            Pass::Joint(step) => {
+            Pass::Joint(k) => {
+                let Some(step) = model.tcp_chain.get(*k) else {
+                    continue; // unreachable: built together
+                };
                 let i = step.index;
                 frame *= step.pre;
                 let u = frame.rotation * step.axis.into_inner();

@@ -106,8 +106,12 @@ pub(crate) struct TcpStep {
 /// the joint before it, so every spring costs one composition and the chain one per joint.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum Pass {
-    Joint(TcpStep),
-    Spring { local: Isometry3<f64>, index: usize },
+    /// The joint `tcp_chain[k]`.
+    Joint(usize),
+    Spring {
+        local: Isometry3<f64>,
+        index: usize,
+    },
 }
 
 /// An immutable serial chain with virtual joints, built once by [`ModelBuilder`] or loaded by
@@ -119,7 +123,7 @@ pub struct Model {
     /// The joints alone, fixed transforms folded across the springs and masses between them.
     pub(crate) tcp_chain: heapless::Vec<TcpStep, MAX_DOF>,
     /// Joints and springs for the pass that also places the springs.
-    pub(crate) pass: heapless::Vec<Pass, MAX_ELEMENTS>,
+    pub(crate) pass: heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }>,
     /// The fixed transform after the last joint.
     pub(crate) tcp_tail: Isometry3<f64>,
     pub(crate) dof: usize,
@@ -476,7 +480,7 @@ impl ModelBuilder {
         // Springs and masses leave the rigid chain as it is: without them, the fixed
         // transforms between two joints fold into one.
         let mut tcp_chain: heapless::Vec<TcpStep, MAX_DOF> = heapless::Vec::new();
-        let mut pass: heapless::Vec<Pass, MAX_ELEMENTS> = heapless::Vec::new();
+        let mut pass: heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }> = heapless::Vec::new();
         let mut tail = Isometry3::identity();
         for e in &self.elements {
             match *e {
@@ -488,7 +492,7 @@ impl ModelBuilder {
                         revolute: matches!(e, Element::Revolute { .. }),
                         index,
                     };
-                    pass.push(Pass::Joint(step.clone())).map_err(|_| capacity)?;
+                    pass.push(Pass::Joint(tcp_chain.len())).map_err(|_| capacity)?;
                     tcp_chain.push(step).map_err(|_| BuildError::Capacity {
                         what: "joints",
                         capacity: MAX_DOF,
@@ -583,5 +587,15 @@ impl Data {
     /// Whether this workspace was made for a model of `model`'s dimensions.
     pub fn check(&self, model: &Model) -> bool {
         self.dof == model.dof && self.springs == model.springs
+    }
+}
+#[cfg(test)]
+mod size {
+    /// A `Model` holds no heap memory and is often built on the stack (debug builds copy it
+    /// on every move): its compiled passes must not grow it much past the element tables.
+    #[test]
+    fn model_stays_under_36_kib() {
+        let size = core::mem::size_of::<super::Model>();
+        assert!(size <= 36 * 1024, "Model is {size} bytes");
     }
 }
