@@ -492,7 +492,8 @@ impl ModelBuilder {
                         revolute: matches!(e, Element::Revolute { .. }),
                         index,
                     };
-                    pass.push(Pass::Joint(tcp_chain.len())).map_err(|_| capacity)?;
+                    pass.push(Pass::Joint(tcp_chain.len()))
+                        .map_err(|_| capacity)?;
                     tcp_chain.push(step).map_err(|_| BuildError::Capacity {
                         what: "joints",
                         capacity: MAX_DOF,
