@@ -116,9 +116,7 @@ impl DisplacementField {
                 continue;
             };
             match self.values.displacement_with([x, y], &[1.0], o, options) {
-                Ok(Placement::Inside) => summary.inside += 1,
-                Ok(Placement::Clamped) => summary.clamped += 1,
-                Ok(Placement::Extrapolated) => summary.extrapolated += 1,
+                Ok(place) => summary.count(place),
                 Err(error) => return Err(BatchError { row, error }),
             }
         }

@@ -269,8 +269,9 @@ pub struct BatchSummary {
 }
 
 impl BatchSummary {
+    /// Counts one row's placement.
     #[inline(always)]
-    fn count(&mut self, place: Placement) {
+    pub(super) fn count(&mut self, place: Placement) {
         match place {
             Placement::Inside => self.inside += 1,
             Placement::Clamped => self.clamped += 1,
