@@ -20,15 +20,20 @@
 //! ([`error`]): [`BuildError`] / [`LoadError`] when a model is assembled or loaded,
 //! [`TickError`] per tick, numerical failure inside a solver as an `Option`.
 //!
-//! | concept | model | per tick |
+//! | concept with per-tick state | model | tick |
 //! |---|---|---|
-//! | virtual-joint deflection | [`vjm::Model`] | [`vjm::deflection`], [`vjm::compliance`], [`vjm::joint_correction`] |
-//! | compliance-map query | [`ComplianceMapView`] | [`compliance_map::query`] |
-//! | D'Alembert correction | [`dalembert::Model`] | [`dalembert::step`] |
-//! | mechanism (IK/FK) | [`mechanism::Mechanism`] | `inverse`, `forward` |
+//! | D'Alembert correction, parallel robot + compliance map | [`dalembert::parallel::Model`] | [`dalembert::parallel::step`] |
+//! | D'Alembert correction, serial arm + VJM | [`dalembert::serial::Model`] | [`dalembert::serial::step`] |
 //! | online compensation | [`compensation::Model`] | [`compensation::step`] |
-//! | drive-train errors | [`drivetrain::Model`] | [`drivetrain::correct_joints`] |
+//! | drive-train errors | [`drivetrain::Model`] | [`drivetrain::step`] |
 //! | contour tracing | [`contour::Model`] | [`contour::step`] |
+//! | compliance-map query | [`compliance_map::Model`] | [`compliance_map::step`] |
+//! | trajectory sampling | [`motion::Model`] | [`motion::step`] |
+//!
+//! Quantities without per-tick state are one function each over the same `(&Model, &mut
+//! Data, inputs)`: the virtual-joint model's [`vjm::forward`], [`vjm::deflection`] (one pass
+//! for every [`vjm::Load`]), [`vjm::compliance`], [`vjm::joint_correction`]; a mechanism's
+//! `inverse` and `forward` ([`mechanism::Mechanism`]).
 //!
 //! ```
 //! use deflect_core::vjm::{self, Data, Vector6};
@@ -42,7 +47,8 @@
 //!     .build()?;
 //! let mut data = Data::new(&model);
 //! // 100 N along +y at the tip: moment 100 N m, angle 0.01 rad, tip moves ~10 mm along y.
-//! let d = vjm::deflection(&model, &mut data, &[0.0], &Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0))?;
+//! let w = Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0);
+//! let d = vjm::deflection(&model, &mut data, &[0.0], &w, vjm::Load::Exact)?;
 //! assert!((d.y - 0.01f64.sin()).abs() < 1e-12);
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

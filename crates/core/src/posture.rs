@@ -20,7 +20,7 @@
 use nalgebra::{Isometry3, Matrix3, Rotation3, Translation3, Unit, UnitQuaternion, Vector3};
 
 use crate::error::{TickError, check_finite};
-use crate::mechanism::{self, Load, PoseIkOptions};
+use crate::mechanism::{self, PoseIkOptions};
 use crate::vjm::{self, Data, MAX_DOF, Model, Vector6};
 
 /// Most angles one sweep takes (a 0.1 degree scan of the full turn).
@@ -194,7 +194,8 @@ impl Task<'_> {
             data,
             &target,
             seed,
-            Load::Rigid,
+            &vjm::Vector6::zeros(),
+            vjm::Load::Rigid,
             &self.options.ik,
         ) {
             Ok(s) => s,
@@ -209,7 +210,8 @@ impl Task<'_> {
         if outside {
             return Err(Reach::JointLimit);
         }
-        let d = vjm::deflection(self.model, data, q, self.wrench).map_err(|_| Reach::OutOfReach)?;
+        let d = vjm::deflection(self.model, data, q, self.wrench, vjm::Load::Exact)
+            .map_err(|_| Reach::OutOfReach)?;
         Ok(AnglePoint {
             angle: theta,
             reach: Reach::Reachable,

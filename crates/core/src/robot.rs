@@ -39,7 +39,8 @@ impl SerialRobot {
     /// let mut data = Data::new(&robot.model);
     /// let q = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
     /// // 750 N along +x at the TCP pushes it about 1.7 mm along x.
-    /// let d = vjm::deflection(&robot.model, &mut data, &q, &Vector6::new(750.0, 0.0, 0.0, 0.0, 0.0, 0.0))?;
+    /// let w = Vector6::new(750.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    /// let d = vjm::deflection(&robot.model, &mut data, &q, &w, vjm::Load::Exact)?;
     /// assert!((d.x - 1.693e-3).abs() < 1e-5);
     /// # Ok::<(), Box<dyn std::error::Error>>(())
     /// ```

@@ -217,7 +217,7 @@ fn compensator_steady_state_cancels_the_model_deflection() {
         w([400.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
         epsilon = 1e-9
     );
-    let d = vjm::deflection(&model, &mut data, &q, &out.wrench).unwrap();
+    let d = vjm::deflection(&model, &mut data, &q, &out.wrench, vjm::Load::Exact).unwrap();
     assert_relative_eq!(out.correction, -d, epsilon = 1e-15);
     assert!(!out.size_limited && !out.rate_limited);
 

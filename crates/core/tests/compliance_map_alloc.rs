@@ -82,7 +82,7 @@ fn displacement_allocates_nothing() {
         // bit for bit, placement and errors included.
         let v = (k % 2) + 2 * (k % 4);
         let (view, data) = (&views[v], &mut datas[v]);
-        let queried = compliance_map::query(view, data, p, &f);
+        let queried = compliance_map::step(view, data, p, &f);
         let displaced = view.displacement(p, &f, &mut direct);
         assert_eq!(queried, displaced);
         match queried {

@@ -5,7 +5,7 @@
 
 use deflect_core::contour::shape::{self, ShapeError};
 use deflect_core::contour::{self, TraceDirection, TracerConfig, TracerState};
-use deflect_core::drivetrain::{self, Data, cartesian_stiffness_xy, correct_joints};
+use deflect_core::drivetrain::{self, Data, cartesian_stiffness_xy};
 use deflect_core::{BuildError, ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
 
@@ -346,7 +346,7 @@ fn trace(shape: &Shape, start: Vector2<f64>, noise: f64) -> TraceResult {
             // The motor readings are the commanded angles.
             raw.push(arm.fk(&q_cmd));
             let w = Vector6::new(out.force.x, out.force.y, 0.0, 0.0, 0.0, 0.0);
-            let c = correct_joints(&arm.drive, &mut data, &q_cmd, &w).unwrap();
+            let c = drivetrain::step(&arm.drive, &mut data, &q_cmd, &w).unwrap();
             comp.push(arm.fk(&[c.q[0], c.q[1]]));
             truth.push(arm.fk(&q_true));
         }
@@ -523,7 +523,7 @@ fn traces_clockwise_and_reports_failures() {
 
     // The object vanishes after contact: bisections run out.
     let mut t = contour::Data::new(&tm);
-    contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap(); // bias
+    let _bias = contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap();
     let out = contour::step(&tm, &mut t, &p, &Vector2::new(10.0, 0.0)).unwrap();
     assert!(out.contact);
     let mut state = out.state;
@@ -536,7 +536,7 @@ fn traces_clockwise_and_reports_failures() {
 
     // A force that stays above the jam force.
     let mut t = contour::Data::new(&tm);
-    contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap();
+    let _bias = contour::step(&tm, &mut t, &p, &Vector2::zeros()).unwrap();
     let mut state = t.state();
     for _ in 0..20 {
         state = contour::step(&tm, &mut t, &p, &Vector2::new(100.0, 0.0))

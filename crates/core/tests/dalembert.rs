@@ -2,13 +2,13 @@
 
 use approx::assert_relative_eq;
 use deflect_core::compliance_map::{ComplianceMap, OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{self, Data, Model, VjmDisplacement};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::io::map_csv;
-use deflect_core::mechanism::{IkOptions, Mechanism, ParallelRobot2, SerialArm};
-use deflect_core::motion::{Limits, Trajectory, paper_limits};
+use deflect_core::mechanism::ParallelRobot2;
+use deflect_core::motion::{Trajectory, paper_limits};
 use deflect_core::units::{ForceUnit, LengthUnit};
-use deflect_core::{ModelBuilder, Placement, TickError, vjm};
-use nalgebra::{Isometry3, SVector, Vector2, Vector3};
+use deflect_core::{Placement, TickError};
+use nalgebra::Vector2;
 
 /// The paper's 3 x 5 grid [m] with the same slopes at every node.
 fn constant_map(c: [[f64; 2]; 2], offsets: [f64; 2]) -> ComplianceMap {
@@ -55,7 +55,7 @@ fn zero_map_leaves_the_path_unchanged() {
     data.set_seed(Vector2::zeros());
     let traj = x_line(5);
     let mut n = 0;
-    dalembert::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
+    parallel::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
         assert_eq!(t.commanded, t.desired);
         assert_eq!(t.joints, robot.ik(&t.desired).unwrap());
         n += 1;
@@ -74,9 +74,9 @@ fn constant_map_gives_exactly_c_m_a() {
     let a = Vector2::new(3.0 * 9.81, -2.0 * 9.81);
     let x = Vector2::new(0.2, 0.01);
     data.set_seed(Vector2::zeros());
-    let t = dalembert::step(&corr, &mut data, &x, &a).unwrap();
+    let t = parallel::step(&corr, &mut data, &x, &a).unwrap();
     // F_D = -m* a; displacement C F_D; command x - C F_D = x + C m* a.
-    assert_eq!(t.force, Vector2::new(-5.0 * 3.0 * 9.81, 5.0 * 2.0 * 9.81));
+    assert_eq!(t.load, Vector2::new(-5.0 * 3.0 * 9.81, 5.0 * 2.0 * 9.81));
     let cma = Vector2::new(
         c[0][0] * 5.0 * a.x + c[0][1] * 5.0 * a.y,
         c[1][0] * 5.0 * a.x + c[1][1] * 5.0 * a.y,
@@ -90,7 +90,7 @@ fn constant_map_gives_exactly_c_m_a() {
         .unwrap();
     let mut data2 = Data::new(&corr2);
     data2.set_seed(Vector2::zeros());
-    let t2 = dalembert::step(&corr2, &mut data2, &x, &a).unwrap();
+    let t2 = parallel::step(&corr2, &mut data2, &x, &a).unwrap();
     assert_eq!(t2.iterations, 1);
     assert_relative_eq!(t2.commanded, t.commanded, epsilon = 1e-18);
 }
@@ -101,7 +101,7 @@ fn fixed_point_reproduces_the_desired_path() {
     let map = paper_map("paksoy2025_compliance_oc.csv");
     let view = map.view();
     let robot = ParallelRobot2::paper();
-    let corr = Model::new(robot, view, dalembert::PAPER_MASS)
+    let corr = Model::new(robot, view, parallel::PAPER_MASS)
         .unwrap()
         .with_fixed_point(20, 1e-13)
         .unwrap();
@@ -119,11 +119,11 @@ fn fixed_point_reproduces_the_desired_path() {
     .unwrap();
     let mut worst: f64 = 0.0;
     let mut largest_correction: f64 = 0.0;
-    dalembert::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
+    parallel::correct_each(&corr, &mut data, &traj, 2000.0, |_, t| {
         let mut d = [0.0; 2];
         view.displacement_with(
             [t.commanded.x, t.commanded.y],
-            t.force.as_slice(),
+            t.load.as_slice(),
             &mut d,
             QueryOptions::default(),
         )
@@ -131,7 +131,7 @@ fn fixed_point_reproduces_the_desired_path() {
         let reached = t.commanded + Vector2::new(d[0], d[1]);
         worst = worst.max((reached - t.desired).norm());
         largest_correction = largest_correction.max((t.commanded - t.desired).norm());
-        assert_eq!(t.placement, Placement::Inside);
+        assert_eq!(t.diagnostics.placement, Placement::Inside);
         assert_relative_eq!(robot.fk(&t.joints).unwrap(), t.commanded, epsilon = 1e-14);
     })
     .unwrap();
@@ -160,14 +160,18 @@ fn streaming_and_offline_agree_exactly() {
         .unwrap();
     let mut data = Data::new(&corr);
     data.set_seed(Vector2::zeros());
-    let offline = dalembert::correct(&corr, &mut data, &traj, 2000.0).unwrap();
-    assert!(offline.iter().any(|t| t.placement == Placement::Clamped));
+    let offline = parallel::correct(&corr, &mut data, &traj, 2000.0).unwrap();
+    assert!(
+        offline
+            .iter()
+            .any(|t| t.diagnostics.placement == Placement::Clamped)
+    );
     let mut q = Vector2::zeros();
     let mut cursor = traj.ticks(2000.0).unwrap();
     let mut i = 0;
     while let Some(s) = cursor.step() {
         data.set_seed(q);
-        let t = dalembert::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
+        let t = parallel::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
         assert_eq!(t, offline[i]);
         q = t.joints;
         i += 1;
@@ -184,7 +188,7 @@ fn out_of_map_points_are_statuses_not_panics() {
     let outside = Vector2::new(0.15, 0.0); // x below the grid's 0.172 m
     let a = Vector2::new(9.81, 0.0);
     data.set_seed(Vector2::zeros());
-    let e = dalembert::step(&corr, &mut data, &outside, &a).unwrap_err();
+    let e = parallel::step(&corr, &mut data, &outside, &a).unwrap_err();
     // The map refuses the point (its default is to refuse out-of-grid queries).
     assert!(matches!(e, TickError::OutOfGrid { .. }), "{e:?}");
     let clamp = map.view().with_options(QueryOptions {
@@ -194,17 +198,17 @@ fn out_of_map_points_are_statuses_not_panics() {
     let corr_clamp = Model::new(robot, clamp, 5.0).unwrap();
     let mut data = Data::new(&corr_clamp);
     data.set_seed(Vector2::zeros());
-    let t = dalembert::step(&corr_clamp, &mut data, &outside, &a).unwrap();
-    assert_eq!(t.placement, Placement::Clamped);
+    let t = parallel::step(&corr_clamp, &mut data, &outside, &a).unwrap();
+    assert_eq!(t.diagnostics.placement, Placement::Clamped);
     // Out of the robot's reach (2 L = 0.3 m): a mechanism error.
     let far = Model::new(robot, clamp, 5.0).unwrap();
     let mut data = Data::new(&far);
     data.set_seed(Vector2::zeros());
-    let e = dalembert::step(&far, &mut data, &Vector2::new(0.35, 0.0), &a).unwrap_err();
+    let e = parallel::step(&far, &mut data, &Vector2::new(0.35, 0.0), &a).unwrap_err();
     assert!(matches!(e, TickError::OutOfWorkspace { .. }), "{e:?}");
     let mut data = Data::new(&corr_clamp);
     data.set_seed(Vector2::zeros());
-    let e = dalembert::step(&corr_clamp, &mut data, &Vector2::new(f64::NAN, 0.0), &a).unwrap_err();
+    let e = parallel::step(&corr_clamp, &mut data, &Vector2::new(f64::NAN, 0.0), &a).unwrap_err();
     assert_eq!(
         e,
         TickError::NonFinite {
@@ -214,57 +218,4 @@ fn out_of_map_points_are_statuses_not_panics() {
     );
     assert!(Model::new(robot, map.view(), -1.0).is_err());
     assert!(Model::new(robot, map.view(), f64::NAN).is_err());
-}
-
-#[test]
-fn serial_arm_corrected_with_its_virtual_joint_model() {
-    // A 3R arm (z, y, y) with compliant joints, driven along a 3-D line at 3 g.
-    let model = ModelBuilder::new()
-        .fixed(Isometry3::translation(0.0, 0.0, 0.3))
-        .unwrap()
-        .revolute(Vector3::z())
-        .unwrap()
-        .spring([2.0e4, 2.0e4, 1.0e4])
-        .unwrap()
-        .revolute(Vector3::y())
-        .unwrap()
-        .spring([2.0e4, 5.0e3, 2.0e4])
-        .unwrap()
-        .fixed(Isometry3::translation(0.5, 0.0, 0.0))
-        .unwrap()
-        .revolute(Vector3::y())
-        .unwrap()
-        .spring([2.0e4, 4.0e3, 2.0e4])
-        .unwrap()
-        .fixed(Isometry3::translation(0.4, 0.0, 0.0))
-        .unwrap()
-        .build()
-        .unwrap();
-    let arm = SerialArm::<3>::new(model.clone(), IkOptions::default()).unwrap();
-    let vjm_model = VjmDisplacement::new(model.clone());
-    let q0 = SVector::<f64, 3>::new(0.2, -0.5, 1.2);
-    let start = arm.forward(&mut arm.new_data(), &q0).unwrap();
-    let end = start + Vector3::new(0.0, 0.1, -0.05);
-    let traj =
-        Trajectory::line(start, end, &Limits::new(0.5, 3.0 * 9.81, 2000.0).unwrap()).unwrap();
-    let corr = Model::new(arm, vjm_model, 2.0)
-        .unwrap()
-        .with_fixed_point(10, 1e-12)
-        .unwrap();
-    let mut corr_data = Data::new(&corr);
-    corr_data.set_seed(q0);
-    let mut worst: f64 = 0.0;
-    let mut largest: f64 = 0.0;
-    dalembert::correct_each(&corr, &mut corr_data, &traj, 2000.0, |_, t| {
-        // The loaded arm commanded to `joints` puts its TCP on the desired point.
-        let mut data = vjm::Data::new(&model);
-        let w = vjm::Vector6::new(t.force.x, t.force.y, t.force.z, 0.0, 0.0, 0.0);
-        let d = vjm::deflection(&model, &mut data, t.joints.as_slice(), &w).unwrap();
-        let reached = data.tcp.translation.vector + Vector3::new(d[0], d[1], d[2]);
-        worst = worst.max((reached - t.desired).norm());
-        largest = largest.max(t.displacement.norm());
-    })
-    .unwrap();
-    assert!(largest > 1e-5, "the test must load the arm: {largest}");
-    assert!(worst < 1e-9, "loaded TCP off the path by {worst} m");
 }

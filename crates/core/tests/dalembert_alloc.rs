@@ -2,7 +2,7 @@
 //! a counting global allocator watches them. One test function only.
 
 use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::io::map_csv;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
@@ -52,7 +52,7 @@ fn corrector_ticks_do_not_allocate() {
         let mut cursor = up.ticks(2000.0).unwrap();
         while let Some(s) = cursor.step() {
             data.set_seed(q);
-            let t = dalembert::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
+            let t = parallel::step(&corr, &mut data, &s.position, &s.acceleration).unwrap();
             q = t.joints;
             sink += t.commanded.x;
             ticks += 1;

@@ -3,8 +3,8 @@
 //! follows Eq. 3-5 by hand, and every failure is a status.
 
 use approx::assert_relative_eq;
-use deflect_core::dalembert::{self, Payload, SerialData, SerialModel};
-use deflect_core::mechanism::{Load, PoseIkOptions, pose_ik};
+use deflect_core::dalembert::serial::{self, Payload};
+use deflect_core::mechanism::{PoseIkOptions, pose_ik};
 use deflect_core::motion::{Limits, PoseLimits, PoseState, PoseTrajectory};
 use deflect_core::vjm::{self, Data, Vector6};
 use deflect_core::{SerialRobot, TickError};
@@ -48,12 +48,12 @@ fn motion(robot: &SerialRobot) -> PoseTrajectory {
 fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
     let robot = kr300();
     // The payload alone, as the paper's D'Alembert force: the link masses left out.
-    let model = SerialModel::new(robot.model.clone(), payload())
+    let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
         .with_joint_limits(&robot.joint_limits)
         .unwrap();
     assert!(!model.link_inertia(), "off by default, as in the paper");
-    let mut data = SerialData::new(&model);
+    let mut data = serial::Data::new(&model);
     data.set_seed(&Q0);
     let traj = motion(&robot);
     let rate = 2000.0;
@@ -63,14 +63,21 @@ fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
     let (mut max_defl, mut max_iter) = (0.0f64, 0usize);
     for k in 0..n {
         let s = traj.sample(traj.tick_time(rate, k, n)).unwrap();
-        let tick = dalembert::serial::step(&model, &mut data, &s, None).unwrap();
+        let tick = serial::step(&model, &mut data, &s, None).unwrap();
         // Independent check: deflect the commanded joints under the tick's wrench.
-        let d = vjm::deflection(&robot.model, &mut check, &tick.joints[..6], &tick.wrench).unwrap();
+        let d = vjm::deflection(
+            &robot.model,
+            &mut check,
+            &tick.joints[..6],
+            &tick.load,
+            vjm::Load::Exact,
+        )
+        .unwrap();
         let loaded = check.tcp_deflected;
         let ep = (loaded.translation.vector - s.pose.translation.vector).norm();
         let er = loaded.rotation.angle_to(&s.pose.rotation);
         assert!(ep <= 1e-8 && er <= 1e-8, "tick {k}: {ep:e} m {er:e} rad");
-        assert_relative_eq!(d, tick.deflection, epsilon = 1e-15);
+        assert_relative_eq!(d, tick.displacement, epsilon = 1e-15);
         max_defl = max_defl.max(d.fixed_rows::<3>(0).norm());
         max_iter = max_iter.max(tick.iterations);
     }
@@ -83,14 +90,14 @@ fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
 fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
     let robot = kr300();
     assert_eq!(robot.model.mass_count(), 6);
-    let model = SerialModel::new(robot.model.clone(), payload())
+    let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
         .with_joint_limits(&robot.joint_limits)
         .unwrap()
         .with_link_inertia(true);
     assert!(model.link_inertia());
     let payload_only = model.clone().with_link_inertia(false);
-    let (mut data, mut data0) = (SerialData::new(&model), SerialData::new(&payload_only));
+    let (mut data, mut data0) = (serial::Data::new(&model), serial::Data::new(&payload_only));
     data.set_seed(&Q0);
     data0.set_seed(&Q0);
     let traj = motion(&robot);
@@ -99,7 +106,7 @@ fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
     let (mut largest_gap, mut worst) = (0.0f64, 0.0f64);
     for k in 0..n {
         let s = traj.sample(traj.tick_time(2000.0, k, n)).unwrap();
-        let tick = dalembert::serial::step(&model, &mut data, &s, None).unwrap();
+        let tick = serial::step(&model, &mut data, &s, None).unwrap();
         let q = &tick.joints[..6];
         // Independent joint rates and accelerations at the command: LU solves of the rigid
         // Jacobian there (the corrector uses damped least squares at its warm start).
@@ -119,7 +126,14 @@ fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
             qdd: qdd.as_slice(),
             gravity: Vector3::zeros(),
         };
-        vjm::deflection_under(&robot.model, &mut check, q, &tick.wrench, &motion).unwrap();
+        vjm::deflection(
+            &robot.model,
+            &mut check,
+            q,
+            &tick.load,
+            vjm::Load::ExactWithArm(motion),
+        )
+        .unwrap();
         let loaded = check.tcp_deflected;
         let ep = (loaded.translation.vector - s.pose.translation.vector).norm();
         let er = loaded.rotation.angle_to(&s.pose.rotation);
@@ -128,7 +142,7 @@ fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
         assert!(ep <= 2e-8 && er <= 2e-8, "tick {k}: {ep:e} m {er:e} rad");
         worst = worst.max(ep);
         // The arm's own inertia moves the command well beyond the payload-only one.
-        let t0 = dalembert::serial::step(&payload_only, &mut data0, &s, None).unwrap();
+        let t0 = serial::step(&payload_only, &mut data0, &s, None).unwrap();
         largest_gap = largest_gap
             .max((tick.commanded.translation.vector - t0.commanded.translation.vector).norm());
     }
@@ -165,42 +179,44 @@ fn inertial_wrench_by_hand() {
 fn failures_are_statuses() {
     let robot = kr300();
     let tight: Vec<(f64, f64)> = Q0.iter().map(|q| (q - 1e-6, q + 1e-6)).collect();
-    let model = SerialModel::new(robot.model.clone(), payload())
+    let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
         .with_joint_limits(&tight)
         .unwrap();
-    let mut data = SerialData::new(&model);
+    let mut data = serial::Data::new(&model);
     data.set_seed(&Q0);
     let traj = motion(&robot);
     let s = traj.sample(0.1).unwrap();
     assert!(matches!(
-        dalembert::serial::step(&model, &mut data, &s, None),
+        serial::step(&model, &mut data, &s, None),
         Err(TickError::JointLimit { .. })
     ));
-    let free = SerialModel::new(robot.model.clone(), payload()).unwrap();
-    let mut data = SerialData::new(&free);
+    let free = serial::Model::new(robot.model.clone(), payload()).unwrap();
+    let mut data = serial::Data::new(&free);
     data.set_seed(&Q0);
     let mut far = s;
     far.pose.translation.vector += Vector3::new(10.0, 0.0, 0.0);
     assert!(matches!(
-        dalembert::serial::step(&free, &mut data, &far, None),
+        serial::step(&free, &mut data, &far, None),
         Err(TickError::NotConverged { .. })
     ));
     let mut nan = s;
     nan.acceleration.x = f64::NAN;
     assert!(matches!(
-        dalembert::serial::step(&free, &mut data, &nan, None),
+        serial::step(&free, &mut data, &nan, None),
         Err(TickError::NonFinite {
             what: "acceleration",
             ..
         })
     ));
     assert!(matches!(
-        dalembert::serial::step(&free, &mut data, &s, Some(&Vector6::repeat(f64::INFINITY))),
+        serial::step(&free, &mut data, &s, Some(&Vector6::repeat(f64::INFINITY))),
         Err(TickError::NonFinite { .. })
     ));
     // Fewer than 6 joints cannot be corrected in 6-D; a bad payload is refused.
-    assert!(SerialModel::new(robot.model.clone(), Payload::point(-1.0, Vector3::zeros())).is_err());
+    assert!(
+        serial::Model::new(robot.model.clone(), Payload::point(-1.0, Vector3::zeros())).is_err()
+    );
 }
 
 #[test]
@@ -214,7 +230,8 @@ fn rigid_pose_ik_round_trips() {
         &mut data,
         &target,
         &seed,
-        Load::Rigid,
+        &Vector6::zeros(),
+        vjm::Load::Rigid,
         &PoseIkOptions::default(),
     )
     .unwrap();

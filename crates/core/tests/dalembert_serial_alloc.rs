@@ -3,8 +3,9 @@
 //! function only).
 
 use deflect_core::SerialRobot;
-use deflect_core::dalembert::{self, Deflection, Payload, SerialData, SerialModel};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
+use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
@@ -39,12 +40,12 @@ fn serial_corrector_ticks_do_not_allocate() {
         com: Vector3::new(0.0, 0.0, 0.25),
         inertia: Matrix3::from_diagonal(&Vector3::new(4.0, 4.0, 2.5)),
     };
-    let exact = SerialModel::new(robot.model.clone(), payload)
+    let exact = serial::Model::new(robot.model.clone(), payload)
         .unwrap()
         .with_joint_limits(&robot.joint_limits)
         .unwrap();
     let linear = exact.clone().with_deflection(Deflection::Linearized);
-    let (mut de, mut dl) = (SerialData::new(&exact), SerialData::new(&linear));
+    let (mut de, mut dl) = (serial::Data::new(&exact), serial::Data::new(&linear));
     de.set_seed(&Q0);
     dl.set_seed(&Q0);
     let process = Vector6::new(0.0, 0.0, -300.0, 0.0, 0.0, 0.0);
@@ -59,8 +60,8 @@ fn serial_corrector_ticks_do_not_allocate() {
             // Forth and back, so the warm start follows a continuous path.
             let k = if (ticks / n) % 2 == 0 { k } else { n - 1 - k };
             let s = motion.sample(motion.tick_time(2000.0, k, n)).unwrap();
-            let a = dalembert::serial::step(&exact, &mut de, &s, None).unwrap();
-            let b = dalembert::serial::step(&linear, &mut dl, &s, Some(&process)).unwrap();
+            let a = serial::step(&exact, &mut de, &s, None).unwrap();
+            let b = serial::step(&linear, &mut dl, &s, Some(&process)).unwrap();
             sink += a.joints[1] + b.joints[1];
             ticks += 1;
         }
@@ -68,7 +69,7 @@ fn serial_corrector_ticks_do_not_allocate() {
     // Failures allocate nothing either.
     let mut bad = motion.sample(0.0).unwrap();
     bad.acceleration.x = f64::NAN;
-    assert!(dalembert::serial::step(&exact, &mut de, &bad, None).is_err());
+    assert!(serial::step(&exact, &mut de, &bad, None).is_err());
     assert_eq!(common::allocations() - before, 0, "serial ticks allocated");
     assert!(sink.is_finite() && ticks >= 3_000);
 }

@@ -5,7 +5,7 @@
 use approx::assert_relative_eq;
 use deflect_core::drivetrain::{
     self, LinkMasses, cartesian_stiffness, cartesian_stiffness_planar, cartesian_stiffness_xy,
-    correct_joints, gravity_torques,
+    gravity_torques,
 };
 use deflect_core::io;
 use deflect_core::units::STANDARD_GRAVITY;
@@ -142,7 +142,7 @@ fn eq10_gravity_hand_example() {
     // drives hold u = -(x m g): u1 = -(0.5*2 + 1.25*1)*g, u2 = -(0.25*1)*g N m with the
     // default standard gravity g (-22.0725 and -2.4525 N m with g = 9.81).
     let g = STANDARD_GRAVITY;
-    let c = correct_joints(
+    let c = drivetrain::step(
         &drive,
         &mut drivetrain::Data::new(&drive),
         &[0.0, 0.0],
@@ -197,7 +197,7 @@ fn eq10_contact_hand_example() {
     // (-0.5, 1.2), (-0.5, 0.2), (0, 0.2). F = (10, 4): J^T F = [-5 + 4.8, -5 + 0.8, 0.8]
     // = [-0.2, -4.2, 0.8] N m.
     let w = Vector6::new(10.0, 4.0, 0.0, 0.0, 0.0, 0.0);
-    let c = correct_joints(&drive, &mut drivetrain::Data::new(&drive), &q, &w).unwrap();
+    let c = drivetrain::step(&drive, &mut drivetrain::Data::new(&drive), &q, &w).unwrap();
     for (u, e) in c.torque.iter().zip([-0.2, -4.2, 0.8]) {
         assert_relative_eq!(*u, e, epsilon = 1e-12);
     }
@@ -207,7 +207,7 @@ fn eq10_contact_hand_example() {
     assert_relative_eq!(c.q[1], q[1] + 1.04e-2, epsilon = 1e-15);
     assert_relative_eq!(c.q[2], q[2] - 4.0e-3, epsilon = 1e-15);
     // sgn(0) = 0: no force, no gravity about z -> the readings come back unchanged.
-    let c0 = correct_joints(
+    let c0 = drivetrain::step(
         &drive,
         &mut drivetrain::Data::new(&drive),
         &q,
@@ -218,7 +218,7 @@ fn eq10_contact_hand_example() {
     assert_eq!(&c0.backlash_sign[..3], &[0.0, 0.0, 0.0]);
     // A deadband keeps small torques from taking up backlash.
     let dead = drive.clone().with_torque_deadband(0.5).unwrap();
-    let cd = correct_joints(&dead, &mut drivetrain::Data::new(&dead), &q, &w).unwrap();
+    let cd = drivetrain::step(&dead, &mut drivetrain::Data::new(&dead), &q, &w).unwrap();
     assert_eq!(&cd.backlash_sign[..3], &[0.0, -1.0, 1.0]);
 }
 
@@ -378,7 +378,7 @@ fn bad_inputs_are_statuses() {
             ..
         })
     ));
-    for _ in 0..drivetrain::MAX_MASSES {
+    for _ in 0..deflect_core::vjm::MAX_MASSES {
         m.push(0, 1.0, Vector3::zeros()).unwrap();
     }
     assert!(matches!(
@@ -399,17 +399,17 @@ fn bad_inputs_are_statuses() {
     ));
     let mut data = drivetrain::Data::new(&drive);
     assert!(matches!(
-        correct_joints(&drive, &mut data, &[0.0], &Vector6::zeros()),
+        drivetrain::step(&drive, &mut data, &[0.0], &Vector6::zeros()),
         Err(TickError::WrongLength { .. })
     ));
     assert!(matches!(
-        correct_joints(&drive, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
+        drivetrain::step(&drive, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
         Err(TickError::NonFinite { .. })
     ));
     let mut w = Vector6::zeros();
     w[3] = f64::INFINITY;
     assert!(matches!(
-        correct_joints(&drive, &mut data, &[0.0, 0.1], &w),
+        drivetrain::step(&drive, &mut data, &[0.0, 0.1], &w),
         Err(TickError::NonFinite { .. })
     ));
     // A drive train of another model: the drive-train model now owns its chain, so the

@@ -5,7 +5,7 @@
 use deflect_core::contour::{self, TracerConfig};
 use deflect_core::drivetrain::{
     self, Data, LinkMasses, cartesian_stiffness, cartesian_stiffness_xy, compensated_forward,
-    correct_joints, gravity_torques,
+    gravity_torques,
 };
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
@@ -72,7 +72,7 @@ fn drive_train_and_tracer_do_not_allocate() {
     for i in 0..3_000 {
         q[0] = 1e-4 * i as f64;
         sink += gravity_torques(&drive, &mut data, &q).unwrap()[1];
-        sink += correct_joints(&drive, &mut data, &q, &wrench).unwrap().q[2];
+        sink += drivetrain::step(&drive, &mut data, &q, &wrench).unwrap().q[2];
         sink += compensated_forward(&drive, &mut data, &q, &wrench)
             .unwrap()
             .translation
@@ -87,7 +87,7 @@ fn drive_train_and_tracer_do_not_allocate() {
         p = out.command;
         tracer_data.set_stiffness(&k).unwrap();
         // Error paths allocate nothing either.
-        let bad = correct_joints(&drive, &mut data, &q[..5], &wrench);
+        let bad = drivetrain::step(&drive, &mut data, &q[..5], &wrench);
         assert!(matches!(bad, Err(TickError::WrongLength { .. })));
         assert!(
             contour::step(&tracer, &mut tracer_data, &Vector2::new(f64::NAN, 0.0), &f).is_err()

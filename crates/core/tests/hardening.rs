@@ -4,7 +4,7 @@
 
 use deflect_core::compliance_map::{ComplianceMap, OutOfGrid, QueryOptions};
 use deflect_core::contour::{self, TracerConfig};
-use deflect_core::dalembert::{self, PAPER_MASS};
+use deflect_core::dalembert::parallel::{self, PAPER_MASS};
 use deflect_core::identification::{
     self, LeastSquaresAccumulator, MAX_MEASUREMENTS, TcpMeasurement,
 };
@@ -77,10 +77,10 @@ fn sampling_has_a_budget_instead_of_an_abort() {
         vec![0.0; 16],
     )
     .unwrap();
-    let model = dalembert::Model::new(ParallelRobot2::paper(), map, PAPER_MASS).unwrap();
-    let mut data = dalembert::Data::new(&model);
+    let model = parallel::Model::new(ParallelRobot2::paper(), map, PAPER_MASS).unwrap();
+    let mut data = parallel::Data::new(&model);
     assert!(matches!(
-        dalembert::correct(&model, &mut data, &slow, 2000.0),
+        parallel::correct(&model, &mut data, &slow, 2000.0),
         Err(TickError::Budget { .. })
     ));
     assert_eq!(
@@ -175,14 +175,14 @@ fn overflowing_outputs_are_a_status_not_nan() {
         Vector6::new(0.0, 2e5, 0.0, 0.0, 0.0, 0.0),
     ] {
         assert!(matches!(
-            vjm::deflection(&robot.model, &mut data, &[0.3], &w),
+            vjm::deflection(&robot.model, &mut data, &[0.3], &w, vjm::Load::Exact),
             Err(TickError::InvalidArgument { value, .. }) if value > vjm::MAX_SPRING_ANGLE
         ));
         assert!(vjm::joint_correction(&robot.model, &mut data, &[0.3], &w, 3, 1e-9).is_err());
     }
     // A realistic load is fine.
     let ok = Vector6::new(0.0, 500.0, 0.0, 0.0, 0.0, 0.0);
-    assert!(vjm::deflection(&robot.model, &mut data, &[0.3], &ok).is_ok());
+    assert!(vjm::deflection(&robot.model, &mut data, &[0.3], &ok, vjm::Load::Exact).is_ok());
     // An extrapolating map queried at 1e300 m returned [nan, nan].
     let map = ComplianceMap::new(
         vec![0.0, 0.1],
@@ -307,7 +307,7 @@ fn python_and_c_share_one_validation() {
         vec![0.0; 16],
     )
     .unwrap();
-    let model = dalembert::Model::new(ParallelRobot2::paper(), map, PAPER_MASS).unwrap();
+    let model = parallel::Model::new(ParallelRobot2::paper(), map, PAPER_MASS).unwrap();
     for tol in [f64::NAN, f64::INFINITY, -1.0] {
         assert!(matches!(
             model.clone().with_fixed_point(3, tol),

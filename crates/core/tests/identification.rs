@@ -94,7 +94,7 @@ fn frame_pairs_recover_the_stiffnesses_exactly() {
     let mut data = Data::new(&model);
     let mut meas = Vec::new();
     for (q, w) in &cases {
-        vjm::deflection(&model, &mut data, q, w).unwrap();
+        vjm::deflection(&model, &mut data, q, w, vjm::Load::Exact).unwrap();
         for s in 0..4 {
             meas.push(FrameMeasurement {
                 q,
@@ -170,7 +170,7 @@ fn tcp_deflections_recover_stiffnesses_and_degrade_gracefully_with_noise() {
     let noisy: Vec<(Vec<f64>, Vector6, Vector6)> = cases
         .iter()
         .map(|(q, w)| {
-            let d = vjm::deflection(&model, &mut data, q, w).unwrap();
+            let d = vjm::deflection(&model, &mut data, q, w, vjm::Load::Exact).unwrap();
             let n = Vector6::new(
                 s_p * rng.gauss(),
                 s_p * rng.gauss(),
@@ -212,7 +212,7 @@ fn unobservable_axes_are_flagged_not_set() {
     let q = vec![0.1, -0.2, 0.9, 0.3];
     let w = Vector6::new(300.0, -200.0, 100.0, 0.0, 0.0, 0.0);
     let mut data = Data::new(&model);
-    vjm::deflection(&model, &mut data, &q, &w).unwrap();
+    vjm::deflection(&model, &mut data, &q, &w, vjm::Load::Exact).unwrap();
     let meas = [FrameMeasurement {
         q: &q,
         wrench: w,

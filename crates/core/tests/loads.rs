@@ -2,7 +2,7 @@
 //! agreement with the payload formula for a mass at the TCP, the acceleration bias against
 //! finite differences of the forward kinematics, and the linearized model's order.
 
-use deflect_core::dalembert::Payload;
+use deflect_core::dalembert::serial::Payload;
 use deflect_core::motion::PoseState;
 use deflect_core::vjm::{self, ArmMotion, Data, Vector6};
 use deflect_core::{ModelBuilder, TickError};
@@ -41,7 +41,14 @@ fn a_swinging_mass_loads_the_spring_with_m_l2_qdd() {
         qdd: &qdd,
         gravity: Vector3::zeros(),
     };
-    let d = vjm::deflection_under(&model, &mut data, &[0.2], &Vector6::zeros(), &motion).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[0.2],
+        &Vector6::zeros(),
+        vjm::Load::ExactWithArm(motion),
+    )
+    .unwrap();
     // Tangential inertial force -m L qdd at L, the centripetal one radial (no moment), the
     // inertia -izz qdd: the spring turns by -(m L^2 + izz) qdd / k.
     let theta = -(m * 1.0 + izz) * qdd[0] / k;
@@ -55,8 +62,8 @@ fn a_swinging_mass_loads_the_spring_with_m_l2_qdd() {
         gravity: Vector3::zeros(),
     };
     let w = Vector6::new(0.0, 50.0, 0.0, 0.0, 0.0, 3.0);
-    let a = vjm::deflection_under(&model, &mut data, &[0.2], &w, &rest).unwrap();
-    let b = vjm::deflection(&model, &mut data, &[0.2], &w).unwrap();
+    let a = vjm::deflection(&model, &mut data, &[0.2], &w, vjm::Load::ExactWithArm(rest)).unwrap();
+    let b = vjm::deflection(&model, &mut data, &[0.2], &w, vjm::Load::Exact).unwrap();
     assert!((a - b).amax() < 1e-18, "{a} {b}");
 }
 
@@ -83,7 +90,14 @@ fn gravity_gives_the_weight_moment() {
         qdd: &[0.0],
         gravity: g,
     };
-    let d = vjm::deflection_under(&model, &mut data, &[0.0], &Vector6::zeros(), &motion).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[0.0],
+        &Vector6::zeros(),
+        vjm::Load::ExactWithArm(motion),
+    )
+    .unwrap();
     let beta = 10.0 * 9.80665 / 2.0e4;
     assert!((data.spring_angles[0].y - beta).abs() < 1e-15);
     // The tip drops by sin(beta) (a rotation about +y turns +x towards -z).
@@ -203,9 +217,16 @@ fn a_mass_at_the_tcp_loads_like_the_payload_formula() {
         angular_acceleration: acc.fixed_rows::<3>(3).into_owned(),
     };
     let w = payload.loading_wrench(&state, &motion.gravity);
-    let a = vjm::deflection_under(&bare, &mut data, &Q, &w, &motion).unwrap();
+    let a = vjm::deflection(&bare, &mut data, &Q, &w, vjm::Load::ExactWithArm(motion)).unwrap();
     let mut data2 = Data::new(&with);
-    let b = vjm::deflection_under(&with, &mut data2, &Q, &Vector6::zeros(), &motion).unwrap();
+    let b = vjm::deflection(
+        &with,
+        &mut data2,
+        &Q,
+        &Vector6::zeros(),
+        vjm::Load::ExactWithArm(motion),
+    )
+    .unwrap();
     assert!((a - b).amax() < 1e-12 * a.amax(), "{a} {b}");
     assert!(a.amax() > 1e-4, "a real deflection: {a}");
 }
@@ -221,9 +242,22 @@ fn linearized_is_first_order_and_errors_are_statuses() {
             qdd: &qdd,
             gravity: Vector3::zeros(),
         };
-        let e = vjm::deflection_under(&model, data, &Q, &Vector6::zeros(), &motion).unwrap();
-        let l =
-            vjm::linearized_deflection_under(&model, data, &Q, &Vector6::zeros(), &motion).unwrap();
+        let e = vjm::deflection(
+            &model,
+            data,
+            &Q,
+            &Vector6::zeros(),
+            vjm::Load::ExactWithArm(motion),
+        )
+        .unwrap();
+        let l = vjm::deflection(
+            &model,
+            data,
+            &Q,
+            &Vector6::zeros(),
+            vjm::Load::LinearizedWithArm(motion),
+        )
+        .unwrap();
         ((e - l).norm(), e.norm())
     };
     let (g1, d1) = gap(0.25, &mut data);
@@ -237,17 +271,36 @@ fn linearized_is_first_order_and_errors_are_statuses() {
     };
     let w = Vector6::zeros();
     assert!(matches!(
-        vjm::deflection_under(&model, &mut data, &Q, &w, &ArmMotion { qd: &QD[..5], ..ok }),
+        vjm::deflection(
+            &model,
+            &mut data,
+            &Q,
+            &w,
+            vjm::Load::ExactWithArm(ArmMotion { qd: &QD[..5], ..ok })
+        ),
         Err(TickError::WrongLength { what: "qd", .. })
     ));
     let nan = [f64::NAN; 6];
     assert!(matches!(
-        vjm::deflection_under(&model, &mut data, &Q, &w, &ArmMotion { qdd: &nan, ..ok }),
+        vjm::deflection(
+            &model,
+            &mut data,
+            &Q,
+            &w,
+            vjm::Load::ExactWithArm(ArmMotion { qdd: &nan, ..ok })
+        ),
         Err(TickError::NonFinite { what: "qdd", .. })
     ));
     let huge = [1e200; 6];
     assert!(
-        vjm::deflection_under(&model, &mut data, &Q, &w, &ArmMotion { qdd: &huge, ..ok }).is_err()
+        vjm::deflection(
+            &model,
+            &mut data,
+            &Q,
+            &w,
+            vjm::Load::ExactWithArm(ArmMotion { qdd: &huge, ..ok })
+        )
+        .is_err()
     );
     // Builder checks.
     let b = || ModelBuilder::new().revolute(Vector3::z()).unwrap();

@@ -126,6 +126,7 @@ fn every_posture_reaches_the_task_and_its_deflection_is_the_models() {
             &mut data,
             q,
             &Vector6::from_column_slice(&WRENCH),
+            vjm::Load::Exact,
         )
         .unwrap();
         assert_eq!(d, a.deflection);

@@ -63,7 +63,7 @@ proptest! {
         let w = Vector6::from_row_slice(&w) * scale;
         let c = vjm::compliance(&model, &mut data, &q).unwrap();
         let err = |w: &Vector6, data: &mut Data| {
-            let d = vjm::deflection(&model, data, &q, w).unwrap();
+            let d = vjm::deflection(&model, data, &q, w, vjm::Load::Exact).unwrap();
             (d - c * w).norm()
         };
         let (e1, e2) = (err(&w, &mut data), err(&(w * 0.5), &mut data));
@@ -211,7 +211,7 @@ proptest! {
         let mut data = Data::new(&model);
         let qs = [q[0], q[1], q[2], 0.1 * q[3]];
         let w = Vector6::from_row_slice(&w) * 300.0;
-        let got = vjm::deflection(&model, &mut data, &qs, &w).unwrap();
+        let got = vjm::deflection(&model, &mut data, &qs, &w, vjm::Load::Exact).unwrap();
         let want = reference_deflection(&model, &qs, &w);
         let scale = want.norm();
         // Both subtract poses about a metre long: rounding leaves a few 1e-16 m absolute.

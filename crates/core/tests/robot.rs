@@ -60,6 +60,7 @@ fn loads_and_matches_hand_computation() {
         &mut data,
         &[0.0, 0.0],
         &Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0),
+        vjm::Load::Exact,
     )
     .unwrap();
     assert_relative_eq!(d[5], 80.0 / 1.0e4 + 20.0 / 2.0e3, epsilon = 1e-15);
@@ -267,7 +268,7 @@ fn a_spring_at_a_joint_has_its_first_axis_along_the_joint_axis() {
     let cb = vjm::compliance(&b.model, &mut db, &q).unwrap();
     // 1/k_torsion about z: a 100 N force normal to the last 0.3 m turns it by 30/2000 rad.
     let w = Vector6::new(0.0, 100.0, 0.0, 0.0, 0.0, 0.0);
-    let d = vjm::deflection(&a.model, &mut da, &[0.0, 0.0], &w).unwrap();
+    let d = vjm::deflection(&a.model, &mut da, &[0.0, 0.0], &w, vjm::Load::Exact).unwrap();
     assert_relative_eq!(d[5], 100.0 * 0.3 / 2.0e3, max_relative = 1e-4);
     for (x, y) in ca.iter().zip(cb.iter()) {
         assert_relative_eq!(*x, *y, epsilon = 1e-18, max_relative = 1e-12);

@@ -24,7 +24,14 @@ fn one_spring_bending_is_exact_rotation() {
         .build()
         .unwrap();
     let mut data = Data::new(&model);
-    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, fy, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[],
+        &w([0.0, fy, 0.0, 0.0, 0.0, 0.0]),
+        vjm::Load::Exact,
+    )
+    .unwrap();
     // Eq. 6: M_A = r x F = L * Fy about z; Eq. 7: gamma = M_A / k_A = 0.03 rad.
     let gamma = l * fy / kz;
     assert_relative_eq!(gamma, 0.03, epsilon = 1e-15);
@@ -35,7 +42,14 @@ fn one_spring_bending_is_exact_rotation() {
     assert_relative_eq!(d[5], gamma, epsilon = 1e-15);
     assert_relative_eq!(data.spring_angles[0].z, gamma, epsilon = 1e-15);
     // The force along the bar loads nothing.
-    let d = vjm::deflection(&model, &mut data, &[], &w([1e4, 0.0, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[],
+        &w([1e4, 0.0, 0.0, 0.0, 0.0, 0.0]),
+        vjm::Load::Exact,
+    )
+    .unwrap();
     assert_eq!(d, Vector6::zeros());
 }
 
@@ -55,7 +69,14 @@ fn two_springs_in_series() {
         .build()
         .unwrap();
     let mut data = Data::new(&model);
-    let d = vjm::deflection(&model, &mut data, &[], &w([0.0, fy, 0.0, 0.0, 0.0, 0.0])).unwrap();
+    let d = vjm::deflection(
+        &model,
+        &mut data,
+        &[],
+        &w([0.0, fy, 0.0, 0.0, 0.0, 0.0]),
+        vjm::Load::Exact,
+    )
+    .unwrap();
     let g1 = (l1 + l2) * fy / k1; // 7.8e-3 rad
     let g2 = l2 * fy / k2; // 15e-3 rad
     let x = l1 * g1.cos() + l2 * (g1 + g2).cos();
@@ -87,6 +108,7 @@ fn moment_load_and_eq4_rotation() {
         &mut data,
         &[],
         &w([0.0, 0.0, 0.0, m[0], m[1], m[2]]),
+        vjm::Load::Exact,
     )
     .unwrap();
     let (a, b, g) = (m[0] / k[0], m[1] / k[1], m[2] / k[2]);
@@ -162,7 +184,14 @@ fn exact_minus_linear_is_second_order() {
     let c = vjm::compliance(&model, &mut data, &q).unwrap();
     let w0 = w([120.0, -80.0, 0.0, 0.0, 0.0, 15.0]);
     let err = |s: f64| {
-        let d = vjm::deflection(&model, &mut Data::new(&model), &q, &(w0 * s)).unwrap();
+        let d = vjm::deflection(
+            &model,
+            &mut Data::new(&model),
+            &q,
+            &(w0 * s),
+            vjm::Load::Exact,
+        )
+        .unwrap();
         (d - c * (w0 * s)).norm()
     };
     let (e1, e2) = (err(1.0), err(0.1));
@@ -182,6 +211,7 @@ fn zero_load_gives_zero_deflection() {
         &mut Data::new(&model),
         &[0.3, 0.2],
         &Vector6::zeros(),
+        vjm::Load::Exact,
     )
     .unwrap();
     assert_eq!(d, Vector6::zeros());
@@ -217,14 +247,14 @@ fn joint_correction_lands_the_deflected_tcp_on_target() {
     let corr = vjm::joint_correction(&model, &mut data, &q, &wr, 30, 1e-14).unwrap();
     assert!(corr.converged, "{corr:?}");
     let qc = [q[0] + corr.dq[0], q[1] + corr.dq[1]];
-    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    vjm::deflection(&model, &mut data, &qc, &wr, vjm::Load::Exact).unwrap();
     let gamma = [data.spring_angles[0].z, data.spring_angles[1].z];
     assert_relative_eq!(corr.dq[0], -gamma[0], epsilon = 1e-13);
     assert_relative_eq!(corr.dq[1], -gamma[1], epsilon = 1e-13);
     assert!((data.tcp_deflected.translation.vector - target.translation.vector).norm() < 1e-14);
     assert_eq!(corr.dq[2..], [0.0; 6]);
     // One step is the paper's first-order -J^+ delta: already within 5 % of the deflection.
-    let d0 = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let d0 = vjm::deflection(&model, &mut data, &q, &wr, vjm::Load::Exact).unwrap();
     let one = vjm::joint_correction(&model, &mut data, &q, &wr, 1, 0.0).unwrap();
     assert!(!one.converged && one.iterations == 1);
     assert!(one.residual < 0.05 * d0.norm(), "{one:?}");
@@ -253,7 +283,7 @@ fn under_actuated_correction_is_least_squares() {
     let q = [0.4, -1.1];
     let target = vjm::forward(&model, &mut data, &q).unwrap();
     let wr = w([200.0, -150.0, -400.0, 0.0, 0.0, 0.0]);
-    let before = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let before = vjm::deflection(&model, &mut data, &q, &wr, vjm::Load::Exact).unwrap();
     let corr = vjm::joint_correction(&model, &mut data, &q, &wr, 20, 1e-12).unwrap();
     // The least-squares fixed point is reached in a few steps; the iteration then stops on
     // its own (it used to spin through all 20 steps) and says why.
@@ -262,7 +292,7 @@ fn under_actuated_correction_is_least_squares() {
         "{corr:?}"
     );
     let qc = [q[0] + corr.dq[0], q[1] + corr.dq[1]];
-    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    vjm::deflection(&model, &mut data, &qc, &wr, vjm::Load::Exact).unwrap();
     let e = data.tcp_deflected.translation.vector - target.translation.vector;
     // The out-of-plane sag stays; the in-plane error is far smaller than before.
     assert_relative_eq!(e.z, before[2], max_relative = 0.05);
@@ -314,12 +344,12 @@ fn joint_correction_six_dof_converges_exactly() {
     for (qi, dq) in qc.iter_mut().zip(corr.dq) {
         *qi += dq;
     }
-    vjm::deflection(&model, &mut data, &qc, &wr).unwrap();
+    vjm::deflection(&model, &mut data, &qc, &wr, vjm::Load::Exact).unwrap();
     let t = data.tcp_deflected;
     assert!((t.translation.vector - target.translation.vector).norm() < 1e-13);
     assert!((t.rotation * target.rotation.inverse()).angle() < 1e-13);
     // The commanded Cartesian pose moves the TCP against the deflection.
-    let d = vjm::deflection(&model, &mut data, &q, &wr).unwrap();
+    let d = vjm::deflection(&model, &mut data, &q, &wr, vjm::Load::Exact).unwrap();
     let cmd = vjm::commanded_pose(&target, &d);
     let dp = cmd.translation.vector - target.translation.vector;
     assert_relative_eq!(dp, -d.fixed_rows::<3>(0).into_owned(), epsilon = 1e-15);
@@ -366,7 +396,13 @@ fn bad_inputs_are_typed_errors() {
         })
     );
     assert_eq!(
-        vjm::deflection(&model, &mut data, &[0.0, f64::NAN], &Vector6::zeros()),
+        vjm::deflection(
+            &model,
+            &mut data,
+            &[0.0, f64::NAN],
+            &Vector6::zeros(),
+            vjm::Load::Exact
+        ),
         Err(TickError::NonFinite {
             what: "q",
             index: 1
@@ -377,7 +413,8 @@ fn bad_inputs_are_typed_errors() {
             &model,
             &mut data,
             &[0.0, 0.0],
-            &w([0.0, 0.0, f64::INFINITY, 0.0, 0.0, 0.0])
+            &w([0.0, 0.0, f64::INFINITY, 0.0, 0.0, 0.0]),
+            vjm::Load::Exact
         ),
         Err(TickError::NonFinite {
             what: "wrench",
@@ -424,7 +461,7 @@ fn data_of_another_model_is_refused() {
     for q in [&[0.3][..], &[0.3, -0.2][..]] {
         assert_eq!(vjm::forward(&one, &mut data, q).unwrap_err(), mismatch);
         assert_eq!(
-            vjm::deflection(&one, &mut data, q, &wr).unwrap_err(),
+            vjm::deflection(&one, &mut data, q, &wr, vjm::Load::Exact).unwrap_err(),
             mismatch
         );
         assert_eq!(vjm::compliance(&one, &mut data, q).unwrap_err(), mismatch);
@@ -451,8 +488,8 @@ fn data_of_another_model_is_refused() {
         }
     );
     assert!(data.check(&two));
-    vjm::deflection(&two, &mut data, &[0.3, -0.2], &wr).unwrap();
-    assert!(vjm::deflection(&one, &mut Data::new(&one), &[0.3], &wr).is_ok());
+    vjm::deflection(&two, &mut data, &[0.3, -0.2], &wr, vjm::Load::Exact).unwrap();
+    assert!(vjm::deflection(&one, &mut Data::new(&one), &[0.3], &wr, vjm::Load::Exact).is_ok());
 }
 
 #[test]
@@ -536,7 +573,7 @@ proptest! {
         let mut data = Data::new(&model);
         let c = vjm::compliance(&model, &mut data, &[q0, q1]).unwrap();
         let wr = w([fx, fy, 0.0, 0.0, 0.0, mz]);
-        let d = vjm::deflection(&model, &mut data, &[q0, q1], &wr).unwrap();
+        let d = vjm::deflection(&model, &mut data, &[q0, q1], &wr, vjm::Load::Exact).unwrap();
         let lin = c * wr;
         // |w| <= 1.7 N gives angles below 4e-4 rad: second-order terms below 1e-6 of |lin|.
         prop_assert!((d - lin).norm() <= 1e-3 * lin.norm() + 1e-15);
@@ -565,8 +602,8 @@ fn a_model_rebuilt_from_its_elements_computes_bit_for_bit_the_same() {
     let w = Vector6::new(-386.1, 386.1, -60.0, 12.0, -7.0, 3.0);
     let (mut a, mut b) = (Data::new(model), Data::new(&rebuilt));
     assert_eq!(
-        vjm::deflection(model, &mut a, &q, &w).unwrap(),
-        vjm::deflection(&rebuilt, &mut b, &q, &w).unwrap()
+        vjm::deflection(model, &mut a, &q, &w, vjm::Load::Exact).unwrap(),
+        vjm::deflection(&rebuilt, &mut b, &q, &w, vjm::Load::Exact).unwrap()
     );
     assert_eq!(
         vjm::compliance(model, &mut a, &q).unwrap(),
@@ -638,7 +675,7 @@ fn compiled_passes_equal_the_definitions() {
     let q = [0.7, -1.2, 0.15];
     let wrench = w([120.0, -80.0, 45.0, 3.0, -2.0, 1.5]);
     let tcp = vjm::forward(&model, &mut data, &q).unwrap();
-    vjm::deflection(&model, &mut data, &q, &wrench).unwrap();
+    vjm::deflection(&model, &mut data, &q, &wrench, vjm::Load::Exact).unwrap();
     assert_relative_eq!(
         tcp.translation.vector,
         data.tcp.translation.vector,
@@ -682,13 +719,15 @@ fn compiled_passes_equal_the_definitions() {
     let c = vjm::compliance(&model, &mut data, &q).unwrap();
     assert_relative_eq!(c, expect, max_relative = 1e-12, epsilon = 1e-22);
     assert_eq!(c, c.transpose(), "symmetric to the bit");
-    // linear_deflection is C w in one call.
-    let d = vjm::linear_deflection(&model, &mut data, &q, &wrench).unwrap();
-    assert_eq!(d, c * wrench);
+    // The linearized load is C w: the same sum taken spring by spring (each spring's turn
+    // to first order) in the deflection's one pass, so equal to rounding.
+    let d = vjm::deflection(&model, &mut data, &q, &wrench, vjm::Load::Linearized).unwrap();
+    let cw = c * wrench;
+    assert_relative_eq!(d, cw, max_relative = 1e-14, epsilon = 1e-15 * cw.amax());
     let mut bad = wrench;
     bad[4] = f64::NAN;
     assert_eq!(
-        vjm::linear_deflection(&model, &mut data, &q, &bad),
+        vjm::deflection(&model, &mut data, &q, &bad, vjm::Load::Linearized),
         Err(TickError::NonFinite {
             what: "wrench",
             index: 4

@@ -44,7 +44,7 @@ fn vjm_calls_do_not_allocate() {
     for i in 0..10_000 {
         q[0] = 1e-4 * i as f64;
         sink += vjm::forward(&model, &mut data, &q).unwrap().translation.x;
-        sink += vjm::deflection(&model, &mut data, &q, &wrench).unwrap()[0];
+        sink += vjm::deflection(&model, &mut data, &q, &wrench, vjm::Load::Exact).unwrap()[0];
         sink += vjm::compliance(&model, &mut data, &q).unwrap()[(0, 0)];
         vjm::joint_jacobian(&model, &mut data, &q).unwrap();
         if i % 100 == 0 {
@@ -53,7 +53,7 @@ fn vjm_calls_do_not_allocate() {
                 .dq[0];
         }
         // Error paths allocate nothing either.
-        let bad = vjm::deflection(&model, &mut data, &q[..5], &wrench);
+        let bad = vjm::deflection(&model, &mut data, &q[..5], &wrench, vjm::Load::Exact);
         assert!(matches!(bad, Err(TickError::WrongLength { .. })));
     }
     let after = common::allocations();

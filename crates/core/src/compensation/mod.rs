@@ -87,6 +87,7 @@ impl CompensatorConfig {
 
 /// What one cycle produced.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct CycleOutput {
     /// The wrench fed to the model \[N, N m\]: TCP, base frame, filtered (and piloted).
     pub wrench: Vector6,
@@ -248,7 +249,7 @@ pub fn step(
         }
         _ => (measured, 0.0),
     };
-    let deflection = vjm::deflection(&model.chain, &mut data.vjm, q, &wrench)?;
+    let deflection = vjm::deflection(&model.chain, &mut data.vjm, q, &wrench, vjm::Load::Exact)?;
     let mut c: Vector3<f64> = -deflection.fixed_rows::<3>(0).into_owned();
     let dr: Vector3<f64> = -deflection.fixed_rows::<3>(3).into_owned();
     let mut projected = false;

@@ -208,6 +208,7 @@ impl ComplianceMap {
         self.options = options;
     }
     /// The same map with other default query options.
+    #[must_use]
     pub fn with_options(mut self, options: QueryOptions) -> Self {
         self.options = options;
         self

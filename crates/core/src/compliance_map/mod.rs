@@ -30,13 +30,13 @@
 //! it, and the CSV/JSON loaders live in [`crate::io`] (`std`).
 //!
 //! ```
-//! use deflect_core::compliance_map::{ComplianceMap, Data, query};
+//! use deflect_core::compliance_map::{self, ComplianceMap, Data};
 //! // A 2 x 2 grid, one force axis, one displacement axis: 1 um/N everywhere, no offset.
 //! let map = ComplianceMap::new(
 //!     vec![0.0, 0.1], vec![0.0, 0.1], 1, 1, vec![1e-6; 4], vec![0.0; 4])?;
 //! let view = map.view();
 //! let mut data = Data::new(&view);
-//! query(&view, &mut data, [0.05, 0.02], &[200.0]).unwrap();
+//! compliance_map::step(&view, &mut data, [0.05, 0.02], &[200.0]).unwrap();
 //! assert!((data.displacement()[0] - 2e-4).abs() < 1e-15);
 //! # Ok::<(), deflect_core::BuildError>(())
 //! ```
@@ -119,7 +119,7 @@ pub struct QueryOptions {
     pub out_of_grid: OutOfGrid,
 }
 
-/// Per-query workspace of the tick shape: the displacement of the last [`query`] and the
+/// Per-query workspace of the tick shape: the displacement of the last [`step`] and the
 /// dimensions of the map it was made for. Queries need no other buffer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Data {
@@ -153,12 +153,17 @@ impl Data {
     }
 }
 
+/// The immutable model of the tick shape: a borrowed compliance map (an owning
+/// [`ComplianceMap`] lends one with `view()`); [`Data`] holds the last query and [`step`]
+/// queries.
+pub type Model<'a> = ComplianceMapView<'a>;
+
 /// One query of the tick shape: the displacement at `position` `[x, y]` \[m\] under `force`
 /// (`n_force` entries \[N | N m\]) with the map's default options, into `data.displacement`.
 /// Allocation-free, never panics; see [`ComplianceMapView::displacement_with`].
 #[inline]
-pub fn query(
-    map: &ComplianceMapView<'_>,
+pub fn step(
+    map: &Model<'_>,
     data: &mut Data,
     position: [f64; 2],
     force: &[f64],

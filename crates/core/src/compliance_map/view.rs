@@ -94,6 +94,7 @@ impl<'a> ComplianceMapView<'a> {
     }
 
     /// The same view with other default query options.
+    #[must_use]
     pub fn with_options(mut self, options: QueryOptions) -> Self {
         self.options = options;
         self

@@ -215,6 +215,7 @@ impl TracerState {
 
 /// What one [`super::step`] returns.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct TracerStep {
     /// Next position command \[m\].
     pub command: Vector2<f64>,

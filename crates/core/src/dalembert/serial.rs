@@ -18,11 +18,11 @@
 //! desired pose, to the IK tolerance.
 //!
 //! When the chain carries link masses (`Element::Mass`, from the URDF's `<inertial>`), the
-//! arm's own inertia loads the springs too ([`vjm::deflection_under`]): the joint rates and
+//! arm's own inertia loads the springs too ([`vjm::Load::ExactWithArm`]): the joint rates and
 //! accelerations of the tick come from the desired TCP motion through the rigid Jacobian at
 //! the warm start, `qd = J^+ [v; w]`, `qdd = J^+ ([a; alpha] - Jd qd)`. On arms whose links
 //! outweigh the payload (a cobot with a few kg, or a heavy arm at high acceleration) these
-//! loads dominate the deflection. [`SerialModel::with_gravity`] adds the weights (payload and
+//! loads dominate the deflection. [`Model::with_gravity`] adds the weights (payload and
 //! links) for a robot whose static sag is not calibrated out. The IK starts from the previous tick's joints
 //! extrapolated linearly (the path moves smoothly), so a tick costs one or two loaded-pose
 //! evaluations and one Jacobian. Bounded, allocation-free, never panics; statuses for
@@ -31,9 +31,9 @@
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use crate::error::{BuildError, TickError, check_finite, check_output};
-use crate::mechanism::pose_ik::{Load, PoseIkOptions, pose_ik};
+use crate::mechanism::pose_ik::{PoseIkOptions, pose_ik};
 use crate::motion::PoseState;
-use crate::vjm::{self, MAX_DOF, Vector6};
+use crate::vjm::{self, Deflection, Load, MAX_DOF, Vector6};
 
 /// Payload and tool beyond the TCP: mass \[kg\], centre of mass \[m\] and inertia tensor about
 /// the centre of mass \[kg m^2\], both in the TCP frame.
@@ -109,20 +109,10 @@ impl Payload {
     }
 }
 
-/// Which deflection model the corrector inverts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Deflection {
-    /// The paper's exact virtual-joint model (Eq. 2-9).
-    #[default]
-    Exact,
-    /// The linearized `C(q) w`.
-    Linearized,
-}
-
 /// The serial-arm corrector: chain, joint limits, payload, deflection model and IK settings,
 /// validated once. Immutable.
 #[derive(Debug, Clone, PartialEq)]
-pub struct SerialModel {
+pub struct Model {
     chain: vjm::Model,
     limits: [(f64, f64); MAX_DOF],
     payload: Payload,
@@ -132,7 +122,7 @@ pub struct SerialModel {
     gravity: Vector3<f64>,
 }
 
-impl SerialModel {
+impl Model {
     /// The corrector of `chain` (at least 6 joints: a pose has 6 components) carrying
     /// `payload`; no joint limits, the exact model, default IK settings, the payload's wrench
     /// only (as in the paper; see [`Self::with_link_inertia`]), no gravity.
@@ -162,6 +152,7 @@ impl SerialModel {
     /// heavy arm the links' own inertia bends it as much as the payload; the tick then also
     /// solves the joint rates and accelerations (about 1.7 us more on the KR 300). No effect
     /// on a chain without masses.
+    #[must_use]
     pub fn with_link_inertia(mut self, on: bool) -> Self {
         self.link_inertia = on;
         self
@@ -215,6 +206,7 @@ impl SerialModel {
     }
 
     /// The deflection model to invert (default [`Deflection::Exact`]).
+    #[must_use]
     pub fn with_deflection(mut self, deflection: Deflection) -> Self {
         self.deflection = deflection;
         self
@@ -252,7 +244,7 @@ impl SerialModel {
 /// The serial corrector's workspace and memory: the chain's [`vjm::Data`] and the last four
 /// ticks' joints (the next tick's IK starts from their cubic extrapolation).
 #[derive(Debug, Clone)]
-pub struct SerialData {
+pub struct Data {
     /// Workspace of the chain.
     pub vjm: vjm::Data,
     last: [f64; MAX_DOF],
@@ -264,10 +256,10 @@ pub struct SerialData {
     qdd: [f64; MAX_DOF],
 }
 
-impl SerialData {
+impl Data {
     /// A workspace for `model`, seeded at zero joints (set a real seed with
     /// [`Self::set_seed`]: the robot's joints at the start of the motion).
-    pub fn new(model: &SerialModel) -> Self {
+    pub fn new(model: &Model) -> Self {
         Self {
             vjm: vjm::Data::new(&model.chain),
             last: [0.0; MAX_DOF],
@@ -281,7 +273,7 @@ impl SerialData {
     }
 
     /// Whether this workspace was made for `model`'s dimensions.
-    pub fn check(&self, model: &SerialModel) -> bool {
+    pub fn check(&self, model: &Model) -> bool {
         self.vjm.check(&model.chain)
     }
 
@@ -304,22 +296,10 @@ impl SerialData {
     }
 }
 
-/// One corrected tick of a serial arm.
+/// What the serial corrector reports beyond the common [`Tick`] fields: the landing error of
+/// the predicted loaded pose and the singularity distance at the command.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SerialTick {
-    /// Desired TCP pose.
-    pub desired: Isometry3<f64>,
-    /// Commanded (rigid) TCP pose: what the joints put the TCP at without load.
-    pub commanded: Isometry3<f64>,
-    /// Joint command \[rad or m\]; entries past the dof are zero.
-    pub joints: [f64; MAX_DOF],
-    /// The wrench the correction cancels, `[F; M]` \[N, N m\], base frame at the TCP:
-    /// D'Alembert plus process.
-    pub wrench: Vector6,
-    /// Predicted deflection `[dp; dr]` \[m, rad\] at the command under that wrench.
-    pub deflection: Vector6,
-    /// IK steps this tick.
-    pub iterations: usize,
+pub struct Diagnostics {
     /// Position error of the predicted loaded pose \[m\] (within the IK tolerance).
     pub position_error: f64,
     /// Orientation error of the predicted loaded pose \[rad\].
@@ -328,6 +308,13 @@ pub struct SerialTick {
     pub sigma_min: f64,
 }
 
+/// One corrected tick of a serial arm: desired TCP pose, commanded (rigid) TCP pose (what the
+/// joints put the TCP at without load), joint command \[rad or m\] (entries past the dof are
+/// zero), the wrench `[F; M]` \[N, N m\] the correction cancels (base frame at the TCP:
+/// D'Alembert plus process) as the load, the predicted deflection `[dp; dr]` \[m, rad\] at the
+/// command under it, the IK steps of the tick and [`Diagnostics`].
+pub type Tick = super::Tick<Isometry3<f64>, Vector6, [f64; MAX_DOF], Diagnostics>;
+
 /// A solution this far from the warm start \[rad or m\] gets its link loads' joint rates
 /// recomputed at the solution (see [`step`]).
 const RATE_REFRESH: f64 = 1.0e-7;
@@ -335,8 +322,8 @@ const RATE_REFRESH: f64 = 1.0e-7;
 /// The loaded pose IK of one tick from `seed`, with the link loads of `data.qd`, `data.qdd`
 /// when `arm`.
 fn solve(
-    model: &SerialModel,
-    data: &mut SerialData,
+    model: &Model,
+    data: &mut Data,
     pose: &nalgebra::Isometry3<f64>,
     seed: &[f64],
     wrench: &Vector6,
@@ -348,13 +335,16 @@ fn solve(
         qdd: data.qdd.get(..dof).unwrap_or(&[]),
         gravity: model.gravity,
     };
-    let load = match (model.deflection, arm) {
-        (Deflection::Exact, false) => Load::Exact(wrench),
-        (Deflection::Linearized, false) => Load::Linearized(wrench),
-        (Deflection::Exact, true) => Load::ExactWithArm(wrench, motion),
-        (Deflection::Linearized, true) => Load::LinearizedWithArm(wrench, motion),
-    };
-    pose_ik(&model.chain, &mut data.vjm, pose, seed, load, &model.ik)
+    let load = Load::new(model.deflection, arm.then_some(motion));
+    pose_ik(
+        &model.chain,
+        &mut data.vjm,
+        pose,
+        seed,
+        wrench,
+        load,
+        &model.ik,
+    )
 }
 
 /// `Jt (J Jt + lambda^2 I)^-1 x` over the first `dof` columns of `data.jacobian`.
@@ -376,8 +366,8 @@ fn dls_solve(data: &vjm::Data, dof: usize, x: &Vector6, lambda2: f64) -> Option<
 /// start): `qd = J^+ [v; w]`, `qdd = J^+ ([a; alpha] - Jd qd)` (damped least squares with the
 /// IK's damping), into `data.qd` and `data.qdd`.
 fn joint_motion(
-    model: &SerialModel,
-    data: &mut SerialData,
+    model: &Model,
+    data: &mut Data,
     q: &[f64],
     desired: &PoseState,
 ) -> Result<(), TickError> {
@@ -412,11 +402,11 @@ fn joint_motion(
 /// One tick (see the module docs): the desired pose state `desired` (base frame) and an
 /// optional process wrench `process` \[N, N m\] at the TCP (base frame, moment about the TCP).
 pub fn step(
-    model: &SerialModel,
-    data: &mut SerialData,
+    model: &Model,
+    data: &mut Data,
     desired: &PoseState,
     process: Option<&Vector6>,
-) -> Result<SerialTick, TickError> {
+) -> Result<Tick, TickError> {
     data.vjm.check_model(&model.chain)?;
     let pose = &desired.pose;
     check_finite("desired position", pose.translation.vector.as_slice())?;
@@ -497,15 +487,17 @@ pub fn step(
     data.before = data.last;
     data.last = solution.q;
     data.ticks = data.ticks.saturating_add(1);
-    Ok(SerialTick {
+    Ok(Tick {
         desired: *pose,
         commanded,
         joints: solution.q,
-        wrench,
-        deflection: solution.deflection,
+        load: wrench,
+        displacement: solution.deflection,
         iterations: solution.iterations,
-        position_error: solution.position_error,
-        orientation_error: solution.orientation_error,
-        sigma_min: solution.sigma_min,
+        diagnostics: Diagnostics {
+            position_error: solution.position_error,
+            orientation_error: solution.orientation_error,
+            sigma_min: solution.sigma_min,
+        },
     })
 }

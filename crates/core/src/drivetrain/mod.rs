@@ -27,8 +27,9 @@
 //!
 //! The [`Model`] holds the chain with its joint stiffnesses, backlashes, link masses and
 //! gravity, validated once; [`Data`] owns every buffer (the chain's [`vjm::Data`] included);
-//! per-tick functions take `(&Model, &mut Data, inputs)`, allocate nothing, never panic and
-//! return a [`TickError`] for wrong-sized or non-finite input.
+//! the tick [`step`] (Eq. 10) and the quantities it is built from take `(&Model, &mut Data,
+//! inputs)`, allocate nothing, never panic and return a [`TickError`] for wrong-sized or
+//! non-finite input.
 
 mod stiffness;
 mod torques;
@@ -36,19 +37,13 @@ mod torques;
 pub use stiffness::{
     cartesian_stiffness, cartesian_stiffness_planar, cartesian_stiffness_xy, free_moment_xy,
 };
-pub use torques::{
-    JointErrors, compensated_forward, contact_torques, correct_joints, gravity_torques,
-};
+pub use torques::{JointErrors, compensated_forward, contact_torques, gravity_torques, step};
 
 use nalgebra::Vector3;
 
 use crate::error::{BuildError, TickError, param};
 use crate::units::GRAVITY_Z_DOWN;
-use crate::vjm::{self, MAX_DOF};
-
-/// Most point masses a [`LinkMasses`] table holds: one per link of an 8-axis cell plus its
-/// tool, sensor and payload parts.
-pub const MAX_MASSES: usize = 16;
+use crate::vjm::{self, MAX_DOF, MAX_MASSES};
 
 /// Default largest `sigma_max / sigma_min` of the square Jacobian in the Cartesian stiffness.
 pub const DEFAULT_MAX_CONDITION: f64 = 1.0e6;
@@ -66,7 +61,8 @@ pub struct PointMass {
     pub com: Vector3<f64>,
 }
 
-/// A fixed-capacity table of link masses ([`MAX_MASSES`] entries), built without a heap.
+/// A fixed-capacity table of link masses ([`vjm::MAX_MASSES`] entries, the same bound as the
+/// chain's own masses), built without a heap.
 /// Masses before the first actuated joint load no joint and need no entry.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct LinkMasses {

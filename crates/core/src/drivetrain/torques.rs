@@ -114,8 +114,9 @@ pub fn contact_torques(
     Ok(out)
 }
 
-/// Result of [`correct_joints`].
+/// Result of [`step`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct JointErrors {
     /// Corrected joint values `theta - sgn(u) theta_b - u / K` (Eq. 10); entries past the
     /// model's dof are zero.
@@ -131,7 +132,7 @@ pub struct JointErrors {
 /// Eq. 10: the link angles from the motor-side readings `q` and the wrench the tool exerts
 /// on the environment (see the module docs for the signs). Gravity and contact torques are
 /// evaluated at the readings. Fills `data`.
-pub fn correct_joints(
+pub fn step(
     model: &Model,
     data: &mut Data,
     q: &[f64],
@@ -162,14 +163,14 @@ pub fn correct_joints(
 }
 
 /// The compensated TCP pose: rigid forward kinematics at the corrected joints of
-/// [`correct_joints`] (the paper's shape recovery with Eq. 10). Fills `data.vjm.tcp` with it.
+/// [`step`] (the paper's shape recovery with Eq. 10). Fills `data.vjm.tcp` with it.
 pub fn compensated_forward(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     wrench: &Vector6<f64>,
 ) -> Result<Isometry3<f64>, TickError> {
-    let c = correct_joints(model, data, q, wrench)?;
+    let c = step(model, data, q, wrench)?;
     vjm::forward(
         model.chain(),
         &mut data.vjm,

@@ -39,6 +39,7 @@ impl Placement {
     /// The worse of two placements (extrapolated > clamped > inside): the status of a tick
     /// that made several queries.
     #[inline]
+    #[must_use]
     pub fn worst(self, other: Self) -> Self {
         match (self, other) {
             (Self::Inside, o) => o,

@@ -47,7 +47,7 @@ pub(crate) fn pose(
 
 /// Appends the `<inertial>` of `link` (if it has mass or inertia) as a link mass: centre of
 /// mass at the inertial origin, inertia rotated from the inertial frame to the link frame.
-/// The mass loads the springs under motion only ([`crate::vjm::deflection_under`]).
+/// The mass loads the springs under motion only ([`crate::vjm::Load::ExactWithArm`]).
 fn link_mass(b: ModelBuilder, link: &urdf_rs::Link) -> Result<ModelBuilder, LoadError> {
     let i = &link.inertial;
     let m = &i.inertia;

@@ -21,7 +21,7 @@ pub mod pose_ik;
 mod serial;
 
 pub use parallel::{DEFAULT_MIN_SIGMA, PAPER_HALF_WIDTH, PAPER_LINK, ParallelRobot2};
-pub use pose_ik::{Load, PoseIkOptions, PoseIkSolution, pose_ik};
+pub use pose_ik::{PoseIkOptions, PoseIkSolution, pose_ik};
 pub use serial::{IkOptions, SerialArm};
 
 use nalgebra::{SMatrix, SVector};

@@ -11,10 +11,10 @@
 //! slower than Newton. Bounded: at most `max_iterations` steps. Allocation-free; the
 //! workspace is the chain's [`Data`].
 
-use nalgebra::{Isometry3, Matrix6, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix6};
 
 use crate::error::{BuildError, TickError, check_finite, check_output, param};
-use crate::vjm::{self, Data, MAX_CORRECTION_ITERATIONS, MAX_DOF, Model, Vector6};
+use crate::vjm::{self, Data, Load, MAX_CORRECTION_ITERATIONS, MAX_DOF, Model, Vector6};
 
 /// Settings of [`pose_ik`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -78,24 +78,9 @@ impl PoseIkOptions {
     }
 }
 
-/// What loads the chain while it is solved for.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Load<'w> {
-    /// The rigid chain.
-    Rigid,
-    /// The exact virtual-joint deflection under this TCP wrench \[N, N m\], base frame.
-    Exact(&'w Vector6),
-    /// The linearized deflection `C(q) w` under this wrench.
-    Linearized(&'w Vector6),
-    /// The exact deflection under this TCP wrench and the link masses' inertial loads of
-    /// this joint motion ([`vjm::deflection_under`]).
-    ExactWithArm(&'w Vector6, vjm::ArmMotion<'w>),
-    /// The linearized deflection under the same loads ([`vjm::linearized_deflection_under`]).
-    LinearizedWithArm(&'w Vector6, vjm::ArmMotion<'w>),
-}
-
 /// Result of [`pose_ik`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct PoseIkSolution {
     /// Joints \[rad or m\]; entries past the dof are zero.
     pub q: [f64; MAX_DOF],
@@ -109,51 +94,6 @@ pub struct PoseIkSolution {
     pub sigma_min: f64,
     /// Deflection `[dp; dr]` of the TCP at `q` under the load (zero for [`Load::Rigid`]).
     pub deflection: Vector6,
-}
-
-/// The loaded TCP pose at `q`, its deflection, and the rigid joint Jacobian at `q` in
-/// `data.jacobian` (one fused pass for the exact model); `data.tcp` is the rigid pose.
-fn loaded_pose(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    load: Load<'_>,
-) -> Result<(Isometry3<f64>, Vector6), TickError> {
-    match load {
-        Load::Rigid => {
-            vjm::joint_jacobian(model, data, q)?;
-            Ok((data.tcp, Vector6::zeros()))
-        }
-        Load::Exact(w) => {
-            let d = vjm::deflection_and_jacobian(model, data, q, w)?;
-            Ok((data.tcp_deflected, d))
-        }
-        Load::Linearized(w) => {
-            let c = vjm::compliance(model, data, q)?;
-            vjm::joint_jacobian(model, data, q)?;
-            let d = c * w;
-            Ok((displaced(&data.tcp, &d), d))
-        }
-        Load::ExactWithArm(w, motion) => {
-            let d = vjm::deflection_and_jacobian_under(model, data, q, w, &motion)?;
-            Ok((data.tcp_deflected, d))
-        }
-        Load::LinearizedWithArm(w, motion) => {
-            let d = vjm::linearized_deflection_under(model, data, q, w, &motion)?;
-            Ok((displaced(&data.tcp, &d), d))
-        }
-    }
-}
-
-/// `t` moved by the small pose change `d = [dp; dr]` (translation, then the rotation vector
-/// applied in the base frame).
-fn displaced(t: &Isometry3<f64>, d: &Vector6) -> Isometry3<f64> {
-    let dp: Vector3<f64> = d.fixed_rows::<3>(0).into_owned();
-    let dr: Vector3<f64> = d.fixed_rows::<3>(3).into_owned();
-    Isometry3::from_parts(
-        (t.translation.vector + dp).into(),
-        UnitQuaternion::from_scaled_axis(dr) * t.rotation,
-    )
 }
 
 /// `J J^T` over the first `dof` columns (no transposed copy of the 6 x 8 Jacobian).
@@ -197,7 +137,9 @@ fn singularity(jj: &Matrix6<f64>, min_sigma: f64) -> Result<f64, f64> {
     }
 }
 
-/// Joints at which the (loaded) TCP reaches `target`, from `seed` (see the module docs).
+/// Joints at which the TCP, loaded by `wrench` \[N, N m\] (base frame, moment about the TCP)
+/// as `load` says ([`vjm::deflection`]; `wrench` is unused for [`Load::Rigid`]), reaches
+/// `target`, from `seed` (see the module docs).
 /// [`TickError::NotConverged`] when the budget ends first (e.g. an unreachable target),
 /// [`TickError::Singular`] at a singular pose, [`TickError::WrongLength`] /
 /// [`TickError::NonFinite`] for bad inputs. On success `data.tcp` is the rigid pose of the
@@ -207,6 +149,7 @@ pub fn pose_ik(
     data: &mut Data,
     target: &Isometry3<f64>,
     seed: &[f64],
+    wrench: &Vector6,
     load: Load<'_>,
     options: &PoseIkOptions,
 ) -> Result<PoseIkSolution, TickError> {
@@ -229,7 +172,9 @@ pub fn pose_ik(
     let mut iterations = 0;
     loop {
         let qs = q.get(..dof).unwrap_or(&[]);
-        let (pose, deflection) = loaded_pose(model, data, qs, load)?;
+        // One pass: the loaded pose, the deflection and the rigid Jacobian at `qs`.
+        let deflection = vjm::deflection(model, data, qs, wrench, load)?;
+        let pose = data.tcp_deflected;
         let jj = gram(&data.jacobian, dof);
         let ep = target.translation.vector - pose.translation.vector;
         let er = vjm::rotation_vector(&(target.rotation * pose.rotation.inverse()));

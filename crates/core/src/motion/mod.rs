@@ -51,7 +51,11 @@ pub use pose::{PoseLimits, PoseState, PoseTrajectory};
 pub use profile::{PathState, Profile};
 #[cfg(feature = "alloc")]
 pub use sampled::SampledTrajectory;
-pub use trajectory::{AxisLimits, Cursor, State, Trajectory};
+pub use trajectory::{AxisLimits, Cursor, Data, State, Trajectory, step};
+
+/// The immutable model of the tick shape: a planned trajectory; [`Data`] is its sampling state
+/// and [`step`] the tick.
+pub type Model<const N: usize> = Trajectory<N>;
 
 use crate::error::{BuildError, param};
 
@@ -69,7 +73,7 @@ pub const DEFAULT_RATE_HZ: f64 = 2000.0;
 /// [`crate::TickError::Budget`].
 pub const MAX_TICKS: u64 = 1 << 40;
 /// Most samples a call that stores every tick may produce (the bindings' `plan_*`,
-/// [`crate::dalembert::correct`]): 2^22 = 4 194 304, 35 min at 2 kHz, about 440 MB for a
+/// [`crate::dalembert::parallel::correct`]): 2^22 = 4 194 304, 35 min at 2 kHz, about 440 MB for a
 /// 3-D trajectory's time, position, velocity, acceleration and jerk. See
 /// [`Trajectory::sample_count`].
 pub const MAX_SAMPLES: usize = 1 << 22;

@@ -335,14 +335,9 @@ impl<const N: usize> Trajectory<N> {
     /// [`TickError::InvalidArgument`] for a rate that is not finite and > 0,
     /// [`TickError::Budget`] past [`MAX_TICKS`].
     pub fn ticks(&self, rate_hz: f64) -> Result<Cursor<'_, N>, TickError> {
-        let count = self.tick_count(rate_hz)?;
         Ok(Cursor {
             trajectory: self,
-            rate_hz,
-            next: 0,
-            last: count.saturating_sub(1),
-            hint: 0,
-            done: false,
+            data: Data::new(self, rate_hz)?,
         })
     }
 
@@ -386,35 +381,47 @@ impl<const N: usize> Trajectory<N> {
     }
 }
 
-/// Steps through a [`Trajectory`] tick by tick ([`Trajectory::ticks`]); an [`Iterator`] of
-/// [`State`]s that a 2 kHz loop can also drive one [`Cursor::step`] at a time.
-#[derive(Debug, Clone)]
-pub struct Cursor<'a, const N: usize> {
-    trajectory: &'a Trajectory<N>,
+/// The per-tick state of sampling a [`Trajectory`] at a fixed rate: the tick counter and the
+/// segment the last tick fell in (the next search starts there). `Copy`, no borrow of the
+/// trajectory, so a controller (or the C API) keeps it beside the trajectory; [`step`]
+/// advances it, [`Cursor`] wraps both as an iterator.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Data {
     rate_hz: f64,
+    /// Duration of the trajectory it was made for \[s\] ([`Self::check`]).
+    duration: f64,
     next: usize,
     last: usize,
     hint: usize,
     done: bool,
 }
 
-impl<const N: usize> Cursor<'_, N> {
-    /// The next tick's state, or `None` after the final tick (at the end point).
-    pub fn step(&mut self) -> Option<State<N>> {
-        if self.done {
-            return None;
-        }
-        let k = self.next;
-        let t = if k >= self.last {
-            self.done = true;
-            self.trajectory.duration
-        } else {
-            (k as f64 / self.rate_hz).min(self.trajectory.duration)
-        };
-        self.next = k.saturating_add(1);
-        let (state, seg) = self.trajectory.sample_from(t, self.hint);
-        self.hint = seg;
-        Some(state)
+impl Data {
+    /// The state before the first tick of `model` sampled at `rate_hz`: tick `k` is at
+    /// `t = k / rate_hz`, computed from `k` (no drift), and a last tick lands exactly on
+    /// [`Trajectory::duration`] (the end point), so there are `ceil(duration * rate) + 1`
+    /// ticks. [`TickError::InvalidArgument`] for a rate that is not finite and > 0,
+    /// [`TickError::Budget`] past [`MAX_TICKS`].
+    pub fn new<const N: usize>(model: &Trajectory<N>, rate_hz: f64) -> Result<Self, TickError> {
+        let count = model.tick_count(rate_hz)?;
+        Ok(Self {
+            rate_hz,
+            duration: model.duration,
+            next: 0,
+            last: count.saturating_sub(1),
+            hint: 0,
+            done: false,
+        })
+    }
+
+    /// Whether this state was made for a trajectory of `model`'s duration.
+    pub fn check<const N: usize>(&self, model: &Trajectory<N>) -> bool {
+        self.duration.to_bits() == model.duration.to_bits()
+    }
+
+    /// The sampling rate \[Hz\].
+    pub fn rate_hz(&self) -> f64 {
+        self.rate_hz
     }
     /// Ticks already returned.
     pub fn ticks_done(&self) -> usize {
@@ -431,6 +438,69 @@ impl<const N: usize> Cursor<'_, N> {
         } else {
             self.last.saturating_sub(self.next).saturating_add(1)
         }
+    }
+
+    /// The next tick of `model` (made for it: the caller checked), or `None` after the last.
+    fn advance<const N: usize>(&mut self, model: &Trajectory<N>) -> Option<State<N>> {
+        if self.done {
+            return None;
+        }
+        let k = self.next;
+        let t = if k >= self.last {
+            self.done = true;
+            model.duration
+        } else {
+            (k as f64 / self.rate_hz).min(model.duration)
+        };
+        self.next = k.saturating_add(1);
+        let (state, seg) = model.sample_from(t, self.hint);
+        self.hint = seg;
+        Some(state)
+    }
+}
+
+/// One tick of sampling: the state of the next tick of `model`, or `None` after the final
+/// tick (at the end point). [`TickError::ModelMismatch`] when `data` was made for another
+/// trajectory. Closed form, allocation-free, bounded by the segment count.
+pub fn step<const N: usize>(
+    model: &Trajectory<N>,
+    data: &mut Data,
+) -> Result<Option<State<N>>, TickError> {
+    if !data.check(model) {
+        return Err(TickError::ModelMismatch {
+            what: "ticks (the data was made for a trajectory of another duration)",
+            expected: model.tick_count(data.rate_hz).unwrap_or(0),
+            got: data.last.saturating_add(1),
+        });
+    }
+    Ok(data.advance(model))
+}
+
+/// Steps through a [`Trajectory`] tick by tick ([`Trajectory::ticks`]): the trajectory and its
+/// [`Data`] as an [`Iterator`] of [`State`]s that a 2 kHz loop can also drive one
+/// [`Cursor::step`] at a time.
+#[derive(Debug, Clone)]
+pub struct Cursor<'a, const N: usize> {
+    trajectory: &'a Trajectory<N>,
+    data: Data,
+}
+
+impl<const N: usize> Cursor<'_, N> {
+    /// The next tick's state, or `None` after the final tick (at the end point).
+    pub fn step(&mut self) -> Option<State<N>> {
+        self.data.advance(self.trajectory)
+    }
+    /// Ticks already returned.
+    pub fn ticks_done(&self) -> usize {
+        self.data.ticks_done()
+    }
+    /// `true` once the final tick has been returned.
+    pub fn is_finished(&self) -> bool {
+        self.data.is_finished()
+    }
+    /// Ticks left, including the final one.
+    pub fn remaining(&self) -> usize {
+        self.data.remaining()
     }
 }
 

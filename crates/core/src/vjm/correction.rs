@@ -5,7 +5,7 @@
 use nalgebra::{Isometry3, SVD, SVector, Translation3, UnitQuaternion, Vector3};
 
 use super::deflection::{check_q, deflection, joint_jacobian};
-use super::{Data, MAX_DOF, Model, Vector6};
+use super::{Data, Load, MAX_DOF, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 
 /// Most Gauss-Newton steps a [`joint_correction`] may be asked for: the correction converges
@@ -41,6 +41,7 @@ pub fn commanded_pose(target: &Isometry3<f64>, deflection: &Vector6) -> Isometry
 
 /// Result of [`joint_correction`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct JointCorrection {
     /// Axis-specific correction `dq` \[rad or m\] to add to the nominal joints; entries past
     /// [`Model::dof`] are zero.
@@ -225,7 +226,8 @@ pub fn joint_correction(
     for it in 0..=max_iterations {
         let qcur = qk;
         let qs = qcur.get(..dof).unwrap_or(&[]);
-        deflection(model, data, qs, wrench)?;
+        // The pass leaves the deflected TCP and the Jacobian at `qs` in `data`.
+        deflection(model, data, qs, wrench, Load::Exact)?;
         let d = data.tcp_deflected;
         let ep = d.translation.vector - target.translation.vector;
         let er = (d.rotation * target.rotation.inverse()).scaled_axis();
@@ -243,7 +245,6 @@ pub fn joint_correction(
         if residual <= tolerance || it == max_iterations {
             break;
         }
-        joint_jacobian(model, data, qs)?;
         let (step, sigma_min) = solve_jacobian(data, dof, &(-e))?;
         out.sigma_min = sigma_min;
         for (qi, si) in qk.iter_mut().zip(step.iter()).take(dof) {

@@ -4,8 +4,9 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
+use super::loads::arm_pass;
 use super::model::{Op, Pass};
-use super::{Data, Model, Vector6};
+use super::{Data, Load, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 
 impl Data {
@@ -183,18 +184,26 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
     Ok(tcp)
 }
 
-/// The spring angles `M / k` (Eq. 5-7) of every spring under the TCP wrench, from the rigid
-/// frames of the last pass, into `data.spring_angles`; refuses angles past
-/// [`MAX_SPRING_ANGLE`].
-fn spring_angles(
-    model: &Model,
-    data: &mut Data,
-    tcp: &Isometry3<f64>,
-    wrench: &Vector6,
-) -> Result<(), TickError> {
+/// The moment on every spring \[N m\] (world axes, about its origin) of the TCP `wrench` at
+/// `tcp`, from the rigid frames of the last pass (Eq. 5-6), into `data.spring_moments`.
+fn tcp_moments(model: &Model, data: &mut Data, tcp: &Isometry3<f64>, wrench: &Vector6) {
     let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
     let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
     let p_tcp = tcp.translation.vector;
+    for k in 0..model.springs {
+        let (Some(f), Some(slot)) = (data.spring_frames.get(k), data.spring_moments.get_mut(k))
+        else {
+            continue;
+        };
+        *slot = moment + (p_tcp - f.translation.vector).cross(&force);
+    }
+}
+
+/// The spring angles `C M` (Eq. 7: `alpha = M_C / k_C`, `beta = M_B / k_B`,
+/// `gamma = M_A / k_A`) of every spring from `data.spring_moments`, each moment expressed in
+/// its spring's frame, into `data.spring_angles`. The one guard of the small-deflection
+/// model: an angle past [`MAX_SPRING_ANGLE`] (or NaN from overflowing moments) is refused.
+fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> {
     for op in model.ops.iter() {
         let Op::Spring {
             compliance, index, ..
@@ -202,19 +211,17 @@ fn spring_angles(
         else {
             continue;
         };
-        let Some(f) = data.spring_frames.get(*index).copied() else {
+        let (Some(f), Some(m)) = (
+            data.spring_frames.get(*index),
+            data.spring_moments.get(*index),
+        ) else {
             continue;
         };
-        // Eq. 5-6: load moved to the spring origin, expressed in the spring frame.
-        let m_local = f
-            .rotation
-            .inverse_transform_vector(&(moment + (p_tcp - f.translation.vector).cross(&force)));
-        // Eq. 7: alpha = M_C / k_C, beta = M_B / k_B, gamma = M_A / k_A.
-        let angles = compliance.component_mul(&m_local);
+        let angles = compliance.component_mul(&f.rotation.inverse_transform_vector(m));
         let largest = angles.amax();
         if largest.is_nan() || largest > MAX_SPRING_ANGLE {
             return Err(TickError::InvalidArgument {
-                what: "wrench (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
+                what: "load (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
                        small-deflection model)",
                 value: largest,
             });
@@ -249,8 +256,35 @@ pub(super) fn deflected_tcp(model: &Model, data: &Data, tcp: &Isometry3<f64>) ->
     Isometry3::from_parts(p.into(), r)
 }
 
+/// The first-order deflection `sum_s [theta_s x (p_tcp - o_s); theta_s]` of the spring
+/// angles, `theta_s = R_s a_s` the world rotation vector of spring `s` about its origin
+/// `o_s`: `C(q) w` when the moments come from the TCP wrench alone.
+fn linear_sum(model: &Model, data: &Data, tcp: &Isometry3<f64>) -> Vector6 {
+    let mut d = Vector6::zeros();
+    for k in 0..model.springs {
+        let (Some(f), Some(a)) = (data.spring_frames.get(k), data.spring_angles.get(k)) else {
+            continue;
+        };
+        let theta = f.rotation * a;
+        let lin = theta.cross(&(tcp.translation.vector - f.translation.vector));
+        d += Vector6::new(lin.x, lin.y, lin.z, theta.x, theta.y, theta.z);
+    }
+    d
+}
+
+/// `t` moved by the small pose change `d = [dp; dr]` (translation, then the rotation vector
+/// applied in the base frame): the loaded pose of the linearized model.
+fn displaced(t: &Isometry3<f64>, d: &Vector6) -> Isometry3<f64> {
+    let dp = Vector3::new(d[0], d[1], d[2]);
+    let dr = Vector3::new(d[3], d[4], d[5]);
+    Isometry3::from_parts(
+        (t.translation.vector + dp).into(),
+        UnitQuaternion::from_scaled_axis(dr) * t.rotation,
+    )
+}
+
 /// `[dp; dr]` of the deflected TCP against the rigid one, and both poses into `data`.
-pub(super) fn finish_deflection(
+fn finish_deflection(
     data: &mut Data,
     tcp: &Isometry3<f64>,
     deflected: &Isometry3<f64>,
@@ -265,26 +299,72 @@ pub(super) fn finish_deflection(
     Ok(d)
 }
 
-/// TCP deflection `[dx, dy, dz, rx, ry, rz]` \[m, rad\] in the base frame under the TCP wrench
-/// `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] (base frame, moment about the TCP): the paper's exact
-/// model. Torques on each spring are taken in the undeformed pose (Eq. 5-6, plus the applied
-/// moment), turned into angles `M / k` (Eq. 7) and inserted as z-y'-x'' rotations (Eq. 3-4);
-/// the result is the deflected FK (Eq. 8) minus the rigid one (Eq. 9): the translation, then
-/// the rotation vector of `R_deflected * R_rigid^T`.
+/// TCP deflection `[dx, dy, dz, rx, ry, rz]` \[m, rad\] in the base frame at joints `q`
+/// \[rad or m\] under the TCP wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] (base frame, moment
+/// about the TCP) and, with an arm motion in `load`, the link masses' own loads: one pass
+/// over the chain for every [`Load`].
 ///
-/// Fills `data.tcp`, `data.tcp_deflected` and `data.spring_angles`.
+/// The paper's exact model ([`Load::Exact`]): torques on each spring are taken in the
+/// undeformed pose (Eq. 5-6, plus the applied moment), turned into angles `M / k` (Eq. 7) and
+/// inserted as z-y'-x'' rotations (Eq. 3-4); the result is the deflected FK (Eq. 8) minus the
+/// rigid one (Eq. 9): the translation, then the rotation vector of `R_deflected * R_rigid^T`.
+/// [`Load::Linearized`] takes each spring's turn to first order (`C(q) w`, the same as
+/// [`compliance`] times the wrench to rounding); [`Load::Rigid`] deflects nothing.
+///
+/// After the pass `data` holds, as pinocchio's `computeJointJacobians` leaves them: the rigid
+/// TCP `data.tcp`, the loaded TCP `data.tcp_deflected` (for the linearized model, the rigid
+/// pose moved by the returned deflection), the actuated-joint Jacobian of the rigid TCP
+/// `data.jacobian`, and per spring `data.spring_moments` and `data.spring_angles` (zero for
+/// [`Load::Rigid`]).
+///
+/// [`TickError::InvalidArgument`] when a load turns a spring past [`MAX_SPRING_ANGLE`]
+/// (outside the small-deflection model), [`TickError::NonFiniteOutput`] when loads far
+/// outside the physical range overflow.
 pub fn deflection(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     wrench: &Vector6,
+    load: Load<'_>,
 ) -> Result<Vector6, TickError> {
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
-    let tcp = rigid_pass(model, data, q);
-    spring_angles(model, data, &tcp, wrench)?;
-    let deflected = deflected_tcp(model, data, &tcp);
-    finish_deflection(data, &tcp, &deflected)
+    let tcp = match load.arm() {
+        Some(motion) => arm_pass(model, data, q, wrench, motion)?,
+        None => {
+            let tcp = rigid_pass(model, data, q);
+            if load != Load::Rigid {
+                tcp_moments(model, data, &tcp, wrench);
+            }
+            tcp
+        }
+    };
+    fill_jacobian(model, data, &tcp);
+    match load {
+        Load::Rigid => {
+            let n = model.springs;
+            for slot in data.spring_angles.iter_mut().take(n) {
+                *slot = Vector3::zeros();
+            }
+            for slot in data.spring_moments.iter_mut().take(n) {
+                *slot = Vector3::zeros();
+            }
+            finish_deflection(data, &tcp, &tcp)
+        }
+        Load::Exact | Load::ExactWithArm(_) => {
+            angles_from_moments(model, data)?;
+            let deflected = deflected_tcp(model, data, &tcp);
+            finish_deflection(data, &tcp, &deflected)
+        }
+        Load::Linearized | Load::LinearizedWithArm(_) => {
+            angles_from_moments(model, data)?;
+            let d = linear_sum(model, data, &tcp);
+            check_output("deflection", d.as_slice())?;
+            data.tcp = tcp;
+            data.tcp_deflected = displaced(&tcp, &d);
+            Ok(d)
+        }
+    }
 }
 
 /// Fills `data.jacobian` from the joint axes and origins of the last pass.
@@ -311,24 +391,6 @@ pub(super) fn fill_jacobian(model: &Model, data: &mut Data, tcp: &Isometry3<f64>
             data.jacobian.set_column(*index, &col);
         }
     }
-}
-
-/// [`deflection`] and [`joint_jacobian`] at the same `q` in one pass over the chain (the
-/// rigid frames serve both): fills `data.tcp`, `data.tcp_deflected`, `data.spring_angles`
-/// and `data.jacobian`, and returns the deflection. What a loaded pose IK needs each step.
-pub fn deflection_and_jacobian(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    wrench: &Vector6,
-) -> Result<Vector6, TickError> {
-    check_q(model, data, q)?;
-    check_finite("wrench", wrench.as_slice())?;
-    let tcp = rigid_pass(model, data, q);
-    spring_angles(model, data, &tcp, wrench)?;
-    fill_jacobian(model, data, &tcp);
-    let deflected = deflected_tcp(model, data, &tcp);
-    finish_deflection(data, &tcp, &deflected)
 }
 
 /// The 6x6 Cartesian compliance of the linearized model, `C = sum_s J_s K_s^-1 J_s^T`
@@ -383,25 +445,9 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
     Ok(c)
 }
 
-/// The linearized deflection `C(q) w` \[m, rad\] under the TCP wrench `[F; M]` \[N, N m\]
-/// (base frame): [`compliance`] times the wrench in one call, the first-order term of
-/// [`deflection`]. Also fills `data.compliance` and `data.tcp`.
-pub fn linear_deflection(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    wrench: &Vector6,
-) -> Result<Vector6, TickError> {
-    check_finite("wrench", wrench.as_slice())?;
-    let c = compliance(model, data, q)?;
-    let d = c * wrench;
-    check_output("deflection", d.as_slice())?;
-    Ok(d)
-}
-
-/// Fills `data.jacobian` with the actuated-joint Jacobian of the rigid TCP, rows
-/// `[v; w]` in the base frame, and `data.tcp` with the rigid pose. Columns past the model's
-/// dof are zero.
+/// The actuated-joint Jacobian of the rigid TCP, rows `[v; w]` in the base frame, into
+/// `data.jacobian` (columns past the model's dof are zero), and the rigid pose into
+/// `data.tcp`. Every [`deflection`] pass leaves the same Jacobian in `data`.
 pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), TickError> {
     check_q(model, data, q)?;
     let tcp = rigid_pass(model, data, q);

@@ -50,6 +50,7 @@ impl Default for EquilibriumOptions {
 
 /// Result of [`equilibrium`].
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[must_use]
 pub struct Equilibrium {
     /// TCP deflection `[dp; dr]` \[m, rad\] in equilibrium, the layout of
     /// [`super::deflection`].
@@ -182,7 +183,7 @@ pub fn equilibrium(
         });
     }
     // The paper's solution is the start (and fills data.tcp with the rigid pose).
-    super::deflection(model, data, q, wrench)?;
+    super::deflection(model, data, q, wrench, super::Load::Exact)?;
     let rigid = data.tcp;
     let n = 3 * model.springs;
     let mut x: Vec<f64> = data

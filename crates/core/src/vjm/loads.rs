@@ -17,16 +17,63 @@
 //! joint rates and accelerations (the springs' own motion is second order and left out, as
 //! the paper leaves out the deflected pose); one backward pass accumulates the moments. The
 //! angles `C M_s` then go through the paper's exact deflected chain (Eq. 3-4, 8-9) or its
-//! linearization. Allocation-free, bounded by the chain length.
+//! linearization ([`super::deflection`] with [`Load::ExactWithArm`] or
+//! [`Load::LinearizedWithArm`]). Allocation-free, bounded by the chain length.
 
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
-use super::deflection::{
-    MAX_SPRING_ANGLE, check_q, deflected_tcp, fill_jacobian, finish_deflection,
-};
+use super::deflection::check_q;
 use super::model::Op;
 use super::{Data, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
+
+/// The deflection model of a loaded chain: what a corrector or a solver is configured with
+/// once; [`Load::new`] pairs it with the tick's arm motion.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Deflection {
+    /// The paper's exact virtual-joint model (Hähn and Weigold, Eq. 2-9).
+    #[default]
+    Exact,
+    /// The linearized model `C(q) w` (each spring's turn to first order).
+    Linearized,
+}
+
+/// What one pass of [`super::deflection`] evaluates: the springs' response (none, exact or
+/// linearized) and whether the link masses' inertial (and weight) loads of an arm motion join
+/// the TCP wrench.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Load<'a> {
+    /// The rigid chain: no deflection (the pass still leaves the rigid pose and the Jacobian).
+    Rigid,
+    /// The exact model (Eq. 2-9) under the TCP wrench.
+    Exact,
+    /// The linearized model under the TCP wrench: `C(q) w`.
+    Linearized,
+    /// The exact model under the TCP wrench and the link masses' loads of this joint motion.
+    ExactWithArm(ArmMotion<'a>),
+    /// The linearized model under the same loads: `sum_s J_s C_s R_s^T M_s`.
+    LinearizedWithArm(ArmMotion<'a>),
+}
+
+impl<'a> Load<'a> {
+    /// The load of `deflection`, with the link masses' loads of `arm` when given.
+    pub fn new(deflection: Deflection, arm: Option<ArmMotion<'a>>) -> Self {
+        match (deflection, arm) {
+            (Deflection::Exact, None) => Self::Exact,
+            (Deflection::Linearized, None) => Self::Linearized,
+            (Deflection::Exact, Some(m)) => Self::ExactWithArm(m),
+            (Deflection::Linearized, Some(m)) => Self::LinearizedWithArm(m),
+        }
+    }
+
+    /// The arm motion whose link loads join the TCP wrench, if any.
+    pub fn arm(&self) -> Option<&ArmMotion<'a>> {
+        match self {
+            Self::ExactWithArm(m) | Self::LinearizedWithArm(m) => Some(m),
+            Self::Rigid | Self::Exact | Self::Linearized => None,
+        }
+    }
+}
 
 /// The joint motion that loads the arm with its own inertia: rates `qd` \[rad/s or m/s\] and
 /// accelerations `qdd` \[rad/s^2 or m/s^2\] (one per joint), and the gravity vector `gravity`
@@ -169,47 +216,16 @@ fn accumulate_moments(model: &Model, data: &mut Data, tcp: &Isometry3<f64>, wren
     }
 }
 
-/// Spring angles `C M_s` (Eq. 7) from the accumulated moments; refuses angles past
-/// [`MAX_SPRING_ANGLE`].
-fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> {
-    for op in model.ops.iter() {
-        let Op::Spring {
-            compliance, index, ..
-        } = op
-        else {
-            continue;
-        };
-        let (Some(f), Some(m)) = (
-            data.spring_frames.get(*index),
-            data.spring_moments.get(*index),
-        ) else {
-            continue;
-        };
-        let angles = compliance.component_mul(&f.rotation.inverse_transform_vector(m));
-        let largest = angles.amax();
-        if largest.is_nan() || largest > MAX_SPRING_ANGLE {
-            return Err(TickError::InvalidArgument {
-                what: "load (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
-                       small-deflection model)",
-                value: largest,
-            });
-        }
-        if let Some(slot) = data.spring_angles.get_mut(*index) {
-            *slot = angles;
-        }
-    }
-    Ok(())
-}
-
-fn loaded_pass(
+/// The loaded pass of an arm motion: the rigid chain at `q` with the motion's velocities and
+/// accelerations, then every spring's moment from the link loads and the TCP `wrench` into
+/// `data.spring_moments`. Returns the rigid TCP pose.
+pub(super) fn arm_pass(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     wrench: &Vector6,
     motion: &ArmMotion<'_>,
 ) -> Result<Isometry3<f64>, TickError> {
-    check_q(model, data, q)?;
-    check_finite("wrench", wrench.as_slice())?;
     check_motion(model, motion)?;
     let (tcp, _, _) = motion_pass(model, data, q, motion);
     accumulate_moments(model, data, &tcp, wrench);
@@ -217,72 +233,7 @@ fn loaded_pass(
     for m in data.spring_moments.get(..model.springs).unwrap_or(&[]) {
         check_output("spring moments", m.as_slice())?;
     }
-    angles_from_moments(model, data)?;
     Ok(tcp)
-}
-
-/// TCP deflection `[dp; dr]` \[m, rad\] of the paper's exact model under the TCP `wrench`
-/// \[N, N m\] (base frame, moment about the TCP) and the inertial (and, with gravity, weight)
-/// loads of the link masses under `motion` (see the module docs). Without masses, or at rest
-/// without gravity, it is [`super::deflection`]. Fills `data.tcp`, `data.tcp_deflected`,
-/// `data.spring_moments` and `data.spring_angles`.
-pub fn deflection_under(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    wrench: &Vector6,
-    motion: &ArmMotion<'_>,
-) -> Result<Vector6, TickError> {
-    let tcp = loaded_pass(model, data, q, wrench, motion)?;
-    let deflected = deflected_tcp(model, data, &tcp);
-    finish_deflection(data, &tcp, &deflected)
-}
-
-/// [`deflection_under`] and the joint Jacobian (`data.jacobian`) at the same `q`, in one pass.
-pub fn deflection_and_jacobian_under(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    wrench: &Vector6,
-    motion: &ArmMotion<'_>,
-) -> Result<Vector6, TickError> {
-    let tcp = loaded_pass(model, data, q, wrench, motion)?;
-    fill_jacobian(model, data, &tcp);
-    let deflected = deflected_tcp(model, data, &tcp);
-    finish_deflection(data, &tcp, &deflected)
-}
-
-/// The linearized deflection under the same loads, `sum_s J_s C_s R_s^T M_s` (each spring's
-/// angles to first order), and the joint Jacobian, at `q`. Fills `data.tcp` (rigid),
-/// `data.spring_moments`, `data.spring_angles` and `data.jacobian`.
-pub fn linearized_deflection_under(
-    model: &Model,
-    data: &mut Data,
-    q: &[f64],
-    wrench: &Vector6,
-    motion: &ArmMotion<'_>,
-) -> Result<Vector6, TickError> {
-    let tcp = loaded_pass(model, data, q, wrench, motion)?;
-    fill_jacobian(model, data, &tcp);
-    let mut d = Vector6::zeros();
-    for op in model.ops.iter() {
-        let Op::Spring { index, .. } = op else {
-            continue;
-        };
-        let (Some(f), Some(a)) = (
-            data.spring_frames.get(*index),
-            data.spring_angles.get(*index),
-        ) else {
-            continue;
-        };
-        // World rotation vector of the spring's small turn, about its origin.
-        let theta = f.rotation * a;
-        let lin = theta.cross(&(tcp.translation.vector - f.translation.vector));
-        d += Vector6::new(lin.x, lin.y, lin.z, theta.x, theta.y, theta.z);
-    }
-    check_output("deflection", d.as_slice())?;
-    data.tcp = tcp;
-    Ok(d)
 }
 
 /// The TCP's acceleration `[a; alpha]` \[m/s^2, rad/s^2\] (base frame) at joints `q` with

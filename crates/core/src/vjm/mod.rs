@@ -7,6 +7,12 @@
 //! (k_C, k_B, k_A of the paper's Table 1). Under a TCP wrench each spring turns by
 //! `M / k` about its axes (Eq. 5-7), the turn is inserted as a z-y'-x'' rotation (Eq. 3-4), and
 //! the deflected forward kinematics (Eq. 8) minus the rigid one (Eq. 9) is the deflection.
+//!
+//! One pass per quantity, pinocchio's habit: [`forward`] (rigid TCP), [`deflection`] (every
+//! [`Load`]: rigid, exact or linearized, with or without the arm's own link loads; the
+//! Jacobian and the per-spring moments and angles are read from [`Data`] after it),
+//! [`compliance`] (the 6x6 Cartesian compliance), [`joint_jacobian`], and the solvers built on
+//! them ([`joint_correction`], [`equilibrium`]).
 
 mod correction;
 mod deflection;
@@ -20,16 +26,10 @@ pub use correction::{
     joint_delta, pose_from_matrix, rotation_from_matrix,
 };
 pub(crate) use deflection::rotation_vector;
-pub use deflection::{
-    MAX_SPRING_ANGLE, compliance, deflection, deflection_and_jacobian, forward, joint_jacobian,
-    linear_deflection,
-};
+pub use deflection::{MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian};
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
-pub use loads::{
-    ArmMotion, deflection_and_jacobian_under, deflection_under, linearized_deflection_under,
-    tcp_acceleration_bias,
-};
+pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};
 pub use model::{
     Data, Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder,
     valid_stiffness,

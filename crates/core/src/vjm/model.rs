@@ -10,8 +10,9 @@ pub const MAX_DOF: usize = 8;
 /// Most virtual joints: the paper's KR 300 model has 11 (Table 1); 32 leaves room for a
 /// spring per joint and per link of an 8-axis cell with a multi-part end effector.
 pub const MAX_SPRINGS: usize = 32;
-/// Most link masses (the arm's own inertia, for loads under motion): one per link of the
-/// largest chain.
+/// Most link masses: the chain's own ([`Element::Mass`], loads under motion) and the point
+/// masses of a drive-train model ([`crate::drivetrain::LinkMasses`]); one per link of the
+/// largest chain with its tool, sensor and payload parts.
 pub const MAX_MASSES: usize = 32;
 /// Most chain elements after merging consecutive fixed transforms. A spring placed inside a
 /// link costs up to three elements (offset, spring, inverse offset), a joint two; 4 * 32
@@ -52,7 +53,7 @@ pub enum Element {
     /// A rigid body attached to the current frame: mass \[kg\], centre of mass \[m\] and
     /// inertia about the centre of mass \[kg m^2\], both in the current frame. It changes no
     /// kinematics; under joint motion its inertial wrench loads every spring before it
-    /// ([`crate::vjm::deflection_under`]).
+    /// ([`crate::vjm::Load::ExactWithArm`]).
     Mass {
         /// Mass \[kg\].
         mass: f64,
@@ -543,14 +544,16 @@ pub struct Data {
     pub(super) springs: usize,
     /// Rigid TCP pose of the last call, base frame.
     pub tcp: Isometry3<f64>,
-    /// Deflected TCP pose of the last [`crate::vjm::deflection`] call, base frame (Eq. 8).
+    /// Loaded TCP pose of the last [`crate::vjm::deflection`] pass, base frame (Eq. 8; for the
+    /// linearized model the rigid pose moved by the first-order deflection).
     pub tcp_deflected: Isometry3<f64>,
     /// Elastic angles `[alpha, beta, gamma]` \[rad\] of each spring from the last
     /// [`crate::vjm::deflection`] call (Eq. 7), in chain order; entries past
     /// [`Model::spring_count`] are zero.
     pub spring_angles: [Vector3<f64>; MAX_SPRINGS],
-    /// Actuated-joint Jacobian `[v; w]` of the TCP \[m/rad or 1, rad/rad\], base frame, from the
-    /// last [`crate::vjm::joint_jacobian`] call; columns past [`Model::dof`] are zero.
+    /// Actuated-joint Jacobian `[v; w]` of the rigid TCP \[m/rad or 1, rad/rad\], base frame,
+    /// from the last [`crate::vjm::deflection`] or [`crate::vjm::joint_jacobian`] pass;
+    /// columns past [`Model::dof`] are zero.
     pub jacobian: SMatrix<f64, 6, MAX_DOF>,
     /// Cartesian compliance of the last [`crate::vjm::compliance`] call.
     pub compliance: Matrix6<f64>,
@@ -560,7 +563,7 @@ pub struct Data {
     pub(crate) joint_axes: [Vector3<f64>; MAX_DOF],
     pub(crate) joint_origins: [Vector3<f64>; MAX_DOF],
     /// Moment on each spring \[N m\] (world axes, about the spring's origin) of the last
-    /// loaded call ([`crate::vjm::deflection_under`]); entries past the spring count are zero.
+    /// [`crate::vjm::deflection`] pass; entries past the spring count are zero.
     pub spring_moments: [Vector3<f64>; MAX_SPRINGS],
     // Inertial force and moment about the world origin of each mass, last loaded call.
     pub(crate) mass_loads: [(Vector3<f64>, Vector3<f64>); MAX_MASSES],
