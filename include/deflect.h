@@ -18,6 +18,15 @@
 #include <stdint.h>
 #include <stdlib.h>
 
+// Query/model status: the position was inside the grid.
+#define DEFLECT_QUERY_INSIDE 0
+
+// Query/model status: the position was outside and was clamped.
+#define DEFLECT_QUERY_CLAMPED 1
+
+// Query/model status: the position was outside and was extrapolated.
+#define DEFLECT_QUERY_EXTRAPOLATED 2
+
 // Largest moving-average window of the online compensator [cycles].
 #define DEFLECT_MAX_AVERAGE_WINDOW 64
 
@@ -35,6 +44,12 @@
 
 // The paper's tuned D'Alembert mass parameter m* [kg].
 #define DEFLECT_PAPER_MASS 5.0
+
+// Invert the paper's exact virtual-joint deflection (Eq. 2-9).
+#define DEFLECT_SERIAL_EXACT 0
+
+// Invert the linearized deflection `C(q) w`.
+#define DEFLECT_SERIAL_LINEARIZED 1
 
 // File force unit: newton.
 #define DEFLECT_FORCE_UNIT_NEWTON 0
@@ -63,26 +78,11 @@
 // Outside the map's grid: extrapolate linearly from the boundary.
 #define DEFLECT_OUT_OF_GRID_EXTRAPOLATE 2
 
-// Query/model status: the position was inside the grid.
-#define DEFLECT_QUERY_INSIDE 0
-
-// Query/model status: the position was outside and was clamped.
-#define DEFLECT_QUERY_CLAMPED 1
-
-// Query/model status: the position was outside and was extrapolated.
-#define DEFLECT_QUERY_EXTRAPOLATED 2
-
 // The paper's correction rate [Hz].
 #define DEFLECT_PAPER_RATE_HZ 2000.0
 
 // Most actuated joints of a serial robot (length of `DeflectJointCorrection.dq`).
 #define DEFLECT_MAX_DOF 8
-
-// Invert the paper's exact virtual-joint deflection (Eq. 2-9).
-#define DEFLECT_SERIAL_EXACT 0
-
-// Invert the linearized deflection `C(q) w`.
-#define DEFLECT_SERIAL_LINEARIZED 1
 
 // The online force-compensation chain of one serial robot: its model (the robot's chain and
 // the validated settings) and its state (filters, pilot control, rate limiter, workspace).
@@ -237,6 +237,54 @@ typedef struct DeflectCorrectedTick2 {
   int32_t placement;
 } DeflectCorrectedTick2;
 
+// Payload and tool beyond the TCP.
+typedef struct DeflectPayload {
+  // Mass [kg], finite and >= 0.
+  double mass;
+  // Centre of mass in the TCP frame [m].
+  double com[3];
+  // Inertia tensor about the centre of mass, TCP frame, row-major 3 x 3 [kg m^2]:
+  // symmetric, positive semi-definite (all zeros for a point mass).
+  double inertia[9];
+} DeflectPayload;
+
+// The state of a pose motion at one time, base frame.
+typedef struct DeflectPoseState {
+  // Time since the start [s].
+  double t;
+  // TCP pose, a 4 x 4 homogeneous matrix in row-major order (translation in elements 3,
+  // 7, 11) [m].
+  double pose[16];
+  // TCP velocity [m/s].
+  double velocity[3];
+  // TCP acceleration [m/s^2].
+  double acceleration[3];
+  // Angular velocity [rad/s].
+  double angular_velocity[3];
+  // Angular acceleration [rad/s^2].
+  double angular_acceleration[3];
+} DeflectPoseState;
+
+// One corrected tick of a serial arm.
+typedef struct DeflectSerialTick {
+  // Commanded rigid TCP pose, row-major 4 x 4: where the joints put the unloaded TCP.
+  double commanded[16];
+  // Joint command [rad or m]; entries past the robot's dof are 0.
+  double joints[DEFLECT_MAX_DOF];
+  // Wrench cancelled, D'Alembert plus process `[F; M]` [N, N m], base frame at the TCP.
+  double wrench[6];
+  // Predicted TCP deflection at the command `[dp; dr]` [m, rad].
+  double deflection[6];
+  // Pose IK iterations done (0 when the warm start already met the tolerance).
+  uint32_t iterations;
+  // Position error left [m].
+  double position_error;
+  // Orientation error left [rad].
+  double orientation_error;
+  // Estimated smallest singular value of the joint Jacobian at the command.
+  double sigma_min;
+} DeflectSerialTick;
+
 // Path limits of a motion: speed [m/s], acceleration [m/s^2], jerk [m/s^3], each finite
 // and > 0.
 typedef struct DeflectLimits {
@@ -272,23 +320,6 @@ typedef struct DeflectState2 {
   double jerk[2];
 } DeflectState2;
 
-// The state of a pose motion at one time, base frame.
-typedef struct DeflectPoseState {
-  // Time since the start [s].
-  double t;
-  // TCP pose, a 4 x 4 homogeneous matrix in row-major order (translation in elements 3,
-  // 7, 11) [m].
-  double pose[16];
-  // TCP velocity [m/s].
-  double velocity[3];
-  // TCP acceleration [m/s^2].
-  double acceleration[3];
-  // Angular velocity [rad/s].
-  double angular_velocity[3];
-  // Angular acceleration [rad/s^2].
-  double angular_acceleration[3];
-} DeflectPoseState;
-
 // Result of `deflect_serial_robot_joint_correction`.
 typedef struct DeflectJointCorrection {
   // Correction to add to the nominal joints [rad or m]; entries past the robot's dof are 0.
@@ -302,37 +333,6 @@ typedef struct DeflectJointCorrection {
   // 1 if `residual <= tolerance`, else 0.
   int32_t converged;
 } DeflectJointCorrection;
-
-// Payload and tool beyond the TCP.
-typedef struct DeflectPayload {
-  // Mass [kg], finite and >= 0.
-  double mass;
-  // Centre of mass in the TCP frame [m].
-  double com[3];
-  // Inertia tensor about the centre of mass, TCP frame, row-major 3 x 3 [kg m^2]:
-  // symmetric, positive semi-definite (all zeros for a point mass).
-  double inertia[9];
-} DeflectPayload;
-
-// One corrected tick of a serial arm.
-typedef struct DeflectSerialTick {
-  // Commanded rigid TCP pose, row-major 4 x 4: where the joints put the unloaded TCP.
-  double commanded[16];
-  // Joint command [rad or m]; entries past the robot's dof are 0.
-  double joints[DEFLECT_MAX_DOF];
-  // Wrench cancelled, D'Alembert plus process `[F; M]` [N, N m], base frame at the TCP.
-  double wrench[6];
-  // Predicted TCP deflection at the command `[dp; dr]` [m, rad].
-  double deflection[6];
-  // Pose IK iterations done (0 when the warm start already met the tolerance).
-  uint32_t iterations;
-  // Position error left [m].
-  double position_error;
-  // Orientation error left [rad].
-  double orientation_error;
-  // Estimated smallest singular value of the joint Jacobian at the command.
-  double sigma_min;
-} DeflectSerialTick;
 
 // Success.
 #define DEFLECT_OK 0
@@ -407,10 +407,6 @@ const char *deflect_version(void);
 // A static NUL-terminated English description of a status code ("ok", "null pointer", ...;
 // "unknown status" for a code this library does not define). Never NULL.
 const char *deflect_status_message(DeflectStatus status);
-
-// Always unwinds (panics) inside Rust and returns `DEFLECT_ERR_PANIC`: lets a C caller check
-// that panics are contained at the boundary. Prints nothing.
-DeflectStatus deflect_test_panic(void);
 
 // Writes the neutral calibration to `*out`: no offsets, no weight, no residual, TCP at the
 // sensor (translation 0, rotation (1, 0, 0, 0)).
@@ -541,6 +537,76 @@ DeflectStatus deflect_dalembert_step(struct DeflectDalembert *corrector,
                                      const double *desired,
                                      const double *acceleration,
                                      struct DeflectCorrectedTick2 *out);
+
+// Creates a corrector for `robot` (6..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
+// limits are copied in) carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
+// `DEFLECT_SERIAL_LINEARIZED`), warm-started from `seed[seed_len]` (the joints the motion
+// starts from; `seed_len` must be the dof). Pose IK: 20 iterations, 1e-8 m and 1e-8 rad.
+// Init time: allocates the handle. On failure `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 6
+// joints), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (negative mass,
+// asymmetric inertia, unknown model) or `DEFLECT_ERR_SINGULAR` (inertia not positive
+// semi-definite).
+//
+// # Safety
+// `robot` is NULL or a live handle; `payload` NULL or readable; `seed` holds `seed_len`
+// doubles; `out` is NULL or writable.
+DeflectStatus deflect_serial_dalembert_create(const struct DeflectSerialRobot *robot,
+                                              const struct DeflectPayload *payload,
+                                              int32_t model,
+                                              const double *seed,
+                                              size_t seed_len,
+                                              struct DeflectSerialDalembert **out);
+
+// Frees a corrector. NULL is a no-op.
+//
+// # Safety
+// `corrector` is NULL or a live handle, not used afterwards.
+void deflect_serial_dalembert_destroy(struct DeflectSerialDalembert *corrector);
+
+// Sets which loads the corrector cancels besides the payload's inertial wrench: with
+// `link_inertia` nonzero, the links' own inertial loads (every URDF `<inertial>`, from the
+// joint rates of the motion; off by default, as in the paper), and `gravity[3]` [m/s^2],
+// base frame (NULL: zero, the default), whose weights then load the springs too. Init time
+// (rebuilds the model; allocates); the warm start is kept. Returns `DEFLECT_ERR_NULL` or
+// `DEFLECT_ERR_NON_FINITE` (gravity).
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `gravity` is NULL or
+// holds 3 doubles.
+DeflectStatus deflect_serial_dalembert_set_loads(struct DeflectSerialDalembert *corrector,
+                                                 int32_t link_inertia,
+                                                 const double *gravity);
+
+// Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
+// that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
+// `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `q` holds `q_len`
+// doubles.
+DeflectStatus deflect_serial_dalembert_reset(struct DeflectSerialDalembert *corrector,
+                                             const double *q,
+                                             size_t q_len);
+
+// One tick: the desired pose state `*desired` (from `deflect_pose_motion_sample`, or the
+// caller's own; base frame) and an optional process wrench `process[6]` [N, N m] at the TCP
+// (NULL: none). Writes the joint command and its diagnostics to `*out`. Per tick: no
+// allocation, bounded iterations.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (a
+// pose that is not a rigid transform, or a load outside the small-deflection model),
+// `DEFLECT_ERR_NOT_CONVERGED`, `DEFLECT_ERR_SINGULAR`, `DEFLECT_ERR_JOINT_LIMIT` or
+// `DEFLECT_ERR_NON_FINITE_OUTPUT`.
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `desired` is NULL or
+// readable; `process` is NULL or holds 6 doubles; `out` is NULL or writable.
+DeflectStatus deflect_serial_dalembert_step(struct DeflectSerialDalembert *corrector,
+                                            const struct DeflectPoseState *desired,
+                                            const double *process,
+                                            struct DeflectSerialTick *out);
 
 // Loads a compliance map from CSV text in the layout of the paper's coefficient tables
 // (Paksoy et al., Tables II/III: columns `x_mm, y_mm` (or `x_m, y_m`, or `x, y` in
@@ -862,75 +928,9 @@ DeflectStatus deflect_serial_robot_joint_correction(struct DeflectSerialRobot *r
                                                     double tolerance,
                                                     struct DeflectJointCorrection *out);
 
-// Creates a corrector for `robot` (6..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
-// limits are copied in) carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
-// `DEFLECT_SERIAL_LINEARIZED`), warm-started from `seed[seed_len]` (the joints the motion
-// starts from; `seed_len` must be the dof). Pose IK: 20 iterations, 1e-8 m and 1e-8 rad.
-// Init time: allocates the handle. On failure `*out` is NULL.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 6
-// joints), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (negative mass,
-// asymmetric inertia, unknown model) or `DEFLECT_ERR_SINGULAR` (inertia not positive
-// semi-definite).
-//
-// # Safety
-// `robot` is NULL or a live handle; `payload` NULL or readable; `seed` holds `seed_len`
-// doubles; `out` is NULL or writable.
-DeflectStatus deflect_serial_dalembert_create(const struct DeflectSerialRobot *robot,
-                                              const struct DeflectPayload *payload,
-                                              int32_t model,
-                                              const double *seed,
-                                              size_t seed_len,
-                                              struct DeflectSerialDalembert **out);
-
-// Frees a corrector. NULL is a no-op.
-//
-// # Safety
-// `corrector` is NULL or a live handle, not used afterwards.
-void deflect_serial_dalembert_destroy(struct DeflectSerialDalembert *corrector);
-
-// Sets which loads the corrector cancels besides the payload's inertial wrench: with
-// `link_inertia` nonzero, the links' own inertial loads (every URDF `<inertial>`, from the
-// joint rates of the motion; off by default, as in the paper), and `gravity[3]` [m/s^2],
-// base frame (NULL: zero, the default), whose weights then load the springs too. Init time
-// (rebuilds the model; allocates); the warm start is kept. Returns `DEFLECT_ERR_NULL` or
-// `DEFLECT_ERR_NON_FINITE` (gravity).
-//
-// # Safety
-// `corrector` is NULL or a live handle not used by another thread; `gravity` is NULL or
-// holds 3 doubles.
-DeflectStatus deflect_serial_dalembert_set_loads(struct DeflectSerialDalembert *corrector,
-                                                 int32_t link_inertia,
-                                                 const double *gravity);
-
-// Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
-// that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
-// `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
-//
-// # Safety
-// `corrector` is NULL or a live handle not used by another thread; `q` holds `q_len`
-// doubles.
-DeflectStatus deflect_serial_dalembert_reset(struct DeflectSerialDalembert *corrector,
-                                             const double *q,
-                                             size_t q_len);
-
-// One tick: the desired pose state `*desired` (from `deflect_pose_motion_sample`, or the
-// caller's own; base frame) and an optional process wrench `process[6]` [N, N m] at the TCP
-// (NULL: none). Writes the joint command and its diagnostics to `*out`. Per tick: no
-// allocation, bounded iterations.
-//
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (a
-// pose that is not a rigid transform, or a load outside the small-deflection model),
-// `DEFLECT_ERR_NOT_CONVERGED`, `DEFLECT_ERR_SINGULAR`, `DEFLECT_ERR_JOINT_LIMIT` or
-// `DEFLECT_ERR_NON_FINITE_OUTPUT`.
-//
-// # Safety
-// `corrector` is NULL or a live handle not used by another thread; `desired` is NULL or
-// readable; `process` is NULL or holds 6 doubles; `out` is NULL or writable.
-DeflectStatus deflect_serial_dalembert_step(struct DeflectSerialDalembert *corrector,
-                                            const struct DeflectPoseState *desired,
-                                            const double *process,
-                                            struct DeflectSerialTick *out);
+// Always unwinds (panics) inside Rust and returns `DEFLECT_ERR_PANIC`: lets a C caller check
+// that panics are contained at the boundary. Prints nothing.
+DeflectStatus deflect_test_panic(void);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -200,3 +200,12 @@ pub(crate) unsafe fn load<T>(
     unsafe { write_message(err, err_len, msg) };
     status
 }
+
+/// Always unwinds (panics) inside Rust and returns `DEFLECT_ERR_PANIC`: lets a C caller check
+/// that panics are contained at the boundary. Prints nothing.
+#[unsafe(no_mangle)]
+pub extern "C" fn deflect_test_panic() -> DeflectStatus {
+    guard(|| {
+        std::panic::resume_unwind(Box::new("deflect_test_panic: deliberate panic"));
+    })
+}

@@ -7,8 +7,8 @@
 //!
 //! Layout: `boundary` (panic containment, pointer and string checks), [`status`] (the
 //! codes and the one mapping from deflect-core's build, load and tick errors), then one
-//! module per concept: [`robot`], [`map`], [`motion`], [`pose_motion`], [`dalembert`],
-//! [`serial_dalembert`], [`compensation`]. Each
+//! module per concept: [`robot`], [`map`], [`motion`], [`pose_motion`], [`dalembert`]
+//! ([`dalembert::parallel`], [`dalembert::serial`]), [`compensation`]. Each
 //! handle wraps deflect-core's `Model` and `Data`; validation is deflect-core's.
 //!
 //! Conventions of the API:
@@ -54,15 +54,15 @@ pub mod map;
 pub mod motion;
 pub mod pose_motion;
 pub mod robot;
-pub mod serial_dalembert;
 
 mod boundary;
 
+pub use boundary::deflect_test_panic;
 pub use compensation::*;
-pub use dalembert::*;
+pub use dalembert::parallel::*;
+pub use dalembert::serial::*;
 pub use map::*;
 pub use motion::*;
 pub use pose_motion::*;
 pub use robot::*;
-pub use serial_dalembert::*;
 pub use status::*;

@@ -33,13 +33,6 @@ pub const DEFLECT_OUT_OF_GRID_ERROR: i32 = 0;
 pub const DEFLECT_OUT_OF_GRID_CLAMP: i32 = 1;
 /// Outside the map's grid: extrapolate linearly from the boundary.
 pub const DEFLECT_OUT_OF_GRID_EXTRAPOLATE: i32 = 2;
-/// Query/model status: the position was inside the grid.
-pub const DEFLECT_QUERY_INSIDE: i32 = 0;
-/// Query/model status: the position was outside and was clamped.
-pub const DEFLECT_QUERY_CLAMPED: i32 = 1;
-/// Query/model status: the position was outside and was extrapolated.
-pub const DEFLECT_QUERY_EXTRAPOLATED: i32 = 2;
-
 /// A compliance map (per-node force-displacement lines over an (x, y) grid). Opaque; create
 /// with `deflect_compliance_map_from_paper_csv`, `_load_paper_csv`, `_from_json` or
 /// `_load_json`, free with `deflect_compliance_map_destroy`.

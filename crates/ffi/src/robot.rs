@@ -172,8 +172,14 @@ pub unsafe extern "C" fn deflect_serial_robot_deflection(
                 slice_mut(out, 6)?,
             )
         };
-        let d = vjm::deflection(&r.robot.model, &mut r.data, q, &Vector6::from(w))
-            .map_err(|e| tick_status(&e))?;
+        let d = vjm::deflection(
+            &r.robot.model,
+            &mut r.data,
+            q,
+            &Vector6::from(w),
+            vjm::Load::Exact,
+        )
+        .map_err(|e| tick_status(&e))?;
         out.copy_from_slice(d.as_slice());
         Ok(())
     })

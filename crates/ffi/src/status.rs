@@ -5,9 +5,6 @@ use std::ffi::c_char;
 
 use deflect_core::{BuildError, LoadError, Placement, TickError};
 
-use crate::boundary::guard;
-use crate::map::{DEFLECT_QUERY_CLAMPED, DEFLECT_QUERY_EXTRAPOLATED, DEFLECT_QUERY_INSIDE};
-
 /// Result of every fallible deflect function: `DEFLECT_OK` (0) on success, a negative
 /// `DEFLECT_ERR_*` code otherwise (in the style of ruckig's `Result`).
 pub type DeflectStatus = i32;
@@ -58,6 +55,13 @@ pub const DEFLECT_ERR_OTHER: DeflectStatus = -98;
 /// unspecified; the handles involved may be destroyed safely.
 pub const DEFLECT_ERR_PANIC: DeflectStatus = -99;
 
+/// Query/model status: the position was inside the grid.
+pub const DEFLECT_QUERY_INSIDE: i32 = 0;
+/// Query/model status: the position was outside and was clamped.
+pub const DEFLECT_QUERY_CLAMPED: i32 = 1;
+/// Query/model status: the position was outside and was extrapolated.
+pub const DEFLECT_QUERY_EXTRAPOLATED: i32 = 2;
+
 /// The library version, a static NUL-terminated string such as "0.1.0".
 #[unsafe(no_mangle)]
 pub extern "C" fn deflect_version() -> *const c_char {
@@ -90,15 +94,6 @@ pub extern "C" fn deflect_status_message(status: DeflectStatus) -> *const c_char
         _ => "unknown status\0",
     };
     s.as_ptr().cast()
-}
-
-/// Always unwinds (panics) inside Rust and returns `DEFLECT_ERR_PANIC`: lets a C caller check
-/// that panics are contained at the boundary. Prints nothing.
-#[unsafe(no_mangle)]
-pub extern "C" fn deflect_test_panic() -> DeflectStatus {
-    guard(|| {
-        std::panic::resume_unwind(Box::new("deflect_test_panic: deliberate panic"));
-    })
 }
 
 /// The C code of a per-tick error: one code per [`TickError`] variant.

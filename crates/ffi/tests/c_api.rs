@@ -97,7 +97,14 @@ fn vjm_through_the_c_api_equals_the_rust_api() {
         deflect_serial_robot_deflection(r, Q.as_ptr(), 6, WRENCH.as_ptr(), d.as_mut_ptr())
     };
     assert_eq!(s, DEFLECT_OK);
-    let want = vjm::deflection(&rust.model, &mut data, &Q, &Vector6::from(WRENCH)).unwrap();
+    let want = vjm::deflection(
+        &rust.model,
+        &mut data,
+        &Q,
+        &Vector6::from(WRENCH),
+        vjm::Load::Exact,
+    )
+    .unwrap();
     assert_eq!(d, <[f64; 6]>::from(want));
     assert!(
         (d[0] - (-0.871e-3)).abs() < 1e-6,

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::io::map_csv;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
@@ -42,7 +42,7 @@ fn run_script(script: &str, out_dir: &str) -> String {
     String::from_utf8(out.stdout).unwrap()
 }
 
-/// The same loop through the Rust API: `dalembert::correct_each` (the corrector's `Data`
+/// The same loop through the Rust API: `parallel::correct_each` (the corrector's `Data`
 /// keeps the previous tick's joints as seed), as `k t desired commanded joints`.
 fn rust_rows() -> Vec<[f64; 8]> {
     let text = std::fs::read_to_string(repo().join("data/paksoy2025_compliance_oc.csv")).unwrap();
@@ -59,12 +59,12 @@ fn rust_rows() -> Vec<[f64; 8]> {
     )
     .unwrap();
     // The C corrector holds its own copy of the map, options included: so does this model.
-    let model = Model::new(ParallelRobot2::paper(), map, dalembert::PAPER_MASS).unwrap();
+    let model = Model::new(ParallelRobot2::paper(), map, parallel::PAPER_MASS).unwrap();
     // The IK seed starts at zero joints, as the C corrector's.
     let mut data = Data::new(&model);
     let times: Vec<f64> = traj.ticks(2000.0).unwrap().map(|s| s.t).collect();
     let mut rows = Vec::new();
-    dalembert::correct_each(&model, &mut data, &traj, 2000.0, |k, t| {
+    parallel::correct_each(&model, &mut data, &traj, 2000.0, |k, t| {
         rows.push([
             k as f64,
             times[k],
@@ -137,7 +137,7 @@ fn cpp_example_matches_the_rust_api_bit_for_bit() {
 /// as `k t desired_xyz commanded_xyz q[0..6]`.
 fn serial_rust_rows() -> Vec<Vec<f64>> {
     use deflect_core::SerialRobot;
-    use deflect_core::dalembert::serial::{self, Payload, SerialData, SerialModel};
+    use deflect_core::dalembert::serial::{self, Payload};
     use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
     use deflect_core::vjm::{self, pose_from_matrix};
     use nalgebra::{Matrix3, Matrix4, Vector3};
@@ -179,11 +179,11 @@ fn serial_rust_rows() -> Vec<Vec<f64>> {
         com: Vector3::new(0.0, 0.0, 0.25),
         inertia: Matrix3::from_diagonal(&Vector3::new(4.0, 4.0, 2.5)),
     };
-    let model = SerialModel::new(robot.model.clone(), payload)
+    let model = serial::Model::new(robot.model.clone(), payload)
         .unwrap()
         .with_joint_limits(&robot.joint_limits)
         .unwrap();
-    let mut data = SerialData::new(&model);
+    let mut data = serial::Data::new(&model);
     data.set_seed(&q0);
     let n = motion.tick_count(2000.0).unwrap();
     (0..n)

@@ -341,7 +341,7 @@ fn every_bad_input_is_a_status() {
 
 #[test]
 fn link_inertia_and_gravity_match_the_core() {
-    use deflect_core::dalembert::{self, SerialData, SerialModel};
+    use deflect_core::dalembert::serial;
     use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
     let robot = kr300();
     let p = payload();
@@ -365,9 +365,9 @@ fn link_inertia_and_gravity_match_the_core() {
     };
     let traj = PoseTrajectory::line(&start, &end, &limits).unwrap();
     let gravity = [0.0, 0.0, -9.81];
-    let core_model = SerialModel::new(
+    let core_model = serial::Model::new(
         core_robot.model.clone(),
-        dalembert::Payload {
+        serial::Payload {
             mass: p.mass,
             com: p.com.into(),
             inertia: nalgebra::Matrix3::from_row_slice(&p.inertia),
@@ -379,7 +379,7 @@ fn link_inertia_and_gravity_match_the_core() {
     .with_link_inertia(true)
     .with_gravity(gravity.into())
     .unwrap();
-    let mut core_data = SerialData::new(&core_model);
+    let mut core_data = serial::Data::new(&core_model);
     core_data.set_seed(&Q0);
     let mut c = ptr::null_mut();
     // SAFETY: live handles, readable inputs, writable outputs.
@@ -413,7 +413,7 @@ fn link_inertia_and_gravity_match_the_core() {
             let s = traj
                 .sample(traj.tick_time(2000.0, k, traj.tick_count(2000.0).unwrap()))
                 .unwrap();
-            let want = dalembert::serial::step(&core_model, &mut core_data, &s, None).unwrap();
+            let want = serial::step(&core_model, &mut core_data, &s, None).unwrap();
             let state = DeflectPoseState {
                 t: s.t,
                 pose: {

@@ -19,7 +19,7 @@
 use deflect_core::compensation::{self, CompensatorConfig, CycleOutput, SensorCalibration};
 use deflect_core::compliance_map::{self, ComplianceMapView, OutOfGrid, QueryOptions};
 use deflect_core::contour::{self, TracerConfig, TracerStep};
-use deflect_core::dalembert::{self, CorrectedTick};
+use deflect_core::dalembert::parallel::{self, Tick};
 use deflect_core::drivetrain::{self, JointErrors};
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Limits, Trajectory};
@@ -67,7 +67,7 @@ pub fn vjm_tick(
     q: &[f64; 2],
     wrench: &Vector6,
 ) -> Result<(Vector6, Matrix6<f64>), CheckError> {
-    let d = vjm::deflection(model, data, q, wrench)?;
+    let d = vjm::deflection(model, data, q, wrench, vjm::Load::Exact)?;
     let c = vjm::compliance(model, data, q)?;
     Ok((d, c))
 }
@@ -100,31 +100,31 @@ pub fn map_lookup(
     position: [f64; 2],
     force: [f64; 2],
 ) -> Result<[f64; 2], CheckError> {
-    compliance_map::query(view, data, position, &force)?;
+    compliance_map::step(view, data, position, &force)?;
     Ok([data.displacement[0], data.displacement[1]])
 }
 
 /// The D'Alembert corrector of the paper's robot over a borrowed map.
-pub type Corrector<'a> = dalembert::Model<ParallelRobot2, ComplianceMapView<'a>>;
+pub type Corrector<'a> = parallel::Model<ParallelRobot2, ComplianceMapView<'a>>;
 
 /// The corrector with the paper's mass parameter.
 pub fn corrector<'a>(view: ComplianceMapView<'a>) -> Result<Corrector<'a>, CheckError> {
-    Ok(dalembert::Model::new(
+    Ok(parallel::Model::new(
         ParallelRobot2::paper(),
         view,
-        dalembert::PAPER_MASS,
+        parallel::PAPER_MASS,
     )?)
 }
 
 /// One 2 kHz D'Alembert tick of the paper's robot at time `t` of `trajectory`.
 pub fn dalembert_tick(
     model: &Corrector<'_>,
-    data: &mut dalembert::Data<(), (), 2>,
+    data: &mut parallel::Data<(), (), 2>,
     trajectory: &Trajectory<2>,
     t: f64,
-) -> Result<CorrectedTick<2, 2>, CheckError> {
+) -> Result<Tick<2, 2>, CheckError> {
     let s = trajectory.sample(t)?;
-    Ok(dalembert::step(model, data, &s.position, &s.acceleration)?)
+    Ok(parallel::step(model, data, &s.position, &s.acceleration)?)
 }
 
 /// The paper's 150 mm y-line, planned without a heap.
@@ -169,7 +169,7 @@ pub fn drive_tick(
     q: &[f64; 2],
     wrench: &Vector6,
 ) -> Result<JointErrors, CheckError> {
-    Ok(drivetrain::correct_joints(model, data, q, wrench)?)
+    Ok(drivetrain::step(model, data, q, wrench)?)
 }
 
 /// A contour tracer with a 1 mm step, a 2..20 N window and a diagonal 1e5 N/m stiffness.

@@ -3,7 +3,7 @@
 //! closed-form inverse kinematics, every servo tick.
 
 use deflect_core::ComplianceMap;
-use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::mechanism::ParallelRobot2;
 use nalgebra::Vector2;
 
@@ -14,7 +14,7 @@ use crate::status::{DEFLECT_ERR_NULL, DeflectStatus, build_failure, placement_co
 /// The paper's tuned D'Alembert mass parameter m* \[kg\].
 pub const DEFLECT_PAPER_MASS: f64 = 5.0;
 
-const _: () = assert!(DEFLECT_PAPER_MASS == dalembert::PAPER_MASS);
+const _: () = assert!(DEFLECT_PAPER_MASS == parallel::PAPER_MASS);
 
 /// Geometry of the paper's 2-DoF planar parallel robot (Paksoy et al., section 4.1).
 #[repr(C)]
@@ -169,18 +169,18 @@ pub unsafe extern "C" fn deflect_dalembert_step(
         if out.is_null() {
             return Err(DEFLECT_ERR_NULL);
         }
-        let t = dalembert::step(&c.model, &mut c.data, &Vector2::from(x), &Vector2::from(a))
+        let t = parallel::step(&c.model, &mut c.data, &Vector2::from(x), &Vector2::from(a))
             .map_err(|e| tick_status(&e))?;
         let v = |v: Vector2<f64>| [v.x, v.y];
         let tick = DeflectCorrectedTick2 {
             desired: v(t.desired),
             commanded: v(t.commanded),
             joints: v(t.joints),
-            force: v(t.force),
+            force: v(t.load),
             displacement: v(t.displacement),
             iterations: u32::try_from(t.iterations).unwrap_or(u32::MAX),
-            fixed_point_residual: t.fixed_point_residual,
-            placement: placement_code(t.placement),
+            fixed_point_residual: t.diagnostics.fixed_point_residual,
+            placement: placement_code(t.diagnostics.placement),
         };
         // SAFETY: non-null (checked), writable by contract.
         unsafe { write(out, tick) }

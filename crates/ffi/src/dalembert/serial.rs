@@ -3,8 +3,9 @@
 //! through the virtual-joint deflection (Hähn and Weigold 2020, Eq. 2-9) to the joints at
 //! which the loaded arm reaches the desired pose, every servo tick.
 
-use deflect_core::dalembert::serial::{self, Deflection, Payload, SerialData, SerialModel};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::PoseState;
+use deflect_core::vjm::Deflection;
 use deflect_core::vjm::Vector6;
 use nalgebra::{Matrix3, Vector3};
 
@@ -62,8 +63,8 @@ pub struct DeflectSerialTick {
 /// thread-safe: one thread at a time.
 #[derive(Debug)]
 pub struct DeflectSerialDalembert {
-    model: SerialModel,
-    data: SerialData,
+    model: serial::Model,
+    data: serial::Data,
 }
 
 fn seed_of(q: &[f64], dof: usize) -> Result<&[f64], DeflectStatus> {
@@ -116,11 +117,11 @@ pub unsafe extern "C" fn deflect_serial_dalembert_create(
         };
         let chain = r.robot.model.clone();
         let q = seed_of(q, chain.dof()).map_err(err)?;
-        let model = SerialModel::new(chain, payload)
+        let model = serial::Model::new(chain, payload)
             .and_then(|m| m.with_joint_limits(&r.robot.joint_limits))
             .map(|m| m.with_deflection(deflection))
             .map_err(build_failure)?;
-        let mut data = SerialData::new(&model);
+        let mut data = serial::Data::new(&model);
         data.set_seed(q);
         Ok(DeflectSerialDalembert { model, data })
     };
@@ -247,12 +248,12 @@ pub unsafe extern "C" fn deflect_serial_dalembert_step(
         let tick = DeflectSerialTick {
             commanded: row_major(&t.commanded),
             joints: t.joints,
-            wrench: t.wrench.into(),
-            deflection: t.deflection.into(),
+            wrench: t.load.into(),
+            deflection: t.displacement.into(),
             iterations: u32::try_from(t.iterations).unwrap_or(u32::MAX),
-            position_error: t.position_error,
-            orientation_error: t.orientation_error,
-            sigma_min: t.sigma_min,
+            position_error: t.diagnostics.position_error,
+            orientation_error: t.diagnostics.orientation_error,
+            sigma_min: t.diagnostics.sigma_min,
         };
         // SAFETY: non-null (checked), writable by contract.
         unsafe { write(out, tick) }
