@@ -9,7 +9,7 @@ use std::hint::black_box;
 use std::ptr;
 
 use deflect::*;
-use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::vjm::{self, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, repo_path};
@@ -40,7 +40,7 @@ fn main() {
     deflect_tests::latency_report("rust: dalembert tick (sample+step)", n, None, |i| {
         let t = (i as f64 / 2000.0) % period;
         let s = traj.sample(black_box(t)).expect("in range");
-        if let Ok(tick) = dalembert::step(&corr, &mut corr_data, &s.position, &s.acceleration) {
+        if let Ok(tick) = parallel::step(&corr, &mut corr_data, &s.position, &s.acceleration) {
             q2 = tick.joints;
         }
         black_box(q2);
@@ -101,7 +101,7 @@ fn main() {
     let mut qk = KR300_MILLING_POSE;
     deflect_tests::latency_report("rust: vjm::deflection (KR 300)", n, None, |i| {
         qk[0] = 1e-6 * (i % 1000) as f64;
-        black_box(vjm::deflection(&robot.model, &mut data, black_box(&qk), &w).ok());
+        black_box(vjm::deflection(&robot.model, &mut data, black_box(&qk), &w, vjm::Load::Exact).ok());
     });
     let mut crobot = ptr::null_mut();
     let (urdf, toml) = (

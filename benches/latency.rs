@@ -5,7 +5,7 @@
 use std::hint::black_box;
 
 use deflect_core::compensation::{self, CompensatorConfig, SensorCalibration};
-use deflect_core::dalembert;
+use deflect_core::dalembert::{self, serial};
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::vjm::{self, Data, Vector6};
 use deflect_tests::{KR300_MILLING_POSE, MILLING_WRENCH, kr300, latency_report};
@@ -27,7 +27,7 @@ fn main() {
     println!("deflect latency harness ({rt}); KR 300 model (6 joints, 11 virtual joints)");
     latency_report("vjm::deflection", n, Some(budget), |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
-        black_box(vjm::deflection(model, &mut data, black_box(&q), &w).ok());
+        black_box(vjm::deflection(model, &mut data, black_box(&q), &w, vjm::Load::Exact).ok());
     });
     latency_report("vjm::compliance", n, Some(budget), |i| {
         q[0] = 1e-6 * (i % 1000) as f64;
@@ -45,18 +45,18 @@ fn main() {
     let robot2 = ParallelRobot2::paper();
     let traj = deflect_tests::paper_y_line_5g();
     let period = traj.duration();
-    let one_shot = dalembert::Model::new(robot2, view, 5.0).expect("valid corrector");
+    let one_shot = dalembert::parallel::Model::new(robot2, view, 5.0).expect("valid corrector");
     let fixed_point = one_shot.clone().with_fixed_point(3, 0.0).expect("valid");
     for (name, corr) in [
         ("dalembert tick (one-shot)", one_shot),
         ("dalembert tick (3 fixed-pt)", fixed_point),
     ] {
-        let mut data = dalembert::Data::new(&corr);
+        let mut data = dalembert::parallel::Data::new(&corr);
         latency_report(name, n, Some(budget), |i| {
             // Tick-by-tick sampling at 2 kHz, wrapping around the 375 ms motion.
             let t = (i as f64 / 2000.0) % period;
             let s = traj.sample(black_box(t)).expect("in range");
-            if let Ok(tick) = dalembert::step(&corr, &mut data, &s.position, &s.acceleration) {
+            if let Ok(tick) = dalembert::parallel::step(&corr, &mut data, &s.position, &s.acceleration) {
                 black_box(tick.joints);
             }
         });
@@ -99,9 +99,9 @@ fn main() {
     // wrench -> loaded pose IK (exact VJM deflection) warm-started from the last ticks, along
     // a 0.33 m / 0.3 rad pose motion at about 1 g, wrapping around; the payload alone (the
     // paper's D'Alembert force) and with the links' own inertia (the URDF's masses).
-    let serial = dalembert::SerialModel::new(
+    let serial = serial::Model::new(
         model.clone(),
-        dalembert::Payload {
+        serial::Payload {
             mass: 150.0,
             com: nalgebra::Vector3::new(0.0, 0.0, 0.25),
             inertia: nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(4.0, 4.0, 2.5)),
@@ -123,7 +123,7 @@ fn main() {
             serial.with_link_inertia(true),
         ),
     ] {
-        let mut sdata = dalembert::SerialData::new(&corrector);
+        let mut sdata = serial::Data::new(&corrector);
         sdata.set_seed(&KR300_MILLING_POSE);
         let mut back = false;
         latency_report(name, n, Some(budget), |i| {
@@ -137,9 +137,54 @@ fn main() {
             } else {
                 &states[k]
             };
-            if let Ok(tick) = dalembert::serial::step(&corrector, &mut sdata, black_box(s), None) {
+            if let Ok(tick) = serial::step(&corrector, &mut sdata, black_box(s), None) {
                 black_box(tick.joints);
             }
         });
     }
+
+    // The same payload through the paper's generic corrector (`dalembert::parallel`): the
+    // arm as a position-only mechanism (damped-least-squares IK of the TCP point) and its
+    // VJM as the displacement model, iterated to the fixed point c = x_d - d(c, F) within
+    // 1e-9 m, against the serial corrector's one loaded pose IK. Both carry a 150 kg point
+    // mass at the TCP along the same motion; the generic form solves only the translation
+    // (3-D), the serial one the whole pose (6-D). Why dalembert keeps two correctors.
+    let point = serial::Model::new(
+        model.clone(),
+        serial::Payload::point(150.0, nalgebra::Vector3::zeros()),
+    )
+    .expect("valid corrector");
+    let mut pdata = serial::Data::new(&point);
+    pdata.set_seed(&KR300_MILLING_POSE);
+    let arm = deflect_core::mechanism::SerialArm::<6>::new(
+        model.clone(),
+        deflect_core::mechanism::IkOptions::default(),
+    )
+    .expect("6 joints");
+    let vjm_model = deflect_tests::VjmDisplacement {
+        model: model.clone(),
+        moment: nalgebra::Vector3::zeros(),
+    };
+    let generic = dalembert::parallel::Model::new(arm, vjm_model, 150.0)
+        .and_then(|m| m.with_fixed_point(dalembert::parallel::MAX_FIXED_POINT_ITERATIONS, 1e-9))
+        .expect("valid corrector");
+    let mut gdata = dalembert::parallel::Data::new(&generic);
+    gdata.set_seed(nalgebra::SVector::<f64, 6>::from_row_slice(&KR300_MILLING_POSE));
+    let forth_and_back = |i: usize| {
+        let k = i % (2 * count);
+        if k < count { k } else { 2 * count - 1 - k }
+    };
+    latency_report("serial 6-D tick (KR 300, point mass)", n / 10, Some(budget), |i| {
+        let s = &states[forth_and_back(i)];
+        if let Ok(tick) = serial::step(&point, &mut pdata, black_box(s), None) {
+            black_box(tick.joints);
+        }
+    });
+    latency_report("generic 3-D tick (KR 300, point mass)", n / 10, Some(budget), |i| {
+        let s = &states[forth_and_back(i)];
+        let (x, a) = (s.pose.translation.vector, s.acceleration);
+        if let Ok(tick) = dalembert::parallel::step(&generic, &mut gdata, black_box(&x), &a) {
+            black_box(tick.joints);
+        }
+    });
 }

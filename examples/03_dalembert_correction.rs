@@ -6,7 +6,7 @@
 
 use deflect_core::Placement;
 use deflect_core::compliance_map::{OutOfGrid, QueryOptions};
-use deflect_core::dalembert::{self, Data, Model};
+use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::io::map_csv;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ..QueryOptions::default()
         },
     );
-    let corrector = Model::new(ParallelRobot2::paper(), map, dalembert::PAPER_MASS)?
+    let corrector = Model::new(ParallelRobot2::paper(), map, parallel::PAPER_MASS)?
         .with_fixed_point(3, 1e-12)?;
     let mut data = Data::new(&corrector);
     println!("g   duration [ms]  ticks  max |correction| [mm]  max |F_D| [N]  clamped ticks");
@@ -35,10 +35,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             &paper_limits(g)?,
         )?;
         let (mut max_c, mut max_f, mut clamped) = (0.0f64, 0.0f64, 0);
-        let ticks = dalembert::correct_each(&corrector, &mut data, &traj, 2000.0, |_, t| {
+        let ticks = parallel::correct_each(&corrector, &mut data, &traj, 2000.0, |_, t| {
             max_c = max_c.max((t.commanded - t.desired).norm());
-            max_f = max_f.max(t.force.norm());
-            if t.placement != Placement::Inside {
+            max_f = max_f.max(t.load.norm());
+            if t.diagnostics.placement != Placement::Inside {
                 clamped += 1;
             }
         })?;

@@ -75,7 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             sent.push_back(out.correction);
             let applied = sent.pop_front().unwrap_or_else(Vector6::zeros);
             // Path error: what the true load deflects minus what the applied correction cancels.
-            let d_true = vjm::deflection(model, &mut data, &q, &true_w)?;
+            let d_true = vjm::deflection(model, &mut data, &q, &true_w, vjm::Load::Exact)?;
             let err = (d_true.fixed_rows::<3>(0) + applied.fixed_rows::<3>(0)).norm();
             if k >= 20 {
                 worst = worst.max(err);

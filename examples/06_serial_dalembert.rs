@@ -10,7 +10,7 @@
 //! `robots/ur5/ur5_stiffness.toml`, tip `tool0`, `Q0 = 0.3,-1.2,1.5,-1.9,-1.57,0.4`).
 
 use deflect_core::SerialRobot;
-use deflect_core::dalembert::{self, Payload, SerialData, SerialModel};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
 use deflect_core::vjm::{self, Data};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
@@ -41,8 +41,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         inertia: Matrix3::from_diagonal(&Vector3::new(4.0, 4.0, 2.5)),
     };
     let model =
-        SerialModel::new(robot.model.clone(), payload)?.with_joint_limits(&robot.joint_limits)?;
-    let mut data = SerialData::new(&model);
+        serial::Model::new(robot.model.clone(), payload)?.with_joint_limits(&robot.joint_limits)?;
+    let mut data = serial::Data::new(&model);
 
     // The motion: from the start pose, 0.1, 0.3, -0.1 m and 0.3 rad about the base z axis.
     let start = vjm::forward(&robot.model, &mut Data::new(&robot.model), &q0)?;
@@ -65,11 +65,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let (mut dp, mut dr, mut f, mut iters) = (0.0f64, 0.0f64, 0.0f64, 0usize);
         for k in 0..n {
             let state = motion.sample(motion.tick_time(2000.0, k, n))?;
-            let tick = dalembert::serial::step(&model, &mut data, &state, None)?;
+            let tick = serial::step(&model, &mut data, &state, None)?;
             let off = tick.commanded.translation.vector - tick.desired.translation.vector;
             dp = dp.max(off.norm());
             dr = dr.max(tick.commanded.rotation.angle_to(&tick.desired.rotation));
-            f = f.max(tick.wrench.fixed_rows::<3>(0).norm());
+            f = f.max(tick.load.fixed_rows::<3>(0).norm());
             iters = iters.max(tick.iterations);
         }
         println!(

@@ -15,7 +15,7 @@ fn kr300_loads_with_table1_stiffnesses() {
     let mut data = Data::new(&r.model);
     let q = KR300_MILLING_POSE;
     let w = Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, 67.0);
-    vjm::deflection(&r.model, &mut data, &q, &w).unwrap();
+    vjm::deflection(&r.model, &mut data, &q, &w, vjm::Load::Exact).unwrap();
     let a = data.spring_angles[spindle];
     // A pure moment reaches the spindle spring unchanged, in its own frame: |angle| = M/k
     // about some mix of its axes, so the angle vector has |a . k_diag| = M on the unit vector.
@@ -32,8 +32,7 @@ fn kr300_milling_deflection_is_in_the_papers_range() {
         &r.model,
         &mut data,
         &q,
-        &Vector6::from_row_slice(&MILLING_WRENCH),
-    )
+        &Vector6::from_row_slice(&MILLING_WRENCH), vjm::Load::Exact)
     .unwrap();
     let dp = d.fixed_rows::<3>(0).norm();
     // The paper measured up to 1.4 mm at 546 N; our data-sheet geometry and end effector
@@ -64,7 +63,7 @@ fn kr300_validation_loads() {
     .iter()
     .enumerate()
     {
-        let d = vjm::deflection(&r.model, &mut data, &q, &Vector6::from_row_slice(f)).unwrap();
+        let d = vjm::deflection(&r.model, &mut data, &q, &Vector6::from_row_slice(f), vjm::Load::Exact).unwrap();
         mm[i] = d.fixed_rows::<3>(0).norm() * 1e3;
     }
     assert_relative_eq!(mm[0], 1.698, max_relative = 2e-3);

@@ -132,7 +132,7 @@ fn check_robot(robot: &SerialRobot, urdf_text: &str, drive_toml: &str) {
             "forward kinematics Ok with a non-finite pose: {tcp:?}"
         );
     }
-    if let Ok(d) = vjm::deflection(&robot.model, &mut data, &q, &wrench) {
+    if let Ok(d) = vjm::deflection(&robot.model, &mut data, &q, &wrench, vjm::Load::Exact) {
         assert!(all_finite(d.as_slice()), "deflection Ok with {d:?}");
     }
     if let Ok(c) = vjm::compliance(&robot.model, &mut data, &q) {
@@ -161,7 +161,7 @@ fn check_drive(model: &drivetrain::Model, robot: &SerialRobot, q: &[f64]) {
     if let Ok(g) = drivetrain::gravity_torques(model, &mut data, q) {
         assert!(all_finite(&g), "gravity torques Ok with {g:?}");
     }
-    if let Ok(c) = drivetrain::correct_joints(model, &mut data, q, &wrench) {
+    if let Ok(c) = drivetrain::step(model, &mut data, q, &wrench) {
         assert!(
             all_finite(&c.q) && all_finite(&c.torque),
             "corrected joints Ok with {c:?}"

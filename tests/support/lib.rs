@@ -136,3 +136,62 @@ pub fn kr300_pose_motion() -> deflect_core::motion::PoseTrajectory {
         Err(e) => panic!("the pose motion must plan: {e}"),
     }
 }
+
+/// The virtual-joint model of a serial arm as the displacement model of the paper's generic
+/// corrector ([`deflect_core::dalembert::parallel`]): the D'Alembert force acts at the TCP
+/// (plus a constant moment), and the displacement is the TCP translation of the exact
+/// deflection at the joints `q`. A user's own [`DisplacementModel`] looks like this; the
+/// tests check the generic corrector with it, and the latency harness times it against the
+/// serial corrector, which solves the same problem as one loaded pose IK.
+///
+/// [`DisplacementModel`]: deflect_core::dalembert::parallel::DisplacementModel
+#[derive(Debug, Clone)]
+pub struct VjmDisplacement {
+    /// The arm.
+    pub model: deflect_core::vjm::Model,
+    /// D'Alembert moment \[N m\], base frame; zero for pure translations.
+    pub moment: nalgebra::Vector3<f64>,
+}
+
+impl<const J: usize> deflect_core::dalembert::parallel::DisplacementModel<3, J>
+    for VjmDisplacement
+{
+    type Data = deflect_core::vjm::Data;
+
+    fn new_data(&self) -> Self::Data {
+        deflect_core::vjm::Data::new(&self.model)
+    }
+
+    fn check(&self) -> Result<(), deflect_core::BuildError> {
+        if self.model.dof() == J {
+            Ok(())
+        } else {
+            Err(deflect_core::BuildError::DofMismatch {
+                what: "VjmDisplacement (joint count J)",
+                expected: self.model.dof(),
+                got: J,
+            })
+        }
+    }
+
+    fn displacement(
+        &self,
+        data: &mut Self::Data,
+        _position: &nalgebra::Vector3<f64>,
+        q: &nalgebra::SVector<f64, J>,
+        force: &nalgebra::Vector3<f64>,
+    ) -> Result<(nalgebra::Vector3<f64>, deflect_core::Placement), deflect_core::TickError> {
+        use deflect_core::vjm::{self, Load, Vector6};
+        let m = self.moment;
+        let w = Vector6::new(force.x, force.y, force.z, m.x, m.y, m.z);
+        let d = vjm::deflection(&self.model, data, q.as_slice(), &w, Load::Exact)?;
+        Ok((
+            nalgebra::Vector3::new(d.x, d.y, d.z),
+            deflect_core::Placement::Inside,
+        ))
+    }
+
+    fn needs_joints(&self) -> bool {
+        true
+    }
+}

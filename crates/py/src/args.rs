@@ -1,7 +1,7 @@
 //! Scalar argument extractors for `#[pyo3(from_py_with = ...)]`, one function per argument
 //! name: pyo3 does not tell an extractor which argument it reads, and the `InputError` it
 //! raises must name it (`args::count::max_iterations` reads `max_iterations` through
-//! [`crate::convert::count`]). The signatures keep their Python defaults (`max_iterations=10`).
+//! [`crate::scalars::count`]). The signatures keep their Python defaults (`max_iterations=10`).
 
 /// Defines `pub mod $module` with one extractor `fn(&Bound<PyAny>) -> PyResult<$ty>` per name.
 macro_rules! extractors {
@@ -20,8 +20,8 @@ macro_rules! extractors {
 }
 
 extractors!(
-    /// Real scalars ([`crate::convert::real`]).
-    real: crate::convert::real => f64 {
+    /// Real scalars ([`crate::scalars::real`]).
+    real: crate::scalars::real => f64 {
         contact_force, cutoff_hz, dt, edge_angle, extension, half_width,
         jam_force, jam_margin, link, lowpass_cutoff_hz, mass, max_condition, max_correction,
         max_rate, max_turn, min_motion_fraction, min_sigma, min_step_fraction, orientation_tolerance,
@@ -31,41 +31,41 @@ extractors!(
 );
 
 extractors!(
-    /// Optional real scalars ([`crate::convert::opt_real`]).
-    opt_real: crate::convert::opt_real => Option<f64> {
+    /// Optional real scalars ([`crate::scalars::opt_real`]).
+    opt_real: crate::scalars::opt_real => Option<f64> {
         approach_step, rate_hz, spacing, stop_radius, target_force,
     }
 );
 
 extractors!(
-    /// Counts ([`crate::convert::count`]).
-    count: crate::convert::count => usize {
+    /// Counts ([`crate::scalars::count`]).
+    count: crate::scalars::count => usize {
         bias_samples, g_level, iterations, max_approach_steps, max_bisections, max_iterations,
         max_jam_steps, max_steps, moving_average_window, window,
     }
 );
 
 extractors!(
-    /// Optional counts ([`crate::convert::opt_count`]).
-    opt_count: crate::convert::opt_count => Option<usize> { n_force }
+    /// Optional counts ([`crate::scalars::opt_count`]).
+    opt_count: crate::scalars::opt_count => Option<usize> { n_force }
 );
 
 extractors!(
-    /// Pairs of reals ([`crate::convert::pair`]).
-    pair: crate::convert::pair => (f64, f64) { approach_direction }
+    /// Pairs of reals ([`crate::scalars::pair`]).
+    pair: crate::scalars::pair => (f64, f64) { approach_direction }
 );
 
 extractors!(
-    /// Optional pairs of reals ([`crate::convert::opt_pair`]).
-    opt_pair: crate::convert::opt_pair => Option<(f64, f64)> { pilot }
+    /// Optional pairs of reals ([`crate::scalars::opt_pair`]).
+    opt_pair: crate::scalars::opt_pair => Option<(f64, f64)> { pilot }
 );
 
 extractors!(
-    /// Triples of reals ([`crate::convert::triple`]).
-    triple: crate::convert::triple => [f64; 3] { angular, linear }
+    /// Triples of reals ([`crate::scalars::triple`]).
+    triple: crate::scalars::triple => [f64; 3] { angular, linear }
 );
 
 extractors!(
-    /// Optional triples of reals ([`crate::convert::opt_triple`]).
-    opt_triple: crate::convert::opt_triple => Option<[f64; 3]> { gravity }
+    /// Optional triples of reals ([`crate::scalars::opt_triple`]).
+    opt_triple: crate::scalars::opt_triple => Option<[f64; 3]> { gravity }
 );

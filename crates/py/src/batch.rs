@@ -1,56 +1,94 @@
-//! Row batches on every core: the rows of a batch are split into one contiguous chunk per
-//! thread (scoped threads, at most [`MAX_THREADS`]), each thread with its own workspace, and
-//! the first failing row in row order is reported. The per-tick core stays single-threaded
-//! and allocation-free; only the batch wrapper spreads it over threads.
+//! The one batch runner of the bindings: the rows of a batch are split into one contiguous
+//! chunk per thread (scoped threads, at most [`MAX_THREADS`]), each thread with its own
+//! workspace, and the first failing row in row order is reported. The per-tick core stays
+//! single-threaded and allocation-free; only this wrapper spreads it over threads.
+//!
+//! When to split is one threshold on the work, not on the row count: a batch goes on several
+//! threads once its estimated single-threaded time, rows times the row's cost
+//! ([`row_cost`]), reaches [`PARALLEL_MIN_NS`].
+
+use core::ops::Range;
 
 use deflect_core::TickError;
+use pyo3::PyErr;
 
-/// Batches of at least this many rows are split over threads (below, thread start-up costs
-/// more than it saves: a thread costs ~20 us, a VJM row ~0.5 us).
-pub const PARALLEL_MIN_ROWS: usize = 2048;
+use crate::InputError;
+use crate::errors::tick_err_at;
+
+/// A batch is split over threads once its estimated single-threaded time reaches 1 ms.
+/// Starting and joining a scoped thread costs 20-60 us on the 2-core machines CI runs on
+/// (`benches/batch_threads.py`), so from 1 ms of work a second thread saves more than 40 %
+/// of the wall time, and below about 0.1 ms it would cost more than it saves.
+pub const PARALLEL_MIN_NS: f64 = 1.0e6;
 
 /// Most threads one batch uses.
 pub const MAX_THREADS: usize = 8;
 
+/// Single-threaded cost of one row \[ns\] of each kind of batch, measured on the release
+/// wheel (`benches/peers.py`, `benches/batch_threads.py`): what [`PARALLEL_MIN_NS`] is
+/// compared against. Estimates, rounded to the slower end; a wrong estimate only moves the
+/// row count at which threads start.
+pub mod row_cost {
+    /// One virtual-joint pass of a 6-axis arm (forward 0.2 us, compliance 0.7 us,
+    /// deflection 0.6-0.9 us): threads from 2,000 rows.
+    pub const VJM: f64 = 500.0;
+    /// One compliance-map or displacement-field query (30-60 ns): threads from 20,000 rows.
+    pub const MAP_QUERY: f64 = 50.0;
+    /// One posture sweep over a full turn of tool angles (about a millisecond): two rows
+    /// already share the work.
+    pub const POSTURE_SWEEP: f64 = 1.0e6;
+}
+
 /// How a batch failed: a row's tick error, or a worker thread that panicked (a bug).
+#[derive(Debug)]
 pub enum BatchFailure {
     Row(usize, TickError),
     Panicked,
 }
 
-/// Threads for `n` rows: one below `min_rows`, else every available core (at most
-/// [`MAX_THREADS`], at most one per row).
-pub fn threads_for(n: usize, min_rows: usize) -> usize {
-    if n < min_rows.max(2) {
+impl From<BatchFailure> for PyErr {
+    /// The exception the single call would raise, naming the row.
+    fn from(e: BatchFailure) -> Self {
+        match e {
+            BatchFailure::Row(i, e) => tick_err_at(format_args!("row {i}"), e),
+            BatchFailure::Panicked => {
+                InputError::new_err("internal: a batch worker thread panicked")
+            }
+        }
+    }
+}
+
+/// Threads for `n` rows of `row_ns` each: one below [`PARALLEL_MIN_NS`] of work, else every
+/// available core (at most [`MAX_THREADS`], at most one per row).
+pub fn threads_for(n: usize, row_ns: f64) -> usize {
+    if n < 2 || (n as f64) * row_ns < PARALLEL_MIN_NS {
         return 1;
     }
     std::thread::available_parallelism().map_or(1, |t| t.get().min(MAX_THREADS).min(n))
 }
 
-/// Fills `out` (n rows of `width` numbers) by `row(i, workspace, out_row)` for every row
-/// `i`, each thread with its own `workspace()`, on several threads from `min_rows` rows
-/// ([`PARALLEL_MIN_ROWS`] for rows of a microsecond; fewer for costlier rows).
-pub fn rows<W, M, F>(
+/// Fills `out` (rows of `width` numbers) chunk by chunk: `chunk(rows, workspace, out_rows)`
+/// gets a contiguous range of rows and their slice of `out`, each thread its own
+/// `workspace()`; a failure names the absolute row. On several threads from
+/// [`PARALLEL_MIN_NS`] of estimated work (`row_ns` per row).
+pub fn chunks<W, M, F>(
     out: &mut [f64],
     width: usize,
-    min_rows: usize,
+    row_ns: f64,
     workspace: M,
-    row: F,
+    chunk: F,
 ) -> Result<(), BatchFailure>
 where
     M: Fn() -> W + Sync,
-    F: Fn(usize, &mut W, &mut [f64]) -> Result<(), TickError> + Sync,
+    F: Fn(Range<usize>, &mut W, &mut [f64]) -> Result<(), (usize, TickError)> + Sync,
 {
     let width = width.max(1);
     let n = out.len() / width;
-    let threads = threads_for(n, min_rows);
+    let threads = threads_for(n, row_ns);
     let chunk_rows = n.div_ceil(threads).max(1);
-    let run = |first: usize, chunk: &mut [f64]| -> Result<(), BatchFailure> {
-        let mut w = workspace();
-        for (k, o) in chunk.chunks_mut(width).enumerate() {
-            row(first + k, &mut w, o).map_err(|e| BatchFailure::Row(first + k, e))?;
-        }
-        Ok(())
+    let run = |first: usize, o: &mut [f64]| -> Result<(), BatchFailure> {
+        let rows = first..first + o.len() / width;
+        chunk(rows, &mut workspace(), o).map_err(|(row, e)| BatchFailure::Row(row, e))
     };
     if threads == 1 {
         return run(0, out);
@@ -59,9 +97,9 @@ where
         let handles: Vec<_> = out
             .chunks_mut(chunk_rows * width)
             .enumerate()
-            .map(|(c, chunk)| {
+            .map(|(c, o)| {
                 let run = &run;
-                scope.spawn(move || run(c * chunk_rows, chunk))
+                scope.spawn(move || run(c * chunk_rows, o))
             })
             .collect();
         handles
@@ -71,4 +109,25 @@ where
     });
     // Chunks are in row order: the first error is the first failing row.
     results.into_iter().collect()
+}
+
+/// [`chunks`] one row at a time: `row(i, workspace, out_row)` for every row `i`.
+pub fn rows<W, M, F>(
+    out: &mut [f64],
+    width: usize,
+    row_ns: f64,
+    workspace: M,
+    row: F,
+) -> Result<(), BatchFailure>
+where
+    M: Fn() -> W + Sync,
+    F: Fn(usize, &mut W, &mut [f64]) -> Result<(), TickError> + Sync,
+{
+    let width = width.max(1);
+    chunks(out, width, row_ns, workspace, |rows, w, o| {
+        for (i, oi) in rows.zip(o.chunks_mut(width)) {
+            row(i, w, oi).map_err(|e| (i, e))?;
+        }
+        Ok(())
+    })
 }

@@ -16,17 +16,16 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    build_err, check_finite_matrix, finite_vector, iso_to_py, matrix, pose, rotation, tick_err,
-};
+use crate::arrays::{iso_to_py, matrix, pose, rotation, vector};
+use crate::errors::{build_err, tick_err};
 use crate::vjm::SerialRobot;
 
 pub(crate) fn v3(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector3<f64>> {
-    Ok(Vector3::from_column_slice(&finite_vector(a, what, 3)?))
+    Ok(Vector3::from_column_slice(&vector(a, what, 3)?))
 }
 
 pub(crate) fn v6(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector6> {
-    Ok(Vector6::from_column_slice(&finite_vector(a, what, 6)?))
+    Ok(Vector6::from_column_slice(&vector(a, what, 6)?))
 }
 
 pub(crate) fn out6<'py>(py: Python<'py>, v: &Vector6) -> Bound<'py, PyArray1<f64>> {
@@ -69,7 +68,6 @@ impl SensorCalibration {
         if let Some(a) = residual {
             let r = matrix(a, "residual", Some(6), Some(POLY_TERMS))?;
             let r = r.as_array();
-            check_finite_matrix("residual", &r)?;
             for (row, src) in c.residual.iter_mut().zip(r.rows()) {
                 for (v, x) in row.iter_mut().zip(src.iter()) {
                     *v = *x;
@@ -469,7 +467,7 @@ impl OnlineCompensator {
         feed_velocity: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
         let dof = self.model.chain().dof();
-        let q = finite_vector(q, "q", dof)?;
+        let q = vector(q, "q", dof)?;
         let reading = v6(reading, "reading")?;
         let est = estimated.map(|e| v6(e, "estimated")).transpose()?;
         let feed = feed_velocity

@@ -15,13 +15,10 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    batch_pair, build_err, indices, load_err, matrix, shape_error, tick_err, tick_err_at,
-    vector_any,
-};
-
-/// Batches of at least this many rows use several threads.
-const PARALLEL_MIN_ROWS: usize = 20_000;
+use crate::arrays::{batch_pair, indices, matrix, vector_any};
+use crate::batch;
+use crate::errors::{build_err, load_err, shape_error, tick_err};
+use crate::field::DisplacementField;
 
 fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
     match s.to_ascii_lowercase().as_str() {
@@ -106,13 +103,6 @@ impl ComplianceMap {
         }
         Ok(o)
     }
-}
-
-/// Why a batch stopped: the first refused row and why, or an internal failure.
-#[derive(Debug)]
-enum BatchFailure {
-    Row(usize, TickError),
-    Internal(&'static str),
 }
 
 /// Rows of a (N, k) float array as a contiguous row-major Vec.
@@ -316,11 +306,10 @@ impl ComplianceMap {
     /// The displacement field under the fixed `force` (n_force,) [N]: every node's
     /// displacement computed once, for position-only queries (`DisplacementField`).
     /// `InputError` for a wrong length or a non-finite force.
-    fn field(
-        slf: &Bound<'_, Self>,
-        force: &Bound<'_, PyAny>,
-    ) -> PyResult<crate::field::DisplacementField> {
-        crate::field::DisplacementField::build(slf, force)
+    fn field(slf: &Bound<'_, Self>, force: &Bound<'_, PyAny>) -> PyResult<DisplacementField> {
+        let f = vector_any(force, "force")?;
+        let inner = slf.get().inner.field(&f).map_err(build_err)?;
+        Ok(DisplacementField::new(slf.as_any(), inner))
     }
 
     /// The same map with other default options.
@@ -371,7 +360,7 @@ impl ComplianceMap {
     /// ignored) and forces `F` (N, n_force) [N]; either may be a single row ((2,), (n_force,)
     /// or one-row 2-D) that broadcasts over the other's rows, as in numpy (a displacement
     /// field under one load, or one point under many loads). float64 C-contiguous arrays are
-    /// read in place. Runs without the GIL, on several threads for N >= 20000. With
+    /// read in place. Runs without the GIL, on every core for large batches. With
     /// `out_of_grid="error"` the first row outside the grid raises `InputError`.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
     #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None))]
@@ -383,63 +372,37 @@ impl ComplianceMap {
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let o = self.options(interpolation, out_of_grid)?;
+        let opts = self.options(interpolation, out_of_grid)?;
         let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
         let (n, pm, fm) = batch_pair((P, "P", &[2, 3]), (F, "F", &[nf]))?;
         let (p, f) = (pm.as_array(), fm.as_array());
         let pc = p.ncols();
-        let map = &self.inner;
-        let out = py.detach(|| -> Result<Vec<f64>, BatchFailure> {
+        let (Some(p), Some(f)) = (p.broadcast((n, pc)), f.broadcast((n, nf))) else {
+            return Err(InputError::new_err("P and F: rows do not broadcast"));
+        };
+        let view = self.inner.view();
+        let mut out = vec![0.0; n * nd];
+        py.detach(|| {
             // A broadcast row is repeated once here; a float64 C-contiguous (N, k) argument
             // is read in place (`as_standard_layout` borrows it).
-            let (Some(p), Some(f)) = (p.broadcast((n, pc)), f.broadcast((n, nf))) else {
-                return Err(BatchFailure::Internal("rows do not broadcast"));
-            };
             let (p, f) = (p.as_standard_layout(), f.as_standard_layout());
-            let (Some(ps), Some(fs)) = (p.as_slice(), f.as_slice()) else {
-                return Err(BatchFailure::Internal("arrays not contiguous"));
-            };
-            let view = map.view();
-            let mut out = vec![0.0; n * nd];
+            let (ps, fs) = (p.as_slice().unwrap_or(&[]), f.as_slice().unwrap_or(&[]));
             let pc = pc.max(1);
-            // Large batches are split over the available cores (at most 8 threads).
-            let threads = if n >= PARALLEL_MIN_ROWS {
-                std::thread::available_parallelism().map_or(1, |t| t.get().min(8))
-            } else {
-                1
-            };
-            let rows = n.div_ceil(threads).max(1);
-            let results: Vec<Result<(), BatchFailure>> = std::thread::scope(|scope| {
-                let handles: Vec<_> = out
-                    .chunks_mut(rows * nd)
-                    .zip(ps.chunks(rows * pc))
-                    .zip(fs.chunks(rows * nf))
-                    .enumerate()
-                    .map(|(k, ((oc, pchunk), fchunk))| {
-                        scope.spawn(move || {
-                            view.displacement_batch(pchunk, pc, fchunk, oc, o)
-                                .map(|_| ())
-                                .map_err(|e| BatchFailure::Row(k * rows + e.row, e.error))
-                        })
-                    })
-                    .collect();
-                handles
-                    .into_iter()
-                    .map(|h| {
-                        h.join()
-                            .unwrap_or(Err(BatchFailure::Internal("worker thread panicked")))
-                    })
-                    .collect()
-            });
-            // The first failing row in row order.
-            for r in results {
-                r?;
-            }
-            Ok(out)
-        });
-        let out = out.map_err(|e| match e {
-            BatchFailure::Row(row, e) => tick_err_at(format_args!("row {row}"), e),
-            BatchFailure::Internal(what) => InputError::new_err(format!("internal: {what}")),
+            batch::chunks(
+                &mut out,
+                nd,
+                batch::row_cost::MAP_QUERY,
+                || (),
+                |rows, _, o| {
+                    let (pr, fr) = (
+                        ps.get(rows.start * pc..rows.end * pc).unwrap_or(&[]),
+                        fs.get(rows.start * nf..rows.end * nf).unwrap_or(&[]),
+                    );
+                    view.displacement_batch(pr, pc, fr, o, opts)
+                        .map(|_| ())
+                        .map_err(|e| (rows.start + e.row, e.error))
+                },
+            )
         })?;
         let arr =
             Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;

@@ -12,14 +12,13 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    build_err, count, finite_vector, fixed_matrix, iso_to_py, load_err, matrix_to_py, real,
-    tick_err, vector, vector_any,
-};
+use crate::arrays::{fixed_matrix, iso_to_py, matrix_to_py, vector, vector_any};
+use crate::errors::{build_err, load_err, tick_err};
+use crate::scalars::{count, real};
 use crate::vjm::SerialRobot;
 
 fn v2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&finite_vector(a, what, 2)?))
+    Ok(Vector2::from_column_slice(&vector(a, what, 2)?))
 }
 
 fn m2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Matrix2<f64>> {
@@ -92,10 +91,10 @@ impl DriveTrain {
         dt::Data::new(&self.inner)
     }
     fn q(&self, q: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-        finite_vector(q, "q", self.inner.dof())
+        vector(q, "q", self.inner.dof())
     }
     fn wrench(w: &Bound<'_, PyAny>) -> PyResult<Vector6<f64>> {
-        Ok(Vector6::from_column_slice(&finite_vector(w, "wrench", 6)?))
+        Ok(Vector6::from_column_slice(&vector(w, "wrench", 6)?))
     }
     fn out<'py>(&self, py: Python<'py>, v: &[f64]) -> Bound<'py, PyArray1<f64>> {
         v.get(..self.inner.dof()).unwrap_or(&[]).to_pyarray(py)
@@ -270,7 +269,7 @@ impl DriveTrain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let q = self.q(q)?;
         let w = Self::wrench(wrench)?;
-        let c = dt::correct_joints(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
+        let c = dt::step(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(self.out(py, &c.torque))
     }
 
@@ -284,7 +283,7 @@ impl DriveTrain {
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let q = self.q(q)?;
         let w = Self::wrench(wrench)?;
-        let c = dt::correct_joints(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
+        let c = dt::step(&self.inner, &mut self.data(), &q, &w).map_err(tick_err)?;
         Ok(self.out(py, &c.q))
     }
 

@@ -6,11 +6,12 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::InputError;
-use crate::compliance_map::ComplianceMap;
-use crate::convert::{build_err, matrix, shape_error, tick_err, tick_err_at, vector_any};
+use crate::arrays::{matrix, vector_any};
+use crate::batch;
+use crate::errors::{shape_error, tick_err};
 
-/// What a pickled field is rebuilt from: its map and its load.
-type FieldState = (Py<ComplianceMap>, Vec<f64>);
+/// What a pickled field is rebuilt from: its map (a `ComplianceMap`) and its load.
+type FieldState = (Py<PyAny>, Vec<f64>);
 
 /// The displacement field of a `ComplianceMap` under one fixed load
 /// (`ComplianceMap.field(force)`): the node displacements (Eq. 9-10 of Paksoy, Dede and
@@ -20,21 +21,18 @@ type FieldState = (Py<ComplianceMap>, Vec<f64>);
 #[derive(Debug)]
 pub struct DisplacementField {
     inner: CoreField,
-    map: Py<ComplianceMap>,
+    /// The `ComplianceMap` the field was computed from (held as the Python object, so this
+    /// module does not depend on the map's).
+    map: Py<PyAny>,
 }
 
 impl DisplacementField {
-    /// `map.field(force)`, for `ComplianceMap.field`.
-    pub(crate) fn build(
-        map: &Bound<'_, ComplianceMap>,
-        force: &Bound<'_, PyAny>,
-    ) -> PyResult<Self> {
-        let f = vector_any(force, "force")?;
-        let inner = map.get().inner.field(&f).map_err(build_err)?;
-        Ok(Self {
+    /// The field `inner` of the Python `ComplianceMap` `map`, for `ComplianceMap.field`.
+    pub(crate) fn new(map: &Bound<'_, PyAny>, inner: CoreField) -> Self {
+        Self {
             inner,
             map: map.clone().unbind(),
-        })
+        }
     }
 }
 
@@ -59,7 +57,8 @@ impl DisplacementField {
     }
 
     /// Displacements (N, n_displacement) [m] at positions `P` (N, 2) or (N, 3) [m]; float64
-    /// C-contiguous input is read in place, the GIL is released.
+    /// C-contiguous input is read in place; runs without the GIL, on every core for large
+    /// batches.
     #[allow(non_snake_case)] // reason: matrix name as in the documented Python signature
     fn displacement_batch<'py>(
         &self,
@@ -74,18 +73,24 @@ impl DisplacementField {
         }
         let nd = self.inner.n_displacement();
         let field = &self.inner;
-        let out = py.detach(|| {
+        let mut out = vec![0.0; n * nd];
+        py.detach(|| {
             let p = p.as_standard_layout();
-            let mut out = vec![0.0; n * nd];
-            let r = field.displacement_batch(
-                p.as_slice().unwrap_or(&[]),
-                pc,
+            let ps = p.as_slice().unwrap_or(&[]);
+            batch::chunks(
                 &mut out,
-                field.options(),
-            );
-            r.map(|_| out)
-        });
-        let out = out.map_err(|e| tick_err_at(format_args!("row {}", e.row), e.error))?;
+                nd,
+                batch::row_cost::MAP_QUERY,
+                || (),
+                |rows, _, o| {
+                    let pr = ps.get(rows.start * pc..rows.end * pc).unwrap_or(&[]);
+                    field
+                        .displacement_batch(pr, pc, o, field.options())
+                        .map(|_| ())
+                        .map_err(|e| (rows.start + e.row, e.error))
+                },
+            )
+        })?;
         let a =
             Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
         Ok(a.into_pyarray(py))
@@ -112,13 +117,13 @@ impl DisplacementField {
 
     /// The map the field was computed from.
     #[getter]
-    fn map(&self, py: Python<'_>) -> Py<ComplianceMap> {
+    fn map(&self, py: Python<'_>) -> Py<PyAny> {
         self.map.clone_ref(py)
     }
 
     /// Pickling: rebuilt as `map.field(force)` (an exact round trip).
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, FieldState)> {
-        let rebuild = py.get_type::<ComplianceMap>().getattr("field")?;
+        let rebuild = self.map.bind(py).get_type().getattr("field")?;
         Ok((
             rebuild,
             (self.map.clone_ref(py), self.inner.force().to_vec()),

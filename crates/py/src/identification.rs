@@ -12,10 +12,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
+use crate::arrays::{array_dyn, indices, matrix, pose, rotation_of};
 use crate::compensation::SensorCalibration;
-use crate::convert::{
-    array_dyn, build_err, check_finite_matrix, indices, matrix, pose, rotation_of, shape_error,
-};
+use crate::errors::{build_err, shape_error};
 use crate::vjm::SerialRobot;
 
 fn stiffness_dict<'py>(
@@ -48,11 +47,10 @@ fn stiffness_dict<'py>(
     Ok(d)
 }
 
-/// A finite (N, cols) array (N fixed by `n` if given), copied in row-major order.
+/// An (N, cols) array (N fixed by `n` if given), copied in row-major order.
 fn rows(a: &Bound<'_, PyAny>, what: &str, cols: usize, n: Option<usize>) -> PyResult<Array2<f64>> {
     let m = matrix(a, what, n, Some(cols))?;
     let v = m.as_array();
-    check_finite_matrix(what, &v)?;
     Ok(v.as_standard_layout().into_owned())
 }
 

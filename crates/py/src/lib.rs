@@ -1,14 +1,7 @@
-//! Python bindings of deflect: thin wrappers that convert numpy arrays, call deflect-core
-//! and map its errors onto one exception tree rooted in `ValueError`.
-//!
-//! ```text
-//! ValueError
-//! └── deflect.DeflectError
-//!     ├── deflect.LoadError        malformed or inconsistent files (URDF, TOML, CSV, JSON)
-//!     ├── deflect.InputError       wrong shapes, NaN/inf, out-of-range inputs
-//!     ├── deflect.SingularError    singular pose: no unique correction
-//!     └── deflect.ConvergenceError an iterative solve missed its tolerance
-//! ```
+//! Python bindings of deflect: thin wrappers that convert numpy arrays ([`arrays`]) and
+//! scalars ([`scalars`], [`args`]), call deflect-core (which validates every value) and map
+//! its errors onto one exception tree rooted in `ValueError` ([`errors`]). Batches run on
+//! every core through one runner ([`batch`]).
 // Bindings must not crash the interpreter: errors become Python exceptions.
 #![deny(
     clippy::unwrap_used,
@@ -21,18 +14,16 @@
 // `__doc__` for `help()`), so unit brackets such as [m] are plain text there, not rustdoc links.
 #![allow(rustdoc::broken_intra_doc_links)]
 
-use pyo3::create_exception;
-use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 
 mod args;
+mod arrays;
 mod batch;
 mod compensation;
 mod compliance_map;
-mod convert;
 mod dalembert;
-mod dalembert_serial;
 mod drivetrain;
+mod errors;
 mod field;
 mod identification;
 mod mechanism;
@@ -40,47 +31,14 @@ mod motion;
 mod pickle;
 mod pose_motion;
 mod posture;
+mod scalars;
 mod vjm;
 
-create_exception!(
-    deflect,
-    DeflectError,
-    PyValueError,
-    "Root of deflect's exceptions."
-);
-create_exception!(
-    deflect,
-    LoadError,
-    DeflectError,
-    "A file could not be loaded or validated."
-);
-create_exception!(
-    deflect,
-    InputError,
-    DeflectError,
-    "An input has the wrong shape or is not finite."
-);
-create_exception!(
-    deflect,
-    SingularError,
-    DeflectError,
-    "The pose is singular."
-);
-create_exception!(
-    deflect,
-    ConvergenceError,
-    DeflectError,
-    "An iterative solve did not converge."
-);
+pub use errors::{ConvergenceError, DeflectError, InputError, LoadError, SingularError};
 
 #[pymodule]
 fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
-    let py = m.py();
-    m.add("DeflectError", py.get_type::<DeflectError>())?;
-    m.add("LoadError", py.get_type::<LoadError>())?;
-    m.add("InputError", py.get_type::<InputError>())?;
-    m.add("SingularError", py.get_type::<SingularError>())?;
-    m.add("ConvergenceError", py.get_type::<ConvergenceError>())?;
+    errors::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     vjm::register(m)?;
     compensation::register(m)?;
@@ -90,7 +48,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     motion::register(m)?;
     mechanism::register(m)?;
     dalembert::register(m)?;
-    dalembert_serial::register(m)?;
     pose_motion::register(m)?;
     drivetrain::register(m)?;
     posture::register(m)?;

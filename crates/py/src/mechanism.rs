@@ -6,7 +6,8 @@ use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::args;
-use crate::convert::{build_err, matrix_to_py, tick_err, vector};
+use crate::arrays::{matrix_to_py, vector};
+use crate::errors::{build_err, tick_err};
 
 fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
     Ok(Vector2::from_column_slice(&vector(a, what, 2)?))

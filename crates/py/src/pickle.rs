@@ -7,14 +7,10 @@ use deflect_core::compensation::SensorCalibration;
 use deflect_core::compensation::sensor::POLY_TERMS;
 use deflect_core::vjm::{Element, Model, ModelBuilder};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
-use numpy::ToPyArray;
-use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
-use pyo3::types::PyTuple;
 
 use crate::InputError;
-use crate::convert::build_err;
-use crate::motion::{LimitSpec, Recipe};
+use crate::errors::build_err;
 
 /// Version of the state layout below.
 const VERSION: u32 = 1;
@@ -179,65 +175,6 @@ pub fn robot_of(state: RobotState) -> PyResult<CoreRobot> {
         base_link,
         tip_link,
     })
-}
-
-/// `(callable, args)` that remakes a trajectory of `recipe` sampled at `rate_hz`: the public
-/// `plan_polyline` (which is what `plan_line` plans with) or `Trajectory.from_samples`, so
-/// that the state is validated again on the way back.
-pub(crate) fn trajectory_reduce<'py>(
-    py: Python<'py>,
-    recipe: &Recipe,
-    rate_hz: Option<f64>,
-) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
-    let module = py.import("deflect._deflect")?;
-    let none = || py.None().into_bound(py);
-    match recipe {
-        Recipe::Planned { points, spec } => {
-            let (v, a, j, segments) = match spec {
-                LimitSpec::Path(l) => (
-                    l.v_max.into_bound_py_any(py)?,
-                    l.a_max.into_bound_py_any(py)?,
-                    l.j_max.into_bound_py_any(py)?,
-                    none(),
-                ),
-                LimitSpec::Axis([v, a, j]) => (
-                    v.clone().into_bound_py_any(py)?,
-                    a.clone().into_bound_py_any(py)?,
-                    j.clone().into_bound_py_any(py)?,
-                    none(),
-                ),
-                LimitSpec::Segments(ls) => {
-                    let rows: Vec<[f64; 3]> =
-                        ls.iter().map(|l| [l.v_max, l.a_max, l.j_max]).collect();
-                    (none(), none(), none(), rows.into_bound_py_any(py)?)
-                }
-            };
-            let args = [
-                points.to_pyarray(py).into_any(),
-                v,
-                a,
-                j,
-                rate_hz.into_bound_py_any(py)?,
-                segments,
-            ];
-            Ok((module.getattr("plan_polyline")?, PyTuple::new(py, args)?))
-        }
-        Recipe::Sampled {
-            position,
-            acceleration,
-        } => {
-            let args = [
-                position.to_pyarray(py).into_any(),
-                rate_hz.unwrap_or(f64::NAN).into_bound_py_any(py)?,
-                match acceleration {
-                    Some(a) => a.to_pyarray(py).into_any(),
-                    None => none(),
-                },
-            ];
-            let ctor = module.getattr("Trajectory")?.getattr("from_samples")?;
-            Ok((ctor, PyTuple::new(py, args)?))
-        }
-    }
 }
 
 /// The `TypeError` of `pickle.dumps` on an object with per-tick state.

@@ -15,10 +15,11 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    build_err, fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, real,
-    shape_error, tick_err, vector_any,
+use crate::arrays::{
+    fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, vector_any,
 };
+use crate::errors::{build_err, shape_error, tick_err};
+use crate::scalars::real;
 use nalgebra::Matrix4;
 
 /// Every tick of a pose motion, one row each.

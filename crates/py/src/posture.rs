@@ -13,8 +13,9 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
+use crate::arrays::{batch_pair, matrix, vector, vector_any};
 use crate::batch::{self, BatchFailure};
-use crate::convert::{batch_pair, matrix, tick_err, tick_err_at, vector, vector_any};
+use crate::errors::{tick_err, tick_err_at};
 use crate::vjm::SerialRobot;
 
 /// Columns of one atlas row before the joints: reachable, reachable angles, best angle, best
@@ -58,7 +59,7 @@ fn settings(
             .map(|(lo, hi)| 0.5 * (lo + hi))
             .collect(),
         Some(s) => {
-            let a = crate::convert::float_array(s, "seeds")?;
+            let a = crate::arrays::float_array(s, "seeds")?;
             if a.ndim() == 1 {
                 vector(s, "seeds", dof)?
             } else {
@@ -97,7 +98,7 @@ fn settings(
         min_sigma,
         ..PostureOptions::default().ik
     };
-    ik.validate().map_err(crate::convert::build_err)?;
+    ik.validate().map_err(crate::errors::build_err)?;
     Ok(Settings {
         angles,
         seeds,
@@ -263,8 +264,7 @@ fn _atlas_chunk<'py>(
         batch::rows(
             &mut out,
             width,
-            // A task is a whole sweep (about a millisecond): two already share the work.
-            2,
+            batch::row_cost::POSTURE_SWEEP,
             || {
                 (
                     Data::new(model),

@@ -3,20 +3,19 @@
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use deflect_core::SerialRobot as CoreRobot;
+use deflect_core::TickError;
 use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
-use numpy::ndarray::Array2;
-use numpy::{IntoPyArray, PyArray, PyArray1, PyArray2, PyArrayDyn, ToPyArray};
+use numpy::ndarray::{Array2, ArrayView2};
+use numpy::{IntoPyArray, PyArray, PyArray1, PyArray2, PyArray3, ToPyArray};
 
-use crate::batch::{self, BatchFailure};
 use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    batch_pair, iso_to_py, load_err, matrix, matrix_to_py, pose, tick_err, tick_err_at, vector,
-    vector6,
-};
+use crate::arrays::{batch_pair, iso_to_py, matrix, matrix_to_py, pose, vector, vector6};
+use crate::batch;
+use crate::errors::{load_err, tick_err};
 
 /// A serial robot with virtual joints (VJM paper, Eq. 1-9). All arrays are SI, base frame.
 #[pyclass(module = "deflect", frozen)]
@@ -141,7 +140,8 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let d = vjm::deflection(model, &mut self.data(), &q, &w).map_err(tick_err)?;
+        let d =
+            vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Exact).map_err(tick_err)?;
         Ok(d.as_slice().to_pyarray(py))
     }
 
@@ -185,7 +185,7 @@ impl SerialRobot {
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let mut data = self.data();
-        vjm::deflection(model, &mut data, &q, &w).map_err(tick_err)?;
+        vjm::deflection(model, &mut data, &q, &w, vjm::Load::Exact).map_err(tick_err)?;
         let n = model.spring_count();
         let flat: Vec<f64> = data
             .spring_angles
@@ -222,7 +222,8 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let d = vjm::linear_deflection(model, &mut self.data(), &q, &w).map_err(tick_err)?;
+        let d = vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Linearized)
+            .map_err(tick_err)?;
         Ok(d.as_slice().to_pyarray(py))
     }
 
@@ -289,33 +290,18 @@ impl SerialRobot {
         Q: &Bound<'py, PyAny>,
         W: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        let model = &self.inner.model;
-        let dof = model.dof();
+        let dof = self.inner.model.dof();
         let (n, qm, wm) = batch_pair((Q, "Q", &[dof]), (W, "W", &[6]))?;
         let (q, w) = (qm.as_array(), wm.as_array());
         let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
             return Err(InputError::new_err("Q and W: rows do not broadcast"));
         };
-        // Rows are read in place (a single row broadcasts with stride 0), on every core for
-        // large batches; the result buffer becomes the numpy array's (no copy).
-        let mut out = vec![0.0; n * 6];
-        py.detach(|| {
-            batch::rows(
-                &mut out,
-                6,
-                batch::PARALLEL_MIN_ROWS,
-                || (Data::new(model), vec![0.0; dof]),
-                |i, (data, qi), o| {
-                    copy_row(qi, q.row(i).iter());
-                    let wi = Vector6::from_iterator(w.row(i).iter().copied());
-                    let d = vjm::deflection(model, data, qi, &wi)?;
-                    o.copy_from_slice(d.as_slice());
-                    Ok(())
-                },
-            )
+        self.per_row(py, q, &[n, 6], |model, data, qi, i, o| {
+            let wi = Vector6::from_iterator(w.row(i).iter().copied());
+            let d = vjm::deflection(model, data, qi, &wi, vjm::Load::Exact)?;
+            o.copy_from_slice(d.as_slice());
+            Ok(())
         })
-        .map_err(batch_err)?;
-        rows_to_py(py, out, &[n, 6])
     }
 
     /// Rigid TCP poses of many joint vectors: `Q` (N, dof) -> (N, 4, 4). float64
@@ -326,30 +312,15 @@ impl SerialRobot {
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let model = &self.inner.model;
-        let dof = model.dof();
-        let qm = matrix(Q, "Q", None, Some(dof))?;
+    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        let qm = matrix(Q, "Q", None, Some(self.inner.model.dof()))?;
         let q = qm.as_array();
-        let n = q.nrows();
-        let mut out = vec![0.0; n * 16];
-        py.detach(|| {
-            batch::rows(
-                &mut out,
-                16,
-                batch::PARALLEL_MIN_ROWS,
-                || (Data::new(model), vec![0.0; dof]),
-                |i, (data, qi), o| {
-                    copy_row(qi, q.row(i).iter());
-                    let t = vjm::forward(model, data, qi)?.to_homogeneous();
-                    // Row-major 4 x 4: the transpose's column-major storage.
-                    o.copy_from_slice(t.transpose().as_slice());
-                    Ok(())
-                },
-            )
+        self.per_row(py, q, &[q.nrows(), 4, 4], |model, data, qi, _, o| {
+            let t = vjm::forward(model, data, qi)?.to_homogeneous();
+            // Row-major 4 x 4: the transpose's column-major storage.
+            o.copy_from_slice(t.transpose().as_slice());
+            Ok(())
         })
-        .map_err(batch_err)?;
-        rows_to_py(py, out, &[n, 4, 4])
     }
 
     /// Cartesian compliances of many joint vectors: `Q` (N, dof) -> (N, 6, 6), as
@@ -360,29 +331,14 @@ impl SerialRobot {
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArrayDyn<f64>>> {
-        let model = &self.inner.model;
-        let dof = model.dof();
-        let qm = matrix(Q, "Q", None, Some(dof))?;
+    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        let qm = matrix(Q, "Q", None, Some(self.inner.model.dof()))?;
         let q = qm.as_array();
-        let n = q.nrows();
-        let mut out = vec![0.0; n * 36];
-        py.detach(|| {
-            batch::rows(
-                &mut out,
-                36,
-                batch::PARALLEL_MIN_ROWS,
-                || (Data::new(model), vec![0.0; dof]),
-                |i, (data, qi), o| {
-                    copy_row(qi, q.row(i).iter());
-                    let c = vjm::compliance(model, data, qi)?;
-                    o.copy_from_slice(c.transpose().as_slice());
-                    Ok(())
-                },
-            )
+        self.per_row(py, q, &[q.nrows(), 6, 6], |model, data, qi, _, o| {
+            let c = vjm::compliance(model, data, qi)?;
+            o.copy_from_slice(c.transpose().as_slice());
+            Ok(())
         })
-        .map_err(batch_err)?;
-        rows_to_py(py, out, &[n, 6, 6])
     }
 
     fn __repr__(&self) -> String {
@@ -416,16 +372,42 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     Ok(())
 }
 
-/// Copies a row of an array view into a joint-vector buffer.
-fn copy_row<'a>(dst: &mut [f64], src: impl Iterator<Item = &'a f64>) {
-    dst.iter_mut().zip(src).for_each(|(d, s)| *d = *s);
-}
-
-/// A batch failure as the exception the single call would raise, naming the row.
-fn batch_err(e: BatchFailure) -> PyErr {
-    match e {
-        BatchFailure::Row(i, e) => tick_err_at(format_args!("row {i}"), e),
-        BatchFailure::Panicked => InputError::new_err("internal: a batch worker thread panicked"),
+impl SerialRobot {
+    /// The batch shape of every `*_batch` method: `row(model, data, q_i, i, out_i)` for each
+    /// row `i` of `q` (N, dof; a broadcast row is read in place), `out_i` the row's
+    /// `shape[1..].product()` numbers of the result of `shape`. Without the GIL, on every core
+    /// for large batches ([`batch::row_cost::VJM`]); the first failing row raises as the
+    /// single call would, naming the row.
+    fn per_row<'py, D, F>(
+        &self,
+        py: Python<'py>,
+        q: ArrayView2<'_, f64>,
+        shape: &[usize],
+        row: F,
+    ) -> PyResult<Bound<'py, PyArray<f64, D>>>
+    where
+        D: numpy::ndarray::Dimension,
+        F: Fn(&vjm::Model, &mut Data, &[f64], usize, &mut [f64]) -> Result<(), TickError> + Sync,
+    {
+        let model = &self.inner.model;
+        let dof = model.dof();
+        let width = shape.iter().skip(1).product();
+        let mut out = vec![0.0; q.nrows() * width];
+        py.detach(|| {
+            batch::rows(
+                &mut out,
+                width,
+                batch::row_cost::VJM,
+                || (Data::new(model), vec![0.0; dof]),
+                |i, (data, qi), o| {
+                    for (d, s) in qi.iter_mut().zip(q.row(i)) {
+                        *d = *s;
+                    }
+                    row(model, data, qi, i, o)
+                },
+            )
+        })?;
+        rows_to_py(py, out, shape)
     }
 }
 

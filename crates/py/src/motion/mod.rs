@@ -9,15 +9,15 @@ use deflect_core::motion::{DEFAULT_RATE_HZ, Limits, SampledTrajectory};
 use nalgebra::SVector;
 use numpy::ndarray::{Array2, ArrayView2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods, ToPyArray};
+use pyo3::IntoPyObjectExt;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyTuple};
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    build_err, check_finite_matrix, float_array, matrix, real, shape_error, tick_err, vector,
-    vector_any,
-};
+use crate::arrays::{float_array, matrix, vector, vector_any};
+use crate::errors::{build_err, shape_error, tick_err};
+use crate::scalars::real;
 
 /// Most coordinates of a planned or sampled motion (joint vectors of up to 8 joints).
 pub const MAX_DIM: usize = 8;
@@ -195,14 +195,10 @@ impl Trajectory {
             matrix(a.as_any(), what, None, cols).map(|m| m.as_array().to_owned())
         };
         let p = as_2d(position, "position", None)?;
-        check_finite_matrix("position", &p.view())?;
         let d = p.ncols();
         let a = acceleration
             .map(|a| as_2d(a, "acceleration", Some(d)))
             .transpose()?;
-        if let Some(a) = &a {
-            check_finite_matrix("acceleration", &a.view())?;
-        }
         let (pv, av) = (p.view(), a.as_ref().map(|a| a.view()));
         let samples = py.detach(|| {
             dispatch_dim!(
@@ -268,7 +264,7 @@ impl Trajectory {
         slf: &Bound<'py, Self>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, pyo3::types::PyTuple>)> {
         let me = slf.get();
-        crate::pickle::trajectory_reduce(slf.py(), &me.recipe, me.rate_hz)
+        trajectory_reduce(slf.py(), &me.recipe, me.rate_hz)
     }
 
     /// Tick times [s], shape (n,).
@@ -464,6 +460,65 @@ fn paper_limits(
 }
 
 /// Adds the motion planner to the module.
+/// `(callable, args)` that remakes a trajectory of `recipe` sampled at `rate_hz`: the public
+/// `plan_polyline` (which is what `plan_line` plans with) or `Trajectory.from_samples`, so
+/// that the state is validated again on the way back.
+fn trajectory_reduce<'py>(
+    py: Python<'py>,
+    recipe: &Recipe,
+    rate_hz: Option<f64>,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    let module = py.import("deflect._deflect")?;
+    let none = || py.None().into_bound(py);
+    match recipe {
+        Recipe::Planned { points, spec } => {
+            let (v, a, j, segments) = match spec {
+                LimitSpec::Path(l) => (
+                    l.v_max.into_bound_py_any(py)?,
+                    l.a_max.into_bound_py_any(py)?,
+                    l.j_max.into_bound_py_any(py)?,
+                    none(),
+                ),
+                LimitSpec::Axis([v, a, j]) => (
+                    v.clone().into_bound_py_any(py)?,
+                    a.clone().into_bound_py_any(py)?,
+                    j.clone().into_bound_py_any(py)?,
+                    none(),
+                ),
+                LimitSpec::Segments(ls) => {
+                    let rows: Vec<[f64; 3]> =
+                        ls.iter().map(|l| [l.v_max, l.a_max, l.j_max]).collect();
+                    (none(), none(), none(), rows.into_bound_py_any(py)?)
+                }
+            };
+            let args = [
+                points.to_pyarray(py).into_any(),
+                v,
+                a,
+                j,
+                rate_hz.into_bound_py_any(py)?,
+                segments,
+            ];
+            Ok((module.getattr("plan_polyline")?, PyTuple::new(py, args)?))
+        }
+        Recipe::Sampled {
+            position,
+            acceleration,
+        } => {
+            let args = [
+                position.to_pyarray(py).into_any(),
+                rate_hz.unwrap_or(f64::NAN).into_bound_py_any(py)?,
+                match acceleration {
+                    Some(a) => a.to_pyarray(py).into_any(),
+                    None => none(),
+                },
+            ];
+            let ctor = module.getattr("Trajectory")?.getattr("from_samples")?;
+            Ok((ctor, PyTuple::new(py, args)?))
+        }
+    }
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
     m.add_function(wrap_pyfunction!(plan_line, m)?)?;

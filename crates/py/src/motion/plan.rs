@@ -10,7 +10,9 @@ use numpy::ndarray::{Array1, Array2, ArrayView2};
 use pyo3::prelude::*;
 
 use super::MAX_DIM;
-use crate::convert::{build_err, float_array, real, shape_error, vector};
+use crate::arrays::{float_array, vector};
+use crate::errors::{build_err, shape_error};
+use crate::scalars::real;
 
 /// A plan in `N` coordinates, `N` known at run time.
 #[derive(Debug, Clone)]

@@ -1,20 +1,12 @@
-//! Python -> Rust argument conversion and the one mapping of deflect-core's errors onto the
-//! exception tree: every wrapper maps core errors through [`build_err`], [`load_err`] and
-//! [`tick_err`] (or [`tick_err_at`]).
-//!
-//! Arguments are taken as `&Bound<PyAny>` (arrays) or through the named extractors of
-//! `crate::args` (scalars), so that every refusal is a `deflect.InputError` naming the
-//! argument: pyo3's own extraction would raise `TypeError` or `OverflowError` without the
-//! name. Arrays go through numpy once: `numpy.asarray`, a dtype-kind check (bool, int,
-//! unsigned and float convert; complex, object, string, datetime and void arrays are refused)
-//! and one conversion to float64.
-
-use core::fmt::Display;
+//! Python array-likes to Rust, and Rust results to numpy arrays. Arrays go through numpy
+//! once: `numpy.asarray`, a dtype-kind check (bool, int, unsigned and float convert; complex,
+//! object, string, datetime and void arrays are refused with an `InputError` naming the
+//! argument) and one conversion to float64; float64 C-contiguous arrays are read in place.
+//! Values are not checked here: the core call validates them and names what it refuses.
 
 use deflect_core::vjm::{self, Vector6};
-use deflect_core::{BuildError, LoadError as CoreLoadError, TickError};
 use nalgebra::{Isometry3, Matrix3, Matrix4, UnitQuaternion};
-use numpy::ndarray::{Array2, ArrayView2};
+use numpy::ndarray::Array2;
 use numpy::{
     PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
     PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods, ToPyArray,
@@ -24,89 +16,14 @@ use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyFloat, PyInt, PyList, PyTuple};
 
-use crate::{ConvergenceError, InputError, LoadError, SingularError};
-
-/// A model, configuration or fit that could not be built: `SingularError` for a singular
-/// matrix parameter, `InputError` otherwise (budgets included).
-pub fn build_err(e: BuildError) -> PyErr {
-    match e {
-        BuildError::Singular { .. } => SingularError::new_err(e.to_string()),
-        _ => InputError::new_err(e.to_string()),
-    }
-}
-
-/// A file that could not be read or validated: `LoadError`.
-pub fn load_err(e: CoreLoadError) -> PyErr {
-    LoadError::new_err(e.to_string())
-}
-
-/// A per-tick error: `SingularError` for a singular pose or stiffness and for a step without
-/// edge motion, `ConvergenceError` for a solve that missed its tolerance, `InputError` for
-/// everything else (shapes, NaN/inf, out of grid or workspace, budgets, joint limits,
-/// overflowing outputs, invalid arguments, ...).
-pub fn tick_err(e: TickError) -> PyErr {
-    tick_exception(e, e.to_string())
-}
-
-/// [`tick_err`] with the message prefixed by where it happened (`"row 3"`, `"tick 17"`).
-pub fn tick_err_at(context: impl Display, e: TickError) -> PyErr {
-    tick_exception(e, format!("{context}: {e}"))
-}
-
-fn tick_exception(e: TickError, message: String) -> PyErr {
-    match e {
-        TickError::Singular { .. } | TickError::NoEdgeMotion => SingularError::new_err(message),
-        TickError::NotConverged { .. } => ConvergenceError::new_err(message),
-        // OutOfGrid, OutOfWorkspace, ModelMismatch, NonFiniteOutput, Budget, JointLimit,
-        // InvalidArgument, WrongLength, NonFinite and any later variant.
-        _ => InputError::new_err(message),
-    }
-}
-
-/// A shape as Python prints it: `()`, `(6,)`, `(3, 6)`.
-pub fn shape_text(shape: &[usize]) -> String {
-    match shape {
-        [n] => format!("({n},)"),
-        _ => {
-            let parts: Vec<String> = shape.iter().map(usize::to_string).collect();
-            format!("({})", parts.join(", "))
-        }
-    }
-}
-
-/// `InputError`: `what` has the wrong shape.
-pub fn shape_error(what: &str, expected: &str, got: &[usize]) -> PyErr {
-    InputError::new_err(format!(
-        "{what}: expected shape {expected}, got {}",
-        shape_text(got)
-    ))
-}
-
-/// Shortens the text of a Python value for a message (a huge integer has many digits).
-fn short(o: &Bound<'_, PyAny>) -> String {
-    let s = o
-        .repr()
-        .map(|r| r.to_string())
-        .unwrap_or_else(|_| "<unprintable>".to_string());
-    if s.chars().count() > 48 {
-        let head: String = s.chars().take(40).collect();
-        format!("{head}... ({} characters)", s.chars().count())
-    } else {
-        s
-    }
-}
-
-/// The Python type name of `o` (`complex`, `str`, `numpy.ndarray`).
-fn type_name(o: &Bound<'_, PyAny>) -> String {
-    o.get_type()
-        .name()
-        .map(|n| n.to_string())
-        .unwrap_or_else(|_| "?".to_string())
-}
+use crate::errors::{InputError, shape_error, shape_text, tick_err_at};
 
 /// `numpy.asarray(o)`; a ValueError of numpy (ragged nested lists) becomes an `InputError`
 /// naming `what`. numpy's own TypeErrors (an object whose `__array__` refuses) stay.
-fn asarray<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUntypedArray>> {
+pub(crate) fn asarray<'py>(
+    o: &Bound<'py, PyAny>,
+    what: &str,
+) -> PyResult<Bound<'py, PyUntypedArray>> {
     static ASARRAY: PyOnceLock<Py<PyAny>> = PyOnceLock::new();
     let py = o.py();
     let f = ASARRAY.import(py, "numpy", "asarray")?;
@@ -122,7 +39,7 @@ fn asarray<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<Bound<'py, PyUnty
 
 /// dtype kinds that convert to float64 with their meaning: bool, signed and unsigned
 /// integers, floats.
-fn is_real_kind(kind: u8) -> bool {
+pub(crate) fn is_real_kind(kind: u8) -> bool {
     matches!(kind, b'b' | b'i' | b'u' | b'f')
 }
 
@@ -217,24 +134,9 @@ pub fn vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> 
     Ok(v.iter().copied().collect())
 }
 
-/// The index of the first non-finite entry, as `InputError` naming `what`.
-fn check_finite(what: &str, v: &[f64]) -> PyResult<()> {
-    match v.iter().position(|x| !x.is_finite()) {
-        Some(i) => Err(InputError::new_err(format!("{what}[{i}] is not finite"))),
-        None => Ok(()),
-    }
-}
-
-/// [`vector`] whose entries must all be finite.
-pub fn finite_vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> {
-    let v = vector(o, what, n)?;
-    check_finite(what, &v)?;
-    Ok(v)
-}
-
-/// A finite 6-vector (wrench or pose change).
+/// A 6-vector (wrench or pose change).
 pub fn vector6(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector6> {
-    Ok(Vector6::from_column_slice(&finite_vector(o, what, 6)?))
+    Ok(Vector6::from_column_slice(&vector(o, what, 6)?))
 }
 
 /// `o` as a 2-D float array; `rows`/`cols` fix a dimension (`None`: any). The message shows
@@ -316,26 +218,13 @@ pub fn batch_pair<'py>(
     Ok((n, x, y))
 }
 
-/// Checks that every entry of a matrix is finite; names the first one that is not.
-pub fn check_finite_matrix(what: &str, m: &ArrayView2<'_, f64>) -> PyResult<()> {
-    for ((i, j), v) in m.indexed_iter() {
-        if !v.is_finite() {
-            return Err(InputError::new_err(format!(
-                "{what}[{i}, {j}] (row {i}) is not finite"
-            )));
-        }
-    }
-    Ok(())
-}
-
-/// A finite `R x C` matrix as a nalgebra matrix.
+/// An `R x C` matrix as a nalgebra matrix.
 pub fn fixed_matrix<const R: usize, const C: usize>(
     o: &Bound<'_, PyAny>,
     what: &str,
 ) -> PyResult<nalgebra::SMatrix<f64, R, C>> {
     let a = matrix(o, what, Some(R), Some(C))?;
     let v = a.as_array();
-    check_finite_matrix(what, &v)?;
     let mut m = nalgebra::SMatrix::<f64, R, C>::zeros();
     for ((i, j), x) in v.indexed_iter() {
         if let Some(dst) = m.get_mut((i, j)) {
@@ -438,126 +327,4 @@ pub fn indices(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<usize>> {
             }
         })
         .collect()
-}
-
-/// A real scalar: a Python int or float, a numpy real scalar or 0-d array, or an object with
-/// `__float__`. Complex numbers, strings, arrays and integers too large for a float are an
-/// `InputError` naming `what`. NaN and infinities pass (the core call names them).
-pub fn real(o: &Bound<'_, PyAny>, what: &str) -> PyResult<f64> {
-    if let Ok(f) = o.cast::<PyFloat>() {
-        return Ok(f.value());
-    }
-    if o.is_instance_of::<PyInt>() {
-        return o.extract::<f64>().map_err(|_| {
-            InputError::new_err(format!("{what} = {} is too large for a float", short(o)))
-        });
-    }
-    let refuse = || {
-        InputError::new_err(format!(
-            "{what}: expected a real number, got {} {}",
-            type_name(o),
-            short(o)
-        ))
-    };
-    let a = asarray(o, what).map_err(|_| refuse())?;
-    if a.ndim() != 0 {
-        return Err(InputError::new_err(format!(
-            "{what}: expected a real number, got an array of shape {}",
-            shape_text(a.shape())
-        )));
-    }
-    match a.dtype().kind() {
-        k if is_real_kind(k) => a.extract::<f64>().map_err(|_| refuse()),
-        // Python objects with __float__ (fractions.Fraction, decimal.Decimal).
-        b'O' => o.extract::<f64>().map_err(|_| refuse()),
-        _ => Err(refuse()),
-    }
-}
-
-/// [`real`], or `None` for Python's None.
-pub fn opt_real(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<f64>> {
-    if o.is_none() {
-        Ok(None)
-    } else {
-        real(o, what).map(Some)
-    }
-}
-
-/// A count (iterations, window, index): a Python or numpy integer >= 0. Negative and huge
-/// integers, floats and anything else are an `InputError` naming `what` (pyo3 would raise
-/// `OverflowError` or `TypeError`); ranges beyond that are checked by the core call.
-pub fn count(o: &Bound<'_, PyAny>, what: &str) -> PyResult<usize> {
-    let index = if o.is_instance_of::<PyInt>() {
-        o.clone()
-    } else {
-        // numpy integers and other objects with __index__; floats have none.
-        o.call_method0("__index__").map_err(|_| {
-            InputError::new_err(format!(
-                "{what}: expected a non-negative integer, got {} {}",
-                type_name(o),
-                short(o)
-            ))
-        })?
-    };
-    if let Ok(n) = index.extract::<usize>() {
-        return Ok(n);
-    }
-    let negative = index.lt(0).unwrap_or(false);
-    Err(InputError::new_err(if negative {
-        format!(
-            "{what} = {} is negative; expected an integer >= 0",
-            short(&index)
-        )
-    } else {
-        format!(
-            "{what} = {} is too large; expected an integer in 0..={}",
-            short(&index),
-            usize::MAX
-        )
-    }))
-}
-
-/// [`count`], or `None` for Python's None.
-pub fn opt_count(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<usize>> {
-    if o.is_none() {
-        Ok(None)
-    } else {
-        count(o, what).map(Some)
-    }
-}
-
-/// A pair of reals (a tuple, list or array of 2), values unchecked.
-pub fn pair(o: &Bound<'_, PyAny>, what: &str) -> PyResult<(f64, f64)> {
-    match vector(o, what, 2)?.as_slice() {
-        &[a, b] => Ok((a, b)),
-        _ => Err(shape_error(what, "(2,)", &[])),
-    }
-}
-
-/// [`pair`], or `None` for Python's None.
-pub fn opt_pair(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<(f64, f64)>> {
-    if o.is_none() {
-        Ok(None)
-    } else {
-        pair(o, what).map(Some)
-    }
-}
-
-/// Three reals (a tuple, list or array of 3), values unchecked.
-pub fn triple(o: &Bound<'_, PyAny>, what: &str) -> PyResult<[f64; 3]> {
-    match vector(o, what, 3)?.as_slice() {
-        &[a, b, c] => Ok([a, b, c]),
-        _ => Err(shape_error(what, "(3,)", &[])),
-    }
-}
-
-/// Three reals (a tuple, list or array of 3), values unchecked; `None` for Python's None.
-pub fn opt_triple(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Option<[f64; 3]>> {
-    if o.is_none() {
-        return Ok(None);
-    }
-    match vector(o, what, 3)?.as_slice() {
-        &[a, b, c] => Ok(Some([a, b, c])),
-        _ => Err(shape_error(what, "(3,)", &[])),
-    }
 }

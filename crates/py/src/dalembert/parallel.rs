@@ -4,7 +4,7 @@
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use deflect_core::compliance_map::ComplianceMap as CoreMap;
-use deflect_core::dalembert::{self, CorrectedTick};
+use deflect_core::dalembert::parallel::{self, Tick};
 use deflect_core::mechanism::ParallelRobot2 as CoreRobot2;
 use deflect_core::{Placement, TickError};
 use nalgebra::Vector2;
@@ -15,18 +15,19 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
+use crate::arrays::vector;
 use crate::compliance_map::ComplianceMap;
-use crate::convert::{build_err, finite_vector, tick_err, tick_err_at};
+use crate::errors::{build_err, tick_err, tick_err_at};
 use crate::mechanism::ParallelRobot2;
 use crate::motion::Trajectory;
 
 /// The corrector of the paper's robot driven by a compliance map (copied in at construction).
-type Model = dalembert::Model<CoreRobot2, CoreMap>;
+type Model = parallel::Model<CoreRobot2, CoreMap>;
 /// Its workspace and last joints (closed-form IK and a map: no buffers).
-type Data = dalembert::Data<(), (), 2>;
+type Data = parallel::Data<(), (), 2>;
 
 fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&finite_vector(a, what, 2)?))
+    Ok(Vector2::from_column_slice(&vector(a, what, 2)?))
 }
 
 /// D'Alembert trajectory correction of the paper's five-bar (Paksoy et al., Fig. 2) from a
@@ -87,7 +88,7 @@ impl DalembertCorrector {
     /// `mechanism` (a `ParallelRobot2`), `mass` m* [kg] (the paper tuned 5 kg); fixed-point
     /// `iterations` (a count) and `tolerance` [m] (finite, >= 0).
     #[new]
-    #[pyo3(signature = (compliance_map, mechanism, mass=dalembert::PAPER_MASS, iterations=0, tolerance=0.0),
+    #[pyo3(signature = (compliance_map, mechanism, mass=parallel::PAPER_MASS, iterations=0, tolerance=0.0),
            text_signature = "(compliance_map, mechanism, mass=5.0, iterations=0, tolerance=0.0)")]
     fn new(
         compliance_map: &Bound<'_, ComplianceMap>,
@@ -160,20 +161,20 @@ impl DalembertCorrector {
         let x = vec2(position, "position")?;
         let a = vec2(acceleration, "acceleration")?;
         let seed = seed.map(|s| vec2(s, "seed")).transpose()?;
-        let t: CorrectedTick<2, 2> = {
+        let t: Tick<2, 2> = {
             let mut data = self.data();
             if let Some(q) = seed {
                 data.set_seed(q);
             }
-            dalembert::step(&self.model, &mut data, &x, &a).map_err(tick_err)?
+            parallel::step(&self.model, &mut data, &x, &a).map_err(tick_err)?
         };
         let d = PyDict::new(py);
         d.set_item("commanded", t.commanded.as_slice().to_pyarray(py))?;
         d.set_item("joints", t.joints.as_slice().to_pyarray(py))?;
-        d.set_item("force", t.force.as_slice().to_pyarray(py))?;
+        d.set_item("force", t.load.as_slice().to_pyarray(py))?;
         d.set_item("displacement", t.displacement.as_slice().to_pyarray(py))?;
         d.set_item("iterations", t.iterations)?;
-        d.set_item("model_status", t.placement.name())?;
+        d.set_item("model_status", t.diagnostics.placement.name())?;
         Ok(d)
     }
 
@@ -198,17 +199,17 @@ impl DalembertCorrector {
             for (i, (prow, arow)) in inputs.enumerate() {
                 let x = Vector2::from_iterator(prow.iter().copied());
                 let a = Vector2::from_iterator(arow.iter().copied());
-                let t = dalembert::step(&self.model, &mut data, &x, &a).map_err(|e| (i, e))?;
+                let t = parallel::step(&self.model, &mut data, &x, &a).map_err(|e| (i, e))?;
                 for (arr, v) in
                     out.iter_mut()
-                        .zip([t.desired, t.commanded, t.joints, t.force, t.displacement])
+                        .zip([t.desired, t.commanded, t.joints, t.load, t.displacement])
                 {
                     arr.row_mut(i)
                         .iter_mut()
                         .zip(v.iter())
                         .for_each(|(d, s)| *d = *s);
                 }
-                if t.placement != Placement::Inside {
+                if t.diagnostics.placement != Placement::Inside {
                     flagged.push(i);
                 }
             }

@@ -3,11 +3,10 @@
 
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
-use deflect_core::dalembert::serial::{
-    self, Deflection, Payload, SerialData, SerialModel, SerialTick,
-};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::mechanism::pose_ik::PoseIkOptions;
 use deflect_core::motion::PoseState;
+use deflect_core::vjm::Deflection;
 use deflect_core::vjm::Vector6;
 use nalgebra::{Matrix3, Vector3};
 use numpy::ndarray::{Array1, Array2, Array3};
@@ -17,10 +16,8 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::convert::{
-    build_err, fixed_matrix, float_array, iso_to_py, matrix, put_pose, tick_err, tick_err_at,
-    vector, vector6,
-};
+use crate::arrays::{fixed_matrix, float_array, iso_to_py, matrix, put_pose, vector, vector6};
+use crate::errors::{build_err, tick_err, tick_err_at};
 use crate::pose_motion::{PoseTrajectory, pose_ticks};
 use crate::vjm::SerialRobot;
 
@@ -61,16 +58,16 @@ fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct SerialDalembertCorrector {
-    model: SerialModel,
+    model: serial::Model,
     /// The tick state (the last joints, the next IK seed), locked per call.
-    data: Mutex<SerialData>,
+    data: Mutex<serial::Data>,
     joint_names: Vec<String>,
     /// The constructor's arguments, as validated, for pickling.
     config: Py<pyo3::types::PyTuple>,
 }
 
 impl SerialDalembertCorrector {
-    fn data(&self) -> MutexGuard<'_, SerialData> {
+    fn data(&self) -> MutexGuard<'_, serial::Data> {
         // A poisoned lock only means another call failed mid-tick; the data stays valid.
         self.data.lock().unwrap_or_else(PoisonError::into_inner)
     }
@@ -103,17 +100,17 @@ pub struct CorrectedPoses {
     orientation_error: Py<PyArray1<f64>>,
 }
 
-fn tick_dict<'py>(py: Python<'py>, t: &SerialTick, dof: usize) -> PyResult<Bound<'py, PyDict>> {
+fn tick_dict<'py>(py: Python<'py>, t: &serial::Tick, dof: usize) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("desired", iso_to_py(py, &t.desired))?;
     d.set_item("commanded", iso_to_py(py, &t.commanded))?;
     d.set_item("joints", t.joints.get(..dof).unwrap_or(&[]).to_pyarray(py))?;
-    d.set_item("wrench", t.wrench.as_slice().to_pyarray(py))?;
-    d.set_item("deflection", t.deflection.as_slice().to_pyarray(py))?;
+    d.set_item("wrench", t.load.as_slice().to_pyarray(py))?;
+    d.set_item("deflection", t.displacement.as_slice().to_pyarray(py))?;
     d.set_item("iterations", t.iterations)?;
-    d.set_item("position_error", t.position_error)?;
-    d.set_item("orientation_error", t.orientation_error)?;
-    d.set_item("sigma_min", t.sigma_min)?;
+    d.set_item("position_error", t.diagnostics.position_error)?;
+    d.set_item("orientation_error", t.diagnostics.orientation_error)?;
+    d.set_item("sigma_min", t.diagnostics.sigma_min)?;
     Ok(d)
 }
 
@@ -178,7 +175,7 @@ impl SerialDalembertCorrector {
             ..PoseIkOptions::default()
         };
         let g = vec3(gravity, "gravity")?;
-        let model = SerialModel::new(chain, payload)
+        let model = serial::Model::new(chain, payload)
             .and_then(|m| m.with_joint_limits(&limits))
             .and_then(|m| m.with_ik_options(ik))
             .map(|m| {
@@ -187,7 +184,7 @@ impl SerialDalembertCorrector {
             })
             .and_then(|m| m.with_gravity(g))
             .map_err(build_err)?;
-        let mut data = SerialData::new(&model);
+        let mut data = serial::Data::new(&model);
         let seed = match seed {
             Some(s) => {
                 let q = vector(s, "seed", dof)?;
@@ -309,7 +306,7 @@ impl SerialDalembertCorrector {
         let _ = t;
         let state = PoseState {
             t: 0.0,
-            pose: crate::convert::pose(pose, "pose")?,
+            pose: crate::arrays::pose(pose, "pose")?,
             velocity: vec3(velocity, "velocity")?,
             acceleration: vec3(acceleration, "acceleration")?,
             angular_velocity: vec3(angular_velocity, "angular_velocity")?,
@@ -385,8 +382,8 @@ impl SerialDalembertCorrector {
                 put_pose(&mut commanded, i, &tick.commanded);
                 for (arr, v) in [
                     (&mut joints, tick.joints.get(..dof).unwrap_or(&[])),
-                    (&mut wrench, tick.wrench.as_slice()),
-                    (&mut deflection, tick.deflection.as_slice()),
+                    (&mut wrench, tick.load.as_slice()),
+                    (&mut deflection, tick.displacement.as_slice()),
                 ] {
                     arr.row_mut(i).iter_mut().zip(v).for_each(|(d, x)| *d = *x);
                 }
@@ -394,10 +391,10 @@ impl SerialDalembertCorrector {
                     *x = u32::try_from(tick.iterations).unwrap_or(u32::MAX);
                 }
                 if let Some(x) = pos_err.get_mut(i) {
-                    *x = tick.position_error;
+                    *x = tick.diagnostics.position_error;
                 }
                 if let Some(x) = ori_err.get_mut(i) {
-                    *x = tick.orientation_error;
+                    *x = tick.diagnostics.orientation_error;
                 }
             }
             Ok((
