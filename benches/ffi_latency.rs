@@ -101,7 +101,16 @@ fn main() {
     let mut qk = KR300_MILLING_POSE;
     deflect_tests::latency_report("rust: vjm::deflection (KR 300)", n, None, |i| {
         qk[0] = 1e-6 * (i % 1000) as f64;
-        black_box(vjm::deflection(&robot.model, &mut data, black_box(&qk), &w, vjm::Load::Exact).ok());
+        black_box(
+            vjm::deflection(
+                &robot.model,
+                &mut data,
+                black_box(&qk),
+                &w,
+                vjm::Load::Exact,
+            )
+            .ok(),
+        );
     });
     let mut crobot = ptr::null_mut();
     let (urdf, toml) = (

@@ -56,7 +56,9 @@ fn main() {
             // Tick-by-tick sampling at 2 kHz, wrapping around the 375 ms motion.
             let t = (i as f64 / 2000.0) % period;
             let s = traj.sample(black_box(t)).expect("in range");
-            if let Ok(tick) = dalembert::parallel::step(&corr, &mut data, &s.position, &s.acceleration) {
+            if let Ok(tick) =
+                dalembert::parallel::step(&corr, &mut data, &s.position, &s.acceleration)
+            {
                 black_box(tick.joints);
             }
         });
@@ -169,22 +171,34 @@ fn main() {
         .and_then(|m| m.with_fixed_point(dalembert::parallel::MAX_FIXED_POINT_ITERATIONS, 1e-9))
         .expect("valid corrector");
     let mut gdata = dalembert::parallel::Data::new(&generic);
-    gdata.set_seed(nalgebra::SVector::<f64, 6>::from_row_slice(&KR300_MILLING_POSE));
+    gdata.set_seed(nalgebra::SVector::<f64, 6>::from_row_slice(
+        &KR300_MILLING_POSE,
+    ));
     let forth_and_back = |i: usize| {
         let k = i % (2 * count);
         if k < count { k } else { 2 * count - 1 - k }
     };
-    latency_report("serial 6-D tick (KR 300, point mass)", n / 10, Some(budget), |i| {
-        let s = &states[forth_and_back(i)];
-        if let Ok(tick) = serial::step(&point, &mut pdata, black_box(s), None) {
-            black_box(tick.joints);
-        }
-    });
-    latency_report("generic 3-D tick (KR 300, point mass)", n / 10, Some(budget), |i| {
-        let s = &states[forth_and_back(i)];
-        let (x, a) = (s.pose.translation.vector, s.acceleration);
-        if let Ok(tick) = dalembert::parallel::step(&generic, &mut gdata, black_box(&x), &a) {
-            black_box(tick.joints);
-        }
-    });
+    latency_report(
+        "serial 6-D tick (KR 300, point mass)",
+        n / 10,
+        Some(budget),
+        |i| {
+            let s = &states[forth_and_back(i)];
+            if let Ok(tick) = serial::step(&point, &mut pdata, black_box(s), None) {
+                black_box(tick.joints);
+            }
+        },
+    );
+    latency_report(
+        "generic 3-D tick (KR 300, point mass)",
+        n / 10,
+        Some(budget),
+        |i| {
+            let s = &states[forth_and_back(i)];
+            let (x, a) = (s.pose.translation.vector, s.acceleration);
+            if let Ok(tick) = dalembert::parallel::step(&generic, &mut gdata, black_box(&x), &a) {
+                black_box(tick.joints);
+            }
+        },
+    );
 }

@@ -18,7 +18,15 @@ fn bench(c: &mut Criterion) {
         b.iter(|| vjm::forward(model, &mut data, black_box(&q)))
     });
     g.bench_function("deflection", |b| {
-        b.iter(|| vjm::deflection(model, &mut data, black_box(&q), black_box(&w), vjm::Load::Exact))
+        b.iter(|| {
+            vjm::deflection(
+                model,
+                &mut data,
+                black_box(&q),
+                black_box(&w),
+                vjm::Load::Exact,
+            )
+        })
     });
     g.bench_function("compliance", |b| {
         b.iter(|| vjm::compliance(model, &mut data, black_box(&q)))

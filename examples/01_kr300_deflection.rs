@@ -53,7 +53,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("546 N milling (xy)", MILLING_WRENCH),
     ];
     for (name, w) in loads {
-        let d = vjm::deflection(model, &mut data, &q, &Vector6::from_row_slice(&w), vjm::Load::Exact)?;
+        let d = vjm::deflection(
+            model,
+            &mut data,
+            &q,
+            &Vector6::from_row_slice(&w),
+            vjm::Load::Exact,
+        )?;
         let dp = d.fixed_rows::<3>(0) * 1e3;
         let dr = d.fixed_rows::<3>(3) * 1e3;
         println!(

@@ -54,7 +54,8 @@ fn serial_arm_corrected_with_its_virtual_joint_model() {
         // The loaded arm commanded to `joints` puts its TCP on the desired point.
         let mut data = vjm::Data::new(&model);
         let w = vjm::Vector6::new(t.load.x, t.load.y, t.load.z, 0.0, 0.0, 0.0);
-        let d = vjm::deflection(&model, &mut data, t.joints.as_slice(), &w, vjm::Load::Exact).unwrap();
+        let d =
+            vjm::deflection(&model, &mut data, t.joints.as_slice(), &w, vjm::Load::Exact).unwrap();
         let reached = data.tcp.translation.vector + Vector3::new(d[0], d[1], d[2]);
         worst = worst.max((reached - t.desired).norm());
         largest = largest.max(t.displacement.norm());

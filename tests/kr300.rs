@@ -32,7 +32,9 @@ fn kr300_milling_deflection_is_in_the_papers_range() {
         &r.model,
         &mut data,
         &q,
-        &Vector6::from_row_slice(&MILLING_WRENCH), vjm::Load::Exact)
+        &Vector6::from_row_slice(&MILLING_WRENCH),
+        vjm::Load::Exact,
+    )
     .unwrap();
     let dp = d.fixed_rows::<3>(0).norm();
     // The paper measured up to 1.4 mm at 546 N; our data-sheet geometry and end effector
@@ -63,7 +65,14 @@ fn kr300_validation_loads() {
     .iter()
     .enumerate()
     {
-        let d = vjm::deflection(&r.model, &mut data, &q, &Vector6::from_row_slice(f), vjm::Load::Exact).unwrap();
+        let d = vjm::deflection(
+            &r.model,
+            &mut data,
+            &q,
+            &Vector6::from_row_slice(f),
+            vjm::Load::Exact,
+        )
+        .unwrap();
         mm[i] = d.fixed_rows::<3>(0).norm() * 1e3;
     }
     assert_relative_eq!(mm[0], 1.698, max_relative = 2e-3);

@@ -6,7 +6,7 @@ use deflect_core::compliance_map::{
     self, ComplianceMap, FitOptions, HoldOutAxis, Interpolation, Measurement, OutOfGrid,
     QueryOptions,
 };
-use deflect_core::dalembert;
+use deflect_core::dalembert::parallel;
 use deflect_core::mechanism::ParallelRobot2;
 use deflect_core::motion::{Trajectory, paper_limits};
 use nalgebra::{Vector2, Vector3};
@@ -349,7 +349,7 @@ pub struct RunOptions {
 impl Default for RunOptions {
     fn default() -> Self {
         Self {
-            mass: dalembert::PAPER_MASS,
+            mass: parallel::PAPER_MASS,
             fixed_point: 0,
             tail: 0.05,
         }
@@ -379,9 +379,9 @@ pub fn run(
     let mut corrector = match map {
         Some(m) => {
             let view = m.view().with_options(map_options());
-            let model = dalembert::Model::new(mech, view, opts.mass)?
+            let model = parallel::Model::new(mech, view, opts.mass)?
                 .with_fixed_point(opts.fixed_point, 1e-9)?;
-            let data = dalembert::Data::new(&model);
+            let data = parallel::Data::new(&model);
             Some((model, data))
         }
         None => None,
@@ -398,8 +398,8 @@ pub fn run(
         let (commanded, force, q) = match corrector.as_mut() {
             Some((model, data)) => {
                 data.set_seed(q_prev);
-                let tick = dalembert::step(model, data, &desired, &state.acceleration)?;
-                (tick.commanded, tick.force, tick.joints)
+                let tick = parallel::step(model, data, &desired, &state.acceleration)?;
+                (tick.commanded, tick.load, tick.joints)
             }
             None => (desired, -opts.mass * state.acceleration, mech.ik(&desired)?),
         };

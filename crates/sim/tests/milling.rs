@@ -69,10 +69,12 @@ fn the_sensor_frame_and_the_rebuilt_model_follow_the_urdf() {
     let q = [0.2, -0.8, 1.3, 0.4, 1.0, -0.3];
     let w = Vector6::new(-386.1, 386.1, -60.0, 5.0, -3.0, 2.0);
     let model = arm.model();
-    let d0 = vjm::deflection(model, &mut Data::new(model), &q, &w, vjm::Load::Exact).expect("deflection");
+    let d0 = vjm::deflection(model, &mut Data::new(model), &q, &w, vjm::Load::Exact)
+        .expect("deflection");
     // The same stiffnesses: the same deflection, bit for bit.
     let same = arm.model_with(&[]).expect("model");
-    let d1 = vjm::deflection(&same, &mut Data::new(&same), &q, &w, vjm::Load::Exact).expect("deflection");
+    let d1 = vjm::deflection(&same, &mut Data::new(&same), &q, &w, vjm::Load::Exact)
+        .expect("deflection");
     assert_eq!(d0, d1);
     // The spindle twice as stiff about y (67 -> 134 kN m/rad): its share halves, nothing else
     // changes; the share is the difference against the spindle made rigid about y.
@@ -85,8 +87,10 @@ fn the_sensor_frame_and_the_rebuilt_model_follow_the_urdf() {
         .model_with(&[(spindle.index, 1, 2.0 * spindle.k[1])])
         .expect("model");
     let rigid = arm.model_with(&[(spindle.index, 1, 1e30)]).expect("model");
-    let ds = vjm::deflection(&stiff, &mut Data::new(&stiff), &q, &w, vjm::Load::Exact).expect("deflection");
-    let dr = vjm::deflection(&rigid, &mut Data::new(&rigid), &q, &w, vjm::Load::Exact).expect("deflection");
+    let ds = vjm::deflection(&stiff, &mut Data::new(&stiff), &q, &w, vjm::Load::Exact)
+        .expect("deflection");
+    let dr = vjm::deflection(&rigid, &mut Data::new(&rigid), &q, &w, vjm::Load::Exact)
+        .expect("deflection");
     let half = (d0 - dr) * 0.5;
     assert!(
         ((ds - dr) - half).norm() < 1e-3 * half.norm(),

@@ -6,7 +6,7 @@
 use deflect_core::contour::{
     self, TraceDirection, TraceFailure, TracerConfig, TracerState, TracerStats, shape,
 };
-use deflect_core::drivetrain::{self, cartesian_stiffness_xy, correct_joints};
+use deflect_core::drivetrain::{self, cartesian_stiffness_xy};
 use nalgebra::{Vector2, Vector6};
 use serde::Serialize;
 
@@ -268,7 +268,7 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
         if out.contact {
             let p_raw = arm.fk(&q_motor);
             let w = Vector6::new(out.force.x, out.force.y, 0.0, 0.0, 0.0, 0.0);
-            let c = correct_joints(&drive, &mut data, &q_motor, &w).map_err(err)?;
+            let c = drivetrain::step(&drive, &mut data, &q_motor, &w).map_err(err)?;
             let p_comp = arm.fk(&[c.q[0], c.q[1]]);
             sample.raw = Some(arr(&p_raw));
             sample.compensated = Some(arr(&p_comp));

@@ -4,7 +4,7 @@
 //! servo-driven motors), with its force/torque sensor frame, a rigid pose IK for the
 //! commanded path and the virtual-joint model rebuilt with identified stiffnesses.
 
-use deflect_core::dalembert::{self, Payload, SerialData, SerialModel};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::io::urdf;
 use deflect_core::motion::PoseState;
 use deflect_core::vjm::{self, Data, Element, Model, ModelBuilder};
@@ -33,7 +33,7 @@ pub struct MillingArm {
     pub sensor_to_tcp: Isometry3<f64>,
     /// The finite virtual joints, chain order.
     pub springs: Vec<SpringInfo>,
-    rigid: SerialModel,
+    rigid: serial::Model,
 }
 
 /// The transform from link `from` to its descendant `to` through fixed URDF joints.
@@ -95,7 +95,7 @@ impl MillingArm {
                 _ => None,
             })
             .collect();
-        let rigid = SerialModel::new(model.clone(), Payload::point(0.0, Vector3::zeros()))?
+        let rigid = serial::Model::new(model.clone(), Payload::point(0.0, Vector3::zeros()))?
             .with_joint_limits(&spec.robot.joint_limits)?;
         Ok(Self {
             spec,
@@ -121,18 +121,17 @@ impl MillingArm {
     }
 
     /// The workspace of [`Self::ik`], warm-started from joints `seed`.
-    pub fn ik_data(&self, seed: &[f64]) -> SerialData {
-        let mut d = SerialData::new(&self.rigid);
+    pub fn ik_data(&self, seed: &[f64]) -> serial::Data {
+        let mut d = serial::Data::new(&self.rigid);
         d.set_seed(seed);
         d
     }
 
     /// Joints that put the rigid TCP on `pose` (damped-least-squares pose IK, warm-started
     /// from the last solution in `data`, within the joint limits).
-    pub fn ik(&self, data: &mut SerialData, pose: &Isometry3<f64>) -> Result<Vec<f64>, SimError> {
-        let tick =
-            dalembert::serial::step(&self.rigid, data, &PoseState::at_rest(0.0, *pose), None)
-                .map_err(|e| SimError::new(format!("milling IK: {e}")))?;
+    pub fn ik(&self, data: &mut serial::Data, pose: &Isometry3<f64>) -> Result<Vec<f64>, SimError> {
+        let tick = serial::step(&self.rigid, data, &PoseState::at_rest(0.0, *pose), None)
+            .map_err(|e| SimError::new(format!("milling IK: {e}")))?;
         Ok(tick.joints.iter().take(self.dof()).copied().collect())
     }
 

@@ -5,8 +5,9 @@
 
 use std::path::Path;
 
-use deflect_core::dalembert::{Deflection, Payload};
+use deflect_core::dalembert::serial::Payload;
 use deflect_core::io::{stiffness, urdf};
+use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data};
 use deflect_sim::SimError;
 use deflect_sim::serial_scene::{self, MotionParams, SerialOptions, output};

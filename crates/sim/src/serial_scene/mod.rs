@@ -13,8 +13,9 @@
 pub mod motion;
 pub mod output;
 
-use deflect_core::dalembert::{self, Deflection, Payload, SerialData, SerialModel};
+use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::PoseState;
+use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::Isometry3;
 use serde::Serialize;
@@ -43,7 +44,7 @@ pub struct SerialOptions {
     #[serde(serialize_with = "deflection_json")]
     pub model: Deflection,
     /// Whether the corrector also cancels the links' own inertial loads (deflect-core's
-    /// `SerialModel::with_link_inertia`), from the URDF's inertials; off, only the payload's.
+    /// `serial::Model::with_link_inertia`), from the URDF's inertials; off, only the payload's.
     pub link_inertia: bool,
 }
 
@@ -189,17 +190,18 @@ pub fn plan(
 pub fn check_motions(spec: &ArmSpec, opts: &SerialOptions) -> Result<(), SimError> {
     let model = &spec.robot.model;
     let start = vjm::forward(model, &mut Data::new(model), &opts.q0)?;
-    let rigid = SerialModel::new(
+    let rigid = serial::Model::new(
         model.clone(),
         Payload::point(0.0, nalgebra::Vector3::zeros()),
     )?
     .with_joint_limits(&spec.robot.joint_limits)?;
     for path in [PathKind::Line, PathKind::Circle] {
         let states = plan(path, &start, &opts.motion, 1.0 / opts.servo.dt)?;
-        let mut data = SerialData::new(&rigid);
+        let mut data = serial::Data::new(&rigid);
         data.set_seed(&opts.q0);
         for (k, s) in states.iter().enumerate() {
-            dalembert::serial::step(&rigid, &mut data, s, None).map_err(|e| {
+            // Only reachability is checked here: the tick itself is not needed.
+            let _reachable = serial::step(&rigid, &mut data, s, None).map_err(|e| {
                 SimError::new(format!(
                     "{} at t = {:.3} s (tick {k}): {e}",
                     path.label(),
@@ -229,11 +231,11 @@ pub fn run(
     } else {
         Payload::point(0.0, nalgebra::Vector3::zeros())
     };
-    let corrector = SerialModel::new(model.clone(), payload)?
+    let corrector = serial::Model::new(model.clone(), payload)?
         .with_joint_limits(&spec.robot.joint_limits)?
         .with_deflection(opts.model)
         .with_link_inertia(corrected && opts.link_inertia);
-    let mut data = SerialData::new(&corrector);
+    let mut data = serial::Data::new(&corrector);
     data.set_seed(&opts.q0);
     let mut arm = FlexSerialArm::new(spec, &opts.q0, Some(&opts.payload), &opts.servo, 1.0)?;
     let dof = model.dof();
@@ -252,7 +254,7 @@ pub fn run(
         };
         let tick = match (k < n_motion, last) {
             (false, Some(t)) => t,
-            _ => dalembert::serial::step(&corrector, &mut data, &state, None)
+            _ => serial::step(&corrector, &mut data, &state, None)
                 .map_err(|e| SimError::new(format!("{} tick {k}: {e}", path.label())))?,
         };
         last = Some(tick);
@@ -272,7 +274,7 @@ pub fn run(
         let (q_link, _) = arm.joint_state();
         let c = tick.commanded.translation.vector;
         let w = if corrected {
-            tick.wrench
+            tick.load
         } else {
             Vector6::zeros()
         };

@@ -48,8 +48,8 @@ pub fn table(r: &SerialResult) -> String {
         o.payload.mass,
         o.motion.g,
         match o.model {
-            deflect_core::dalembert::Deflection::Exact => "exact",
-            deflect_core::dalembert::Deflection::Linearized => "linearized",
+            deflect_core::vjm::Deflection::Exact => "exact",
+            deflect_core::vjm::Deflection::Linearized => "linearized",
         },
         if o.link_inertia {
             "payload's and the links' inertial loads"

@@ -21,7 +21,7 @@
 //!   Gravity is off: a robot's static sag under its own weight is calibrated out in practice,
 //!   and the scenarios study inertial and process loads.
 
-use deflect_core::dalembert::Payload;
+use deflect_core::dalembert::serial::Payload;
 use deflect_core::vjm::Vector6;
 use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
 use rapier3d_f64::prelude::*;
