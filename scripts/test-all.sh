@@ -20,6 +20,11 @@ cargo build -p deflect-core --no-default-features --quiet
 # ... and its per-tick paths must work from a #![no_std] crate without alloc. Build that crate
 # alone: built with the workspace, cargo unifies deflect-core's features and proves nothing.
 cargo build -p deflect-nostd-check --quiet
+# ... and for an embedded target (Cortex-M4F/M7, hard float), the core and the crate that uses
+# its per-tick paths without std or alloc: what links into a controller's firmware.
+rustup target add thumbv7em-none-eabihf
+cargo build -p deflect-core --no-default-features --target thumbv7em-none-eabihf --quiet
+cargo build -p deflect-nostd-check --target thumbv7em-none-eabihf --quiet
 # No std/alloc feature may reach nalgebra or deflect-core in that build (normal edges only:
 # deflect-core's dev-dependencies enable nalgebra/std for its own tests).
 if cargo tree -p deflect-nostd-check -e normal,features \
@@ -27,6 +32,11 @@ if cargo tree -p deflect-nostd-check -e normal,features \
   echo "error: the no_std build of deflect-core enables std/alloc" >&2
   exit 1
 fi
+# The declared rust-version (workspace Cargo.toml) is the oldest toolchain that compiles every
+# crate, all targets: checked with that toolchain (its own target directory).
+MSRV=$(sed -n 's/^rust-version = "\(.*\)"/\1/p' Cargo.toml)
+rustup toolchain install "$MSRV" --profile minimal
+CARGO_TARGET_DIR=target/msrv cargo +"$MSRV" check --workspace --all-targets --quiet
 # Benchmarks must keep compiling (they are run by hand, not timed here).
 cargo bench --workspace --no-run --quiet
 # The numbered examples run (built-in defaults), each next to its Python twin below.

@@ -2,12 +2,13 @@
 //! control, projection onto the plane normal to the feed, axis-specific output) allocate
 //! nothing: a counting global allocator watches them. One test function only.
 
+use deflect_core::TickError;
 use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
 use deflect_core::vjm::{self, Vector6};
-use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Vector3};
 
 mod common;
+mod fixtures;
 
 #[global_allocator]
 static GLOBAL: common::Counting = common::Counting;
@@ -17,26 +18,7 @@ fn compensation_cycles_do_not_allocate() {
     common::watch_this_thread();
     common::assert_counter_works();
     // A 6R chain with a compliant virtual joint after every axis.
-    let mut b = ModelBuilder::new();
-    for (i, axis) in [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        b = b
-            .revolute(axis)
-            .unwrap()
-            .spring([3.0e6, 2.0e6, 1.0e6])
-            .unwrap()
-            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
-            .unwrap();
-    }
+    let b = fixtures::six_r(fixtures::Link::Spring([3.0e6, 2.0e6, 1.0e6]));
     let chain = b.build().unwrap();
     let dt = 0.004;
     let cal = SensorCalibration {

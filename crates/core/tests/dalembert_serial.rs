@@ -10,17 +10,9 @@ use deflect_core::vjm::{self, Data, Vector6};
 use deflect_core::{SerialRobot, TickError};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
-const Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+mod fixtures;
 
-fn kr300() -> SerialRobot {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
-    SerialRobot::from_path(
-        format!("{dir}kr300_r2500.urdf"),
-        format!("{dir}kr300_r2500_stiffness.toml"),
-        "tcp",
-    )
-    .unwrap()
-}
+const Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
 
 fn payload() -> Payload {
     Payload {
@@ -46,7 +38,7 @@ fn motion(robot: &SerialRobot) -> PoseTrajectory {
 
 #[test]
 fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     // The payload alone, as the paper's D'Alembert force: the link masses left out.
     let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
@@ -88,7 +80,7 @@ fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
 
 #[test]
 fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     assert_eq!(robot.model.mass_count(), 6);
     let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
@@ -177,7 +169,7 @@ fn inertial_wrench_by_hand() {
 
 #[test]
 fn failures_are_statuses() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let tight: Vec<(f64, f64)> = Q0.iter().map(|q| (q - 1e-6, q + 1e-6)).collect();
     let model = serial::Model::new(robot.model.clone(), payload())
         .unwrap()
@@ -221,7 +213,7 @@ fn failures_are_statuses() {
 
 #[test]
 fn rigid_pose_ik_round_trips() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let mut data = Data::new(&robot.model);
     let target = vjm::forward(&robot.model, &mut data, &Q0).unwrap();
     let seed = [0.05, -0.85, 1.35, 0.05, 1.0, -0.05];

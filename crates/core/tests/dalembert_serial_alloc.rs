@@ -2,7 +2,6 @@
 //! and linearized loaded-pose IK over 3000 ticks (three passes) under a counting global allocator (one test
 //! function only).
 
-use deflect_core::SerialRobot;
 use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::{Limits, PoseLimits, PoseTrajectory};
 use deflect_core::vjm::Deflection;
@@ -10,6 +9,7 @@ use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::{Isometry3, Matrix3, Translation3, UnitQuaternion, Vector3};
 
 mod common;
+mod fixtures;
 
 #[global_allocator]
 static GLOBAL: common::Counting = common::Counting;
@@ -18,13 +18,7 @@ const Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
 
 #[test]
 fn serial_corrector_ticks_do_not_allocate() {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
-    let robot = SerialRobot::from_path(
-        format!("{dir}kr300_r2500.urdf"),
-        format!("{dir}kr300_r2500_stiffness.toml"),
-        "tcp",
-    )
-    .unwrap();
+    let robot = fixtures::kr300();
     let start = vjm::forward(&robot.model, &mut Data::new(&robot.model), &Q0).unwrap();
     let end = Isometry3::from_parts(
         Translation3::from(start.translation.vector + Vector3::new(0.1, 0.3, -0.1)),

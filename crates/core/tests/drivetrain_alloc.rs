@@ -11,6 +11,7 @@ use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix2, Vector2, Vector3, Vector6};
 
 mod common;
+mod fixtures;
 
 #[global_allocator]
 static GLOBAL: common::Counting = common::Counting;
@@ -19,24 +20,9 @@ static GLOBAL: common::Counting = common::Counting;
 fn drive_train_and_tracer_do_not_allocate() {
     common::watch_this_thread();
     common::assert_counter_works();
-    let mut b = ModelBuilder::new();
+    let b = fixtures::six_r(fixtures::Link::Rigid);
     let mut masses = LinkMasses::new();
-    for (i, axis) in [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        b = b
-            .revolute(axis)
-            .unwrap()
-            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
-            .unwrap();
+    for i in 0..6 {
         masses
             .push(i, 10.0 - i as f64, Vector3::new(0.1, 0.0, 0.02))
             .unwrap();

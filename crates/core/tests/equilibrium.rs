@@ -5,6 +5,8 @@ use deflect_core::vjm::{self, Data, EquilibriumOptions, Vector6};
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Vector3};
 
+mod fixtures;
+
 /// A 1 m link about z with one spring at the joint, soft (k [N m/rad]) about z.
 fn one_link(k: f64) -> vjm::Model {
     ModelBuilder::new()
@@ -103,27 +105,9 @@ fn zero_load_is_zero_deflection() {
 }
 
 fn six_axis() -> vjm::Model {
-    let mut b = ModelBuilder::new();
-    for (i, axis) in [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        b = b
-            .revolute(axis)
-            .unwrap()
-            .spring([3.0e5, 2.0e5, 1.0e5])
-            .unwrap()
-            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
-            .unwrap();
-    }
-    b.build().unwrap()
+    fixtures::six_r(fixtures::Link::Spring([3.0e5, 2.0e5, 1.0e5]))
+        .build()
+        .unwrap()
 }
 
 #[test]

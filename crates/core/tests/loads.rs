@@ -8,6 +8,8 @@ use deflect_core::vjm::{self, ArmMotion, Data, Vector6};
 use deflect_core::{ModelBuilder, TickError};
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
+mod fixtures;
+
 const INF: f64 = f64::INFINITY;
 
 /// A 1 m link about z, soft about z at the joint (k), with a point mass m at its tip plus a
@@ -106,31 +108,7 @@ fn gravity_gives_the_weight_moment() {
 
 /// A 6-joint arm with springs on every joint and a mass on every link.
 fn six_axis(tip_mass: Option<(f64, Vector3<f64>, Matrix3<f64>)>) -> vjm::Model {
-    let mut b = ModelBuilder::new();
-    let axes = [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ];
-    for (i, axis) in axes.into_iter().enumerate() {
-        let l = 0.3 + 0.1 * i as f64;
-        b = b
-            .revolute(axis)
-            .unwrap()
-            .spring([3.0e5, 2.0e5, 1.0e5])
-            .unwrap()
-            .mass(
-                5.0 + i as f64,
-                Vector3::new(0.5 * l, 0.01, 0.02),
-                Matrix3::from_diagonal(&Vector3::new(0.02, 0.1, 0.1)),
-            )
-            .unwrap()
-            .fixed(Isometry3::translation(l, 0.0, 0.05))
-            .unwrap();
-    }
+    let mut b = fixtures::six_r(fixtures::Link::SpringAndMass([3.0e5, 2.0e5, 1.0e5]));
     if let Some((m, c, i)) = tip_mass {
         b = b.mass(m, c, i).unwrap();
     }

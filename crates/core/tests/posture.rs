@@ -8,20 +8,12 @@ use deflect_core::posture::{self, AnglePoint, Measure, PostureOptions, Reach};
 use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::{Unit, Vector3};
 
+mod fixtures;
+
 const Q0: [f64; 6] = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
 /// The milling wrench of the VJM paper's test (Hähn and Weigold, sec. 3): 386.1 N in -x and
 /// +y, 60 N in -z.
 const WRENCH: [f64; 6] = [-386.1, 386.1, -60.0, 0.0, 0.0, 0.0];
-
-fn kr300() -> SerialRobot {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
-    SerialRobot::from_path(
-        format!("{dir}kr300_r2500.urdf"),
-        format!("{dir}kr300_r2500_stiffness.toml"),
-        "tcp",
-    )
-    .unwrap()
-}
 
 /// The task of the posture Q0: its TCP position and tool (z) axis.
 fn task(robot: &SerialRobot) -> (Vector3<f64>, Vector3<f64>) {
@@ -63,7 +55,7 @@ fn run(
 
 #[test]
 fn the_refined_optimum_agrees_with_a_brute_scan_at_a_tenth_of_a_degree() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let (p, z) = task(&robot);
     let coarse = degrees(-90.0, 90.0, 5.0);
     let (out, s) = run(&robot, &p, &z, &coarse, &PostureOptions::default());
@@ -103,7 +95,7 @@ fn the_refined_optimum_agrees_with_a_brute_scan_at_a_tenth_of_a_degree() {
 
 #[test]
 fn every_posture_reaches_the_task_and_its_deflection_is_the_models() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let (p, z) = task(&robot);
     let (out, _) = run(
         &robot,
@@ -151,7 +143,7 @@ fn measures_by_hand() {
 
 #[test]
 fn unreachable_angles_are_reported_never_as_zeros() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let (_, z) = task(&robot);
     let far = Vector3::new(10.0, 0.0, 1.0);
     let (out, s) = run(
@@ -169,7 +161,7 @@ fn unreachable_angles_are_reported_never_as_zeros() {
     }
     // Joint limits pinned around Q0's wrist: turning the tool needs the wrist, so most
     // angles are refused as joint-limit violations, the original one stays.
-    let mut pinned = kr300();
+    let mut pinned = fixtures::kr300();
     pinned.joint_limits[5] = (Q0[5] - 0.01, Q0[5] + 0.01);
     pinned.joint_limits[3] = (Q0[3] - 0.01, Q0[3] + 0.01);
     let (p, z) = task(&pinned);
@@ -190,7 +182,7 @@ fn unreachable_angles_are_reported_never_as_zeros() {
 
 #[test]
 fn bad_inputs_are_statuses() {
-    let robot = kr300();
+    let robot = fixtures::kr300();
     let (p, z) = task(&robot);
     let mut data = Data::new(&robot.model);
     let w = Vector6::from_column_slice(&WRENCH);

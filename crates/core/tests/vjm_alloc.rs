@@ -1,11 +1,11 @@
 //! The per-call VJM paths allocate nothing: a counting global allocator watches 1e4 calls.
 //! One test function only, so no other test thread allocates meanwhile.
 
+use deflect_core::TickError;
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_core::{ModelBuilder, TickError};
-use nalgebra::{Isometry3, Vector3};
 
 mod common;
+mod fixtures;
 
 #[global_allocator]
 static GLOBAL: common::Counting = common::Counting;
@@ -14,26 +14,7 @@ static GLOBAL: common::Counting = common::Counting;
 fn vjm_calls_do_not_allocate() {
     common::watch_this_thread();
     common::assert_counter_works();
-    let mut b = ModelBuilder::new();
-    for (i, axis) in [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ]
-    .into_iter()
-    .enumerate()
-    {
-        b = b
-            .revolute(axis)
-            .unwrap()
-            .spring([3.0e6, 3.0e6, 1.0e6])
-            .unwrap()
-            .fixed(Isometry3::translation(0.3 + 0.1 * i as f64, 0.0, 0.05))
-            .unwrap();
-    }
+    let b = fixtures::six_r(fixtures::Link::Spring([3.0e6, 3.0e6, 1.0e6]));
     let model = b.build().unwrap();
     let mut data = Data::new(&model);
     let wrench = Vector6::new(300.0, -200.0, -500.0, 10.0, 0.0, -5.0);
