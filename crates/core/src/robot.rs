@@ -1,5 +1,6 @@
 //! A serial robot loaded from files: the real-time virtual-joint [`Model`] plus the names that
-//! tie it back to its URDF. Loaders: [`crate::io::urdf`] and [`crate::io::stiffness`].
+//! tie it back to its URDF. Loaders: [`crate::io::urdf`] (which also gives
+//! `SerialRobot::from_path` and `from_str`) and [`crate::io::stiffness`].
 
 use std::string::String;
 use std::vec::Vec;
@@ -23,43 +24,4 @@ pub struct SerialRobot {
     pub base_link: String,
     /// The chain's tip (TCP) link.
     pub tip_link: String,
-}
-
-#[cfg(feature = "urdf")]
-impl SerialRobot {
-    /// Loads a URDF file and a stiffness TOML file; the chain runs from the URDF's root link
-    /// to `tip_link` ([`crate::io::urdf::from_path`] also takes a base link).
-    ///
-    /// ```
-    /// use deflect_core::SerialRobot;
-    /// use deflect_core::vjm::{self, Data, Vector6};
-    /// let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
-    /// let robot = SerialRobot::from_path(
-    ///     format!("{dir}kr300_r2500.urdf"), format!("{dir}kr300_r2500_stiffness.toml"), "tcp")?;
-    /// let mut data = Data::new(&robot.model);
-    /// let q = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
-    /// // 750 N along +x at the TCP pushes it about 1.7 mm along x.
-    /// let w = Vector6::new(750.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-    /// let d = vjm::deflection(&robot.model, &mut data, &q, &w, vjm::Load::Exact)?;
-    /// assert!((d.x - 1.693e-3).abs() < 1e-5);
-    /// # Ok::<(), Box<dyn std::error::Error>>(())
-    /// ```
-    pub fn from_path(
-        urdf_path: impl AsRef<std::path::Path>,
-        stiffness_path: impl AsRef<std::path::Path>,
-        tip_link: &str,
-    ) -> Result<Self, crate::LoadError> {
-        crate::io::urdf::from_path(urdf_path, stiffness_path, None, tip_link)
-    }
-
-    /// Loads from URDF and stiffness TOML texts; `base_link` defaults to the URDF's root.
-    /// See [`crate::io::urdf::from_str`].
-    pub fn from_str(
-        urdf: &str,
-        stiffness: &str,
-        base_link: Option<&str>,
-        tip_link: &str,
-    ) -> Result<Self, crate::LoadError> {
-        crate::io::urdf::from_str(urdf, stiffness, base_link, tip_link)
-    }
 }

@@ -52,7 +52,11 @@ fn serial_corrector_ticks_do_not_allocate() {
     while ticks < 3_000 {
         for k in 0..n {
             // Forth and back, so the warm start follows a continuous path.
-            let k = if (ticks / n) % 2 == 0 { k } else { n - 1 - k };
+            let k = if (ticks / n).is_multiple_of(2) {
+                k
+            } else {
+                n - 1 - k
+            };
             let s = motion.sample(motion.tick_time(2000.0, k, n)).unwrap();
             let a = serial::step(&exact, &mut de, &s, None).unwrap();
             let b = serial::step(&linear, &mut dl, &s, Some(&process)).unwrap();

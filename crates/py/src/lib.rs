@@ -1,7 +1,7 @@
-//! Python bindings of deflect: thin wrappers that convert numpy arrays ([`arrays`]) and
-//! scalars ([`scalars`], [`args`]), call deflect-core (which validates every value) and map
-//! its errors onto one exception tree rooted in `ValueError` ([`errors`]). Batches run on
-//! every core through one runner ([`batch`]).
+//! Python bindings of deflect: thin wrappers that convert numpy arrays (`arrays`) and
+//! scalars (`scalars`, `args`), call deflect-core (which validates every value) and map its
+//! errors onto one exception tree rooted in `ValueError` (`errors`). Batches run on every
+//! core through one runner (`batch`).
 // Bindings must not crash the interpreter: errors become Python exceptions.
 #![deny(
     clippy::unwrap_used,

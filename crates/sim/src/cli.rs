@@ -212,12 +212,12 @@ impl SerialArgs {
         }
         RAMP.check(self.ramp)?;
         TURN.check(self.turn)?;
-        if let Some(q) = &self.q0 {
-            if let Some((i, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(CliError::Usage(format!(
-                    "--q0: joint {i} is {v}: expected a finite angle [rad]"
-                )));
-            }
+        if let Some(q) = &self.q0
+            && let Some((i, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite())
+        {
+            return Err(CliError::Usage(format!(
+                "--q0: joint {i} is {v}: expected a finite angle [rad]"
+            )));
         }
         JOBS.check_int(count(self.jobs))
     }

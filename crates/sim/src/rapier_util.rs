@@ -73,20 +73,20 @@ pub fn set_spring(
     stiffness: f64,
     rest: f64,
 ) {
-    if let Some((mb, id)) = world.multibody_joints.get_mut(joint) {
-        if let Some(link) = mb.link_mut(id) {
-            link.joint.set_spring(axis, stiffness, rest);
-        }
+    if let Some((mb, id)) = world.multibody_joints.get_mut(joint)
+        && let Some(link) = mb.link_mut(id)
+    {
+        link.joint.set_spring(axis, stiffness, rest);
     }
 }
 
 /// Sets the generalized damping of the last degree of freedom of the multibody that holds
 /// `joint`: the joint's own when it was the last one inserted and has one degree of freedom.
 pub fn set_last_dof_damping(world: &mut PhysicsWorld, joint: MultibodyJointHandle, damping: f64) {
-    if let Some((mb, _)) = world.multibody_joints.get_mut(joint) {
-        if let Some(d) = mb.damping_mut().iter_mut().last() {
-            *d = damping;
-        }
+    if let Some((mb, _)) = world.multibody_joints.get_mut(joint)
+        && let Some(d) = mb.damping_mut().iter_mut().last()
+    {
+        *d = damping;
     }
 }
 

@@ -72,7 +72,7 @@ pub fn leave_one_node_out(
 ) -> Result<CrossValidation, BuildError> {
     let (nx, ny) = (map.x().len(), map.y().len());
     let (nf, nd) = (map.n_force(), map.n_displacement());
-    if forces.is_empty() || forces.len() % nf != 0 {
+    if forces.is_empty() || !forces.len().is_multiple_of(nf) {
         return Err(BuildError::WrongLength {
             what: "forces",
             expected: nf,

@@ -326,13 +326,13 @@ pub fn fit(
             .then(a.cmp(b))
     });
     for w in order.windows(2) {
-        if let [a, b] = w {
-            if key(*a) == key(*b) {
-                return Err(BuildError::DuplicateMeasurement {
-                    row: *b,
-                    previous_row: *a,
-                });
-            }
+        if let [a, b] = w
+            && key(*a) == key(*b)
+        {
+            return Err(BuildError::DuplicateMeasurement {
+                row: *b,
+                previous_row: *a,
+            });
         }
     }
     let block = nd * nf;

@@ -33,13 +33,13 @@ pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, Build
         }
     }
     for (index, w) in nodes.windows(2).enumerate() {
-        if let [a, b] = w {
-            if b <= a {
-                return Err(BuildError::NotIncreasing {
-                    what: axis,
-                    index: index + 1,
-                });
-            }
+        if let [a, b] = w
+            && b <= a
+        {
+            return Err(BuildError::NotIncreasing {
+                what: axis,
+                index: index + 1,
+            });
         }
     }
     Ok(uniform_inv_step(nodes))

@@ -216,13 +216,12 @@ impl ComplianceMapView<'_> {
             for (a, wa) in sx.w.iter().take(sx.len).enumerate() {
                 for (b, wb) in sy.w.iter().take(sy.len).enumerate() {
                     let w = wa * wb;
-                    if w != 0.0 {
-                        if let (Some(n), Some(ws)) = (nodes.get_mut(count), weights.get_mut(count))
-                        {
-                            *n = (sx.base + a) * ny + sy.base + b;
-                            *ws = w;
-                            count += 1;
-                        }
+                    if w != 0.0
+                        && let (Some(n), Some(ws)) = (nodes.get_mut(count), weights.get_mut(count))
+                    {
+                        *n = (sx.base + a) * ny + sy.base + b;
+                        *ws = w;
+                        count += 1;
                     }
                 }
             }

@@ -21,7 +21,7 @@
 //!   chosen at run time ([`MAX_AXES`]); the paper's case is 2 x 2 (`Fx, Fy -> dx, dy`).
 //! * Grid: `nx x ny >= 2 x 2`, strictly increasing coordinates, uneven spacing allowed. Cell
 //!   lookup is O(1) on evenly spaced axes and a binary search otherwise.
-//! * Per query ([`ComplianceMapView::displacement`], or [`query`] in the crate's tick shape
+//! * Per query ([`ComplianceMapView::displacement`], or [`step`] in the crate's tick shape
 //!   with a [`Data`]): no allocation, no panic, a [`crate::Placement`] or a
 //!   [`crate::TickError`]. Out-of-grid positions follow [`OutOfGrid`].
 //!

@@ -52,7 +52,7 @@ use crate::motion::Trajectory;
 /// A compliance model the corrector can query: the static displacement \[m\] of the task point
 /// at `position` \[m\] (robot at joints `q`) under the force `force` \[N\] acting there.
 pub trait DisplacementModel<const T: usize, const J: usize> {
-    /// Per-call workspace (`()` for a compliance map, the chain's [`vjm::Data`] for the
+    /// Per-call workspace (`()` for a compliance map, the chain's [`crate::vjm::Data`] for the
     /// virtual-joint model). Made once, outside the tick.
     type Data;
 

@@ -15,6 +15,44 @@ use crate::error::LoadError;
 use crate::robot::SerialRobot;
 use crate::vjm::ModelBuilder;
 
+impl SerialRobot {
+    /// Loads a URDF file and a stiffness TOML file; the chain runs from the URDF's root link
+    /// to `tip_link` ([`from_path`] also takes a base link).
+    ///
+    /// ```
+    /// use deflect_core::SerialRobot;
+    /// use deflect_core::vjm::{self, Data, Vector6};
+    /// let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../robots/kr300/");
+    /// let robot = SerialRobot::from_path(
+    ///     format!("{dir}kr300_r2500.urdf"), format!("{dir}kr300_r2500_stiffness.toml"), "tcp")?;
+    /// let mut data = Data::new(&robot.model);
+    /// let q = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+    /// // 750 N along +x at the TCP pushes it about 1.7 mm along x.
+    /// let w = Vector6::new(750.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+    /// let d = vjm::deflection(&robot.model, &mut data, &q, &w, vjm::Load::Exact)?;
+    /// assert!((d.x - 1.693e-3).abs() < 1e-5);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn from_path(
+        urdf_path: impl AsRef<std::path::Path>,
+        stiffness_path: impl AsRef<std::path::Path>,
+        tip_link: &str,
+    ) -> Result<Self, crate::LoadError> {
+        from_path(urdf_path, stiffness_path, None, tip_link)
+    }
+
+    /// Loads from URDF and stiffness TOML texts; `base_link` defaults to the URDF's root.
+    /// See [`from_str`].
+    pub fn from_str(
+        urdf: &str,
+        stiffness: &str,
+        base_link: Option<&str>,
+        tip_link: &str,
+    ) -> Result<Self, crate::LoadError> {
+        from_str(urdf, stiffness, base_link, tip_link)
+    }
+}
+
 /// Largest origin coordinate a loader accepts \[m\] (and rpy angle \[rad\]): 10 km. A robot is
 /// metres across; larger values are typos or hostile files, and they overflow the model.
 pub const MAX_ORIGIN: f64 = 1.0e4;
@@ -178,13 +216,13 @@ pub fn assemble(
             referenced_by: "tip_link".to_string(),
         });
     }
-    if let Some(b) = base_link {
-        if !links.contains(b) {
-            return Err(LoadError::UnknownLink {
-                link: b.to_string(),
-                referenced_by: "base_link".to_string(),
-            });
-        }
+    if let Some(b) = base_link
+        && !links.contains(b)
+    {
+        return Err(LoadError::UnknownLink {
+            link: b.to_string(),
+            referenced_by: "base_link".to_string(),
+        });
     }
     // Walk from the tip to the base (or the root).
     let mut path: Vec<&urdf_rs::Joint> = Vec::new();

@@ -147,12 +147,12 @@ impl AtlasArgs {
             ));
         }
         finite("--wrench", &self.wrench, 6, "components [N, N m]")?;
-        if let Some(q) = &self.seed {
-            if let Some((i, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-                return Err(CliError::Usage(format!(
-                    "--seed: joint {i} is {v}: expected a finite angle [rad]"
-                )));
-            }
+        if let Some(q) = &self.seed
+            && let Some((i, v)) = q.iter().enumerate().find(|(_, v)| !v.is_finite())
+        {
+            return Err(CliError::Usage(format!(
+                "--seed: joint {i} is {v}: expected a finite angle [rad]"
+            )));
         }
         JOBS.check_int(count(self.jobs))
     }

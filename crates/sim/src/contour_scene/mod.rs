@@ -17,7 +17,7 @@
 //!   physics-step sample. deflect-core's tracer ([`deflect_core::contour::step`]) consumes one
 //!   settled reading per step; its command goes through the closed-form IK to the motors. On
 //!   each contact sample the motor readings are recorded; the shape is recovered raw (FK of
-//!   the motor readings) and compensated (Eq. 10, [`deflect_core::drivetrain::correct_joints`]
+//!   the motor readings) and compensated (Eq. 10, [`deflect_core::drivetrain::step`]
 //!   with the arm's stiffness, backlash and masses and the sensed force).
 //! * [`output`]: summary table, CSV, JSON, MCAP log and one plot per object.
 

@@ -1,7 +1,7 @@
 //! Tracing one object: the tracer of deflect-core ([`deflect_core::contour::step`], Eq. 21)
 //! drives the rapier arm through the closed-form IK, the sensor averages the settled contact
 //! force with bias and noise, and every contact sample is recovered raw (FK of the motor
-//! readings) and compensated (Eq. 10, [`deflect_core::drivetrain::correct_joints`]).
+//! readings) and compensated (Eq. 10, [`deflect_core::drivetrain::step`]).
 
 use deflect_core::contour::{
     self, TraceDirection, TraceFailure, TracerConfig, TracerState, TracerStats, shape,

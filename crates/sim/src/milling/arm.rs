@@ -168,10 +168,12 @@ impl MillingArm {
                         .map(|c| if c > 0.0 { 1.0 / c } else { f64::INFINITY })
                         .into();
                     for &(s, a, v) in identified {
-                        if s == index && v.is_finite() && v > 0.0 {
-                            if let Some(ka) = k.get_mut(a) {
-                                *ka = v;
-                            }
+                        if s == index
+                            && v.is_finite()
+                            && v > 0.0
+                            && let Some(ka) = k.get_mut(a)
+                        {
+                            *ka = v;
                         }
                     }
                     b.spring_at(offset, k)?

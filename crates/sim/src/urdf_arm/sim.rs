@@ -193,17 +193,17 @@ impl FlexSerialArm {
         let mut qi = 0usize;
         for (index, b) in spec.bodies.iter().enumerate() {
             let mut inertia = b.inertia;
-            if index == last {
-                if let Some(p) = payload {
-                    inertia.add(
-                        &Inertia {
-                            mass: p.mass,
-                            com: p.com,
-                            inertia: p.inertia,
-                        },
-                        &spec.tcp,
-                    );
-                }
+            if index == last
+                && let Some(p) = payload
+            {
+                inertia.add(
+                    &Inertia {
+                        mass: p.mass,
+                        com: p.com,
+                        inertia: p.inertia,
+                    },
+                    &spec.tcp,
+                );
             }
             if inertia.mass <= 0.0 {
                 let m = servo.filler_mass;
@@ -453,14 +453,13 @@ impl FlexSerialArm {
             if let Some(rb) = body.and_then(|h| self.world.bodies.get_mut(h)) {
                 rb.add_torque(torque, false);
             }
-            if b > 0 {
-                if let Some(rb) = self
+            if b > 0
+                && let Some(rb) = self
                     .bodies
                     .get(b - 1)
                     .and_then(|h| self.world.bodies.get_mut(*h))
-                {
-                    rb.add_torque(-torque, false);
-                }
+            {
+                rb.add_torque(-torque, false);
             }
         }
         if let (Some(w), Some(last)) = (wrench, self.bodies.last().copied()) {
