@@ -1,43 +1,34 @@
 //! `deflect-sim`: a rapier3d-f64 testbed for the models of deflect-core, and the project's
 //! main command.
 //!
-//! * The D'Alembert trajectory correction of Paksoy, Dede and Kiper (2025), "Enhancing
-//!   trajectory-tracking accuracy of high-acceleration parallel robots by predicting
-//!   compliant displacements": the 2-DoF planar parallel robot (OC / NC, upper / lower head)
-//!   with compliant joints and finite-bandwidth servos ([`robot`]), simulated static tests, a
-//!   fitted compliance map, the paper's motions at 1-5 g with and without correction
-//!   ([`pipeline`]) and the paper's evaluation (Appendix C, [`analysis`], [`report`],
-//!   [`output`]).
-//! * The online force-based compensation of Hähn and Weigold (sec. 2.2-2.6) in a milling
-//!   scenario on the flexible KR 300 R2500 ([`milling`]).
-//! * Any serial arm from a URDF and a stiffness file as a flexible arm ([`urdf_arm`]) and the
-//!   6-D D'Alembert corrector for serial arms at high acceleration on it ([`serial_scene`]).
-//! * Force-feedback contour tracing and shape recovery ("Shape recovery from robot contour
-//!   tracking with force feedback", Eq. 10 and 21) by a 2R arm with compliant, backlashed
-//!   joints ([`contour_scene`]).
+//! The scenes ([`scenes`]), one folder per domain:
 //!
-//! Shared by all scenes: seeded noise ([`noise`]), rapier helpers ([`rapier_util`]), the
-//! parallel job runner ([`jobs`]) and a small serial arm ([`serial`]). Gravity, where a scene
-//! has it, is deflect-core's [`deflect_core::units::GRAVITY_Z_DOWN`].
+//! * [`scenes::parallel`]: the D'Alembert trajectory correction of Paksoy, Dede and Kiper
+//!   (2025) on the paper's 2-DoF planar parallel robot, from simulated static tests and a
+//!   fitted compliance map to the paper's evaluation (Appendix C).
+//! * [`scenes::milling`]: the online force-based compensation of Hähn and Weigold (sec.
+//!   2.2-2.6) on the flexible KR 300 R2500.
+//! * [`scenes::serial`]: any serial arm from a URDF and a stiffness file as a flexible arm and
+//!   the 6-D D'Alembert corrector for serial arms at high acceleration on it; the
+//!   stiffness-optimal posture over a workspace ([`scenes::serial::atlas`]).
+//! * [`scenes::contour`]: force-feedback contour tracing and shape recovery ("Shape recovery
+//!   from robot contour tracking with force feedback", Eq. 10 and 21) by a 2R arm with
+//!   compliant, backlashed joints.
+//!
+//! Shared by the scenes: the flexible arm built from any URDF ([`urdf_arm`], for milling and
+//! serial), the MCAP writer ([`mcap_log`]), the plot style ([`plot_style`]), rapier helpers
+//! ([`rapier_util`]), seeded noise ([`noise`]) and the parallel job runner ([`jobs`]). Gravity,
+//! where a scene has it, is deflect-core's [`deflect_core::units::GRAVITY_Z_DOWN`].
 #![deny(missing_docs)]
 // No input may kill the process: errors are returned, never panicked (tests may unwrap).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-pub mod analysis;
-pub mod atlas;
-pub mod contour_scene;
 pub mod jobs;
 pub mod mcap_log;
-pub mod milling;
 pub mod noise;
-pub mod output;
-pub mod pipeline;
 pub mod plot_style;
 pub mod rapier_util;
-pub mod report;
-pub mod robot;
-pub mod serial;
-pub mod serial_scene;
+pub mod scenes;
 pub mod urdf_arm;
 
 use core::fmt;

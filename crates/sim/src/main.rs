@@ -1,6 +1,6 @@
 //! `deflect-sim`: the project's main command. With no arguments it runs `reproduce`.
 //!
-//! The binary's own modules: [`cli`] (the command line) and [`scenario`] (one module per
+//! The binary's own modules: [`cli`] (the command line) and [`commands`] (one module per
 //! command); the simulation itself is the `deflect_sim` library.
 //!
 //! Before any work, the arguments are checked against their documented ranges, input files
@@ -11,14 +11,14 @@
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
 mod cli;
-mod scenario;
+mod commands;
 
 use std::sync::Mutex;
 
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use scenario::{atlas, contour, fit, milling, reproduce, run, serial, static_test};
+use commands::{atlas, contour, fit, milling, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -58,7 +58,7 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Atlas(a) => Some(atlas::load(a)?),
         _ => None,
     };
-    scenario::prepare_out(out)?;
+    commands::prepare_out(out)?;
     match command {
         Command::Reproduce(a) => reproduce::reproduce(a, out),
         Command::StaticTest { mechanism } => static_test::static_test(*mechanism, out),

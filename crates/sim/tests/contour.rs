@@ -3,7 +3,7 @@
 //! more than a few readings and without reaching the jam force, and the Eq. 10 compensation
 //! shrinks the shape error.
 
-use deflect_sim::contour_scene::{self, ContourRun, ObjectSpec, Outline, TraceOptions};
+use deflect_sim::scenes::contour::{self, ContourRun, ObjectSpec, Outline, TraceOptions};
 
 fn opts() -> TraceOptions {
     TraceOptions {
@@ -97,14 +97,14 @@ fn check(r: &ContourRun, jam_force: f64) {
 #[test]
 fn traces_a_convex_circle_and_compensation_shrinks_the_error() {
     let o = opts();
-    let r = contour_scene::trace(&circle(), &o).unwrap();
+    let r = contour::trace(&circle(), &o).unwrap();
     check(&r, o.jam_force);
 }
 
 #[test]
 fn traces_a_non_convex_l_shape_and_compensation_shrinks_the_error() {
     let o = opts();
-    let r = contour_scene::trace(&l_shape(), &o).unwrap();
+    let r = contour::trace(&l_shape(), &o).unwrap();
     check(&r, o.jam_force);
     // Both concave and convex corners were passed: points near every vertex.
     if let Outline::Polygon { vertices } = &r.outline {
@@ -126,8 +126,8 @@ fn deterministic_and_independent_of_threads() {
         ..opts()
     };
     let objects = [circle(), l_shape()];
-    let a = contour_scene::trace_all(&objects, &o, 1).unwrap();
-    let b = contour_scene::trace_all(&objects, &o, 2).unwrap();
+    let a = contour::trace_all(&objects, &o, 1).unwrap();
+    let b = contour::trace_all(&objects, &o, 2).unwrap();
     for (x, y) in a.iter().zip(&b) {
         assert_eq!(x.samples.len(), y.samples.len());
         for (s, t) in x.samples.iter().zip(&y.samples) {

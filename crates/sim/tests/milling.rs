@@ -3,7 +3,7 @@
 //! the stiffnesses and the sensor.
 
 use deflect_core::vjm::{self, Data, Vector6};
-use deflect_sim::milling::{self, MillingArm, MillingOptions, Mode};
+use deflect_sim::scenes::milling::{self, MillingArm, MillingOptions, Mode};
 
 #[test]
 fn short_milling_scenario() {

@@ -1,12 +1,15 @@
 //! Short scenarios (seconds in debug builds): static compliance against J K^-1 J^T, the
 //! correction reducing the path deviation, the serial arm, determinism.
 
-use deflect_sim::pipeline::{
+use deflect_sim::scenes::parallel::robot::{Constraint, Head, RobotParams, linear_compliance};
+use deflect_sim::scenes::parallel::run::{
     self, Motion, RunOptions, StaticOptions, grid_node, linear_map, static_test_node,
 };
-use deflect_sim::robot::{Constraint, Head, RobotParams, linear_compliance};
-use deflect_sim::serial::SerialArmSim;
 use nalgebra::Vector2;
+
+#[path = "common/serial_arm.rs"]
+mod serial_arm;
+use serial_arm::SerialArmSim;
 
 #[test]
 fn static_compliance_matches_j_kinv_jt() {
@@ -46,8 +49,8 @@ fn correction_reduces_path_deviation_at_5g() {
             tail: 0.0,
             ..Default::default()
         };
-        let plain = pipeline::run(&params, Motion::YLine, 5, None, &opts).unwrap();
-        let corr = pipeline::run(&params, Motion::YLine, 5, Some(&map), &opts).unwrap();
+        let plain = run::run(&params, Motion::YLine, 5, None, &opts).unwrap();
+        let corr = run::run(&params, Motion::YLine, 5, Some(&map), &opts).unwrap();
         let (a, b) = (&plain.metrics, &corr.metrics);
         assert!(a.max_dev_mm > 0.05, "{a:?}");
         assert!(b.max_dev_mm < 0.5 * a.max_dev_mm, "{a:?} -> {b:?}");
@@ -78,8 +81,8 @@ fn runs_are_deterministic() {
         tail: 0.0,
         ..Default::default()
     };
-    let a = pipeline::run(&params, Motion::XLine, 5, None, &opts).unwrap();
-    let b = pipeline::run(&params, Motion::XLine, 5, None, &opts).unwrap();
+    let a = run::run(&params, Motion::XLine, 5, None, &opts).unwrap();
+    let b = run::run(&params, Motion::XLine, 5, None, &opts).unwrap();
     assert_eq!(a.samples, b.samples);
     assert_eq!(a.metrics, b.metrics);
 }

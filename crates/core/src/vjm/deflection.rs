@@ -5,43 +5,10 @@
 use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
 use super::loads::arm_pass;
+use super::model::check_q;
 use super::model::{Op, Pass};
 use super::{Data, Load, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
-
-impl Data {
-    /// [`Self::check`] as the status every per-tick function returns.
-    pub(crate) fn check_model(&self, model: &Model) -> Result<(), TickError> {
-        if self.dof != model.dof {
-            return Err(TickError::ModelMismatch {
-                what: "dof",
-                expected: model.dof,
-                got: self.dof,
-            });
-        }
-        if self.springs != model.springs {
-            return Err(TickError::ModelMismatch {
-                what: "springs",
-                expected: model.springs,
-                got: self.springs,
-            });
-        }
-        Ok(())
-    }
-}
-
-/// Validates the workspace and a joint vector against the model.
-pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickError> {
-    data.check_model(model)?;
-    if q.len() != model.dof {
-        return Err(TickError::WrongLength {
-            what: "q",
-            expected: model.dof,
-            got: q.len(),
-        });
-    }
-    check_finite("q", q)
-}
 
 /// Largest elastic angle of a virtual joint the deflection accepts \[rad\]: 0.5 rad (29 deg). Real
 /// robots turn their springs by milliradians; a load that turns one by more is far outside

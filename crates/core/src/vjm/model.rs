@@ -2,7 +2,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, SMatrix, Unit, Vector3};
 
-use crate::error::BuildError;
+use crate::error::{BuildError, TickError, check_finite};
 
 /// Most actuated joints a model may have: a 6-axis arm plus a linear track and a turntable,
 /// the largest cell the machining papers consider. Sizes the fixed Jacobian in [`Data`].
@@ -593,6 +593,40 @@ impl Data {
         self.dof == model.dof && self.springs == model.springs
     }
 }
+impl Data {
+    /// [`Self::check`] as the status every per-tick function returns.
+    pub(crate) fn check_model(&self, model: &Model) -> Result<(), TickError> {
+        if self.dof != model.dof {
+            return Err(TickError::ModelMismatch {
+                what: "dof",
+                expected: model.dof,
+                got: self.dof,
+            });
+        }
+        if self.springs != model.springs {
+            return Err(TickError::ModelMismatch {
+                what: "springs",
+                expected: model.springs,
+                got: self.springs,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Validates the workspace and a joint vector against the model.
+pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickError> {
+    data.check_model(model)?;
+    if q.len() != model.dof {
+        return Err(TickError::WrongLength {
+            what: "q",
+            expected: model.dof,
+            got: q.len(),
+        });
+    }
+    check_finite("q", q)
+}
+
 #[cfg(test)]
 mod size {
     /// A `Model` holds no heap memory and is often built on the stack (debug builds copy it

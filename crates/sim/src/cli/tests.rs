@@ -84,13 +84,13 @@ fn defaults_are_in_range() {
 
 #[test]
 fn ranges_match_the_scenes() {
-    let t = deflect_sim::contour_scene::TraceOptions::default();
+    let t = deflect_sim::scenes::contour::TraceOptions::default();
     assert_eq!(
         (TARGET_FORCE.min, TARGET_FORCE.max),
         (t.contact_force, t.jam_force)
     );
     assert_eq!(
-        deflect_sim::milling::MillingOptions::default().dt,
+        deflect_sim::scenes::milling::MillingOptions::default().dt,
         robot::DT
     );
     assert_eq!(CYCLE_MS.min, robot::DT * 1e3);

@@ -13,7 +13,7 @@
 //!   test is the virtual joints'), with relative damping. Each motor is a rotor of reflected
 //!   inertia under a discrete PD position loop with velocity and acceleration feed-forward at
 //!   the simulation rate, integrated implicitly with the drive spring's reaction: the five-bar
-//!   scene's servo ([`crate::robot`]). Its gains come from a bandwidth and a loop stiffness
+//!   scene's servo ([`crate::scenes::parallel::robot`]). Its gains come from a bandwidth and a loop stiffness
 //!   [`ServoParams::kp_ratio`] times the stiffest virtual joint.
 //! * The URDF links' mass properties sit on the body after the link's last spring (the
 //!   proximal part of a link split by an in-link spring is lumped distally); bodies that carry

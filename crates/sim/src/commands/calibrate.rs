@@ -7,8 +7,8 @@ use std::path::Path;
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::map_json;
 use deflect_sim::jobs::{parallel_map, progress};
-use deflect_sim::pipeline::{self, StaticOptions, StaticReading};
-use deflect_sim::robot::{Constraint, Head, RobotParams};
+use deflect_sim::scenes::parallel::robot::{Constraint, Head, RobotParams};
+use deflect_sim::scenes::parallel::run::{self, StaticOptions, StaticReading};
 use deflect_sim::{SimError, write_file};
 use indicatif::ProgressBar;
 
@@ -54,15 +54,15 @@ fn calibrate(
 ) -> Result<(ComplianceMap, String), SimError> {
     let params = RobotParams::new(constraint, Head::Upper);
     let opts = StaticOptions::default();
-    let readings = pipeline::static_tests(&params, &opts, || pb.inc(1))?;
+    let readings = run::static_tests(&params, &opts, || pb.inc(1))?;
     let tag = constraint.label().to_lowercase();
     write_file(
         &out.join(format!("static_tests_{tag}.csv")),
         "the static-test CSV",
         static_csv(&readings),
     )?;
-    let (worst_small, rms_small) = pipeline::linear_agreement(&readings, 50.0);
-    let (worst, rms) = pipeline::linear_agreement(&readings, f64::INFINITY);
+    let (worst_small, rms_small) = run::linear_agreement(&readings, 50.0);
+    let (worst, rms) = run::linear_agreement(&readings, f64::INFINITY);
     let dmax = readings
         .iter()
         .map(|r| (r.d[0].powi(2) + r.d[1].powi(2)).sqrt())
@@ -77,13 +77,13 @@ fn calibrate(
         worst,
         rms
     );
-    let map = pipeline::fit_map(&readings)?;
+    let map = run::fit_map(&readings)?;
     write_file(
         &out.join(format!("compliance_map_{tag}.json")),
         "the compliance map JSON",
         map_json::to_string(&map)?,
     )?;
-    let ho = pipeline::held_out(&params, &map, &opts)?;
+    let ho = run::held_out(&params, &map, &opts)?;
     pb.inc(1);
     text.push_str(&format!(
         "{}: map held-out error: cell centres (fresh static tests, 245 N) RMS {:.4} mm, max \

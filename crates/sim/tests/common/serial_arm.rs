@@ -1,15 +1,15 @@
-//! A small serial flexible arm for later scenarios: a planar chain of links on revolute-z
+//! A small serial flexible arm (test-only):  a planar chain of links on revolute-z
 //! multibody joints, each driven through a drive spring (stiffness `k[i]`) whose rest angle is
 //! the joint command. Its static tip compliance is `J K^-1 J^T` ([`SerialArmSim::linear_compliance`]).
 
 use nalgebra::{DMatrix, Matrix2, Vector2};
 use rapier3d_f64::prelude::*;
 
-use crate::SimError;
-use crate::rapier_util::{
+use deflect_sim::SimError;
+use deflect_sim::rapier_util::{
     ANG_Z, body_point, insert_planar_chain, new_world, set_last_dof_damping, set_spring,
 };
-use crate::robot::DT;
+use deflect_sim::scenes::parallel::robot::DT;
 
 /// A planar serial arm with compliant joints in rapier.
 pub struct SerialArmSim {

@@ -14,7 +14,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::arm::MillingArm;
-use super::scenario::MillingOptions;
+use super::options::MillingOptions;
 use crate::SimError;
 use crate::noise::Noise;
 

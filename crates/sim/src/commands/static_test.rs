@@ -5,8 +5,8 @@
 use std::path::Path;
 
 use deflect_sim::jobs::progress;
-use deflect_sim::pipeline::{self, StaticOptions};
-use deflect_sim::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::run::{self, StaticOptions};
 use deflect_sim::{SimError, write_file};
 
 use super::calibrate::static_csv;
@@ -16,9 +16,9 @@ use crate::cli::Mech;
 pub fn static_test(mechanism: Mech, out: &Path) -> Result<(), SimError> {
     let params = RobotParams::new(mechanism.constraint(), Head::Upper);
     let pb = progress(30, "static");
-    let r = pipeline::static_tests(&params, &StaticOptions::default(), || pb.inc(1))?;
+    let r = run::static_tests(&params, &StaticOptions::default(), || pb.inc(1))?;
     pb.finish_and_clear();
-    let (worst, rms) = pipeline::linear_agreement(&r, 50.0);
+    let (worst, rms) = run::linear_agreement(&r, 50.0);
     let path = out.join(format!(
         "static_tests_{}.csv",
         mechanism.constraint().label().to_lowercase()

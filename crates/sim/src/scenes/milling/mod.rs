@@ -8,7 +8,8 @@
 //! * [`sensor`]: the flange force/torque sensor with offsets, tool weight and noise.
 //! * [`identification`]: the stiffnesses from frame-pair rotations and TCP deflections under
 //!   static loads in rapier, and the sensor from unloaded readings at several orientations.
-//! * [`scenario`]: a straight groove along +x at constant feed with the tool pointing down; a
+//! * [`options`]: the settings.
+//! * [`run`]: a straight groove along +x at constant feed with the tool pointing down; a
 //!   process force that steps up at cutter entry and down at exit acts at the TCP; the sensor
 //!   reads it with an internal offset, the tool's weight and seeded Gaussian noise. Runs:
 //!   uncompensated, Cartesian compensation ([`deflect_core::compensation::step`], measured
@@ -21,13 +22,15 @@
 
 pub mod arm;
 pub mod identification;
+pub mod options;
 pub mod output;
-pub mod scenario;
+pub mod run;
 pub mod sensor;
 
 pub use arm::{MillingArm, SpringInfo};
 pub use identification::{
     JointEstimate, SensorEstimate, identify_sensor_calibration, identify_stiffness,
 };
-pub use scenario::{Metrics, MillingOptions, MillingResult, Mode, Run, Sample, milling, run};
+pub use options::MillingOptions;
+pub use run::{Metrics, MillingResult, Mode, Run, Sample, milling, run};
 pub use sensor::SensorParams;

@@ -1,11 +1,11 @@
 //! `milling`: the online force-based compensation of Hähn and Weigold (sec. 2.2-2.6, 3) in
-//! the milling scenario of [`deflect_sim::milling`], with the command line's feed, force,
+//! the milling scenario of [`deflect_sim::scenes::milling`], with the command line's feed, force,
 //! timing and noise settings; prints the summary table and writes its files.
 
 use std::path::Path;
 
 use deflect_sim::SimError;
-use deflect_sim::milling::{self, output};
+use deflect_sim::scenes::milling::{self, output};
 
 use crate::cli::MillingArgs;
 

@@ -8,9 +8,10 @@ use std::time::Instant;
 
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_sim::jobs::{parallel_map, progress};
-use deflect_sim::pipeline::{self, Motion, RunOptions, RunResult, configurations};
-use deflect_sim::robot::{Constraint, RobotParams};
-use deflect_sim::{SimError, output, report, write_file};
+use deflect_sim::scenes::parallel::robot::{Constraint, RobotParams};
+use deflect_sim::scenes::parallel::run::{self, Motion, RunOptions, RunResult, configurations};
+use deflect_sim::scenes::parallel::{output, report};
+use deflect_sim::{SimError, write_file};
 
 use super::calibrate::calibrate_all;
 use crate::cli::ReproduceArgs;
@@ -40,7 +41,7 @@ fn run_jobs(
         } else {
             None
         };
-        let r = pipeline::run(&job.params, job.motion, job.g, map, opts);
+        let r = run::run(&job.params, job.motion, job.g, map, opts);
         pb.inc(1);
         r
     })?;
@@ -122,7 +123,7 @@ fn mass_sweep(maps: &[(Constraint, ComplianceMap)], out: &Path) -> Result<(), Si
                 mass,
                 ..Default::default()
             };
-            let r = pipeline::run(&params, Motion::YLine, 5, Some(map), &opts)?;
+            let r = run::run(&params, Motion::YLine, 5, Some(map), &opts)?;
             let m = &r.metrics;
             text.push_str(&format!(" {:>6.4}/{:.4}", m.max_dev_mm, m.max_track_mm));
             csv.push_str(&format!(

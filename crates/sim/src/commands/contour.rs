@@ -1,19 +1,19 @@
 //! `contour`: force-feedback contour tracing and shape recovery ("Shape recovery from robot
 //! contour tracking with force feedback", Eq. 10 and 21) of the default objects of
-//! [`deflect_sim::contour_scene`], one worker thread per object; prints the summary table and
+//! [`deflect_sim::scenes::contour`], one worker thread per object; prints the summary table and
 //! writes its files.
 
 use std::path::Path;
 use std::time::Instant;
 
 use deflect_sim::SimError;
-use deflect_sim::contour_scene::{self, output};
+use deflect_sim::scenes::contour::{self, output};
 
 use crate::cli::ContourArgs;
 
 /// The `contour` command (arguments checked by [`ContourArgs::check`]).
 pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
-    let mut opts = contour_scene::TraceOptions {
+    let mut opts = contour::TraceOptions {
         step: a.step_mm * 1e-3,
         target_force: a.target_force,
         noise: a.noise,
@@ -22,7 +22,7 @@ pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
     };
     opts.approach_step = opts.approach_step.min(opts.step);
     let t = Instant::now();
-    let runs = contour_scene::trace_all(&contour_scene::default_objects(), &opts, a.jobs)?;
+    let runs = contour::trace_all(&contour::default_objects(), &opts, a.jobs)?;
     let wall = t.elapsed().as_secs_f64();
     let table = output::table(&runs);
     put!("{table}");
@@ -34,7 +34,7 @@ pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
         runs.len(),
         sim,
         steps,
-        1e-3 / contour_scene::DT,
+        1e-3 / contour::DT,
         wall,
         a.jobs.max(1),
         sim / wall

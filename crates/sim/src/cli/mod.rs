@@ -14,9 +14,10 @@
 use std::path::PathBuf;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use deflect_sim::pipeline::Motion;
-use deflect_sim::robot::{Constraint, Head};
-use deflect_sim::{SimError, robot};
+use deflect_sim::SimError;
+use deflect_sim::scenes::parallel::robot;
+use deflect_sim::scenes::parallel::robot::{Constraint, Head};
+use deflect_sim::scenes::parallel::run::Motion;
 
 /// Why a command did not succeed, with its exit code.
 #[derive(Debug, Clone, PartialEq)]

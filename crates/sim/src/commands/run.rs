@@ -7,9 +7,10 @@ use std::time::Instant;
 
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::map_json;
-use deflect_sim::pipeline::{self, RunOptions, RunResult};
-use deflect_sim::robot::RobotParams;
-use deflect_sim::{SimError, output, write_file};
+use deflect_sim::scenes::parallel::output;
+use deflect_sim::scenes::parallel::robot::RobotParams;
+use deflect_sim::scenes::parallel::run::{self, RunOptions, RunResult};
+use deflect_sim::{SimError, write_file};
 
 use super::calibrate::calibrate_all;
 use super::{input_file, load_error};
@@ -104,7 +105,7 @@ pub fn run_one(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(),
         };
         if wanted {
             let t = Instant::now();
-            let r = pipeline::run(
+            let r = run::run(
                 &params,
                 motion,
                 args.g,

@@ -15,14 +15,14 @@ use crate::cli::CliError;
 /// fails (`deflect-sim | head -1`), instead of panicking.
 macro_rules! say {
     ($($t:tt)*) => {
-        $crate::scenario::stdout(format_args!("{}\n", format_args!($($t)*)))?
+        $crate::commands::stdout(format_args!("{}\n", format_args!($($t)*)))?
     };
 }
 
 /// `print!` that returns an error when stdout fails; see `say!`.
 macro_rules! put {
     ($($t:tt)*) => {
-        $crate::scenario::stdout(format_args!($($t)*))?
+        $crate::commands::stdout(format_args!($($t)*))?
     };
 }
 

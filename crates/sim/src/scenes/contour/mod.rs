@@ -12,7 +12,7 @@
 //! * Contact: a penalty force computed from the tool point's penetration into the objects
 //!   ([`objects`]: spring `k_contact`, damper `c_contact` on the inward velocity, never
 //!   pulling), no friction; only the tool point touches (the links pass above the objects).
-//! * [`trace`](mod@trace): the force sensor at the tool reads the mean contact force over the last
+//! * [`run`]: the force sensor at the tool reads the mean contact force over the last
 //!   `average` seconds of each settle, plus a constant bias and seeded Gaussian noise on every
 //!   physics-step sample. deflect-core's tracer ([`deflect_core::contour::step`]) consumes one
 //!   settled reading per step; its command goes through the closed-form IK to the motors. On
@@ -24,11 +24,11 @@
 pub mod arm;
 pub mod objects;
 pub mod output;
-pub mod trace;
+pub mod run;
 
 pub use arm::{ArmParams, ArmSim};
 pub use objects::{ObjectSpec, Outline, default_objects};
-pub use trace::{ContourRun, Sample, ShapeErr, TraceOptions, trace, trace_all};
+pub use run::{ContourRun, Sample, ShapeErr, TraceOptions, trace, trace_all};
 
 use crate::SimError;
 

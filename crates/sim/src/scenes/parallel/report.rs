@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use crate::pipeline::{Motion, RunResult};
+use crate::scenes::parallel::run::{Motion, RunResult};
 
 fn find<'a>(
     runs: &'a [RunResult],

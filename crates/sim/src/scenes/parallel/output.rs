@@ -8,11 +8,11 @@ use plotters::prelude::*;
 use serde_json::json;
 
 use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, poses_in_frame, scene_update};
-use crate::pipeline::{Motion, RunResult};
 use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, config_role, config_words, draw_legend, figure,
     line, new_chart, padded_range, perr, present,
 };
+use crate::scenes::parallel::run::{Motion, RunResult};
 use crate::{SimError, write_file};
 
 /// Topics written for each run, as `/<scenario>/<run>/<topic>` (`crates/sim/README.md`).

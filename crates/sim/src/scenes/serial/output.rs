@@ -6,15 +6,16 @@ use std::path::Path;
 
 use plotters::prelude::*;
 
-use super::{PathKind, SerialResult, SerialRun};
+use super::motion::PathKind;
+use super::run::{SerialResult, SerialRun};
 use crate::SimError;
 use crate::mcap_log::{self, Kind, Line, McapLog, RunInfo, scene_update};
-use crate::output::write_summary;
 use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
     present,
 };
-use crate::report::reduction;
+use crate::scenes::parallel::output::write_summary;
+use crate::scenes::parallel::report::reduction;
 
 fn run_label(r: &SerialRun) -> String {
     format!(
@@ -277,7 +278,7 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
     let root = canvas(path, (1250, 900))?;
     let start = |run: &SerialRun| {
         let p = run.samples.first().map(|s| s.desired).unwrap_or_default();
-        super::pose_of(&p)
+        super::run::pose_of(&p)
     };
     let series = |run: &SerialRun, rot: bool| -> Vec<(f64, f64)> {
         let s0 = start(run);
@@ -285,7 +286,10 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
             .iter()
             .filter(|s| s.active)
             .map(|s| {
-                let (a, d) = (super::pose_of(&s.actual), super::pose_of(&s.desired));
+                let (a, d) = (
+                    super::run::pose_of(&s.actual),
+                    super::run::pose_of(&s.desired),
+                );
                 let v = if rot {
                     a.rotation.angle_to(&d.rotation) * 1e3
                 } else {

@@ -9,11 +9,11 @@ use serde_json::json;
 use super::{MillingOptions, MillingResult, Mode, Sample};
 use crate::SimError;
 use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
-use crate::output::write_summary;
 use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
     present,
 };
+use crate::scenes::parallel::output::write_summary;
 
 /// The summary table printed on stdout and written to `milling_summary.txt`.
 pub fn table(r: &MillingResult) -> String {

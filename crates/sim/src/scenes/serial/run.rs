@@ -1,17 +1,5 @@
-//! The serial testbed: a flexible arm from any URDF and stiffness file in rapier
-//! ([`crate::urdf_arm`]) carries a payload through a line and a circle in pose at high
-//! acceleration, commanded by the rigid inverse kinematics (uncorrected) or by deflect-core's
-//! 6-D D'Alembert corrector for serial arms (`dalembert::serial`: the payload's inertial
-//! wrench through the virtual-joint deflection, loaded-pose IK per tick).
-//!
-//! Per run the servo gets the joint command of each 2 kHz tick with its rate and acceleration
-//! (backward differences, as in the five-bar scene); the TCP pose after each physics step is
-//! compared with the desired pose of that tick: the distance from the planned path, the
-//! tracking error and the orientation error, over the motion. The static compliance of the
-//! rapier arm at the start pose is checked against deflect-core's `J K^-1 J^T` first.
-
-pub mod motion;
-pub mod output;
+//! One run of the serial testbed and the whole scenario: the static check, the motions'
+//! reachability, each path with and without the corrector, the evaluation.
 
 use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::motion::PoseState;
@@ -20,9 +8,9 @@ use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::Isometry3;
 use serde::Serialize;
 
+use super::motion::{MotionParams, PathKind};
 use crate::SimError;
 use crate::urdf_arm::{ArmSpec, FlexSerialArm, ServoParams};
-pub use motion::{MotionParams, PathKind};
 
 /// Everything a serial testbed run needs besides the arm.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -179,8 +167,8 @@ pub fn plan(
     rate_hz: f64,
 ) -> Result<Vec<PoseState>, SimError> {
     match path {
-        PathKind::Line => motion::line(start, params, rate_hz),
-        PathKind::Circle => motion::circle(start, params, rate_hz),
+        PathKind::Line => super::motion::line(start, params, rate_hz),
+        PathKind::Circle => super::motion::circle(start, params, rate_hz),
     }
 }
 
@@ -319,7 +307,7 @@ pub fn evaluate(
     let (mut sq_p, mut sq_r, mut n) = (0.0, 0.0, 0usize);
     for s in samples.iter().filter(|s| s.active) {
         let (a, d) = (pose_of(&s.actual), pose_of(&s.desired));
-        let dist = motion::path_distance(path, start, params, &a.translation.vector) * 1e3;
+        let dist = super::motion::path_distance(path, start, params, &a.translation.vector) * 1e3;
         let track = (a.translation.vector - d.translation.vector).norm() * 1e3;
         let rot = a.rotation.angle_to(&d.rotation) * 1e3;
         let corr = (nalgebra::Vector3::from(s.commanded) - d.translation.vector).norm() * 1e3;

@@ -1,4 +1,4 @@
-//! `serial`: the serial testbed of [`deflect_sim::serial_scene`] on the built-in KR 300 or
+//! `serial`: the serial testbed of [`deflect_sim::scenes::serial`] on the built-in KR 300 or
 //! on the user's URDF and stiffness file. [`load`] reads and checks everything before any
 //! work (files, chain, start pose, motion reach); [`serial_cmd`] runs, prints the table and
 //! writes the files.
@@ -10,7 +10,7 @@ use deflect_core::io::{stiffness, urdf};
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data};
 use deflect_sim::SimError;
-use deflect_sim::serial_scene::{self, MotionParams, SerialOptions, output};
+use deflect_sim::scenes::serial::{self, MotionParams, SerialOptions, output};
 use deflect_sim::urdf_arm::{
     ArmSpec, KR300_Q0, KR300_STIFFNESS, KR300_URDF, ServoParams, arm_spec,
 };
@@ -263,7 +263,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
         link_inertia: !a.payload_only && spec.robot.model.mass_count() > 0,
     };
     // The motions must be plannable and reachable (rigid IK along them) before the runs.
-    serial_scene::check_motions(&spec, &options).map_err(|e| {
+    serial::check_motions(&spec, &options).map_err(|e| {
         CliError::Usage(format!(
             "the motions from the start pose do not fit {urdf_name} (change --q0, --scale or \
              --turn): {}",
@@ -275,7 +275,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
 
 /// The `serial` command (arguments checked by [`SerialArgs::check`], inputs by [`load`]).
 pub fn serial_cmd(a: &SerialArgs, input: SerialInput, out: &Path) -> Result<(), SimError> {
-    let r = serial_scene::serial(&input.spec, &input.options, a.jobs)?;
+    let r = serial::serial(&input.spec, &input.options, a.jobs)?;
     put!("{}", output::table(&r));
     let n = output::write_all(out, &r)?;
     say!(

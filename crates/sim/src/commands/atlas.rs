@@ -1,4 +1,4 @@
-//! `atlas`: the workspace compliance atlas of [`deflect_sim::atlas`] on the built-in KR 300
+//! `atlas`: the workspace compliance atlas of [`deflect_sim::scenes::serial::atlas`] on the built-in KR 300
 //! or on the user's URDF and stiffness file. [`load`] reads and checks everything before any
 //! work; [`atlas_cmd`] runs, prints the summary and writes `atlas.npz` and `atlas.png`.
 
@@ -8,8 +8,8 @@ use std::time::Instant;
 use deflect_core::SerialRobot;
 use deflect_core::io::urdf;
 use deflect_sim::SimError;
-use deflect_sim::atlas::{self, AtlasTask};
 use deflect_sim::jobs::progress;
+use deflect_sim::scenes::serial::atlas::{self, AtlasTask};
 use deflect_sim::urdf_arm::{KR300_Q0, KR300_STIFFNESS, KR300_URDF};
 use nalgebra::Vector3;
 

@@ -11,11 +11,11 @@ use plotters::prelude::*;
 use super::{ContourRun, Sample, TraceOptions};
 use crate::SimError;
 use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
-use crate::output::write_summary;
 use crate::plot_style::{
     ChartStyle, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, present,
 };
-use crate::report::reduction;
+use crate::scenes::parallel::output::write_summary;
+use crate::scenes::parallel::report::reduction;
 
 /// The summary table: shape errors raw vs compensated, forces, contact losses.
 pub fn table(runs: &[ContourRun]) -> String {

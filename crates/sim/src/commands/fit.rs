@@ -8,8 +8,8 @@ use std::path::Path;
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
-use deflect_sim::pipeline::{self, StaticOptions};
-use deflect_sim::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::run::{self, StaticOptions};
 use deflect_sim::{SimError, write_file};
 
 use super::calibrate::calibrate_all;
@@ -98,7 +98,7 @@ pub fn fit_csv(path: &Path) -> Result<ComplianceMap, deflect_core::LoadError> {
             )?
         }
     };
-    Ok(map.with_options(pipeline::map_options()))
+    Ok(map.with_options(run::map_options()))
 }
 
 /// The `fit` command: the map of `mech` fitted from `--input` (`input`, loaded by
@@ -117,7 +117,7 @@ pub fn fit_cmd(mech: Mech, input: Option<ComplianceMap>, out: &Path) -> Result<(
                 "the compliance map JSON",
                 map_json::to_string(&map)?,
             )?;
-            let ho = pipeline::held_out(
+            let ho = run::held_out(
                 &RobotParams::new(constraint, Head::Upper),
                 &map,
                 &StaticOptions::default(),
