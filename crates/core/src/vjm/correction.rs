@@ -4,8 +4,8 @@
 
 use nalgebra::{Isometry3, SVD, SVector, Translation3, UnitQuaternion, Vector3};
 
+use super::data::check_q;
 use super::deflection::{deflection, joint_jacobian};
-use super::model::check_q;
 use super::{Data, Load, MAX_DOF, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 

@@ -4,8 +4,8 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
+use super::data::check_q;
 use super::loads::arm_pass;
-use super::model::check_q;
 use super::model::{Op, Pass};
 use super::{Data, Load, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};

@@ -24,8 +24,8 @@ use alloc::vec::Vec;
 
 use nalgebra::{DMatrix, DVector, Isometry3, Translation3, UnitQuaternion, Vector3};
 
+use super::data::check_q;
 use super::model::Op;
-use super::model::check_q;
 use super::{Data, MAX_SPRING_ANGLE, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 

@@ -22,8 +22,8 @@
 
 use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
+use super::data::check_q;
 use super::model::Op;
-use super::model::check_q;
 use super::{Data, Model, Vector6};
 use crate::error::{TickError, check_finite, check_output};
 

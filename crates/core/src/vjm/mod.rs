@@ -15,6 +15,7 @@
 //! them ([`joint_correction`], [`equilibrium`]).
 
 mod correction;
+mod data;
 mod deflection;
 #[cfg(feature = "alloc")]
 mod equilibrium;
@@ -25,14 +26,14 @@ pub use correction::{
     JointCorrection, MAX_CORRECTION_ITERATIONS, POSE_TOLERANCE, commanded_pose, joint_correction,
     joint_delta, pose_from_matrix, rotation_from_matrix,
 };
+pub use data::Data;
 pub(crate) use deflection::rotation_vector;
 pub use deflection::{MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian};
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
 pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};
 pub use model::{
-    Data, Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder,
-    valid_stiffness,
+    Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder, valid_stiffness,
 };
 
 /// A 6-vector `[x, y, z, rx, ry, rz]`: a wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] or a small

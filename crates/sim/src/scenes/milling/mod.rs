@@ -9,7 +9,7 @@
 //! * [`identification`]: the stiffnesses from frame-pair rotations and TCP deflections under
 //!   static loads in rapier, and the sensor from unloaded readings at several orientations.
 //! * [`options`]: the settings.
-//! * [`run`]: a straight groove along +x at constant feed with the tool pointing down; a
+//! * [`run`](mod@run): a straight groove along +x at constant feed with the tool pointing down; a
 //!   process force that steps up at cutter entry and down at exit acts at the TCP; the sensor
 //!   reads it with an internal offset, the tool's weight and seeded Gaussian noise. Runs:
 //!   uncompensated, Cartesian compensation ([`deflect_core::compensation::step`], measured
