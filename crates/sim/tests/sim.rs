@@ -1,7 +1,7 @@
 //! Short scenarios (seconds in debug builds): static compliance against J K^-1 J^T, the
 //! correction reducing the path deviation, the serial arm, determinism.
 
-use deflect_sim::scenes::parallel::robot::{Constraint, Head, RobotParams, linear_compliance};
+use deflect_sim::scenes::parallel::params::{Constraint, Head, RobotParams, linear_compliance};
 use deflect_sim::scenes::parallel::run::{
     self, Motion, RunOptions, StaticOptions, grid_node, linear_map, static_test_node,
 };

@@ -3,6 +3,7 @@
 use clap::{CommandFactory, Parser};
 
 use super::*;
+use deflect_sim::scenes::parallel::params;
 
 fn parse(args: &[&str]) -> Command {
     let mut all = vec!["deflect-sim"];
@@ -91,9 +92,9 @@ fn ranges_match_the_scenes() {
     );
     assert_eq!(
         deflect_sim::scenes::milling::MillingOptions::default().dt,
-        robot::DT
+        params::DT
     );
-    assert_eq!(CYCLE_MS.min, robot::DT * 1e3);
+    assert_eq!(CYCLE_MS.min, params::DT * 1e3);
 }
 
 #[test]

@@ -7,7 +7,7 @@ use std::path::Path;
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::map_json;
 use deflect_sim::jobs::{parallel_map, progress};
-use deflect_sim::scenes::parallel::robot::{Constraint, Head, RobotParams};
+use deflect_sim::scenes::parallel::params::{Constraint, Head, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, StaticOptions, StaticReading};
 use deflect_sim::{SimError, write_file};
 use indicatif::ProgressBar;

@@ -8,7 +8,7 @@ use std::path::Path;
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
-use deflect_sim::scenes::parallel::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::params::{Head, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, StaticOptions};
 use deflect_sim::{SimError, write_file};
 

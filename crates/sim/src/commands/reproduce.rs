@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_sim::jobs::{parallel_map, progress};
-use deflect_sim::scenes::parallel::robot::{Constraint, RobotParams};
+use deflect_sim::scenes::parallel::params::{Constraint, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, Motion, RunOptions, RunResult, configurations};
 use deflect_sim::scenes::parallel::{output, report};
 use deflect_sim::{SimError, write_file};

@@ -8,7 +8,7 @@ use std::time::Instant;
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::map_json;
 use deflect_sim::scenes::parallel::output;
-use deflect_sim::scenes::parallel::robot::RobotParams;
+use deflect_sim::scenes::parallel::params::RobotParams;
 use deflect_sim::scenes::parallel::run::{self, RunOptions, RunResult};
 use deflect_sim::{SimError, write_file};
 

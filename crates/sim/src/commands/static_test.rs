@@ -5,7 +5,7 @@
 use std::path::Path;
 
 use deflect_sim::jobs::progress;
-use deflect_sim::scenes::parallel::robot::{Head, RobotParams};
+use deflect_sim::scenes::parallel::params::{Head, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, StaticOptions};
 use deflect_sim::{SimError, write_file};
 

@@ -9,7 +9,7 @@ use deflect_sim::SimError;
 use deflect_sim::rapier_util::{
     ANG_Z, body_point, insert_planar_chain, new_world, set_last_dof_damping, set_spring,
 };
-use deflect_sim::scenes::parallel::robot::DT;
+use deflect_sim::scenes::parallel::params::DT;
 
 /// A planar serial arm with compliant joints in rapier.
 pub struct SerialArmSim {

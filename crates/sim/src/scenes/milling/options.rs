@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::sensor::SensorParams;
-use crate::scenes::parallel::robot::DT;
+use crate::scenes::parallel::params::DT;
 use crate::urdf_arm::KR300_Q0;
 
 /// The milling scenario's settings.

@@ -31,197 +31,17 @@
 //! compliance (`1/kp`) the static tests (motors locked) do not see.
 
 use deflect_core::mechanism::ParallelRobot2;
-use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 use rapier3d_f64::prelude::*;
 
+use super::params::{
+    ACTUATED_LINK_MASS, DT, HALF_WIDTH, INTERMEDIATE_MASS, LINK, PLATFORM_MASS, RobotParams,
+    THICK_LINK_MASS, THIN_LINK_MASS,
+};
 use crate::SimError;
 use crate::rapier_util::{
     ANG_X, ANG_Y, ANG_Z, body_point, gravity_z_down, new_world, revolute_z_state, set_spring,
 };
-
-/// Simulation step \[s\]: the paper's 2 kHz servo rate.
-pub const DT: f64 = 1.0 / 2000.0;
-/// Link length \[m\] (section 4.1).
-pub const LINK: f64 = 0.150;
-/// Half width |A0O| = |BC| \[m\].
-pub const HALF_WIDTH: f64 = 0.090;
-/// Moving platform with end effector \[kg\].
-pub const PLATFORM_MASS: f64 = 3.6;
-/// Thick distal link \[kg\].
-pub const THICK_LINK_MASS: f64 = 0.2194;
-/// Thin link \[kg\].
-pub const THIN_LINK_MASS: f64 = 0.1236;
-/// Intermediate platform \[kg\].
-pub const INTERMEDIATE_MASS: f64 = 0.2512;
-/// Actuated link: not reported by the paper ("assumed rigid"); our value \[kg\].
-pub const ACTUATED_LINK_MASS: f64 = 0.30;
-/// CoM height above G, upper head \[m\].
-pub const D_UPPER: f64 = 0.0359;
-/// CoM height above G, lower head \[m\].
-pub const D_LOWER: f64 = 0.0053;
-/// Tool point W (laser working point) below G \[m\]: our choice.
-pub const Z_TOOL: f64 = 0.030;
-
-/// Over- or normal-constrained mechanism.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-pub enum Constraint {
-    /// Over-constrained (stiffer, symmetric).
-    Oc,
-    /// Normal-constrained (softer, arm B softer than arm A).
-    Nc,
-}
-
-/// Head (laser) position: centre of mass high or low above G.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
-pub enum Head {
-    /// G_U: CoM 35.9 mm above G.
-    Upper,
-    /// G_L: CoM 5.3 mm above G.
-    Lower,
-}
-
-impl Constraint {
-    /// "OC" / "NC".
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Oc => "OC",
-            Self::Nc => "NC",
-        }
-    }
-}
-
-impl Head {
-    /// "GU" / "GL".
-    pub fn label(self) -> &'static str {
-        match self {
-            Self::Upper => "GU",
-            Self::Lower => "GL",
-        }
-    }
-    /// CoM height above G \[m\].
-    pub fn com_height(self) -> f64 {
-        match self {
-            Self::Upper => D_UPPER,
-            Self::Lower => D_LOWER,
-        }
-    }
-}
-
-/// Every physical parameter of one robot configuration (SI).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct RobotParams {
-    /// Mechanism variant.
-    pub constraint: Constraint,
-    /// Head position.
-    pub head: Head,
-    /// Drive stiffness of arm A \[N m/rad\].
-    pub k_a: f64,
-    /// Drive stiffness of arm B \[N m/rad\].
-    pub k_b: f64,
-    /// Relative damping of each drive spring \[N m s/rad\].
-    pub c_drive: f64,
-    /// Out-of-plane bending (tilt) stiffness of the head about G \[N m/rad\].
-    pub k_tilt: f64,
-    /// Tilt damping \[N m s/rad\].
-    pub c_tilt: f64,
-    /// Orientation stiffness of the parallelograms \[N m/rad\].
-    pub k_orient: f64,
-    /// Orientation damping \[N m s/rad\].
-    pub c_orient: f64,
-    /// Reflected motor inertia \[kg m^2\].
-    pub j_motor: f64,
-    /// Servo position gain \[N m/rad\].
-    pub kp: f64,
-    /// Servo velocity gain \[N m s/rad\].
-    pub kd: f64,
-    /// Head CoM height above G \[m\].
-    pub com_height: f64,
-    /// Tool point below G \[m\].
-    pub z_tool: f64,
-    /// rapier solver iterations (substeps).
-    pub solver_iterations: usize,
-    /// rapier internal PGS iterations per substep.
-    pub pgs_iterations: usize,
-}
-
-impl RobotParams {
-    /// The documented defaults of one configuration.
-    ///
-    /// Stiffnesses were chosen so that the static compliance over the paper's grid is of the
-    /// order of its tables: OC about 0.2-0.5 mm, NC about 0.4-1.1 mm of displacement at
-    /// 245 N. Damping ratios are a few percent; the servo loop has about 250 Hz bandwidth.
-    pub fn new(constraint: Constraint, head: Head) -> Self {
-        let (k_a, k_b, k_tilt) = match constraint {
-            Constraint::Oc => (16_000.0, 16_000.0, 2_500.0),
-            Constraint::Nc => (9_000.0, 7_000.0, 1_500.0),
-        };
-        let j_motor = 0.05;
-        let w = 2.0 * core::f64::consts::PI * 250.0;
-        Self {
-            constraint,
-            head,
-            k_a,
-            k_b,
-            c_drive: 3.0,
-            k_tilt,
-            c_tilt: 0.5,
-            k_orient: 40_000.0,
-            c_orient: 2.0,
-            j_motor,
-            kp: j_motor * w * w,
-            kd: 2.0 * 0.7 * w * j_motor,
-            com_height: head.com_height(),
-            z_tool: Z_TOOL,
-            solver_iterations: 1,
-            pgs_iterations: 4,
-        }
-    }
-
-    /// "OC GU" etc.
-    pub fn label(&self) -> String {
-        format!("{} {}", self.constraint.label(), self.head.label())
-    }
-}
-
-/// The linearized static compliance of the model at the tool point for an in-plane force at
-/// G: `J K^-1 J^T` \[m/N\] over the three elastic coordinates of the closed chain,
-/// `K = diag(k_a, k_b, k_orient)` (the two drive springs and the parallelograms' orientation
-/// spring) and `J = d(x, y, psi)/d(theta_a, theta_b, psi)` at the tool point `p` \[m\] (x, y
-/// block returned). Without the orientation spring (`k_orient -> inf`) this is the robot's
-/// 2 x 2 `J K^-1 J^T` with [`ParallelRobot2::jacobian_at`].
-///
-/// `J^-1` is built by central differences of the arms' closed-form IK: with the platform
-/// rotated by `psi`, arm A reaches `D - A0 = p + R(psi) (0, h) - (0, h)` and arm B
-/// `E - B0 = p + R(psi) (0, -h) - (0, -h)`.
-pub fn linear_compliance(params: &RobotParams, p: &Vector2<f64>) -> Result<Matrix2<f64>, SimError> {
-    let mech = ParallelRobot2::paper();
-    let h = HALF_WIDTH;
-    let joints = |x: f64, y: f64, psi: f64| -> Result<Vector3<f64>, SimError> {
-        let (s, c) = psi.sin_cos();
-        let ta = Vector2::new(x - h * s, y + h * c - h);
-        let tb = Vector2::new(x + h * s, y - h * c + h);
-        Ok(Vector3::new(mech.ik(&ta)?.x, mech.ik(&tb)?.y, psi))
-    };
-    let e = 1e-7;
-    let mut jinv = Matrix3::zeros();
-    for k in 0..3 {
-        let mut dp = Vector3::zeros();
-        dp[k] = e;
-        let plus = joints(p.x + dp.x, p.y + dp.y, dp.z)?;
-        let minus = joints(p.x - dp.x, p.y - dp.y, -dp.z)?;
-        jinv.set_column(k, &((plus - minus) / (2.0 * e)));
-    }
-    let j = jinv
-        .try_inverse()
-        .ok_or_else(|| SimError::new("singular pose in linear_compliance"))?;
-    let kinv = Matrix3::from_diagonal(&Vector3::new(
-        1.0 / params.k_a,
-        1.0 / params.k_b,
-        1.0 / params.k_orient,
-    ));
-    let c = j * kinv * j.transpose();
-    Ok(Matrix2::new(c[(0, 0)], c[(0, 1)], c[(1, 0)], c[(1, 1)]))
-}
 
 /// Mass properties of a set of point masses / rods along a body's local x axis:
 /// `(mass, x, own inertia about the body's y and z axes)`.
@@ -272,18 +92,27 @@ impl core::fmt::Debug for ParallelSim {
     }
 }
 
-impl ParallelSim {
-    /// Builds the robot at rest with its tool point at `start` = (x, y) \[m\] (task frame C - O),
-    /// under standard gravity down z ([`deflect_core::units::GRAVITY_Z_DOWN`]), normal to the
-    /// plane of motion.
-    pub fn new(params: RobotParams, start: &Vector2<f64>) -> Result<Self, SimError> {
-        let mech = ParallelRobot2::paper();
-        let q = mech.ik(start)?;
-        let (l, h) = (LINK, HALF_WIDTH);
-        let mut world = new_world(gravity_z_down(), DT);
-        world.integration_parameters.num_solver_iterations = params.solver_iterations;
-        world.integration_parameters.num_internal_pgs_iterations = params.pgs_iterations;
+/// The rigid bodies of the robot at rest with the tool point at `start`, in insertion order:
+/// the base, per arm (A, then B) the actuated and the distal link, then the platform.
+struct Bodies {
+    base: RigidBodyHandle,
+    /// Actuated links A1, B1.
+    links: [RigidBodyHandle; 2],
+    /// Distal links A2, B2.
+    tips: [RigidBodyHandle; 2],
+    platform: RigidBodyHandle,
+    /// Angles of the distal links \[rad\] (absolute, from +x).
+    phis: [f64; 2],
+}
 
+impl Bodies {
+    fn insert(
+        world: &mut PhysicsWorld,
+        params: &RobotParams,
+        q: &Vector2<f64>,
+        start: &Vector2<f64>,
+    ) -> Self {
+        let l = LINK;
         let base = world.insert_body(RigidBodyBuilder::fixed());
         // Actuated link: rod + intermediate platform at the elbow.
         let rod = |m: f64| m * l * l / 12.0;
@@ -294,52 +123,27 @@ impl ParallelSim {
         // Distal link: thick link + its parallel thin link, both rods.
         let dm = THICK_LINK_MASS + THIN_LINK_MASS;
         let a2_mass = lumped(&[(dm, 0.5 * l, rod(dm))]);
-        let d = params.com_height;
         let platform_mass = MassProperties::new(
-            Vector::new(0.0, 0.0, d),
+            Vector::new(0.0, 0.0, params.com_height),
             PLATFORM_MASS,
             Vector::new(0.008, 0.008, 0.006),
         );
-
-        let mut links = [base; 2];
-        let mut joints = Vec::new();
-        let mut tips = [base; 2];
+        let (mut links, mut tips, mut phis) = ([base; 2], [base; 2], [0.0; 2]);
         for (k, (theta, sign)) in [(q.x, 1.0), (q.y, -1.0)].into_iter().enumerate() {
-            let pivot = Vector2::new(0.0, sign * h);
-            let elbow = pivot + l * Vector2::new(theta.cos(), theta.sin());
-            let tip = start + pivot; // D = C + A0, E = C + B0
-            let phi = (tip.y - elbow.y).atan2(tip.x - elbow.x);
-            let b1 = world.insert_body(
+            let (pivot, elbow, phi) = arm_geometry(theta, sign, start);
+            links[k] = world.insert_body(
                 RigidBodyBuilder::dynamic()
                     .pose(pose(pivot.x, pivot.y, theta))
                     .additional_mass_properties(a1_mass)
                     .can_sleep(false),
             );
-            let b2 = world.insert_body(
+            tips[k] = world.insert_body(
                 RigidBodyBuilder::dynamic()
                     .pose(pose(elbow.x, elbow.y, phi))
                     .additional_mass_properties(a2_mass)
                     .can_sleep(false),
             );
-            let j1 = GenericJointBuilder::new(REVOLUTE_Z)
-                .local_frame1(pose(pivot.x, pivot.y, theta))
-                .local_frame2(Pose::IDENTITY)
-                .contacts_enabled(false)
-                .build();
-            let j2 = GenericJointBuilder::new(REVOLUTE_Z)
-                .local_frame1(pose(l, 0.0, phi - theta))
-                .local_frame2(Pose::IDENTITY)
-                .contacts_enabled(false)
-                .build();
-            let h1 = world
-                .insert_multibody_joint(base, b1, j1)
-                .ok_or_else(|| SimError::new("multibody joint A0/B0 rejected"))?;
-            world
-                .insert_multibody_joint(b1, b2, j2)
-                .ok_or_else(|| SimError::new("multibody elbow joint rejected"))?;
-            links[k] = b1;
-            tips[k] = b2;
-            joints.push((h1, phi));
+            phis[k] = phi;
         }
         let platform = world.insert_body(
             RigidBodyBuilder::dynamic()
@@ -347,78 +151,154 @@ impl ParallelSim {
                 .additional_mass_properties(platform_mass)
                 .can_sleep(false),
         );
+        Self {
+            base,
+            links,
+            tips,
+            platform,
+            phis,
+        }
+    }
+}
+
+/// Pivot, elbow and distal-link angle of the arm with actuated angle `theta` on the side
+/// `sign` (+1 for A, -1 for B) whose tip meets the platform with the tool point at `start`.
+fn arm_geometry(theta: f64, sign: f64, start: &Vector2<f64>) -> (Vector2<f64>, Vector2<f64>, f64) {
+    let pivot = Vector2::new(0.0, sign * HALF_WIDTH);
+    let elbow = pivot + LINK * Vector2::new(theta.cos(), theta.sin());
+    let tip = start + pivot; // D = C + A0, E = C + B0
+    (pivot, elbow, (tip.y - elbow.y).atan2(tip.x - elbow.x))
+}
+
+/// The robot's joints: the multibody tree (drives at A0 and B0, passive elbows, the platform's
+/// free in-plane translation and rotations) and the two loop closures.
+struct Joints {
+    /// The drive joints at A0 and B0.
+    drives: [MultibodyJointHandle; 2],
+    /// The platform's joint to the base.
+    platform: MultibodyJointHandle,
+}
+
+impl Joints {
+    fn insert(
+        world: &mut PhysicsWorld,
+        bodies: &Bodies,
+        q: &Vector2<f64>,
+        start: &Vector2<f64>,
+    ) -> Result<Self, SimError> {
+        let mut drives = Vec::new();
+        for (k, (theta, sign)) in [(q.x, 1.0), (q.y, -1.0)].into_iter().enumerate() {
+            let (pivot, _, phi) = arm_geometry(theta, sign, start);
+            let j1 = GenericJointBuilder::new(REVOLUTE_Z)
+                .local_frame1(pose(pivot.x, pivot.y, theta))
+                .local_frame2(Pose::IDENTITY)
+                .contacts_enabled(false)
+                .build();
+            let j2 = GenericJointBuilder::new(REVOLUTE_Z)
+                .local_frame1(pose(LINK, 0.0, phi - theta))
+                .local_frame2(Pose::IDENTITY)
+                .contacts_enabled(false)
+                .build();
+            let (b1, b2) = (bodies.links[k], bodies.tips[k]);
+            drives.push(
+                world
+                    .insert_multibody_joint(bodies.base, b1, j1)
+                    .ok_or_else(|| SimError::new("multibody joint A0/B0 rejected"))?,
+            );
+            world
+                .insert_multibody_joint(b1, b2, j2)
+                .ok_or_else(|| SimError::new("multibody elbow joint rejected"))?;
+        }
         let pj = GenericJointBuilder::new(JointAxesMask::LIN_Z)
             .local_frame1(pose(start.x, start.y, 0.0))
             .local_frame2(Pose::IDENTITY)
             .contacts_enabled(false)
             .build();
-        let ph = world
-            .insert_multibody_joint(base, platform, pj)
+        let platform = world
+            .insert_multibody_joint(bodies.base, bodies.platform, pj)
             .ok_or_else(|| SimError::new("platform joint rejected"))?;
         // Loop closures: the distal tips pinned in the plane to D and E on the platform.
         for (k, sign) in [(0usize, 1.0), (1, -1.0)] {
-            let phi = joints[k].1;
             let closure = GenericJointBuilder::new(JointAxesMask::LIN_X | JointAxesMask::LIN_Y)
-                .local_frame1(pose(l, 0.0, 0.0))
-                .local_frame2(pose(0.0, sign * h, phi))
+                .local_frame1(pose(LINK, 0.0, 0.0))
+                .local_frame2(pose(0.0, sign * HALF_WIDTH, bodies.phis[k]))
                 .contacts_enabled(false)
                 .build();
-            world.insert_impulse_joint(tips[k], platform, closure);
+            world.insert_impulse_joint(bodies.tips[k], bodies.platform, closure);
         }
-        // Springs and damping.
-        let drive = [joints[0].0, joints[1].0];
-        let (ka, kb) = (params.k_a, params.k_b);
-        for (hd, k) in [(drive[0], ka), (drive[1], kb)] {
-            set_spring(&mut world, hd, ANG_Z, k, 0.0);
+        match drives.as_slice() {
+            &[a, b] => Ok(Self {
+                drives: [a, b],
+                platform,
+            }),
+            _ => Err(SimError::new("two drive joints expected")),
         }
-        set_spring(&mut world, ph, ANG_X, params.k_tilt, 0.0);
-        set_spring(&mut world, ph, ANG_Y, params.k_tilt, 0.0);
-        set_spring(&mut world, ph, ANG_Z, params.k_orient, 0.0);
-        if let Some((mb, _)) = world.multibody_joints.get_mut(ph) {
-            // Generalized damping, in link order (assembly ids are the running DoF count).
-            let mut offsets = Vec::new();
-            let mut n = 0;
-            for link in mb.links() {
-                offsets.push((link.rigid_body_handle(), n, link.joint().ndofs()));
-                n += link.joint().ndofs();
-            }
-            let damping = mb.damping_mut();
-            for (body, start_dof, ndofs) in offsets {
-                for i in 0..ndofs {
-                    let value = if body == platform {
-                        // LinX, LinY, AngX, AngY, AngZ
-                        [0.0, 0.0, params.c_tilt, params.c_tilt, params.c_orient]
-                            .get(i)
-                            .copied()
-                            .unwrap_or(0.0)
-                    } else if links.contains(&body) {
-                        0.0 // drive damping is applied relative to the motor, explicitly
-                    } else {
-                        0.002 // passive elbows
-                    };
-                    if let Some(slot) = damping.get_mut(start_dof + i) {
-                        *slot = value;
-                    }
+    }
+
+    /// The joints' compliance: the drive springs `k_a`, `k_b`, the platform's tilt and
+    /// orientation springs, and the generalized damping of every degree of freedom (drive
+    /// damping acts relative to the motor and is applied per step by the servo instead).
+    fn set_compliance(&self, world: &mut PhysicsWorld, params: &RobotParams, bodies: &Bodies) {
+        for (hd, k) in [(self.drives[0], params.k_a), (self.drives[1], params.k_b)] {
+            set_spring(world, hd, ANG_Z, k, 0.0);
+        }
+        let ph = self.platform;
+        set_spring(world, ph, ANG_X, params.k_tilt, 0.0);
+        set_spring(world, ph, ANG_Y, params.k_tilt, 0.0);
+        set_spring(world, ph, ANG_Z, params.k_orient, 0.0);
+        let Some((mb, _)) = world.multibody_joints.get_mut(ph) else {
+            return;
+        };
+        // Generalized damping, in link order (assembly ids are the running DoF count).
+        let mut offsets = Vec::new();
+        let mut n = 0;
+        for link in mb.links() {
+            offsets.push((link.rigid_body_handle(), n, link.joint().ndofs()));
+            n += link.joint().ndofs();
+        }
+        let damping = mb.damping_mut();
+        for (body, start_dof, ndofs) in offsets {
+            for i in 0..ndofs {
+                let value = if body == bodies.platform {
+                    // LinX, LinY, AngX, AngY, AngZ
+                    [0.0, 0.0, params.c_tilt, params.c_tilt, params.c_orient]
+                        .get(i)
+                        .copied()
+                        .unwrap_or(0.0)
+                } else if bodies.links.contains(&body) {
+                    0.0 // drive damping is applied relative to the motor, explicitly
+                } else {
+                    0.002 // passive elbows
+                };
+                if let Some(slot) = damping.get_mut(start_dof + i) {
+                    *slot = value;
                 }
             }
         }
+    }
+}
+
+impl ParallelSim {
+    /// Builds the robot at rest with its tool point at `start` = (x, y) \[m\] (task frame C - O),
+    /// under standard gravity down z ([`deflect_core::units::GRAVITY_Z_DOWN`]), normal to the
+    /// plane of motion: its [`Bodies`], their [`Joints`] and the loop closures, the joints'
+    /// springs and damping, and the servos at rest.
+    pub fn new(params: RobotParams, start: &Vector2<f64>) -> Result<Self, SimError> {
+        let q = ParallelRobot2::paper().ik(start)?;
+        let mut world = new_world(gravity_z_down(), DT);
+        world.integration_parameters.num_solver_iterations = params.solver_iterations;
+        world.integration_parameters.num_internal_pgs_iterations = params.pgs_iterations;
+        let bodies = Bodies::insert(&mut world, &params, &q, start);
+        let joints = Joints::insert(&mut world, &bodies, &q, start)?;
+        joints.set_compliance(&mut world, &params, &bodies);
         Ok(Self {
             world,
             params,
             q_ref: q,
-            links,
-            platform,
-            joints: drive,
-            motors: [
-                Motor {
-                    angle: q.x,
-                    speed: 0.0,
-                },
-                Motor {
-                    angle: q.y,
-                    speed: 0.0,
-                },
-            ],
+            links: bodies.links,
+            platform: bodies.platform,
+            joints: joints.drives,
+            motors: [q.x, q.y].map(|angle| Motor { angle, speed: 0.0 }),
             time: 0.0,
         })
     }

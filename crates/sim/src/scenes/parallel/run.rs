@@ -13,7 +13,8 @@ use nalgebra::{Vector2, Vector3};
 
 use crate::SimError;
 use crate::scenes::parallel::analysis::{LineMetrics, evaluate_line};
-use crate::scenes::parallel::robot::{Constraint, DT, ParallelSim, RobotParams, linear_compliance};
+use crate::scenes::parallel::params::{Constraint, DT, RobotParams, linear_compliance};
+use crate::scenes::parallel::robot::ParallelSim;
 
 /// The paper's force levels: 5..25 kgf in 5 kgf steps \[N\], as the paper converts them (with
 /// 9.81 m/s^2, like [`deflect_core::motion::PAPER_G`]; not a gravity of the simulation).
@@ -491,7 +492,7 @@ pub fn evaluate_run(motion: Motion, samples: &[Sample]) -> RunMetrics {
 
 /// The configurations of the paper's Table I (OC/NC x upper/lower head).
 pub fn configurations() -> Vec<RobotParams> {
-    use crate::scenes::parallel::robot::Head;
+    use crate::scenes::parallel::params::Head;
     let mut v = Vec::new();
     for c in [Constraint::Oc, Constraint::Nc] {
         for h in [Head::Upper, Head::Lower] {
