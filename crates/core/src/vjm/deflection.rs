@@ -151,25 +151,65 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
     Ok(tcp)
 }
 
-/// The moment on every spring \[N m\] (world axes, about its origin) of the TCP `wrench` at
-/// `tcp`, from the rigid frames of the last pass (Eq. 5-6), into `data.spring_moments`.
-fn tcp_moments(model: &Model, data: &mut Data, tcp: &Isometry3<f64>, wrench: &Vector6) {
+/// Eq. 7 for one spring, `alpha = M_C / k_C`, `beta = M_B / k_B`, `gamma = M_A / k_A`: the
+/// angles \[rad\] of the spring with compliances `compliance` and rigid world frame `frame`
+/// under the moment `m` \[N m\] (world axes, about its origin). The one guard of the
+/// small-deflection model: an angle past [`MAX_SPRING_ANGLE`] (or NaN from overflowing
+/// moments) is refused.
+#[inline]
+fn spring_angles(
+    compliance: &Vector3<f64>,
+    frame: &Isometry3<f64>,
+    m: &Vector3<f64>,
+) -> Result<Vector3<f64>, TickError> {
+    let angles = compliance.component_mul(&frame.rotation.inverse_transform_vector(m));
+    let largest = angles.amax();
+    if largest.is_nan() || largest > MAX_SPRING_ANGLE {
+        return Err(TickError::InvalidArgument {
+            what: "load (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
+                   small-deflection model)",
+            value: largest,
+        });
+    }
+    Ok(angles)
+}
+
+/// The moment on every spring of the TCP `wrench` at `tcp` (Eq. 5-6: the load moved to the
+/// spring's origin, world axes) and its angles (Eq. 7), from the rigid frames of the last
+/// pass, into `data.spring_moments` and `data.spring_angles`.
+fn tcp_loads(
+    model: &Model,
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    wrench: &Vector6,
+) -> Result<(), TickError> {
     let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
     let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
     let p_tcp = tcp.translation.vector;
-    for k in 0..model.springs {
-        let (Some(f), Some(slot)) = (data.spring_frames.get(k), data.spring_moments.get_mut(k))
+    for op in model.ops.iter() {
+        let Op::Spring {
+            compliance, index, ..
+        } = op
         else {
             continue;
         };
-        *slot = moment + (p_tcp - f.translation.vector).cross(&force);
+        let Some(f) = data.spring_frames.get(*index).copied() else {
+            continue;
+        };
+        let m = moment + (p_tcp - f.translation.vector).cross(&force);
+        let angles = spring_angles(compliance, &f, &m)?;
+        if let (Some(ms), Some(a)) = (
+            data.spring_moments.get_mut(*index),
+            data.spring_angles.get_mut(*index),
+        ) {
+            *ms = m;
+            *a = angles;
+        }
     }
+    Ok(())
 }
 
-/// The spring angles `C M` (Eq. 7: `alpha = M_C / k_C`, `beta = M_B / k_B`,
-/// `gamma = M_A / k_A`) of every spring from `data.spring_moments`, each moment expressed in
-/// its spring's frame, into `data.spring_angles`. The one guard of the small-deflection
-/// model: an angle past [`MAX_SPRING_ANGLE`] (or NaN from overflowing moments) is refused.
+/// The angles (Eq. 7) of every spring from `data.spring_moments`, into `data.spring_angles`.
 fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> {
     for op in model.ops.iter() {
         let Op::Spring {
@@ -184,15 +224,7 @@ fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> 
         ) else {
             continue;
         };
-        let angles = compliance.component_mul(&f.rotation.inverse_transform_vector(m));
-        let largest = angles.amax();
-        if largest.is_nan() || largest > MAX_SPRING_ANGLE {
-            return Err(TickError::InvalidArgument {
-                what: "load (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
-                       small-deflection model)",
-                value: largest,
-            });
-        }
+        let angles = spring_angles(compliance, f, m)?;
         if let Some(slot) = data.spring_angles.get_mut(*index) {
             *slot = angles;
         }
@@ -297,34 +329,35 @@ pub fn deflection(
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
     let tcp = match load.arm() {
-        Some(motion) => arm_pass(model, data, q, wrench, motion)?,
+        Some(motion) => {
+            let tcp = arm_pass(model, data, q, wrench, motion)?;
+            angles_from_moments(model, data)?;
+            tcp
+        }
         None => {
             let tcp = rigid_pass(model, data, q);
-            if load != Load::Rigid {
-                tcp_moments(model, data, &tcp, wrench);
+            if load == Load::Rigid {
+                let n = model.springs;
+                for slot in data.spring_angles.iter_mut().take(n) {
+                    *slot = Vector3::zeros();
+                }
+                for slot in data.spring_moments.iter_mut().take(n) {
+                    *slot = Vector3::zeros();
+                }
+            } else {
+                tcp_loads(model, data, &tcp, wrench)?;
             }
             tcp
         }
     };
     fill_jacobian(model, data, &tcp);
     match load {
-        Load::Rigid => {
-            let n = model.springs;
-            for slot in data.spring_angles.iter_mut().take(n) {
-                *slot = Vector3::zeros();
-            }
-            for slot in data.spring_moments.iter_mut().take(n) {
-                *slot = Vector3::zeros();
-            }
-            finish_deflection(data, &tcp, &tcp)
-        }
+        Load::Rigid => finish_deflection(data, &tcp, &tcp),
         Load::Exact | Load::ExactWithArm(_) => {
-            angles_from_moments(model, data)?;
             let deflected = deflected_tcp(model, data, &tcp);
             finish_deflection(data, &tcp, &deflected)
         }
         Load::Linearized | Load::LinearizedWithArm(_) => {
-            angles_from_moments(model, data)?;
             let d = linear_sum(model, data, &tcp);
             check_output("deflection", d.as_slice())?;
             data.tcp = tcp;
@@ -334,28 +367,23 @@ pub fn deflection(
     }
 }
 
-/// Fills `data.jacobian` from the joint axes and origins of the last pass.
+/// Fills `data.jacobian` from the joint axes and origins of the last pass: one column per
+/// joint (the columns past the model's dof stay zero from [`Data::new`]).
 pub(super) fn fill_jacobian(model: &Model, data: &mut Data, tcp: &Isometry3<f64>) {
-    data.jacobian.fill(0.0);
-    for op in model.ops.iter() {
-        let Op::Joint {
-            revolute, index, ..
-        } = op
-        else {
+    let p = tcp.translation.vector;
+    for step in model.tcp_chain.iter() {
+        let i = step.index;
+        let (Some(u), Some(o)) = (data.joint_axes.get(i), data.joint_origins.get(i)) else {
             continue;
         };
-        let (Some(u), Some(o)) = (data.joint_axes.get(*index), data.joint_origins.get(*index))
-        else {
-            continue;
-        };
-        let col = if *revolute {
-            let lin = u.cross(&(tcp.translation.vector - o));
+        let col = if step.revolute {
+            let lin = u.cross(&(p - o));
             Vector6::new(lin.x, lin.y, lin.z, u.x, u.y, u.z)
         } else {
             Vector6::new(u.x, u.y, u.z, 0.0, 0.0, 0.0)
         };
-        if *index < data.jacobian.ncols() {
-            data.jacobian.set_column(*index, &col);
+        if i < data.jacobian.ncols() {
+            data.jacobian.set_column(i, &col);
         }
     }
 }
