@@ -17,8 +17,7 @@
 //! two steps from its warm start, where the generic form would pay one full IK per
 //! fixed-point iteration (the latency harness, `benches/latency.rs`, times both on the KR 300
 //! with a point mass: 1.9-2.0 us for the serial tick against 7.2-7.3 us for the generic one),
-//! and a 6-D pose is not a task
-//! point of a [`crate::mechanism::Mechanism`].
+//! and a 6-D pose is not a task point of a [`crate::mechanism::Mechanism`].
 
 pub mod parallel;
 pub mod serial;
