@@ -215,6 +215,7 @@ fn check_count(count: usize) -> Result<(), BuildError> {
     if count > MAX_MEASUREMENTS {
         return Err(BuildError::Budget {
             what: "measurements",
+            budget: "MAX_MEASUREMENTS",
             limit: MAX_MEASUREMENTS,
             requested: count,
         });

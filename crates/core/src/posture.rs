@@ -94,6 +94,57 @@ pub enum Reach {
     Singular,
     /// The only solutions found violate a joint limit.
     JointLimit,
+    /// A posture exists, but the wrench turns a spring past
+    /// [`vjm::MAX_SPRING_ANGLE`] (or overflows the deflection): the point is reachable,
+    /// its deflection is beyond the small-deflection model's validity.
+    BeyondModel,
+}
+
+impl Reach {
+    /// How much a failure says about the point, for reporting the most telling one: a
+    /// posture outside the model's validity says more than a limit or a singularity, which
+    /// say more than "out of reach".
+    fn rank(self) -> u8 {
+        match self {
+            Self::Reachable => 4,
+            Self::BeyondModel => 3,
+            Self::JointLimit | Self::Singular => 2,
+            Self::OutOfReach => 1,
+        }
+    }
+
+    /// Short name: `reachable`, `out_of_reach`, `singular`, `joint_limit`, `beyond_model`
+    /// (the bindings' and the testbed's spelling).
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Reachable => "reachable",
+            Self::OutOfReach => "out_of_reach",
+            Self::Singular => "singular",
+            Self::JointLimit => "joint_limit",
+            Self::BeyondModel => "beyond_model",
+        }
+    }
+
+    /// Stable numeric code (0 reachable, 1 out of reach, 2 singular, 3 joint limit, 4
+    /// beyond the model), the order of [`Self::ALL`]: what tables and archives store.
+    pub fn code(self) -> u8 {
+        match self {
+            Self::Reachable => 0,
+            Self::OutOfReach => 1,
+            Self::Singular => 2,
+            Self::JointLimit => 3,
+            Self::BeyondModel => 4,
+        }
+    }
+
+    /// Every status, in code order.
+    pub const ALL: [Self; 5] = [
+        Self::Reachable,
+        Self::OutOfReach,
+        Self::Singular,
+        Self::JointLimit,
+        Self::BeyondModel,
+    ];
 }
 
 /// One angle of a sweep.
@@ -118,6 +169,12 @@ pub struct AnglePoint {
 pub struct SweepSummary {
     /// Reachable angles.
     pub reachable: usize,
+    /// Angles with a posture whose deflection is beyond the model ([`Reach::BeyondModel`]).
+    pub beyond_model: usize,
+    /// The point's status: [`Reach::Reachable`] when an angle is, otherwise the most telling
+    /// failure over the angles ([`Reach::BeyondModel`] before a joint limit or a
+    /// singularity, those before [`Reach::OutOfReach`]).
+    pub status: Reach,
     /// Index of the best angle of the sweep, if any is reachable.
     pub best_index: Option<usize>,
     /// Index of the worst reachable angle.
@@ -210,8 +267,10 @@ impl Task<'_> {
         if outside {
             return Err(Reach::JointLimit);
         }
+        // The pose IK succeeded: a failing deflection is the spring-angle guard (or an
+        // overflow), a load beyond the model, not a point out of reach.
         let d = vjm::deflection(self.model, data, q, self.wrench, vjm::Load::Exact)
-            .map_err(|_| Reach::OutOfReach)?;
+            .map_err(|_| Reach::BeyondModel)?;
         Ok(AnglePoint {
             angle: theta,
             reach: Reach::Reachable,
@@ -244,7 +303,7 @@ impl Task<'_> {
                     }
                 }
                 Err(r) => {
-                    if why == Reach::OutOfReach {
+                    if r.rank() > why.rank() {
                         why = r;
                     }
                 }
@@ -332,6 +391,8 @@ pub fn sweep(
     }
     let mut summary = SweepSummary {
         reachable: 0,
+        beyond_model: 0,
+        status: Reach::OutOfReach,
         best_index: None,
         worst_index: None,
         best: None,
@@ -340,6 +401,12 @@ pub fn sweep(
     let mut worst_m = f64::NEG_INFINITY;
     for (i, (o, &theta)) in out.iter_mut().zip(angles).enumerate() {
         *o = task.best_of_seeds(data, theta, &mut warm, n_seeds);
+        if o.reach.rank() > summary.status.rank() {
+            summary.status = o.reach;
+        }
+        if o.reach == Reach::BeyondModel {
+            summary.beyond_model += 1;
+        }
         if o.reach == Reach::Reachable {
             summary.reachable += 1;
             if o.measure < best_m {

@@ -56,6 +56,27 @@ fn sampling_has_a_budget_instead_of_an_abort() {
         y_line(1e-300).ticks(2000.0),
         Err(TickError::Budget { what: "ticks", .. })
     ));
+    // A call that stores every tick names one budget however far past it the request is
+    // (not MAX_TICKS for the farthest), with whole numbers.
+    let far = y_line(1e-300).sample_count(2000.0).unwrap_err();
+    assert!(matches!(
+        far,
+        TickError::Budget {
+            what: "samples",
+            budget: "MAX_SAMPLES",
+            ..
+        }
+    ));
+    assert!(
+        far.to_string()
+            .ends_with("samples requested; the limit is MAX_SAMPLES = 4194304 samples"),
+        "{far}"
+    );
+    let ticks = (normal.duration() * 1e9 - 1e-9).ceil() as u64 + 1;
+    assert_eq!(
+        normal.sample_count(1e9).unwrap_err().to_string(),
+        format!("{ticks} samples requested; the limit is MAX_SAMPLES = 4194304 samples")
+    );
     // A sub-normal limit would give an infinite (or wrongly zero) duration: refused.
     assert!(matches!(
         Limits::new(5e-324, 49.05, 5207.0),

@@ -154,6 +154,7 @@ fn unreachable_angles_are_reported_never_as_zeros() {
         &PostureOptions::default(),
     );
     assert_eq!(s.reachable, 0);
+    assert_eq!((s.status, s.beyond_model), (Reach::OutOfReach, 0));
     assert!(s.best.is_none() && s.best_index.is_none() && s.worst_index.is_none());
     for a in &out {
         assert_eq!(a.reach, Reach::OutOfReach);
@@ -177,6 +178,61 @@ fn unreachable_angles_are_reported_never_as_zeros() {
         s.reachable >= 1 && s.reachable < out.len() / 2,
         "{}",
         s.reachable
+    );
+}
+
+/// The sweep at Q0's task under `wrench` over `angles`.
+fn sweep_under(wrench: [f64; 6], angles: &[f64]) -> (Vec<AnglePoint>, posture::SweepSummary) {
+    let robot = fixtures::kr300();
+    let (p, z) = task(&robot);
+    let mut data = Data::new(&robot.model);
+    let mut out = vec![AnglePoint::default(); angles.len()];
+    let s = posture::sweep(
+        &robot.model,
+        &mut data,
+        &robot.joint_limits,
+        &p,
+        &z,
+        &Vector6::from_column_slice(&wrench),
+        angles,
+        &Q0,
+        &PostureOptions::default(),
+        &mut out,
+    )
+    .unwrap();
+    (out, s)
+}
+
+#[test]
+fn an_overload_is_beyond_the_model_not_out_of_reach() {
+    // 1e12 N: every angle has a posture, the springs would turn by far more than
+    // MAX_SPRING_ANGLE. Reported as such, with NaN (never a deflection), and the point's
+    // status says the task is in reach.
+    let angles = degrees(-30.0, 30.0, 10.0);
+    let (out, s) = sweep_under([1e12, 0.0, 0.0, 0.0, 0.0, 0.0], &angles);
+    assert_eq!(s.reachable, 0);
+    assert_eq!(s.beyond_model, angles.len());
+    assert_eq!(s.status, Reach::BeyondModel);
+    assert!(s.best.is_none());
+    for a in &out {
+        assert_eq!(a.reach, Reach::BeyondModel);
+        assert!(a.measure.is_nan() && a.deflection.iter().all(|v| v.is_nan()));
+    }
+    // The same task under the paper's wrench: every angle reachable, none beyond.
+    let (_, s) = sweep_under(WRENCH, &angles);
+    assert_eq!((s.reachable, s.beyond_model), (angles.len(), 0));
+    assert_eq!(s.status, Reach::Reachable);
+    // Codes and names are stable (the atlas archives store the codes).
+    let named: Vec<(u8, &str)> = Reach::ALL.iter().map(|r| (r.code(), r.name())).collect();
+    assert_eq!(
+        named,
+        [
+            (0, "reachable"),
+            (1, "out_of_reach"),
+            (2, "singular"),
+            (3, "joint_limit"),
+            (4, "beyond_model")
+        ]
     );
 }
 

@@ -205,6 +205,7 @@ mod tests {
             },
             TickError::Budget {
                 what: "samples",
+                budget: "MAX_SAMPLES",
                 limit: 1e7,
                 requested: 1e9,
             },

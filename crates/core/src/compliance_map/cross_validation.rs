@@ -3,7 +3,9 @@
 
 use alloc::vec::Vec;
 
-use super::{ComplianceMap, Interpolation, MAX_AXES, OutOfGrid, QueryOptions, sqrt};
+use super::{
+    ComplianceMap, Interpolation, MAX_AXES, MAX_MEASUREMENTS, OutOfGrid, QueryOptions, sqrt,
+};
 use crate::error::BuildError;
 
 /// Which grid line is removed to hold a node out (see [`leave_one_node_out`]).
@@ -62,7 +64,8 @@ impl CrossValidation {
 /// along that column. Nodes held out are those interior along `axis`
 /// (`0 < j < ny - 1` for `Y`), all indices across it; the axis must keep >= 2 nodes.
 ///
-/// `forces` holds the test forces back to back, `n_force` entries each \[N\]. The error at a
+/// `forces` holds the test forces back to back, `n_force` entries each \[N\], at most
+/// [`MAX_MEASUREMENTS`] rows ([`BuildError::Budget`] past it). The error at a
 /// node for one force is the Euclidean norm of predicted minus the node's own lines
 /// (Eq. 10) \[m\]; reported as RMS per node and over everything.
 pub fn leave_one_node_out(
@@ -72,6 +75,14 @@ pub fn leave_one_node_out(
 ) -> Result<CrossValidation, BuildError> {
     let (nx, ny) = (map.x().len(), map.y().len());
     let (nf, nd) = (map.n_force(), map.n_displacement());
+    if forces.len() / nf.max(1) > MAX_MEASUREMENTS {
+        return Err(BuildError::Budget {
+            what: "force rows",
+            budget: "MAX_MEASUREMENTS",
+            limit: MAX_MEASUREMENTS,
+            requested: forces.len() / nf.max(1),
+        });
+    }
     if forces.is_empty() || !forces.len().is_multiple_of(nf) {
         return Err(BuildError::WrongLength {
             what: "forces",

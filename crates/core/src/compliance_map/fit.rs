@@ -6,7 +6,7 @@ use alloc::vec;
 use alloc::vec::Vec;
 
 use super::view::check_counts;
-use super::{ComplianceMap, MAX_AXES, sqrt};
+use super::{ComplianceMap, MAX_AXES, MAX_MEASUREMENTS, sqrt};
 use crate::error::BuildError;
 
 /// Column names used in errors for the displacement entries of a [`Measurement`].
@@ -274,13 +274,22 @@ pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, Bu
 ///
 /// Errors: non-finite values ([`BuildError::NonFinite`] with row and column `x`, `y`,
 /// `force` or `d<k>`), a force axis `>= n_force`, ambiguous or non-rectilinear positions, a
-/// missing node, a repeated (node, axis, force), fewer than 2 force levels for a line.
+/// missing node, a repeated (node, axis, force), fewer than 2 force levels for a line;
+/// [`BuildError::Budget`] past [`MAX_MEASUREMENTS`].
 pub fn fit(
     measurements: &[Measurement],
     options: &FitOptions,
 ) -> Result<ComplianceMap, BuildError> {
     let (nf, nd) = (options.n_force, options.n_displacement);
     check_counts(nf, nd)?;
+    if measurements.len() > MAX_MEASUREMENTS {
+        return Err(BuildError::Budget {
+            what: "measurements",
+            budget: "MAX_MEASUREMENTS",
+            limit: MAX_MEASUREMENTS,
+            requested: measurements.len(),
+        });
+    }
     let tol = options.position_tolerance;
     for (row, m) in measurements.iter().enumerate() {
         for (column, v) in [("x", m.x), ("y", m.y), ("force", m.force)] {

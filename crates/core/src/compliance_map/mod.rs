@@ -73,6 +73,11 @@ use crate::error::{Placement, TickError};
 /// Most force axes and most displacement axes a map holds (a 6-D wrench and a 6-D twist).
 pub const MAX_AXES: usize = 6;
 
+/// Most measurements one [`fit`] takes, and most force rows one [`leave_one_node_out`]
+/// evaluates: the one budget of measurements in deflect (the identification's), far above a
+/// static test campaign (the paper's maps take 245 rows).
+pub use crate::identification::MAX_MEASUREMENTS;
+
 /// How node values are blended between nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(

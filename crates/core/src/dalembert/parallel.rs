@@ -229,6 +229,7 @@ impl<M, D> Model<M, D> {
         if iterations > MAX_FIXED_POINT_ITERATIONS {
             return Err(BuildError::Budget {
                 what: "fixed-point iterations",
+                budget: "MAX_FIXED_POINT_ITERATIONS",
                 limit: MAX_FIXED_POINT_ITERATIONS,
                 requested: iterations,
             });

@@ -223,6 +223,8 @@ pub enum BuildError {
     Budget {
         /// What grows.
         what: &'static str,
+        /// The name of the documented limit (`"MAX_MEASUREMENTS"`).
+        budget: &'static str,
         /// The documented limit.
         limit: usize,
         /// What was asked for.
@@ -375,11 +377,12 @@ impl fmt::Display for BuildError {
             Self::Numerical { what } => write!(f, "{what}: the solver did not converge"),
             Self::Budget {
                 what,
+                budget,
                 limit,
                 requested,
             } => write!(
                 f,
-                "{requested:?} {what} requested; the limit is {limit:?} (see the function's docs)"
+                "{requested} {what} requested; the limit is {budget} = {limit} {what}"
             ),
             Self::UnknownGLevel { g_level } => {
                 write!(f, "the paper's motions exist for 1..=5 g, not {g_level} g")

@@ -89,6 +89,9 @@ pub enum TickError {
     Budget {
         /// What grows ("samples", "iterations", ...).
         what: &'static str,
+        /// The name of the documented limit (`"MAX_SAMPLES"`): one budget per quantity,
+        /// named in every message that refuses it.
+        budget: &'static str,
         /// The documented limit.
         limit: f64,
         /// What the arguments ask for.
@@ -163,11 +166,14 @@ impl fmt::Display for TickError {
             ),
             Self::Budget {
                 what,
+                budget,
                 limit,
                 requested,
             } => write!(
                 f,
-                "{requested:?} {what} requested; the limit is {limit:?} (see the function's docs)"
+                "{} {what} requested; the limit is {budget} = {} {what}",
+                Count(*requested),
+                Count(*limit)
             ),
             Self::ModelMismatch {
                 what,
@@ -182,6 +188,21 @@ impl fmt::Display for TickError {
 }
 
 impl core::error::Error for TickError {}
+
+/// A count held as `f64` (it may be past `u64`), shown as a whole number when it is one
+/// below 2^53, as `{:?}` otherwise.
+struct Count(f64);
+
+impl fmt::Display for Count {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let x = self.0;
+        if x.fract() == 0.0 && x.abs() < 9.0e15 {
+            write!(f, "{}", x as i64)
+        } else {
+            write!(f, "{x:?}")
+        }
+    }
+}
 
 /// Checks that every entry of `values` is finite; names the first one that is not.
 #[inline]

@@ -57,7 +57,7 @@ pub use trajectory::{AxisLimits, Cursor, Data, State, Trajectory, step};
 /// and [`step`] the tick.
 pub type Model<const N: usize> = Trajectory<N>;
 
-use crate::error::{BuildError, param};
+use crate::error::{BuildError, TickError, param};
 
 /// Most points of a polyline (so at most `MAX_POINTS - 1` segments). The paper's longest
 /// path, the triangle, has 4; 32 leaves room for a polygonal contour without costing much
@@ -172,4 +172,53 @@ pub fn paper_limits(g_level: u8) -> Result<Limits, BuildError> {
         4.0 * v / (ta * ta)
     };
     Limits::new(v, a, j)
+}
+
+/// Ticks of a motion of `duration` \[s\] at `rate_hz`: tick `k` at `k / rate_hz`, the last
+/// exactly at the duration, so `ceil(duration * rate) + 1` (rounding of 1e-9 tick tolerated,
+/// so that a duration of exactly `k` ticks gives `k + 1`). [`TickError::InvalidArgument`] for
+/// a rate that is not finite and > 0, [`TickError::Budget`] past [`MAX_TICKS`].
+pub(crate) fn tick_count(duration: f64, rate_hz: f64) -> Result<usize, TickError> {
+    counted(duration, rate_hz, "ticks", "MAX_TICKS", MAX_TICKS as f64)
+}
+
+/// [`tick_count`] for a call that stores every tick: [`TickError::Budget`] past
+/// [`MAX_SAMPLES`], checked on the count itself so that such a call names this one budget
+/// however far past it the request is (not [`MAX_TICKS`] for the farthest).
+pub(crate) fn sample_count(duration: f64, rate_hz: f64) -> Result<usize, TickError> {
+    counted(
+        duration,
+        rate_hz,
+        "samples",
+        "MAX_SAMPLES",
+        MAX_SAMPLES as f64,
+    )
+}
+
+fn counted(
+    duration: f64,
+    rate_hz: f64,
+    what: &'static str,
+    budget: &'static str,
+    limit: f64,
+) -> Result<usize, TickError> {
+    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+        return Err(TickError::InvalidArgument {
+            what: "rate_hz",
+            value: rate_hz,
+        });
+    }
+    let intervals = nalgebra::ComplexField::ceil(duration * rate_hz - 1.0e-9).max(0.0);
+    let count = intervals + 1.0;
+    if count.is_nan() || count > limit {
+        return Err(TickError::Budget {
+            what,
+            budget,
+            limit,
+            requested: count,
+        });
+    }
+    // Exact: at most 2^40 < 2^53, and usize holds it on 64-bit targets; a 32-bit target
+    // saturates, which the sample budget and the cursor's own bound catch.
+    Ok(usize::try_from(count as u64).unwrap_or(usize::MAX))
 }

@@ -5,7 +5,7 @@
 
 use nalgebra::{Isometry3, Translation3, Unit, UnitQuaternion, Vector3};
 
-use super::{Limits, MAX_TICKS, Profile};
+use super::{Limits, Profile};
 use crate::error::{BuildError, TickError};
 
 /// Limits of a pose motion: `linear` on the TCP's path (\[m/s, m/s^2, m/s^3\]) and `angular`
@@ -171,40 +171,16 @@ impl PoseTrajectory {
     }
 
     /// Number of ticks at `rate_hz`, as [`super::Trajectory::tick_count`]: tick `k` at
-    /// `k / rate_hz`, the last exactly at the duration.
+    /// `k / rate_hz`, the last exactly at the duration; [`TickError::Budget`] past
+    /// [`MAX_TICKS`].
     pub fn tick_count(&self, rate_hz: f64) -> Result<usize, TickError> {
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(TickError::InvalidArgument {
-                what: "rate_hz",
-                value: rate_hz,
-            });
-        }
-        let intervals = nalgebra::ComplexField::ceil(self.duration() * rate_hz - 1.0e-9).max(0.0);
-        let limit = MAX_TICKS as f64;
-        if intervals.is_nan() || intervals >= limit {
-            return Err(TickError::Budget {
-                what: "ticks",
-                limit,
-                requested: intervals + 1.0,
-            });
-        }
-        Ok(usize::try_from(intervals as u64)
-            .unwrap_or(usize::MAX)
-            .saturating_add(1))
+        super::tick_count(self.duration(), rate_hz)
     }
 
     /// [`Self::tick_count`] for a call that stores every tick: [`TickError::Budget`] past
-    /// [`super::MAX_SAMPLES`].
+    /// [`super::MAX_SAMPLES`] (the one budget such calls report).
     pub fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
-        let n = self.tick_count(rate_hz)?;
-        if n > super::MAX_SAMPLES {
-            return Err(TickError::Budget {
-                what: "samples",
-                limit: super::MAX_SAMPLES as f64,
-                requested: n as f64,
-            });
-        }
-        Ok(n)
+        super::sample_count(self.duration(), rate_hz)
     }
 
     /// Time of tick `k` of `count` at `rate_hz` (the last tick exactly at the duration).

@@ -41,6 +41,7 @@ fn check_samples<const N: usize>(
     if v.len() > MAX_SAMPLES {
         return Err(BuildError::Budget {
             what: "samples",
+            budget: "MAX_SAMPLES",
             limit: MAX_SAMPLES,
             requested: v.len(),
         });

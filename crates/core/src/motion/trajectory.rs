@@ -2,10 +2,7 @@
 
 use nalgebra::{ComplexField, SVector};
 
-use super::{
-    Limits, MAX_POINTS, MAX_SAMPLES, MAX_SEGMENTS, MAX_TICKS, MIN_SEGMENT_LENGTH, PathState,
-    Profile,
-};
+use super::{Limits, MAX_POINTS, MAX_SEGMENTS, MIN_SEGMENT_LENGTH, PathState, Profile};
 use crate::error::{BuildError, TickError};
 
 /// The state of an N-D trajectory at one time.
@@ -343,41 +340,14 @@ impl<const N: usize> Trajectory<N> {
 
     /// Number of ticks at `rate_hz` (see [`Self::ticks`]), at most [`MAX_TICKS`].
     pub fn tick_count(&self, rate_hz: f64) -> Result<usize, TickError> {
-        if !(rate_hz.is_finite() && rate_hz > 0.0) {
-            return Err(TickError::InvalidArgument {
-                what: "rate_hz",
-                value: rate_hz,
-            });
-        }
-        // Tolerate rounding so that a duration of exactly k ticks gives k + 1 ticks.
-        let intervals = ComplexField::ceil(self.duration * rate_hz - 1.0e-9).max(0.0);
-        let limit = MAX_TICKS as f64;
-        if intervals.is_nan() || intervals >= limit {
-            return Err(TickError::Budget {
-                what: "ticks",
-                limit,
-                requested: intervals + 1.0,
-            });
-        }
-        // Exact: below 2^40 < 2^53, and usize holds it on 64-bit targets; a 32-bit target
-        // saturates, which `sample_count` and the cursor's own bound catch.
-        Ok(usize::try_from(intervals as u64)
-            .unwrap_or(usize::MAX)
-            .saturating_add(1))
+        super::tick_count(self.duration, rate_hz)
     }
 
     /// [`Self::tick_count`] for a call that stores every tick: [`TickError::Budget`] past
-    /// [`MAX_SAMPLES`], so that nothing allocates more than that documents.
+    /// [`MAX_SAMPLES`], so that nothing allocates more than that documents (the one budget
+    /// such calls report, however far past it the request is).
     pub fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
-        let n = self.tick_count(rate_hz)?;
-        if n > MAX_SAMPLES {
-            return Err(TickError::Budget {
-                what: "samples",
-                limit: MAX_SAMPLES as f64,
-                requested: n as f64,
-            });
-        }
-        Ok(n)
+        super::sample_count(self.duration, rate_hz)
     }
 }
 

@@ -202,6 +202,7 @@ pub fn joint_correction(
     if max_iterations > MAX_CORRECTION_ITERATIONS {
         return Err(TickError::Budget {
             what: "Gauss-Newton iterations",
+            budget: "MAX_CORRECTION_ITERATIONS",
             limit: MAX_CORRECTION_ITERATIONS as f64,
             requested: max_iterations as f64,
         });
