@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use deflect_core::SerialRobot;
 use deflect_core::io::urdf;
+use deflect_core::posture::Reach;
 use deflect_sim::SimError;
 use deflect_sim::jobs::progress;
 use deflect_sim::scenes::serial::atlas::{self, AtlasTask};
@@ -99,13 +100,14 @@ pub fn atlas_cmd(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimE
     let wall = t0.elapsed().as_secs_f64();
     let evaluations = points.len() * task.angles.len();
     let reachable = points.iter().filter(|p| p.reachable_angles > 0).count();
+    let why = unreachable_summary(&points);
     let npz = out.join("atlas.npz");
     atlas::write_npz(&npz, task, &points)?;
     let png = out.join("atlas.png");
     atlas::plot_heat_map(&png, task, &points)?;
     stdout(format_args!(
         "atlas: {}, {} points x {} angles on {} thread(s) in {wall:.2} s ({:.0} pose \
-         evaluations/s)\n{}\nreachable points: {reachable} of {}\n",
+         evaluations/s)\n{}\nreachable points: {reachable} of {}{why}\n",
         task.name,
         points.len(),
         task.angles.len(),
@@ -130,6 +132,11 @@ pub fn atlas_cmd(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimE
             p.best_angle.to_degrees(),
             p.worst_measure * 1e3
         ))?,
+        None if points.iter().any(|p| p.status == Reach::BeyondModel) => stdout(format_args!(
+            "no point has a valid posture: the postures exist, but the wrench turns a spring \
+             past MAX_SPRING_ANGLE = {} rad (beyond the small-deflection model)\n",
+            deflect_core::vjm::MAX_SPRING_ANGLE
+        ))?,
         None => stdout(format_args!("no point of the region is reachable\n"))?,
     }
     stdout(format_args!(
@@ -137,4 +144,27 @@ pub fn atlas_cmd(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimE
         npz.display(),
         png.display()
     ))
+}
+
+/// Why the points without a posture have none, as "; 3 out of reach, 2 beyond the model's
+/// validity ..." (empty when every point is reachable).
+fn unreachable_summary(points: &[atlas::AtlasPoint]) -> String {
+    let mut text = String::new();
+    for status in Reach::ALL {
+        let n = points.iter().filter(|p| p.status == status).count();
+        let what = match status {
+            Reach::Reachable => continue,
+            Reach::OutOfReach => "out of reach",
+            Reach::Singular => "only singular postures",
+            Reach::JointLimit => "only postures past a joint limit",
+            Reach::BeyondModel => {
+                "in reach but beyond the model's validity (the wrench turns a spring past \
+                 MAX_SPRING_ANGLE)"
+            }
+        };
+        if n > 0 {
+            text.push_str(&format!("; {n} {what}"));
+        }
+    }
+    text
 }

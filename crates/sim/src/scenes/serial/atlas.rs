@@ -11,7 +11,7 @@
 use std::path::Path;
 
 use deflect_core::SerialRobot;
-use deflect_core::posture::{self, AnglePoint, PostureOptions};
+use deflect_core::posture::{self, AnglePoint, PostureOptions, Reach};
 use deflect_core::vjm::{Data, Vector6};
 use indicatif::ProgressBar;
 use nalgebra::Vector3;
@@ -48,8 +48,15 @@ pub struct AtlasTask {
 /// The result at one grid point; NaN fields where nothing is reachable.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AtlasPoint {
+    /// The point's status: reachable, or the most telling reason it is not (a posture
+    /// beyond the model's validity before a joint limit or a singularity, those before out
+    /// of reach), as [`posture::SweepSummary::status`].
+    pub status: Reach,
     /// Angles of the sweep with a posture.
     pub reachable_angles: usize,
+    /// Angles with a posture whose deflection under the wrench is beyond the model (a
+    /// spring past `MAX_SPRING_ANGLE`).
+    pub beyond_model_angles: usize,
     /// Best angle about the tool axis \[rad\].
     pub best_angle: f64,
     /// Norm of the best translational deflection \[m\].
@@ -105,7 +112,9 @@ pub fn compute(
                     let worst = s.worst_index.and_then(|k| out.get(k));
                     Ok(match s.best {
                         Some(b) => AtlasPoint {
+                            status: s.status,
                             reachable_angles: s.reachable,
+                            beyond_model_angles: s.beyond_model,
                             best_angle: b.angle,
                             best_measure: b.measure,
                             best_deflection: core::array::from_fn(|k| b.deflection[k]),
@@ -114,7 +123,9 @@ pub fn compute(
                             worst_measure: worst.map_or(f64::NAN, |w| w.measure),
                         },
                         None => AtlasPoint {
+                            status: s.status,
                             reachable_angles: 0,
+                            beyond_model_angles: s.beyond_model,
                             best_angle: f64::NAN,
                             best_measure: f64::NAN,
                             best_deflection: [f64::NAN; 6],
@@ -138,7 +149,8 @@ pub fn compute(
 
 /// Writes `atlas.npz`: `x` (nx,), `y` (ny,), `z`, `tool_axis` (3,), `wrench` (6,), `angles`
 /// (n,) \[rad\], and per grid point, shaped (nx, ny) or (nx, ny, k): `reachable` (0/1),
-/// `reachable_angles`, `best_angle` \[rad\], `best_measure` \[m\], `best_deflection` (6) [m,
+/// `status` (0 reachable, 1 out of reach, 2 singular, 3 joint limit, 4 beyond the model's
+/// validity: `posture::Reach::code`), `reachable_angles`, `beyond_model_angles`, `best_angle` \[rad\], `best_measure` \[m\], `best_deflection` (6) [m,
 /// rad], `best_q` (dof) \[rad or m\], `worst_angle` \[rad\], `worst_measure` \[m\].
 pub fn write_npz(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Result<(), SimError> {
     let err = |e: &dyn std::fmt::Display| SimError::file(path, "write the atlas archive", e);
@@ -163,12 +175,16 @@ pub fn write_npz(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Result
     )?;
     add1("wrench", Array1::from_iter(task.wrench.iter().copied()))?;
     add1("angles", Array1::from_vec(task.angles.clone()))?;
-    let fields: [(&str, &Field); 6] = [
+    let fields: [(&str, &Field); 8] = [
         ("reachable", &|p: &AtlasPoint| {
             f64::from(u8::from(p.reachable_angles > 0))
         }),
+        ("status", &|p: &AtlasPoint| f64::from(p.status.code())),
         ("reachable_angles", &|p: &AtlasPoint| {
             p.reachable_angles as f64
+        }),
+        ("beyond_model_angles", &|p: &AtlasPoint| {
+            p.beyond_model_angles as f64
         }),
         ("best_angle", &|p: &AtlasPoint| p.best_angle),
         ("best_measure", &|p: &AtlasPoint| p.best_measure),

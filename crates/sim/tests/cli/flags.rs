@@ -1,0 +1,198 @@
+//! Numeric flags: each has a checked, documented range; usage errors exit 2.
+
+use super::*;
+
+#[test]
+fn milling_cut_1e9_is_refused_instead_of_a_failed_86_tb_allocation() {
+    let d = scratch("cut1e9");
+    out_of_range(
+        &d,
+        &["milling", "--cut", "1e9"],
+        "--cut",
+        "1e9",
+        "[0.01, 5] s",
+    );
+}
+
+#[test]
+fn milling_cut_3000_is_refused_instead_of_running_for_minutes() {
+    let d = scratch("cut3000");
+    out_of_range(
+        &d,
+        &["milling", "--cut", "3000"],
+        "--cut",
+        "3000",
+        "[0.01, 5] s",
+    );
+}
+
+#[test]
+fn every_length_count_and_level_flag_has_a_checked_range() {
+    let d = scratch("ranges");
+    // (subcommand, flag, range, values outside it as the error shows them)
+    let cases: &[(&str, &str, &str, &[&str])] = &[
+        (
+            "milling",
+            "--feed",
+            "[0.1, 50] mm/s",
+            &["0.09", "51", "NaN", "inf"],
+        ),
+        ("milling", "--force", "[0, 2000] N", &["-1", "2001", "1e30"]),
+        ("milling", "--cut", "[0.01, 5] s", &["0.001", "5.5", "-inf"]),
+        ("milling", "--rise-ms", "[0.1, 300] ms", &["0", "301"]),
+        (
+            "milling",
+            "--cycle-ms",
+            "[0.5, 20] ms",
+            &["0", "0.25", "20.5", "1e9"],
+        ),
+        ("milling", "--lead-ms", "[0, 500] ms", &["-1", "501"]),
+        (
+            "milling",
+            "--estimate-error",
+            "[-1, 1]",
+            &["-1.5", "2", "NaN"],
+        ),
+        ("contour", "--step-mm", "[0.2, 20] mm", &["0", "0.1", "21"]),
+        (
+            "contour",
+            "--target-force",
+            "(1.5, 30) N",
+            &["1.5", "30", "100"],
+        ),
+        ("contour", "--noise", "[0, 5] N", &["-0.1", "6", "inf"]),
+        (
+            "contour",
+            "--jobs",
+            "[1, 64]",
+            &["65", "18446744073709551615"],
+        ),
+        ("reproduce", "--mass", "[0, 50] kg", &["-1", "51", "NaN"]),
+        ("reproduce", "--g", "[1, 5] g", &["0", "6", "255"]),
+        ("reproduce", "--fixed-point", "[0, 50]", &["51", "1000000"]),
+        ("reproduce", "--jobs", "[1, 64]", &["65"]),
+        ("run", "--g", "[1, 5] g", &["0", "7"]),
+        ("run", "--mass", "[0, 50] kg", &["-0.5", "1e6"]),
+    ];
+    for (sub, flag, range, values) in cases {
+        for v in *values {
+            let arg = format!("{flag}={v}");
+            out_of_range(&d, &[sub, &arg], flag, v, range);
+        }
+    }
+}
+
+#[test]
+fn jobs_0_is_refused_not_silently_one() {
+    let d = scratch("jobs0");
+    for sub in ["reproduce", "contour"] {
+        out_of_range(&d, &[sub, "--jobs", "0"], "--jobs", "0", "[1, 64]");
+    }
+    // Without a subcommand, `reproduce` runs with its defaults (in range): nothing to refuse.
+}
+
+#[test]
+fn run_g_6_is_refused_before_the_static_tests_and_the_fit() {
+    let d = scratch("g6");
+    // Arguments are checked before the input files and the output directory.
+    out_of_range(
+        &d,
+        &["run", "--g", "6", "--map", "/nonexistent/map.json"],
+        "--g",
+        "6",
+        "[1, 5] g",
+    );
+}
+
+#[test]
+fn reproduce_levels_must_be_distinct() {
+    let d = scratch("levels");
+    refused(
+        &d,
+        &["reproduce", "--g", "1,2,2"],
+        2,
+        &["--g 2 is given twice", "[1, 5] g"],
+    );
+}
+
+#[test]
+fn milling_cycle_must_be_a_whole_number_of_physics_steps() {
+    let d = scratch("cycle");
+    // 0.7 ms used to run with 0.5 ms cycles while the compensator assumed 0.7 ms.
+    refused(
+        &d,
+        &["milling", "--cycle-ms", "0.7"],
+        2,
+        &[
+            "--cycle-ms 0.7",
+            "multiple of the 0.5 ms physics step",
+            "[0.5, 20] ms",
+        ],
+    );
+}
+
+#[test]
+fn negative_estimate_error_is_a_value_not_a_flag() {
+    let d = scratch("negative");
+    out_of_range(
+        &d,
+        &["milling", "--estimate-error", "-2"],
+        "--estimate-error",
+        "-2",
+        "[-1, 1]",
+    );
+}
+
+#[test]
+fn clap_usage_errors_exit_2() {
+    for args in [
+        &["milling", "--cut", "abc"][..],
+        &["contour", "--jobs", "-1"],
+        &["reproduce", "--g", ""],
+        &["run", "--no-such-flag"],
+        &["no-such-command"],
+    ] {
+        let o = sim(args);
+        assert_eq!(o.code, 2, "{args:?}: {}", o.stderr);
+        assert!(o.stderr.starts_with("error: "), "{args:?}: {}", o.stderr);
+        assert!(o.stdout.is_empty(), "{args:?}");
+    }
+}
+
+#[test]
+fn every_range_is_in_the_help() {
+    let cases: &[(&str, &[&str])] = &[
+        (
+            "milling",
+            &[
+                "[0.1, 50] mm/s",
+                "[0, 2000] N",
+                "[0.01, 5] s",
+                "[0.1, 300] ms",
+                "[0.5, 20] ms",
+                "[0, 500] ms",
+                "[-1, 1]",
+            ],
+        ),
+        (
+            "contour",
+            &["[0.2, 20] mm", "(1.5, 30) N", "[0, 5] N", "[1, 64]"],
+        ),
+        (
+            "reproduce",
+            &["[0, 50] kg", "[1, 5] g", "[0, 50]", "[1, 64]"],
+        ),
+        ("run", &["[1, 5] g", "[0, 50] kg"]),
+    ];
+    for (sub, ranges) in cases {
+        let o = sim(&[sub, "--help"]);
+        assert_eq!(o.code, 0);
+        for r in *ranges {
+            assert!(
+                o.stdout.contains(&format!("Range: {r}.")),
+                "{sub} --help lacks {r}: {}",
+                o.stdout
+            );
+        }
+    }
+}
