@@ -67,6 +67,10 @@ target/smoke-venv/bin/python -m pip install --quiet "$WHEEL"
 target/smoke-venv/bin/python scripts/wheel_smoke.py
 # The type stubs match the compiled module: every class, signature and default.
 "$VENV/bin/python" -m mypy.stubtest deflect
+# ... and type checking needs none of the optional integrations (ray, dask): the same check
+# with mypy reading the smoke venv's site-packages, which hold the wheel and numpy only.
+printf '[mypy]\npython_executable = %s\n' "$PWD/target/smoke-venv/bin/python" > target/mypy-bare.ini
+"$VENV/bin/python" -m mypy.stubtest deflect --mypy-config-file target/mypy-bare.ini
 "$VENV/bin/python" -m pytest -q crates/py/tests
 # Every Python snippet of README.md runs as printed.
 "$VENV/bin/python" scripts/readme_snippets.py

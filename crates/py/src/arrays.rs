@@ -11,7 +11,7 @@ use numpy::{
     PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
     PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods, ToPyArray,
 };
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyMemoryError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::sync::PyOnceLock;
 use pyo3::types::{PyFloat, PyInt, PyList, PyTuple};
@@ -107,9 +107,63 @@ fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
     None
 }
 
-/// `o` as a 1-D float array of any length, copied.
-pub fn vector_any(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
+/// A buffer of `n` zeros for a result (or a copy) whose size the caller chose, allocated
+/// fallibly: `MemoryError` naming `what`, the count and the bytes when the system refuses it
+/// (numpy's answer to the same request), never an abort of the interpreter. A size past
+/// `isize::MAX` bytes is refused the same way.
+pub fn try_zeros(n: usize, what: &str) -> PyResult<Vec<f64>> {
+    let mut v = try_with_capacity(n, what)?;
+    v.resize(n, 0.0);
+    Ok(v)
+}
+
+/// An empty vector with room for `n` numbers, allocated fallibly (see [`try_zeros`]).
+pub fn try_with_capacity(n: usize, what: &str) -> PyResult<Vec<f64>> {
+    if n.checked_mul(8).is_none_or(|b| b > isize::MAX as usize) {
+        return Err(no_memory(what, n as u128));
+    }
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| no_memory(what, n as u128))?;
+    Ok(v)
+}
+
+/// [`try_zeros`] for `rows` rows of `width` numbers (a batch's result).
+pub fn try_rows(rows: usize, width: usize, what: &str) -> PyResult<Vec<f64>> {
+    let n = rows
+        .checked_mul(width)
+        .ok_or_else(|| no_memory(what, rows as u128 * width as u128))?;
+    try_zeros(n, what)
+}
+
+/// The `MemoryError` of a refused allocation of `n` float64 numbers.
+fn no_memory(what: &str, n: u128) -> PyErr {
+    PyMemoryError::new_err(format!(
+        "{what}: cannot allocate {n} float64 numbers ({} bytes)",
+        n.saturating_mul(8)
+    ))
+}
+
+/// The entries of `v` in row-major order, copied into a fallibly allocated vector.
+pub fn try_copy<D: numpy::ndarray::Dimension>(
+    v: &numpy::ndarray::ArrayView<'_, f64, D>,
+    what: &str,
+) -> PyResult<Vec<f64>> {
+    let mut out = try_with_capacity(v.len(), what)?;
+    out.extend(v.iter().copied());
+    Ok(out)
+}
+
+/// `o` as a 1-D float array of at most `max` entries (the documented limit named `budget`),
+/// copied; a longer one is refused with an `InputError` before anything is copied.
+pub fn vector_upto(
+    o: &Bound<'_, PyAny>,
+    what: &str,
+    max: usize,
+    budget: &str,
+) -> PyResult<Vec<f64>> {
     if let Some(v) = fast_vector(o) {
+        check_count(what, v.len(), "entries", max, budget)?;
         return Ok(v);
     }
     let a = array_dyn(o, what)?;
@@ -117,7 +171,19 @@ pub fn vector_any(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<f64>> {
     if v.ndim() != 1 {
         return Err(shape_error(what, "(n,)", v.shape()));
     }
-    Ok(v.iter().copied().collect())
+    check_count(what, v.len(), "entries", max, budget)?;
+    try_copy(&v, what)
+}
+
+/// `InputError` when `n` `unit` ("entries", "rows") of `what` exceed the documented limit
+/// `budget` = `max`.
+pub fn check_count(what: &str, n: usize, unit: &str, max: usize, budget: &str) -> PyResult<()> {
+    if n > max {
+        return Err(InputError::new_err(format!(
+            "{what}: {n} {unit}; the limit is {budget} = {max} {unit}"
+        )));
+    }
+    Ok(())
 }
 
 /// `o` as a 1-D float array of exactly `n` entries, copied (no finiteness check: the core
@@ -294,9 +360,11 @@ pub fn matrix_to_py<'py, const R: usize, const C: usize>(
 }
 
 /// `o` as a 1-D array of non-negative integer indices: integer arrays (and float arrays of
-/// whole numbers) are accepted, anything else is an `InputError` naming `what`.
-pub fn indices(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vec<usize>> {
+/// whole numbers) are accepted, anything else is an `InputError` naming `what`; more than
+/// `max` entries (the limit named `budget`) are refused before any copy.
+pub fn indices(o: &Bound<'_, PyAny>, what: &str, max: usize, budget: &str) -> PyResult<Vec<usize>> {
     let a = asarray(o, what)?;
+    check_count(what, a.len(), "entries", max, budget)?;
     let dtype = a.dtype();
     if !matches!(dtype.kind(), b'i' | b'u' | b'f' | b'b') {
         return Err(InputError::new_err(format!(

@@ -9,6 +9,8 @@
 
 use core::ops::Range;
 
+use numpy::ndarray::{ArrayView2, s};
+
 use deflect_core::TickError;
 use pyo3::PyErr;
 
@@ -130,4 +132,33 @@ where
         }
         Ok(())
     })
+}
+
+/// Rows per block when a batch reads an argument that is not C-contiguous (a broadcast row,
+/// a strided view): such an argument is copied one block at a time into the worker's
+/// buffer, so that its memory stays 4,096 rows however long the batch (a broadcast view of
+/// 1e10 rows costs nothing to create and must not cost 1e10 rows to read).
+pub const BLOCK_ROWS: usize = 4096;
+
+/// Rows `rows` of `a` as one row-major slice: borrowed when `a` is C-contiguous, else copied
+/// into `buf` (at most [`BLOCK_ROWS`] rows by the callers).
+pub fn block<'a, 'd: 'a>(
+    a: &ArrayView2<'d, f64>,
+    rows: Range<usize>,
+    buf: &'a mut Vec<f64>,
+) -> &'a [f64] {
+    let v = (*a).slice_move(s![rows, ..]);
+    if let Some(contiguous) = v.to_slice() {
+        return contiguous;
+    }
+    buf.clear();
+    buf.extend(v.iter().copied());
+    buf
+}
+
+/// The blocks of at most [`BLOCK_ROWS`] rows of `rows`, in order.
+pub fn blocks(rows: Range<usize>) -> impl Iterator<Item = Range<usize>> {
+    let end = rows.end;
+    rows.step_by(BLOCK_ROWS)
+        .map(move |start| start..(start + BLOCK_ROWS).min(end))
 }

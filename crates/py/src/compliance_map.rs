@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyList};
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{batch_pair, indices, matrix, vector_any};
+use crate::arrays::{batch_pair, check_count, indices, matrix, try_rows, vector_upto};
 use crate::batch;
 use crate::errors::{build_err, load_err, shape_error, tick_err};
 use crate::field::DisplacementField;
@@ -107,7 +107,7 @@ impl ComplianceMap {
 
 /// Rows of a (N, k) float array as a contiguous row-major Vec.
 fn rows_of(a: &PyReadonlyArray2<'_, f64>) -> Vec<f64> {
-    a.as_array().as_standard_layout().iter().copied().collect()
+    a.as_array().iter().copied().collect()
 }
 
 #[pymethods]
@@ -178,11 +178,24 @@ impl ComplianceMap {
         if p.ncols() != 2 && p.ncols() != 3 {
             return Err(shape_error("positions", "(N, 2) or (N, 3)", p.shape()));
         }
-        let axes = indices(force_axis, "force_axis")?;
+        // Before any copy: core's fit refuses the same count, after the copies.
+        check_count(
+            "positions",
+            n,
+            "measurements",
+            cm::MAX_MEASUREMENTS,
+            "MAX_MEASUREMENTS",
+        )?;
+        let axes = indices(
+            force_axis,
+            "force_axis",
+            cm::MAX_MEASUREMENTS,
+            "MAX_MEASUREMENTS",
+        )?;
         if axes.len() != n {
             return Err(shape_error("force_axis", &format!("({n},)"), &[axes.len()]));
         }
-        let forces = vector_any(force, "force")?;
+        let forces = vector_upto(force, "force", cm::MAX_MEASUREMENTS, "MAX_MEASUREMENTS")?;
         if forces.len() != n {
             return Err(shape_error("force", &format!("({n},)"), &[forces.len()]));
         }
@@ -307,7 +320,7 @@ impl ComplianceMap {
     /// displacement computed once, for position-only queries (`DisplacementField`).
     /// `InputError` for a wrong length or a non-finite force.
     fn field(slf: &Bound<'_, Self>, force: &Bound<'_, PyAny>) -> PyResult<DisplacementField> {
-        let f = vector_any(force, "force")?;
+        let f = vector_upto(force, "force", cm::MAX_AXES, "MAX_AXES")?;
         let inner = slf.get().inner.field(&f).map_err(build_err)?;
         Ok(DisplacementField::new(slf.as_any(), inner))
     }
@@ -339,11 +352,11 @@ impl ComplianceMap {
         out_of_grid: Option<&str>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let o = self.options(interpolation, out_of_grid)?;
-        let p = match vector_any(position, "position")?.as_slice() {
+        let p = match vector_upto(position, "position", 3, "3 coordinates")?.as_slice() {
             &[x, y] | &[x, y, _] => [x, y],
             other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
         };
-        let f = vector_any(force, "force")?;
+        let f = vector_upto(force, "force", cm::MAX_AXES, "MAX_AXES")?;
         let mut buf = [0.0; MAX_AXES];
         let out = buf
             .get_mut(..self.inner.n_displacement())
@@ -381,26 +394,29 @@ impl ComplianceMap {
             return Err(InputError::new_err("P and F: rows do not broadcast"));
         };
         let view = self.inner.view();
-        let mut out = vec![0.0; n * nd];
+        let mut out = try_rows(n, nd, "the batch's result")?;
         py.detach(|| {
-            // A broadcast row is repeated once here; a float64 C-contiguous (N, k) argument
-            // is read in place (`as_standard_layout` borrows it).
-            let (p, f) = (p.as_standard_layout(), f.as_standard_layout());
-            let (ps, fs) = (p.as_slice().unwrap_or(&[]), f.as_slice().unwrap_or(&[]));
-            let pc = pc.max(1);
             batch::chunks(
                 &mut out,
                 nd,
                 batch::row_cost::MAP_QUERY,
-                || (),
-                |rows, _, o| {
-                    let (pr, fr) = (
-                        ps.get(rows.start * pc..rows.end * pc).unwrap_or(&[]),
-                        fs.get(rows.start * nf..rows.end * nf).unwrap_or(&[]),
-                    );
-                    view.displacement_batch(pr, pc, fr, o, opts)
-                        .map(|_| ())
-                        .map_err(|e| (rows.start + e.row, e.error))
+                || (Vec::new(), Vec::new()),
+                |rows, (pb, fb), o| {
+                    // Block by block: a C-contiguous argument is read in place, a broadcast
+                    // or strided one copied a block at a time.
+                    let first = rows.start;
+                    for b in batch::blocks(rows) {
+                        let (pr, fr) = (
+                            batch::block(&p, b.clone(), pb),
+                            batch::block(&f, b.clone(), fb),
+                        );
+                        let ob = o
+                            .get_mut((b.start - first) * nd..(b.end - first) * nd)
+                            .unwrap_or_default();
+                        view.displacement_batch(pr, pc.max(1), fr, ob, opts)
+                            .map_err(|e| (b.start + e.row, e.error))?;
+                    }
+                    Ok(())
                 },
             )
         })?;
@@ -429,6 +445,14 @@ impl ComplianceMap {
             }
         };
         let forces = matrix(forces, "forces", None, Some(self.inner.n_force()))?;
+        let rows = forces.as_array().nrows();
+        check_count(
+            "forces",
+            rows,
+            "rows",
+            cm::MAX_MEASUREMENTS,
+            "MAX_MEASUREMENTS",
+        )?;
         let cv = cm::leave_one_node_out(&self.inner, &rows_of(&forces), a).map_err(build_err)?;
         // deflect-core does not check these outputs: forces near f64::MAX overflow the RMS.
         let rms = [cv.rms_bilinear, cv.rms_bicubic].into_iter().chain(

@@ -5,6 +5,7 @@ use deflect_core::contour::{self, TraceDirection, TracerConfig, TracerStep};
 use deflect_core::drivetrain::{self as dt, LinkMasses};
 use deflect_core::io;
 use deflect_core::units::GRAVITY_Z_DOWN;
+use deflect_core::vjm::MAX_DOF;
 use nalgebra::{Matrix2, Vector2, Vector3, Vector6};
 use numpy::{PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
@@ -12,7 +13,7 @@ use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{fixed_matrix, iso_to_py, matrix_to_py, vector, vector_any};
+use crate::arrays::{fixed_matrix, iso_to_py, matrix_to_py, vector, vector_upto};
 use crate::errors::{build_err, load_err, tick_err};
 use crate::scalars::{count, real};
 use crate::vjm::SerialRobot;
@@ -124,9 +125,9 @@ impl DriveTrain {
     ) -> PyResult<Self> {
         // Values are validated by deflect-core's builders.
         let (handle, robot) = (robot.clone().unbind(), robot.get());
-        let k = vector_any(stiffness, "stiffness")?;
+        let k = vector_upto(stiffness, "stiffness", MAX_DOF, "MAX_DOF")?;
         let b = match backlash {
-            Some(b) => vector_any(b, "backlash")?,
+            Some(b) => vector_upto(b, "backlash", MAX_DOF, "MAX_DOF")?,
             None => vec![0.0; robot.inner.model.dof()],
         };
         let mut table = LinkMasses::new();

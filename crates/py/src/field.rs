@@ -6,7 +6,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::InputError;
-use crate::arrays::{matrix, vector_any};
+use crate::arrays::{matrix, try_rows, vector_upto};
 use crate::batch;
 use crate::errors::{shape_error, tick_err};
 
@@ -44,7 +44,7 @@ impl DisplacementField {
         py: Python<'py>,
         position: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = match vector_any(position, "position")?.as_slice() {
+        let p = match vector_upto(position, "position", 3, "3 coordinates")?.as_slice() {
             &[x, y] | &[x, y, _] => [x, y],
             other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
         };
@@ -73,21 +73,27 @@ impl DisplacementField {
         }
         let nd = self.inner.n_displacement();
         let field = &self.inner;
-        let mut out = vec![0.0; n * nd];
+        let mut out = try_rows(n, nd, "the batch's result")?;
         py.detach(|| {
-            let p = p.as_standard_layout();
-            let ps = p.as_slice().unwrap_or(&[]);
             batch::chunks(
                 &mut out,
                 nd,
                 batch::row_cost::MAP_QUERY,
-                || (),
-                |rows, _, o| {
-                    let pr = ps.get(rows.start * pc..rows.end * pc).unwrap_or(&[]);
-                    field
-                        .displacement_batch(pr, pc, o, field.options())
-                        .map(|_| ())
-                        .map_err(|e| (rows.start + e.row, e.error))
+                Vec::new,
+                |rows, pb, o| {
+                    // Block by block: a C-contiguous `P` is read in place, a broadcast or
+                    // strided one copied a block at a time.
+                    let first = rows.start;
+                    for b in batch::blocks(rows) {
+                        let pr = batch::block(&p, b.clone(), pb);
+                        let ob = o
+                            .get_mut((b.start - first) * nd..(b.end - first) * nd)
+                            .unwrap_or_default();
+                        field
+                            .displacement_batch(pr, pc, ob, field.options())
+                            .map_err(|e| (b.start + e.row, e.error))?;
+                    }
+                    Ok(())
                 },
             )
         })?;

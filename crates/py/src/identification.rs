@@ -2,7 +2,7 @@
 //! `identify_stiffness_from_frames`, `identify_sensor`.
 
 use deflect_core::identification::{
-    self as ident, FrameMeasurement, StiffnessIdentification, TcpMeasurement,
+    self as ident, FrameMeasurement, MAX_MEASUREMENTS, StiffnessIdentification, TcpMeasurement,
 };
 use deflect_core::vjm::Vector6;
 use nalgebra::{Isometry3, Matrix3, Vector3};
@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
-use crate::arrays::{array_dyn, indices, matrix, pose, rotation_of};
+use crate::arrays::{array_dyn, check_count, indices, matrix, pose, rotation_of};
 use crate::compensation::SensorCalibration;
 use crate::errors::{build_err, shape_error};
 use crate::vjm::SerialRobot;
@@ -51,6 +51,14 @@ fn stiffness_dict<'py>(
 fn rows(a: &Bound<'_, PyAny>, what: &str, cols: usize, n: Option<usize>) -> PyResult<Array2<f64>> {
     let m = matrix(a, what, n, Some(cols))?;
     let v = m.as_array();
+    // Before the copy: core refuses the same count after it.
+    check_count(
+        what,
+        v.nrows(),
+        "measurements",
+        MAX_MEASUREMENTS,
+        "MAX_MEASUREMENTS",
+    )?;
     Ok(v.as_standard_layout().into_owned())
 }
 
@@ -124,7 +132,12 @@ fn identify_stiffness_from_frames<'py>(
         rows(W, "W", 6, Some(n))?,
         rows(rotations, "rotations", 3, Some(n))?,
     );
-    let springs = indices(springs, "springs")?;
+    let springs = indices(
+        springs,
+        "springs",
+        deflect_core::vjm::MAX_SPRINGS,
+        "MAX_SPRINGS",
+    )?;
     if springs.len() != n {
         return Err(shape_error("springs", &format!("({n},)"), &[springs.len()]));
     }
@@ -163,6 +176,13 @@ fn identify_sensor<'py>(
         &[n, 3, 3] => n,
         s => return Err(shape_error("rotations", "(N, 3, 3)", s)),
     };
+    check_count(
+        "rotations",
+        n,
+        "measurements",
+        MAX_MEASUREMENTS,
+        "MAX_MEASUREMENTS",
+    )?;
     let w = rows(readings, "readings", 6, Some(n))?;
     let mut quats = Vec::with_capacity(n);
     for (i, m) in r.outer_iter().enumerate() {

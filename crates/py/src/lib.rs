@@ -40,6 +40,21 @@ pub use errors::{ConvergenceError, DeflectError, InputError, LoadError, Singular
 fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     errors::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    // The budgets and bounds that errors name, under the same names.
+    m.add("MAX_SAMPLES", deflect_core::motion::MAX_SAMPLES)?;
+    m.add("MAX_TICKS", deflect_core::motion::MAX_TICKS)?;
+    m.add("MAX_SPRING_ANGLE", deflect_core::vjm::MAX_SPRING_ANGLE)?;
+    m.add("MAX_DOF", deflect_core::vjm::MAX_DOF)?;
+    m.add("MAX_SPRINGS", deflect_core::vjm::MAX_SPRINGS)?;
+    m.add(
+        "MAX_MEASUREMENTS",
+        deflect_core::identification::MAX_MEASUREMENTS,
+    )?;
+    m.add("MAX_POINTS", deflect_core::motion::MAX_POINTS)?;
+    m.add("MAX_ANGLES", deflect_core::posture::MAX_ANGLES)?;
+    m.add("MAX_SEEDS", deflect_core::posture::MAX_SEEDS)?;
+    m.add("MAX_DIRECTIONS", deflect_core::posture::MAX_DIRECTIONS)?;
+    m.add("MAX_AXES", deflect_core::compliance_map::MAX_AXES)?;
     vjm::register(m)?;
     compensation::register(m)?;
     identification::register(m)?;

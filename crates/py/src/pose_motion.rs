@@ -6,7 +6,7 @@ use std::sync::OnceLock;
 
 use deflect_core::TickError;
 use deflect_core::motion::{
-    DEFAULT_RATE_HZ, Limits, PoseLimits, PoseState, PoseTrajectory as Core,
+    DEFAULT_RATE_HZ, Limits, MAX_SAMPLES, PoseLimits, PoseState, PoseTrajectory as Core,
 };
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods, ToPyArray};
@@ -16,7 +16,7 @@ use pyo3::types::PyDict;
 use crate::InputError;
 use crate::args;
 use crate::arrays::{
-    fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, vector_any,
+    fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, vector_upto,
 };
 use crate::errors::{build_err, shape_error, tick_err};
 use crate::scalars::real;
@@ -134,12 +134,13 @@ impl PoseTrajectory {
     /// The exact state at time `t` [s] (a number, or an array of m times): a dict with `t`,
     /// `pose` (4, 4), `velocity` (3,) [m/s], `acceleration` (3,) [m/s^2],
     /// `angular_velocity` (3,) [rad/s] and `angular_acceleration` (3,) [rad/s^2], base
-    /// frame; with a leading axis of m for an array. At rest before 0 and from `duration` on.
+    /// frame; with a leading axis of m for an array (at most `MAX_SAMPLES` times). Before 0
+    /// the start pose at rest, from `duration` on the end pose at rest (held, not an error).
     fn at<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
         let a = float_array(t, "t")?;
         let (times, scalar) = match a.ndim() {
             0 => (vec![real(t, "t")?], true),
-            1 => (vector_any(t, "t")?, false),
+            1 => (vector_upto(t, "t", MAX_SAMPLES, "MAX_SAMPLES")?, false),
             _ => return Err(shape_error("t", "a number or (m,)", a.shape())),
         };
         let states = times

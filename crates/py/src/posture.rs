@@ -4,7 +4,9 @@
 
 use deflect_core::TickError;
 use deflect_core::mechanism::PoseIkOptions;
-use deflect_core::posture::{self, AnglePoint, MAX_ANGLES, Measure, PostureOptions, Reach};
+use deflect_core::posture::{
+    self, AnglePoint, MAX_ANGLES, MAX_DIRECTIONS, MAX_SEEDS, Measure, PostureOptions, Reach,
+};
 use deflect_core::vjm::{self, Data, Vector6};
 use nalgebra::Vector3;
 use numpy::ndarray::{Array1, Array2};
@@ -13,16 +15,17 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
-use crate::arrays::{batch_pair, matrix, vector, vector_any};
+use crate::arrays::{batch_pair, check_count, matrix, try_rows, vector, vector_upto};
 use crate::batch::{self, BatchFailure};
 use crate::errors::{tick_err, tick_err_at};
 use crate::vjm::SerialRobot;
 
-/// Columns of one atlas row before the joints: reachable, reachable angles, best angle, best
-/// measure, best deflection (6).
+/// Columns of one atlas row before the joints: status code, reachable angles, best angle,
+/// best measure, best deflection (6).
 const HEAD: usize = 10;
-/// Columns after the joints: worst angle, worst measure, compliance (36), seed index.
-const TAIL: usize = 39;
+/// Columns after the joints: worst angle, worst measure, compliance (36), seed index, angles
+/// beyond the model.
+const TAIL: usize = 40;
 
 /// The sweep's settings from the Python arguments.
 struct Settings {
@@ -43,7 +46,7 @@ fn settings(
     let angles = match angles {
         // One degree over the full turn.
         None => (0..360).map(|k| f64::from(k - 180).to_radians()).collect(),
-        Some(a) => vector_any(a, "angles")?,
+        Some(a) => vector_upto(a, "angles", MAX_ANGLES, "MAX_ANGLES")?,
     };
     if angles.is_empty() || angles.len() > MAX_ANGLES {
         return Err(InputError::new_err(format!(
@@ -64,6 +67,13 @@ fn settings(
                 vector(s, "seeds", dof)?
             } else {
                 let m = matrix(s, "seeds", None, Some(dof))?;
+                check_count(
+                    "seeds",
+                    m.as_array().nrows(),
+                    "rows",
+                    MAX_SEEDS,
+                    "MAX_SEEDS",
+                )?;
                 m.as_array().iter().copied().collect()
             }
         }
@@ -83,6 +93,8 @@ fn settings(
         }
         Some(m) => {
             let d = matrix(m, "measure", None, Some(3))?;
+            let k = d.as_array().nrows();
+            check_count("measure", k, "directions", MAX_DIRECTIONS, "MAX_DIRECTIONS")?;
             let dirs: Vec<Vector3<f64>> = d
                 .as_array()
                 .rows()
@@ -110,15 +122,6 @@ fn settings(
     })
 }
 
-fn reach_name(r: Reach) -> &'static str {
-    match r {
-        Reach::Reachable => "reachable",
-        Reach::OutOfReach => "out_of_reach",
-        Reach::Singular => "singular",
-        Reach::JointLimit => "joint_limit",
-    }
-}
-
 /// The rotation about the tool axis that deflects least: for the TCP `position` (3,) [m]
 /// and `tool_axis` (3,) (the TCP z axis, base frame) under the TCP `wrench` (6,) [N, N m],
 /// solves the pose IK at every angle of `angles` [rad] (default: -180..179 degrees in 1
@@ -129,7 +132,10 @@ fn reach_name(r: Reach) -> &'static str {
 /// `refine`: a golden-section search between the best angle's neighbours.
 ///
 /// Returns a dict: `angle` (n,), `reach` (n strings: 'reachable', 'out_of_reach',
-/// 'singular', 'joint_limit'), `reachable` (n,) bool, `measure` (n,) [m], `deflection` (n, 6)
+/// 'singular', 'joint_limit', or 'beyond_model': a posture exists but the wrench turns a
+/// spring past `MAX_SPRING_ANGLE`, outside the small-deflection model), `status` (the
+/// point's: 'reachable' if an angle is, else the most telling of the others,
+/// 'beyond_model' first), `reachable` (n,) bool, `measure` (n,) [m], `deflection` (n, 6)
 /// [m, rad], `q` (n, dof) (NaN where not reachable), `best` (a dict with `angle`, `measure`,
 /// `deflection`, `q`, or None if nothing is reachable), `best_index`, `worst_index`.
 #[pyfunction]
@@ -177,8 +183,9 @@ fn posture_sweep<'py>(
         "angle",
         Array1::from_iter(out.iter().map(|o| o.angle)).into_pyarray(py),
     )?;
-    let reach: Vec<&str> = out.iter().map(|o| reach_name(o.reach)).collect();
+    let reach: Vec<&str> = out.iter().map(|o| o.reach.name()).collect();
     d.set_item("reach", reach)?;
+    d.set_item("status", summary.status.name())?;
     let reachable: Vec<bool> = out.iter().map(|o| o.reach == Reach::Reachable).collect();
     d.set_item("reachable", numpy::PyArray1::from_vec(py, reachable))?;
     d.set_item(
@@ -215,9 +222,10 @@ fn posture_sweep<'py>(
 
 /// One chunk of `deflect.atlas` (see there): positions (N, 3), tool axes (N, 3) or (3,),
 /// wrenches (N, 6) or (6,) -> (N, 10 + dof + 39) rows, on every core without the GIL.
-/// Row layout: reachable (0/1), reachable angles, best angle, best measure, best deflection
+/// Row layout: the point's status (`posture::Reach::code`: 0 reachable, 1 out of reach, 2
+/// singular, 3 joint limit, 4 beyond the model), reachable angles, best angle, best measure, best deflection
 /// (6), best joints (dof), worst angle, worst measure, compliance at the best posture (36,
-/// row-major), best seed; NaN where nothing is reachable.
+/// row-major), best seed, angles beyond the model; NaN where nothing is reachable.
 #[pyfunction]
 #[pyo3(signature = (robot, positions, tool_axes, wrenches, angles=None, seeds=None, measure=None, refine=true, min_sigma=1e-3),
        text_signature = "(robot, positions, tool_axes, wrenches, angles=None, seeds=None, measure=None, refine=True, min_sigma=0.001)")]
@@ -258,7 +266,8 @@ fn _atlas_chunk<'py>(
     let model = &robot.inner.model;
     let dof = model.dof();
     let width = HEAD + dof + TAIL;
-    let mut out = vec![f64::NAN; n * width];
+    let mut out = try_rows(n, width, "the atlas's result")?;
+    out.fill(f64::NAN);
     let limits = &robot.inner.joint_limits;
     py.detach(|| {
         batch::rows(
@@ -315,8 +324,9 @@ fn fill_row(
             *x = v;
         }
     };
-    put(0, f64::from(u8::from(summary.best.is_some())));
+    put(0, f64::from(summary.status.code()));
     put(1, summary.reachable as f64);
+    put(HEAD + dof + TAIL - 1, summary.beyond_model as f64);
     let Some(best) = summary.best else {
         return Ok(());
     };
@@ -342,7 +352,7 @@ fn fill_row(
             );
         }
     }
-    put(HEAD + dof + TAIL - 1, best.seed as f64);
+    put(HEAD + dof + TAIL - 2, best.seed as f64);
     Ok(())
 }
 

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{batch_pair, iso_to_py, matrix, matrix_to_py, pose, vector, vector6};
+use crate::arrays::{batch_pair, iso_to_py, matrix, matrix_to_py, pose, try_rows, vector, vector6};
 use crate::batch;
 use crate::errors::{load_err, tick_err};
 
@@ -392,7 +392,7 @@ impl SerialRobot {
         let model = &self.inner.model;
         let dof = model.dof();
         let width = shape.iter().skip(1).product();
-        let mut out = vec![0.0; q.nrows() * width];
+        let mut out = try_rows(q.nrows(), width, "the batch's result")?;
         py.detach(|| {
             batch::rows(
                 &mut out,

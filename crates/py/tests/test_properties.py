@@ -192,3 +192,33 @@ def test_displacement_batch_equals_loop(P, seed, interpolation):
     loop = np.array([MAP.displacement(p, f, interpolation=interpolation) for p, f in zip(P, F)])
     assert batch.shape == (len(P), 2)
     close(batch, loop)
+
+
+# Leading dimensions whose result cannot exist: from 2**44 rows (at 16 bytes a row, past the
+# 128 TiB address space of x86-64, so no allocator says yes whatever the overcommit policy)
+# to 2**57 (numpy's own limit for a (N, 6) float64 view).
+huge_rows = st.integers(2**44, 2**57)
+
+
+@settings(max_examples=40, deadline=None, database=None)
+@given(rows=huge_rows, q=joints, w=wrenches, p=grid_points, f=map_forces,
+       kind=st.sampled_from(["deflection", "compliance", "forward", "map", "field"]),
+       broadcast_second=st.booleans())
+def test_batches_of_huge_broadcast_inputs_raise_memory_error_and_the_process_survives(
+    rows, q, w, p, f, kind, broadcast_second
+):
+    Q = np.broadcast_to(q, (rows, 6))
+    P = np.broadcast_to(p, (rows, 2))
+    calls = {
+        "deflection": lambda: ROBOT.deflection_batch(Q, np.broadcast_to(w, (rows, 6))
+                                                     if broadcast_second else w),
+        "compliance": lambda: ROBOT.compliance_batch(Q),
+        "forward": lambda: ROBOT.forward_batch(Q),
+        "map": lambda: MAP.displacement_batch(P, np.broadcast_to(f, (rows, 2))
+                                              if broadcast_second else f),
+        "field": lambda: MAP.field(f).displacement_batch(P),
+    }
+    with pytest.raises(MemoryError, match="cannot allocate"):
+        calls[kind]()
+    # Still alive and still right: the same call on one row.
+    assert np.all(np.isfinite(ROBOT.deflection_batch(q[None, :], w)))

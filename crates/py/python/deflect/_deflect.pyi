@@ -9,7 +9,40 @@ import numpy as np
 import numpy.typing as npt
 
 __version__: str
+#: Most samples a call that stores every tick may produce (2**22, 35 min at 2 kHz).
+MAX_SAMPLES: int
+#: Most ticks a motion may have at its sampling rate (2**40).
+MAX_TICKS: int
+#: Largest elastic angle of a spring the small-deflection model accepts [rad].
+MAX_SPRING_ANGLE: float
+#: Most joints of a serial arm.
+MAX_DOF: int
+#: Most springs (virtual joints) of a serial arm.
+MAX_SPRINGS: int
+#: Most measurements of an identification or a compliance-map fit.
+MAX_MEASUREMENTS: int
+#: Most points of a planned polyline.
+MAX_POINTS: int
+#: Most angles of one posture sweep.
+MAX_ANGLES: int
+#: Most IK seeds (branches) of one posture sweep.
+MAX_SEEDS: int
+#: Most directions of a posture measure.
+MAX_DIRECTIONS: int
+#: Most force (and displacement) axes of a compliance map.
+MAX_AXES: int
 __all__ = [
+    "MAX_SAMPLES",
+    "MAX_TICKS",
+    "MAX_SPRING_ANGLE",
+    "MAX_DOF",
+    "MAX_SPRINGS",
+    "MAX_MEASUREMENTS",
+    "MAX_POINTS",
+    "MAX_ANGLES",
+    "MAX_SEEDS",
+    "MAX_DIRECTIONS",
+    "MAX_AXES",
     "DeflectError",
     "LoadError",
     "InputError",
@@ -277,7 +310,9 @@ class Trajectory:
     ) -> "Trajectory":
         """(n, d) positions at ``rate_hz``; derivatives by second-order finite differences."""
     def at(self, t: Union[float, _ArrayLike]) -> Dict[str, Any]:
-        """State at ``t`` (a number or (m,)): t, position, velocity, acceleration, jerk."""
+        """State at ``t`` [s] (a number or (m,), at most MAX_SAMPLES): t, position, velocity,
+        acceleration, jerk. Before 0 the start at rest, from ``duration`` on the end at rest
+        (a controller holds the end states); planned trajectories only."""
     def sampled(self, rate_hz: float) -> "Trajectory": ...
     @property
     def t(self) -> _FloatArray: ...
@@ -327,7 +362,9 @@ class PoseTrajectory:
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
         """Pickling and ``copy.deepcopy``: ``plan_pose`` with the same arguments (exact)."""
     def at(self, t: Union[float, _ArrayLike]) -> Dict[str, Any]:
-        """t, pose (4, 4), velocity, acceleration, angular_velocity, angular_acceleration."""
+        """State at ``t`` [s] (a number or (m,), at most MAX_SAMPLES): t, pose (4, 4),
+        velocity, acceleration, angular_velocity, angular_acceleration. Before 0 the start
+        pose at rest, from ``duration`` on the end pose at rest."""
     def sampled(self, rate_hz: float) -> "PoseTrajectory": ...
     @property
     def t(self) -> _FloatArray: ...

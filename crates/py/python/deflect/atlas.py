@@ -12,6 +12,7 @@ numbers, bit for bit.
 
 from __future__ import annotations
 
+import importlib
 from concurrent.futures import Executor, Future
 from dataclasses import dataclass
 from typing import Any, Callable, List, Optional
@@ -26,6 +27,15 @@ __all__ = ["AtlasResult", "ChunkError", "RayExecutor", "atlas"]
 #: per chunk for a 360-angle sweep, long enough to hide the scheduling cost of Dask or Ray
 #: (~1 ms a task) and short enough to keep every worker busy to the end.
 DEFAULT_CHUNK = 256
+
+#: The point statuses in the order of their codes in a chunk's rows.
+_STATUS = ("reachable", "out_of_reach", "singular", "joint_limit", "beyond_model")
+_STATUS_TEXT = {
+    "out_of_reach": "out of reach",
+    "singular": "only singular postures",
+    "joint_limit": "only postures past a joint limit",
+    "beyond_model": "in reach but beyond the model's validity (a spring past MAX_SPRING_ANGLE)",
+}
 
 
 class ChunkError(DeflectError):
@@ -45,7 +55,11 @@ class ChunkError(DeflectError):
 class AtlasResult:
     """Per task (N of them): whether any posture reaches it, and the best and worst ones.
 
-    Unreachable tasks have ``reachable`` False and NaN everywhere else (never zeros).
+    Tasks without a posture have ``reachable`` False and NaN everywhere else (never
+    zeros); ``status`` says why: ``'out_of_reach'``, ``'singular'``, ``'joint_limit'``, or
+    ``'beyond_model'`` (postures exist, but the wrench turns a spring past
+    ``MAX_SPRING_ANGLE``, outside the small-deflection model: the task is reachable, its
+    deflection cannot be predicted).
     Angles in rad about the tool axis (``deflect.posture_sweep``'s convention), measures and
     deflections in m (and rad for the rotational part), compliance in m/N, rad/(N m)."""
 
@@ -59,11 +73,24 @@ class AtlasResult:
     worst_measure: np.ndarray  #: (N,) [m]
     compliance: np.ndarray  #: (N, 6, 6) at the best posture
     best_seed: np.ndarray  #: (N,) int: the seed (IK branch) of the best posture, -1 if none
+    #: (N,) str: 'reachable', 'out_of_reach', 'singular', 'joint_limit' or 'beyond_model'
+    status: np.ndarray
+    beyond_model_angles: np.ndarray  #: (N,) int: angles with a posture beyond the model
+
+    def summary(self) -> str:
+        """One line: how many tasks are reachable, and why the others are not."""
+        names, counts = np.unique(self.status, return_counts=True)
+        why = ", ".join(
+            f"{c} {_STATUS_TEXT[str(k)]}" for k, c in zip(names, counts) if k != "reachable"
+        )
+        n = len(self.status)
+        return f"reachable: {int(self.reachable.sum())} of {n}" + (f"; {why}" if why else "")
 
     @staticmethod
     def _from_rows(rows: np.ndarray, dof: int) -> "AtlasResult":
         n = rows.shape[0]
-        reachable = rows[:, 0] == 1.0
+        code = rows[:, 0].astype(np.int64)
+        reachable = code == 0
         seed = rows[:, 10 + dof + 38]
         return AtlasResult(
             reachable=reachable,
@@ -76,6 +103,8 @@ class AtlasResult:
             worst_measure=rows[:, 11 + dof].copy(),
             compliance=rows[:, 12 + dof : 48 + dof].reshape(n, 6, 6).copy(),
             best_seed=np.where(reachable, np.nan_to_num(seed, nan=-1.0), -1.0).astype(np.int64),
+            status=np.array(_STATUS, dtype=object)[code].astype(str),
+            beyond_model_angles=rows[:, 10 + dof + 39].astype(np.int64),
         )
 
 
@@ -86,7 +115,9 @@ class RayExecutor(Executor):
 
     def __init__(self, **options: Any):
         try:
-            import ray
+            # Imported by name: Ray is optional, and type checkers (mypy, stubtest) must not
+            # need it where it is not installed.
+            ray = importlib.import_module("ray")
         except ImportError as e:  # pragma: no cover - depends on the environment
             raise ImportError(
                 "RayExecutor needs Ray: pip install 'deflect-robotics[ray]'"
@@ -102,6 +133,23 @@ class RayExecutor(Executor):
             remote = self._ray.remote(**self._options)(fn) if self._options else self._ray.remote(fn)
             self._remote[fn] = remote
         return remote.remote(*args, **kwargs).future()
+
+
+def _real_array(a: Any, what: str) -> np.ndarray:
+    """``a`` as float64, refusing what is not real numbers (complex would lose its imaginary
+    part with a warning only), as the compiled functions do."""
+    from ._deflect import InputError
+
+    try:
+        x = np.asarray(a)
+    except ValueError as e:
+        raise InputError(f"{what}: not an array of numbers ({e})") from e
+    if x.dtype.kind not in "biuf":
+        raise InputError(
+            f"{what}: expected an array of real numbers (float, int or bool dtype), got dtype "
+            f"{x.dtype} with shape {x.shape}"
+        )
+    return x.astype(np.float64, copy=False)
 
 
 def _run_chunk(*args: Any, **kwargs: Any) -> np.ndarray:
@@ -145,33 +193,37 @@ def atlas(
     ``measure``, ``refine`` and ``min_sigma`` as ``deflect.posture_sweep``. Without
     ``executor`` the tasks run here on every core (GIL released). With one (a
     ``concurrent.futures.Executor``, a ``dask.distributed.Client``, or ``RayExecutor()``),
-    they go out in chunks of ``chunk_size`` tasks (default 256) and come back in order; a
+    they go out in chunks of ``chunk_size`` tasks (an integer >= 1; None for
+    ``DEFAULT_CHUNK`` = 256; checked even without an executor) and come back in order; a
     failed chunk raises ``ChunkError`` naming it. Bad input raises ``deflect.InputError``
     before anything is sent.
     """
-    p = np.asarray(positions, dtype=np.float64)
-    if p.ndim != 2 or p.shape[1] != 3:
-        from ._deflect import InputError
+    from ._deflect import InputError
 
+    # chunk_size is checked whether or not an executor uses it: a wrong value is a mistake
+    # either way (0 is not "automatic": None is).
+    if chunk_size is None:
+        chunk_size = DEFAULT_CHUNK
+    elif isinstance(chunk_size, bool) or not (
+        isinstance(chunk_size, (int, np.integer)) and chunk_size >= 1
+    ):
+        raise InputError(
+            f"chunk_size: expected an integer >= 1 (or None for {DEFAULT_CHUNK}), "
+            f"got {chunk_size!r}"
+        )
+    p = _real_array(positions, "positions")
+    if p.ndim != 2 or p.shape[1] != 3:
         raise InputError(f"positions: expected shape (N, 3), got {p.shape}")
     n = p.shape[0]
     options = dict(angles=angles, seeds=seeds, measure=measure, refine=refine, min_sigma=min_sigma)
     dof = robot.dof
     if executor is None:
         return AtlasResult._from_rows(_atlas_chunk(robot, p, tool_axes, wrenches, **options), dof)
-    if chunk_size is None:
-        chunk_size = DEFAULT_CHUNK
-    if not (isinstance(chunk_size, (int, np.integer)) and chunk_size >= 1):
-        from ._deflect import InputError
-
-        raise InputError(f"chunk_size: expected an integer >= 1, got {chunk_size!r}")
-    t = np.asarray(tool_axes, dtype=np.float64)
-    w = np.asarray(wrenches, dtype=np.float64)
+    t = _real_array(tool_axes, "tool_axes")
+    w = _real_array(wrenches, "wrenches")
     # Validate everything here, on one task, before any work is sent out.
     _atlas_chunk(robot, p[:0], t if t.ndim == 1 else t[:0], w if w.ndim == 1 else w[:0], **options)
     if t.ndim == 2 and t.shape[0] != n or w.ndim == 2 and w.shape[0] != n:
-        from ._deflect import InputError
-
         raise InputError(
             f"positions, tool_axes, wrenches: {n}, {t.shape[0] if t.ndim == 2 else 1} and "
             f"{w.shape[0] if w.ndim == 2 else 1} rows do not broadcast together"
@@ -204,5 +256,5 @@ def atlas(
             for g in futures[k + 1 :]:
                 g.cancel()
             raise ChunkError(k, r, e) from e
-    rows = np.concatenate(parts) if parts else np.zeros((0, 48 + 2 + dof))
+    rows = np.concatenate(parts) if parts else np.zeros((0, 50 + dof))
     return AtlasResult._from_rows(rows, dof)

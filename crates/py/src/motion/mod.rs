@@ -5,7 +5,7 @@
 
 use std::sync::OnceLock;
 
-use deflect_core::motion::{DEFAULT_RATE_HZ, Limits, SampledTrajectory};
+use deflect_core::motion::{DEFAULT_RATE_HZ, Limits, MAX_POINTS, MAX_SAMPLES, SampledTrajectory};
 use nalgebra::SVector;
 use numpy::ndarray::{Array2, ArrayView2};
 use numpy::{PyArray1, PyArray2, PyArrayMethods, PyUntypedArrayMethods, ToPyArray};
@@ -15,7 +15,7 @@ use pyo3::types::{PyDict, PyTuple};
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{float_array, matrix, vector, vector_any};
+use crate::arrays::{check_count, float_array, matrix, vector, vector_upto};
 use crate::errors::{build_err, shape_error, tick_err};
 use crate::scalars::real;
 
@@ -192,7 +192,18 @@ impl Trajectory {
             } else {
                 a
             };
-            matrix(a.as_any(), what, None, cols).map(|m| m.as_array().to_owned())
+            let m = matrix(a.as_any(), what, None, cols)?;
+            let v = m.as_array();
+            // Before the copy: core refuses the same counts after it.
+            check_count(what, v.nrows(), "samples", MAX_SAMPLES, "MAX_SAMPLES")?;
+            if v.ncols() == 0 || v.ncols() > MAX_DIM {
+                return Err(shape_error(
+                    what,
+                    &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
+                    v.shape(),
+                ));
+            }
+            Ok::<_, PyErr>(v.to_owned())
         };
         let p = as_2d(position, "position", None)?;
         let d = p.ncols();
@@ -227,7 +238,8 @@ impl Trajectory {
 
     /// The exact state at time `t` [s] (a number, or an array of times): a dict with `t`,
     /// `position`, `velocity`, `acceleration`, `jerk`, each (d,) for a number and (m, d) for
-    /// m times. Before 0 the start at rest, from `duration` on the end at rest. Planned
+    /// m times (at most `MAX_SAMPLES`). Before 0 the start at rest, from `duration` on the
+    /// end at rest (held, as a controller holds the end states; not an error). Planned
     /// trajectories only.
     fn at<'py>(&self, py: Python<'py>, t: &Bound<'py, PyAny>) -> PyResult<Bound<'py, PyDict>> {
         let Some(plan) = &self.plan else {
@@ -239,7 +251,7 @@ impl Trajectory {
         let a = float_array(t, "t")?;
         let (times, scalar) = match a.ndim() {
             0 => (vec![real(t, "t")?], true),
-            1 => (vector_any(t, "t")?, false),
+            1 => (vector_upto(t, "t", MAX_SAMPLES, "MAX_SAMPLES")?, false),
             _ => {
                 return Err(shape_error("t", "a number or (m,)", a.shape()));
             }
@@ -361,18 +373,20 @@ fn plan_line(
     j_max: &Bound<'_, PyAny>,
     #[pyo3(from_py_with = args::opt_real::rate_hz)] rate_hz: Option<f64>,
 ) -> PyResult<Trajectory> {
-    let s = vector_any(start, "start")?;
-    let e = vector(end, "end", s.len())?;
-    let d = s.len();
-    let pts = Array2::from_shape_vec((2, d), [s, e].concat())
-        .map_err(|e| InputError::new_err(e.to_string()))?;
-    if !(1..=MAX_DIM).contains(&d) {
+    // The dimension is checked before anything is copied.
+    let sa = float_array(start, "start")?;
+    let d = sa.len();
+    if sa.ndim() != 1 || !(1..=MAX_DIM).contains(&d) {
         return Err(shape_error(
             "start",
             &format!("(d,) with 1 <= d <= {MAX_DIM}"),
-            &[d],
+            sa.shape(),
         ));
     }
+    let s = vector(start, "start", d)?;
+    let e = vector(end, "end", d)?;
+    let pts = Array2::from_shape_vec((2, d), [s, e].concat())
+        .map_err(|e| InputError::new_err(e.to_string()))?;
     let spec = limit_spec(v_max, a_max, j_max, d)?;
     let plan = plan_dyn(pts.view(), &spec)?;
     Trajectory::planned(plan, Recipe::Planned { points: pts, spec }, rate_hz)
@@ -396,6 +410,15 @@ fn plan_polyline(
 ) -> PyResult<Trajectory> {
     let points = matrix(points, "points", None, None)?;
     let points = points.as_array();
+    // Before anything is copied (segment limits, the plan's points): core refuses the same.
+    check_count("points", points.nrows(), "rows", MAX_POINTS, "MAX_POINTS")?;
+    if points.ncols() == 0 || points.ncols() > MAX_DIM {
+        return Err(shape_error(
+            "points",
+            &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
+            &[points.nrows(), points.ncols()],
+        ));
+    }
     let spec = match (v_max, a_max, j_max, segment_limits) {
         (Some(v), Some(a), Some(j), None) => limit_spec(v, a, j, points.ncols())?,
         (None, None, None, Some(s)) => {
@@ -430,13 +453,6 @@ fn plan_polyline(
             ));
         }
     };
-    if points.ncols() == 0 || points.ncols() > MAX_DIM {
-        return Err(shape_error(
-            "points",
-            &format!("(n, d) with 1 <= d <= {MAX_DIM}"),
-            &[points.nrows(), points.ncols()],
-        ));
-    }
     let plan = plan_dyn(points, &spec)?;
     let recipe = Recipe::Planned {
         points: points.to_owned(),
