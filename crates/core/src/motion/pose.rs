@@ -172,7 +172,7 @@ impl PoseTrajectory {
 
     /// Number of ticks at `rate_hz`, as [`super::Trajectory::tick_count`]: tick `k` at
     /// `k / rate_hz`, the last exactly at the duration; [`TickError::Budget`] past
-    /// [`MAX_TICKS`].
+    /// [`MAX_TICKS`](super::MAX_TICKS).
     pub fn tick_count(&self, rate_hz: f64) -> Result<usize, TickError> {
         super::tick_count(self.duration(), rate_hz)
     }

@@ -330,7 +330,7 @@ impl<const N: usize> Trajectory<N> {
     /// `t = k / rate_hz`, computed from `k` (no drift), and a last tick lands exactly on
     /// [`Self::duration`] (the end point), so there are `ceil(duration * rate) + 1` ticks.
     /// [`TickError::InvalidArgument`] for a rate that is not finite and > 0,
-    /// [`TickError::Budget`] past [`MAX_TICKS`].
+    /// [`TickError::Budget`] past [`MAX_TICKS`](super::MAX_TICKS).
     pub fn ticks(&self, rate_hz: f64) -> Result<Cursor<'_, N>, TickError> {
         Ok(Cursor {
             trajectory: self,
@@ -338,13 +338,13 @@ impl<const N: usize> Trajectory<N> {
         })
     }
 
-    /// Number of ticks at `rate_hz` (see [`Self::ticks`]), at most [`MAX_TICKS`].
+    /// Number of ticks at `rate_hz` (see [`Self::ticks`]), at most [`MAX_TICKS`](super::MAX_TICKS).
     pub fn tick_count(&self, rate_hz: f64) -> Result<usize, TickError> {
         super::tick_count(self.duration, rate_hz)
     }
 
     /// [`Self::tick_count`] for a call that stores every tick: [`TickError::Budget`] past
-    /// [`MAX_SAMPLES`], so that nothing allocates more than that documents (the one budget
+    /// [`MAX_SAMPLES`](super::MAX_SAMPLES), so that nothing allocates more than that documents (the one budget
     /// such calls report, however far past it the request is).
     pub fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
         super::sample_count(self.duration, rate_hz)
@@ -371,7 +371,7 @@ impl Data {
     /// `t = k / rate_hz`, computed from `k` (no drift), and a last tick lands exactly on
     /// [`Trajectory::duration`] (the end point), so there are `ceil(duration * rate) + 1`
     /// ticks. [`TickError::InvalidArgument`] for a rate that is not finite and > 0,
-    /// [`TickError::Budget`] past [`MAX_TICKS`].
+    /// [`TickError::Budget`] past [`MAX_TICKS`](super::MAX_TICKS).
     pub fn new<const N: usize>(model: &Trajectory<N>, rate_hz: f64) -> Result<Self, TickError> {
         let count = model.tick_count(rate_hz)?;
         Ok(Self {

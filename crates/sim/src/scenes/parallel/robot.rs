@@ -19,7 +19,7 @@
 //! Each actuated link hangs on its motor through a drive spring `k_a` / `k_b` (gearbox, shaft
 //! and coupling) with relative damping `c_drive`. A force at G in the plane gives no moment
 //! about the tilt pivot, so the static compliance at the tool point is exactly the linearized
-//! `J K^-1 J^T` with `K = diag(k_a, k_b)` and `J` the robot Jacobian ([`linear_compliance`]).
+//! `J K^-1 J^T` with `K = diag(k_a, k_b)` and `J` the robot Jacobian ([`linear_compliance`](super::params::linear_compliance)).
 //! Inertial forces act at the head's centre of mass, `d` above G (35.9 mm upper, 5.3 mm lower
 //! head), and tilt the head: the tool point W, `z_tool` below G, then moves by the tilt too,
 //! which a static test at G does not see (the paper's section 5.2).
@@ -281,7 +281,7 @@ impl Joints {
 impl ParallelSim {
     /// Builds the robot at rest with its tool point at `start` = (x, y) \[m\] (task frame C - O),
     /// under standard gravity down z ([`deflect_core::units::GRAVITY_Z_DOWN`]), normal to the
-    /// plane of motion: its [`Bodies`], their [`Joints`] and the loop closures, the joints'
+    /// plane of motion: its bodies, their joints and the loop closures, the joints'
     /// springs and damping, and the servos at rest.
     pub fn new(params: RobotParams, start: &Vector2<f64>) -> Result<Self, SimError> {
         let q = ParallelRobot2::paper().ik(start)?;
