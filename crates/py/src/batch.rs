@@ -18,9 +18,10 @@ use crate::InputError;
 use crate::errors::tick_err_at;
 
 /// A batch is split over threads once its estimated single-threaded time reaches 1 ms.
-/// Starting and joining a scoped thread costs 20-60 us on the 2-core machines CI runs on
-/// (`benches/batch_threads.py`), so from 1 ms of work a second thread saves more than 40 %
-/// of the wall time, and below about 0.1 ms it would cost more than it saves.
+/// Measured on a 2-core machine like CI's (`benches/batch_threads.py`, release wheel): just
+/// past the threshold two threads take 0.92 ms for the 1.35 ms of 2,000 deflections (-32 %)
+/// and 0.79 ms for 0.95 ms of 20,000 map queries (-17 %); the second thread's start, join
+/// and shared caches cost 0.15-0.3 ms there, so well below 1 ms of work it gains nothing.
 pub const PARALLEL_MIN_NS: f64 = 1.0e6;
 
 /// Most threads one batch uses.
@@ -31,8 +32,8 @@ pub const MAX_THREADS: usize = 8;
 /// compared against. Estimates, rounded to the slower end; a wrong estimate only moves the
 /// row count at which threads start.
 pub mod row_cost {
-    /// One virtual-joint pass of a 6-axis arm (forward 0.2 us, compliance 0.7 us,
-    /// deflection 0.6-0.9 us): threads from 2,000 rows.
+    /// One virtual-joint pass of a 6-axis arm (forward 0.22 us, compliance 0.7 us,
+    /// deflection 0.7 us, single-threaded on the KR 300): threads from 2,000 rows.
     pub const VJM: f64 = 500.0;
     /// One compliance-map or displacement-field query (30-60 ns): threads from 20,000 rows.
     pub const MAP_QUERY: f64 = 50.0;
