@@ -13,6 +13,8 @@ use deflect_core::vjm::{self, Data};
 use deflect_core::{BuildError, Model, ModelBuilder, SerialRobot, TickError};
 use nalgebra::{Isometry3, Matrix2, Matrix6, Vector3, Vector6};
 
+mod fixtures;
+
 /// The joints of a 6-axis arm with a prismatic track: (axis, revolute?, link offset).
 fn arm_joints() -> [(Vector3<f64>, bool, Vector3<f64>); 6] {
     [
@@ -224,14 +226,7 @@ fn eq10_contact_hand_example() {
 
 /// 6R arm whose virtual joints are only about the joint axes.
 fn spring_arm(k: &[f64; 6]) -> Model {
-    let axes = [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ];
+    let axes = fixtures::SIX_R_AXES;
     let offsets = [
         Vector3::new(0.3, 0.0, 0.6),
         Vector3::new(1.0, 0.0, 0.1),

@@ -8,16 +8,11 @@ use deflect_core::vjm::{self, Data, Model, ModelBuilder, Vector6};
 use nalgebra::{Isometry3, Vector2, Vector3};
 use proptest::prelude::*;
 
+mod fixtures;
+
 /// A spatial 6R arm with a spring about every axis of every joint.
 fn arm(k: &[f64; 6]) -> Model {
-    let axes = [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ];
+    let axes = fixtures::SIX_R_AXES;
     let offsets = [
         Vector3::new(0.0, 0.0, 0.4),
         Vector3::new(0.6, 0.0, 0.0),

@@ -85,14 +85,7 @@ fn under_actuated_correction_is_least_squares() {
 fn joint_correction_six_dof_converges_exactly() {
     // A spatial 6R arm with springs about every axis: 6 joints can cancel the full pose error.
     let mut b = ModelBuilder::new();
-    let axes = [
-        Vector3::z(),
-        Vector3::y(),
-        Vector3::y(),
-        Vector3::x(),
-        Vector3::y(),
-        Vector3::x(),
-    ];
+    let axes = fixtures::SIX_R_AXES;
     let offsets = [
         Vector3::new(0.0, 0.0, 0.4),
         Vector3::new(0.6, 0.0, 0.0),
