@@ -46,11 +46,12 @@ pub struct LeastSquares {
     pub residual_rms: f64,
 }
 
-/// Most measurements one identification accepts: 100 000 (a calibration campaign has tens to
-/// thousands; the VJM paper's had a few dozen). Past it the call refuses with
+/// Most measurements one identification accepts (the one measurements budget of deflect,
+/// [`crate::compliance_map::MAX_MEASUREMENTS`]: 100 000; a calibration campaign has tens to
+/// thousands, the VJM paper's had a few dozen). Past it the call refuses with
 /// [`BuildError::Budget`] before any work, which bounds its time (about 10 us per TCP
-/// measurement) ; memory does not grow with the count at all ([`LeastSquaresAccumulator`]).
-pub const MAX_MEASUREMENTS: usize = 100_000;
+/// measurement); memory does not grow with the count at all ([`LeastSquaresAccumulator`]).
+pub use crate::compliance_map::MAX_MEASUREMENTS;
 
 /// Rows folded into the accumulated factor at a time.
 const BLOCK: usize = 256;
