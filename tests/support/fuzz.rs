@@ -8,7 +8,8 @@
 //! answer a small query with a finite result or a typed error, never NaN with `Ok`.
 
 use deflect_core::compliance_map::ComplianceMap;
-use deflect_core::io::{drive, map_csv, map_json, stiffness, urdf};
+use deflect_core::io::{drive, gcode, map_csv, map_json, stiffness, urdf};
+use deflect_core::machining::Motion;
 use deflect_core::units::{ForceUnit, LengthUnit};
 use deflect_core::vjm::{self, Vector6};
 use deflect_core::{SerialRobot, TickError, drivetrain};
@@ -16,12 +17,13 @@ use deflect_core::{SerialRobot, TickError, drivetrain};
 /// The fuzz targets, each with its harness: the names of `fuzz/fuzz_targets/*.rs` and of
 /// the directories of `fuzz/corpus/` and `fuzz/regressions/`. A harness returns whether a
 /// model loaded (the replay test wants each seed corpus to load at least one).
-pub const TARGETS: [(&str, Harness); 5] = [
+pub const TARGETS: [(&str, Harness); 6] = [
     ("urdf_stiffness", urdf_stiffness),
     ("map_csv", map_csv),
     ("static_csv", static_csv),
     ("map_json", map_json),
     ("drive_toml", drive_toml),
+    ("gcode", gcode),
 ];
 
 /// A harness: arbitrary bytes in, whether a model loaded out.
@@ -343,4 +345,61 @@ pub fn kr300_robot() -> &'static SerialRobot {
             Err(e) => panic!("the shipped KR 300 model must load: {e}"),
         },
     )
+}
+
+/// Target `gcode`: a G-code program read in mm from the origin and in inch from an offset
+/// start. Whatever reads is a continuous path of finite moves: each starts where the one
+/// before ended, arcs have a radius > 0 and a sweep in (0, 2 pi], `point(0)` and `point(1)`
+/// are the ends, feeds are finite (0 for rapids, > 0 otherwise).
+pub fn gcode(data: &[u8]) -> bool {
+    let text = String::from_utf8_lossy(data);
+    let mut loaded = false;
+    for options in [
+        gcode::GcodeOptions::default(),
+        gcode::GcodeOptions {
+            start: nalgebra::Vector3::new(0.1, -0.2, 0.3),
+            units: LengthUnit::Inch,
+        },
+    ] {
+        let Ok(program) = gcode::from_str(&text, &options) else {
+            continue;
+        };
+        let mut at = options.start;
+        for m in &program.moves {
+            assert_eq!(
+                m.start, at,
+                "line {}: a move starts where the last ended",
+                m.line
+            );
+            at = m.end;
+            let finite = |v: &nalgebra::Vector3<f64>| v.iter().all(|x| x.is_finite());
+            assert!(finite(&m.end) && m.length().is_finite(), "line {}", m.line);
+            assert!(
+                m.feed.is_finite() && m.spindle.is_finite(),
+                "line {}",
+                m.line
+            );
+            match m.motion {
+                Motion::Rapid => assert_eq!(m.feed, 0.0),
+                Motion::Linear => assert!(m.feed > 0.0),
+                Motion::Arc { sweep, .. } => {
+                    assert!(m.feed > 0.0 && m.radius() > 0.0, "line {}", m.line);
+                    assert!(
+                        sweep != 0.0 && sweep.abs() <= std::f64::consts::TAU,
+                        "line {}: sweep {sweep}",
+                        m.line
+                    );
+                }
+            }
+            assert_eq!(m.point(0.0), m.start, "line {}", m.line);
+            assert_eq!(m.point(1.0), m.end, "line {}", m.line);
+            assert!(
+                finite(&m.point(0.5)) && finite(&m.tangent(0.5)),
+                "line {}",
+                m.line
+            );
+        }
+        loaded |= !program.moves.is_empty();
+    }
+    loaded
 }

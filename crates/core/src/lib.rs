@@ -80,6 +80,7 @@ pub mod error;
 pub mod identification;
 #[cfg(feature = "std")]
 pub mod io;
+pub mod machining;
 pub mod mechanism;
 pub mod motion;
 pub mod posture;

@@ -47,6 +47,8 @@ pub enum LengthUnit {
     Metre,
     /// Millimetre.
     Millimetre,
+    /// Inch (25.4 mm exactly), for G-code in `G20`.
+    Inch,
 }
 
 impl LengthUnit {
@@ -55,14 +57,17 @@ impl LengthUnit {
         match self {
             Self::Metre => 1.0,
             Self::Millimetre => 1e-3,
+            Self::Inch => 25.4e-3,
         }
     }
-    /// Parses "m" or "mm" (case-insensitive).
+    /// Parses "m", "mm" or "in" (case-insensitive).
     pub fn parse(s: &str) -> Option<Self> {
         if s.eq_ignore_ascii_case("m") {
             Some(Self::Metre)
         } else if s.eq_ignore_ascii_case("mm") {
             Some(Self::Millimetre)
+        } else if s.eq_ignore_ascii_case("in") {
+            Some(Self::Inch)
         } else {
             None
         }

@@ -64,7 +64,7 @@ fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit
     })?;
     let l = LengthUnit::parse(length_unit).ok_or_else(|| {
         InputError::new_err(format!(
-            "length_unit must be \"m\" or \"mm\", got {length_unit:?}"
+            "length_unit must be \"m\", \"mm\" or \"in\", got {length_unit:?}"
         ))
     })?;
     Ok((f, l))

@@ -129,6 +129,15 @@ pub enum LoadError {
         /// What was found.
         got: String,
     },
+    /// A G-code program line is malformed or uses what the reader does not support.
+    Program {
+        /// 1-based line.
+        line: usize,
+        /// 1-based column (byte) of the word at fault.
+        column: usize,
+        /// What was expected, and what was found.
+        message: String,
+    },
     /// The CSV reader failed (malformed record, wrong field count).
     Csv {
         /// 1-based line, when known.
@@ -251,6 +260,14 @@ impl fmt::Display for LoadError {
                 expected,
                 got,
             } => write!(f, "{element}: {field} is {got}; expected {expected}"),
+            Self::Program {
+                line,
+                column,
+                message,
+            } => write!(
+                f,
+                "program line {line}, column {column}: expected {message}"
+            ),
             Self::Csv { line, message } => match line {
                 Some(l) => write!(f, "CSV line {l}: {message}"),
                 None => write!(f, "CSV: {message}"),

@@ -1,0 +1,15 @@
+//! Robot machining: the program a CAM system writes, as moves in the workpiece frame
+//! ([`Program`], read by [`crate::io::gcode`]), and the milling force it makes
+//! ([`cutting`]: the mechanistic model of end milling).
+//!
+//! This is the offline half of the hybrid compensation of Hähn and Weigold ("Hybrid
+//! compliance compensation for path accuracy enhancement in robot machining", 2020, sec. 2.4):
+//! "the motion commands stored in the robot program are combined with roughly estimated
+//! cutting forces prior to the machining process".
+
+pub mod cutting;
+#[cfg(feature = "alloc")]
+mod program;
+
+#[cfg(feature = "alloc")]
+pub use program::{MAX_MOVES, Motion, Move, Program};

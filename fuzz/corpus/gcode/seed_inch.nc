@@ -1,0 +1,6 @@
+G20 G90
+G0 X0 Y0 Z0.2
+G1 Z-0.05 F20
+G2 X1 Y1 I1 J0
+G1 X2 (line)
+M30
