@@ -80,6 +80,23 @@ def main():
 
     sweep("ComplianceMap.displacement_batch", 50.0, lambda p: cmap.displacement_batch(p, force), points)
 
+    # Arguments that are not C-contiguous (a broadcast row, a strided view) are read block by
+    # block (batch::BLOCK_ROWS rows at a time), never copied whole: same time per row.
+    n = 1_000_000
+    p = points(n)
+    f = np.tile(force, (n, 1))
+    strided = np.empty((n, 4))
+    strided[:, ::2] = p
+    print(f"ComplianceMap.displacement_batch, {n} rows, by layout of P and F:")
+    for name, pp, ff in [
+        ("C-contiguous      ", p, f),
+        ("P strided         ", strided[:, ::2], f),
+        ("P broadcast row   ", np.broadcast_to(p[0], (n, 2)), f),
+        ("F broadcast row   ", p, force),
+    ]:
+        t = best_of(lambda: cmap.displacement_batch(pp, ff))
+        print(f"  {name}: {t / n * 1e9:6.1f} ns/row")
+
 
 if __name__ == "__main__":
     main()
