@@ -26,6 +26,7 @@ mod drivetrain;
 mod errors;
 mod field;
 mod identification;
+mod machining;
 mod mechanism;
 mod motion;
 mod pickle;
@@ -66,5 +67,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     pose_motion::register(m)?;
     drivetrain::register(m)?;
     posture::register(m)?;
+    machining::register(m)?;
     Ok(())
 }

@@ -5,6 +5,9 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 """
 
 from ._deflect import (
+    AL7075_T6_CARBIDE,
+    GcodeProgram,
+    milling_force,
     commanded_pose,
     ComplianceMap,
     DisplacementField,
@@ -55,6 +58,9 @@ from ._deflect import (
 from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
 
 __all__ = [
+    "AL7075_T6_CARBIDE",
+    "GcodeProgram",
+    "milling_force",
     "commanded_pose",
     "ComplianceMap",
     "DisplacementField",

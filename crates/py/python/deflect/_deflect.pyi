@@ -31,6 +31,9 @@ MAX_SEEDS: int
 MAX_DIRECTIONS: int
 #: Most force (and displacement) axes of a compliance map.
 MAX_AXES: int
+#: Cutting and edge coefficients of Al7075-T6 with a carbide end mill: (k_tc, k_rc, k_ac)
+#: [N/m^2], (k_te, k_re, k_ae) [N/m] (Table 5 of Zhang et al., CJME 34, 2021).
+AL7075_T6_CARBIDE: Tuple[float, float, float, float, float, float]
 __all__ = [
     "MAX_SAMPLES",
     "MAX_TICKS",
@@ -43,6 +46,9 @@ __all__ = [
     "MAX_SEEDS",
     "MAX_DIRECTIONS",
     "MAX_AXES",
+    "AL7075_T6_CARBIDE",
+    "GcodeProgram",
+    "milling_force",
     "DeflectError",
     "LoadError",
     "InputError",
@@ -770,3 +776,63 @@ def _atlas_chunk(
     min_sigma: float = 0.001,
 ) -> _FloatArray:
     """One chunk of ``deflect.atlas``: (N, 10 + dof + 39) rows."""
+
+@final
+class GcodeProgram:
+    """A machining program read from ISO G-code: its moves as arrays, SI, workpiece frame."""
+    @staticmethod
+    def from_file(
+        path: _StrPath, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+    ) -> "GcodeProgram":
+        """Reads a G-code file; ``start`` (3,) [m] before the first move, ``units`` "mm" | "in"."""
+    @staticmethod
+    def from_text(
+        text: str, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+    ) -> "GcodeProgram":
+        """Same as ``from_file``, from the program's text."""
+    def __len__(self) -> int: ...
+    @property
+    def line(self) -> npt.NDArray[np.uint64]:
+        """The program line of each move (1-based), (n,)."""
+    @property
+    def kind(self) -> List[str]:
+        """"rapid", "linear" or "arc" per move."""
+    @property
+    def start(self) -> _FloatArray:
+        """Start points (n, 3) [m]."""
+    @property
+    def end(self) -> _FloatArray:
+        """End points (n, 3) [m]."""
+    @property
+    def center(self) -> _FloatArray:
+        """Arc centres (n, 2) [m]; NaN for straight moves."""
+    @property
+    def sweep(self) -> _FloatArray:
+        """Signed arc sweeps (n,) [rad], > 0 counter-clockwise; 0 for straight moves."""
+    @property
+    def feed(self) -> _FloatArray:
+        """Programmed feeds (n,) [m/s]; 0 for rapids."""
+    @property
+    def spindle(self) -> _FloatArray:
+        """Spindle speeds (n,) [rev/s]; 0 while off."""
+    @property
+    def length(self) -> _FloatArray:
+        """Path lengths (n,) [m]."""
+    @property
+    def cutting_length(self) -> float:
+        """Total length of the feed moves [m]."""
+
+def milling_force(
+    diameter: float,
+    flutes: int,
+    depth: float,
+    feed_per_tooth: float,
+    *,
+    entry: float = 0.0,
+    exit: float = 3.141592653589793,
+    helix: float = 0.0,
+    coefficients: Optional[_ArrayLike] = None,
+    angles: Optional[_ArrayLike] = None,
+    discs: int = 1,
+) -> _FloatArray:
+    """Milling force [N], tool frame: the per-revolution average (3,), or (m, 3) at ``angles``."""
