@@ -1,6 +1,7 @@
 //! Robot machining: the program a CAM system writes, as moves in the workpiece frame
 //! ([`Program`], read by [`crate::io::gcode`]), and the milling force it makes
-//! ([`cutting`]: the mechanistic model of end milling).
+//! ([`cutting`]: the mechanistic model of end milling), and the stock it cuts ([`stock`]: a
+//! z-map lowered by a flat or ball end mill).
 //!
 //! This is the offline half of the hybrid compensation of Hähn and Weigold ("Hybrid
 //! compliance compensation for path accuracy enhancement in robot machining", 2020, sec. 2.4):
@@ -10,6 +11,8 @@
 pub mod cutting;
 #[cfg(feature = "alloc")]
 mod program;
+#[cfg(feature = "alloc")]
+pub mod stock;
 
 #[cfg(feature = "alloc")]
 pub use program::{MAX_MOVES, Motion, Move, Program};

@@ -1,0 +1,171 @@
+//! The z-map stock against hand-derived cuts: a straight slot leaves a groove of the tool's
+//! width (within a cell) and of the programmed depth (exactly), the removed volume is the
+//! swept area times the depth within the grid's resolution, a ramp's floor follows the tip,
+//! a ball end mill leaves its circular profile.
+
+use std::f64::consts::PI;
+
+use deflect_core::BuildError;
+use deflect_core::TickError;
+use deflect_core::machining::stock::{Cutter, MAX_CELLS, ZMap};
+use nalgebra::{Vector2, Vector3};
+
+const CELL: f64 = 1.0e-4;
+
+fn stock() -> ZMap {
+    // 100 mm x 40 mm, top at z = 0, 0.1 mm cells.
+    ZMap::new(Vector2::new(0.0, -0.02), Vector2::new(0.1, 0.02), 0.0, CELL).unwrap()
+}
+
+#[test]
+fn a_slot_leaves_a_groove_of_the_tool_width_and_depth() {
+    let mut z = stock();
+    assert_eq!(z.shape(), (1000, 400));
+    let (d, a, l) = (0.01, 0.002, 0.06);
+    let flat = Cutter::Flat { radius: d / 2.0 };
+    let above = Vector3::new(0.02, 0.0, 0.005);
+    let down = Vector3::new(0.02, 0.0, -a);
+    let end = Vector3::new(0.02 + l, 0.0, -a);
+    let plunge = z.cut(&flat, &above, &down).unwrap();
+    let slot = z.cut(&flat, &down, &end).unwrap();
+    // Across the middle of the slot (x = 50 mm): the cut cells span D within one cell, at
+    // depth a exactly.
+    let i = 500;
+    let cut: Vec<usize> = (0..400)
+        .filter(|&j| z.height(i, j).unwrap() < 0.0)
+        .collect();
+    let width = cut.len() as f64 * CELL;
+    assert!((width - d).abs() <= CELL, "groove width {width} m");
+    for &j in &cut {
+        assert!((z.height(i, j).unwrap() + a).abs() < 1e-9);
+    }
+    let deepest = z.heights().iter().copied().fold(f64::INFINITY, f64::min);
+    assert!((deepest + a).abs() < 1e-9, "{deepest}");
+    // Volume: a (L D + pi R^2), within a times the outline's length times a cell.
+    let r = d / 2.0;
+    let exact = a * (l * d + PI * r * r);
+    let outline = 2.0 * l + 2.0 * PI * r;
+    let removed = plunge.volume + slot.volume;
+    assert!(
+        (removed - exact).abs() <= a * outline * CELL,
+        "{removed} vs {exact}"
+    );
+    let total: f64 = z.heights().iter().map(|h| -h * CELL * CELL).sum();
+    assert!((total - removed).abs() < 1e-15);
+    // Cutting the same path again removes nothing.
+    assert_eq!(z.cut(&flat, &down, &end).unwrap().cells, 0);
+}
+
+#[test]
+fn a_ramp_floor_follows_the_tip_and_a_ball_leaves_its_profile() {
+    // Ramp from (10, 0, 0) to (50, 0, -4) mm with a 10 mm flat mill: the cell centred at
+    // (30.05, 0.05) mm is under the tool while the tip is within the half chord
+    // sqrt(5^2 - 0.05^2) mm of its x, and is cut to the deepest tip height there, at the
+    // far end of that stretch.
+    let mut z = stock();
+    let flat = Cutter::Flat { radius: 0.005 };
+    let ramp = z.cut(
+        &flat,
+        &Vector3::new(0.01, 0.0, 0.0),
+        &Vector3::new(0.05, 0.0, -0.004),
+    );
+    assert!(ramp.unwrap().cells > 0);
+    let c = z.center(300, 200);
+    assert!((c - Vector2::new(0.03005, 0.00005)).norm() < 1e-15);
+    let half = (0.005f64 * 0.005 - c.y * c.y).sqrt();
+    let want = -0.004 * (c.x + half - 0.01) / 0.04;
+    assert!((z.height(300, 200).unwrap() - want).abs() < 1e-12);
+
+    // A 10 mm ball along y = 0 at tip height -2 mm: the profile -2 mm + R - sqrt(R^2 - y^2).
+    let mut z = stock();
+    let ball = Cutter::Ball { radius: 0.005 };
+    let slot = z.cut(
+        &ball,
+        &Vector3::new(0.02, 0.0, -0.002),
+        &Vector3::new(0.08, 0.0, -0.002),
+    );
+    assert!(slot.unwrap().volume > 0.0);
+    for j in [200, 210, 220, 230, 240, 245] {
+        let y = z.center(500, j).y;
+        let want = (-0.002 + 0.005 - (0.005f64 * 0.005 - y * y).sqrt()).min(0.0);
+        assert!((z.height(500, j).unwrap() - want).abs() < 1e-12, "y = {y}");
+    }
+    // A ball ramp: the convex minimum inside the move.
+    let mut z = stock();
+    let ramp = z.cut(
+        &ball,
+        &Vector3::new(0.02, 0.0, 0.0),
+        &Vector3::new(0.08, 0.0, -0.006),
+    );
+    assert!(ramp.unwrap().cells > 0);
+    let (i, j) = (500, 230);
+    let c = z.center(i, j);
+    // By brute force over the move.
+    let brute = (0..=200_000)
+        .map(|k| {
+            let t = f64::from(k) / 200_000.0;
+            let p = Vector3::new(0.02 + 0.06 * t, 0.0, -0.006 * t);
+            let d2 = (p.xy() - c).norm_squared();
+            if d2 <= 0.005 * 0.005 {
+                p.z + 0.005 - (0.005 * 0.005 - d2).sqrt()
+            } else {
+                f64::INFINITY
+            }
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!((z.height(i, j).unwrap() - brute.min(0.0)).abs() < 1e-9);
+}
+
+#[test]
+fn budgets_and_bad_inputs_are_typed_errors() {
+    let big = ZMap::new(Vector2::zeros(), Vector2::new(10.0, 10.0), 0.0, 1e-4);
+    assert!(matches!(
+        big,
+        Err(BuildError::Budget { budget: "MAX_CELLS", limit, .. }) if limit == MAX_CELLS
+    ));
+    assert!(matches!(
+        ZMap::new(Vector2::zeros(), Vector2::new(1.0, 1.0), 0.0, 0.0),
+        Err(BuildError::InvalidParameter {
+            what: "cell size",
+            ..
+        })
+    ));
+    assert!(matches!(
+        ZMap::new(Vector2::zeros(), Vector2::new(-1.0, 1.0), 0.0, 1e-3),
+        Err(BuildError::InvalidParameter {
+            what: "stock x extent",
+            ..
+        })
+    ));
+    assert!(matches!(
+        ZMap::new(
+            Vector2::new(f64::NAN, 0.0),
+            Vector2::new(1.0, 1.0),
+            0.0,
+            1e-3
+        ),
+        Err(BuildError::InvalidParameter { .. })
+    ));
+    let mut z = stock();
+    let flat = Cutter::Flat { radius: 0.005 };
+    assert!(matches!(
+        z.cut(&flat, &Vector3::new(f64::NAN, 0.0, 0.0), &Vector3::zeros()),
+        Err(TickError::NonFinite { .. })
+    ));
+    assert!(matches!(
+        z.cut(
+            &Cutter::Ball { radius: -1.0 },
+            &Vector3::zeros(),
+            &Vector3::x()
+        ),
+        Err(TickError::InvalidArgument { .. })
+    ));
+    // A move outside the stock cuts nothing.
+    let far = z.cut(
+        &flat,
+        &Vector3::new(1.0, 1.0, -1.0),
+        &Vector3::new(2.0, 1.0, -1.0),
+    );
+    assert_eq!(far.unwrap().cells, 0);
+    assert!(z.height(1000, 0).is_none() && z.height(0, 400).is_none());
+}
