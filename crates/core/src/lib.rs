@@ -76,6 +76,7 @@ pub mod contour;
 pub mod dalembert;
 pub mod drivetrain;
 pub mod error;
+mod golden;
 #[cfg(feature = "std")]
 pub mod identification;
 #[cfg(feature = "std")]

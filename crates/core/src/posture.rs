@@ -467,35 +467,16 @@ fn refine(
         None if full => first + dir * turn,
         None => best.angle,
     };
-    let (mut a, mut b) = (before.min(after), before.max(after));
+    let (a, b) = (before.min(after), before.max(after));
     if b - a <= 0.0 {
         return best;
     }
     let dof = task.model.dof();
     let seed = best.q;
     let seed = seed.get(..dof).unwrap_or(&[]);
-    let mut eval = |theta: f64| task.solve(data, theta, seed).ok();
+    let eval = |theta: f64| task.solve(data, theta, seed).ok();
     let m = |p: &Option<AnglePoint>| p.map_or(f64::INFINITY, |p| p.measure);
-    const R: f64 = 0.618_033_988_749_894_9;
-    let mut c = b - R * (b - a);
-    let mut d = a + R * (b - a);
-    let (mut pc, mut pd) = (eval(c), eval(d));
-    for _ in 0..REFINE_ITERATIONS {
-        if m(&pc) < m(&pd) {
-            b = d;
-            d = c;
-            pd = pc;
-            c = b - R * (b - a);
-            pc = eval(c);
-        } else {
-            a = c;
-            c = d;
-            pc = pd;
-            d = a + R * (b - a);
-            pd = eval(d);
-        }
-    }
-    let found = if m(&pc) < m(&pd) { pc } else { pd };
+    let found = crate::golden::minimise(a, b, REFINE_ITERATIONS, eval, m);
     match found {
         Some(mut f) if f.measure < best.measure => {
             f.seed = best.seed;

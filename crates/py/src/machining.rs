@@ -9,12 +9,12 @@ use deflect_core::motion::MAX_SAMPLES;
 use deflect_core::units::LengthUnit;
 use nalgebra::Vector3;
 use numpy::ndarray::{Array1, Array2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyUntypedArrayMethods};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::InputError;
-use crate::arrays::{float_array, try_rows, vector, vector_upto};
-use crate::errors::{build_err, load_err, shape_error, tick_err};
+use crate::arrays::{try_rows, vector, vector_upto};
+use crate::errors::{build_err, load_err, tick_err};
 use crate::scalars::{count, real};
 
 /// A machining program read from ISO G-code: its moves as arrays, SI, workpiece frame.
@@ -232,10 +232,6 @@ fn milling_force<'py>(
         let f = cutting::average(&k, &tool, &e).map_err(tick_err)?;
         return Ok(f.as_slice().to_vec().into_pyarray(py).into_any());
     };
-    let a = float_array(angles, "angles")?;
-    if a.ndim() != 1 {
-        return Err(shape_error("angles", "(m,)", a.shape()));
-    }
     let angles = vector_upto(angles, "angles", MAX_SAMPLES, "MAX_SAMPLES")?;
     let discs = discs.map_or(Ok(1), |d| count(d, "discs"))?;
     if !(1..=MAX_DISCS).contains(&discs) {

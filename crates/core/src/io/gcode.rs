@@ -257,6 +257,7 @@ impl Reader {
     fn line(&mut self, line: usize, words: &[Word]) -> Result<(), LoadError> {
         let mut axes: [Option<(usize, f64)>; 8] = [None; 8];
         let mut motion: Option<(usize, u8)> = None;
+        // G17 is the only plane: its slot only catches a second plane word on the line.
         let mut plane = None;
         let mut units = None;
         let mut distance = None;
@@ -371,7 +372,6 @@ impl Reader {
         if let Some((_, g)) = distance {
             self.absolute = g == 90;
         }
-        let _ = plane;
         if let Some((column, rpm)) = s {
             if !(0.0..=MAX_SPINDLE_RPM).contains(&rpm) {
                 return Err(error(

@@ -273,28 +273,10 @@ fn lowest(
                 let d2 = (a + b * t).norm_squared();
                 z(t) + radius - ComplexField::sqrt((radius * radius - d2).max(0.0))
             };
-            // Convex on [t0, t1]: golden section to 1e-12 of the move.
-            const G: f64 = 0.618_033_988_749_894_9;
-            let (mut lo, mut hi) = (t0, t1);
-            let mut x1 = hi - G * (hi - lo);
-            let mut x2 = lo + G * (hi - lo);
-            let (mut f1, mut f2) = (surface(x1), surface(x2));
-            while hi - lo > 1.0e-12 {
-                if f1 <= f2 {
-                    hi = x2;
-                    x2 = x1;
-                    f2 = f1;
-                    x1 = hi - G * (hi - lo);
-                    f1 = surface(x1);
-                } else {
-                    lo = x1;
-                    x1 = x2;
-                    f1 = f2;
-                    x2 = lo + G * (hi - lo);
-                    f2 = surface(x2);
-                }
-            }
-            Some(surface(t0).min(surface(t1)).min(f1.min(f2)))
+            // Convex on [t0, t1]: golden section, 60 steps take the bracket below 1e-12 of
+            // the move.
+            let inner = crate::golden::minimise(t0, t1, 60, surface, |f| *f);
+            Some(surface(t0).min(surface(t1)).min(inner))
         }
     }
 }
