@@ -95,7 +95,7 @@ pub use compliance_map::ComplianceMap;
 pub use compliance_map::{ComplianceMapView, Interpolation, OutOfGrid, QueryOptions};
 #[cfg(feature = "std")]
 pub use error::LoadError;
-pub use error::{BuildError, Placement, TickError};
+pub use error::{BuildError, JobError, Placement, TickError};
 #[cfg(feature = "std")]
 pub use robot::SerialRobot;
 pub use vjm::{Data, Model, ModelBuilder};

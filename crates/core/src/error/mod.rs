@@ -13,11 +13,13 @@
 //! map's grid): inside, clamped to it or extrapolated beyond it.
 
 mod build;
+mod job;
 #[cfg(feature = "std")]
 mod load;
 mod tick;
 
 pub use build::BuildError;
+pub use job::JobError;
 #[cfg(feature = "std")]
 pub use load::LoadError;
 pub use tick::TickError;

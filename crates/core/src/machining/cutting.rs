@@ -337,6 +337,27 @@ pub fn average(
     Ok(mean)
 }
 
+/// The cutting torque about the tool axis averaged over one revolution \[N m\], on the tool,
+/// positive about +z of the tool frame: every edge's tangential force acts at the radius
+/// (`(p x F)_z = R F_t`; the radial and axial forces have no moment about the axis), so
+/// `M = R a N / (2 pi) (K_tc c (cos(entry) - cos(exit)) + K_te (exit - entry))`. The spindle
+/// housing passes it to the flange: part of the wrench the arm bends under.
+pub fn average_torque(
+    coefficients: &Coefficients,
+    tool: &Tool,
+    engagement: &Engagement,
+) -> Result<f64, TickError> {
+    engagement.validate()?;
+    let c = coefficients;
+    let e = engagement;
+    let n = f64::from(tool.flutes.max(1));
+    let integral =
+        c.k_tc * e.feed_per_tooth * (e.entry.cos() - e.exit.cos()) + c.k_te * (e.exit - e.entry);
+    let m = 0.5 * tool.diameter * e.depth * n / core::f64::consts::TAU * integral;
+    crate::error::check_output("average cutting torque", &[m])?;
+    Ok(m)
+}
+
 /// The rotation from the tool frame to the base frame for a tool axis `axis` (from the tip
 /// towards the spindle) and a feed direction `feed` (any length; its part along the axis is
 /// dropped), base frame. `None` when either is zero or they are parallel.

@@ -10,6 +10,12 @@
 
 pub mod cutting;
 #[cfg(feature = "alloc")]
+pub mod engagement;
+#[cfg(feature = "alloc")]
+pub mod job;
+#[cfg(feature = "alloc")]
+pub mod path;
+#[cfg(feature = "alloc")]
 mod program;
 #[cfg(feature = "alloc")]
 pub mod stock;

@@ -176,6 +176,22 @@ impl ZMap {
             .copied()
     }
 
+    /// Height of the cell holding the point (x, y) \[m\]; `None` outside the grid (or for a
+    /// non-finite point).
+    pub fn height_at(&self, p: &Vector2<f64>) -> Option<f64> {
+        let u = (p - self.origin) / self.cell;
+        if !(u.x >= 0.0 && u.y >= 0.0 && u.x < self.nx as f64 && u.y < self.ny as f64) {
+            return None;
+        }
+        // In range and non-negative: the casts truncate to the cell index.
+        self.height(u.x as usize, u.y as usize)
+    }
+
+    /// Lower corner (x, y) of cell (0, 0) \[m\].
+    pub fn origin(&self) -> Vector2<f64> {
+        self.origin
+    }
+
     /// Every height, row-major (cell (i, j) at `j * nx + i`) \[m\].
     pub fn heights(&self) -> &[f64] {
         &self.heights

@@ -1,0 +1,273 @@
+//! The offline pass over a program against hand-derived values: the path's duration is the
+//! closed-form profile's, it stops at corners and runs through tangent joins; the engagement
+//! of a slot is 0..pi at the programmed depth and half immersion is a quarter turn; the force
+//! of a slot on the KR 300 equals Altintas' closed form for slotting; the compensated arm
+//! lands on the program and the uncompensated one leaves material; every fault names its
+//! program line.
+
+mod fixtures;
+
+use std::f64::consts::PI;
+
+use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::engagement::{self, Contact};
+use deflect_core::machining::job::{self, Job, Setup, Stock};
+use deflect_core::machining::path::{self, PathOptions};
+use deflect_core::machining::stock::{Cutter, ZMap};
+use deflect_core::mechanism::PoseIkOptions;
+use deflect_core::motion::{Limits, Profile};
+use deflect_core::units::LengthUnit;
+use deflect_core::vjm::{self, Data};
+use deflect_core::{JobError, TickError};
+use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
+
+fn program(text: &str) -> deflect_core::machining::Program {
+    gcode::from_str(
+        text,
+        &GcodeOptions {
+            start: Vector3::new(0.0, 0.0, 0.02),
+            units: LengthUnit::Millimetre,
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn a_line_takes_the_closed_form_profile_time_and_ends_exactly() {
+    let p = program("G1 X60 F1500\n");
+    let o = PathOptions::default();
+    let profile = Profile::new(0.06, &Limits::new(0.025, o.acceleration, o.jerk).unwrap()).unwrap();
+    let t = path::duration(&p, &o).unwrap();
+    assert_eq!(t, profile.duration());
+    let s = path::sample(&p, &o).unwrap();
+    assert_eq!(s.len(), (t * 250.0 - 1e-9).ceil() as usize + 1);
+    assert_eq!(s[0].position, Vector3::new(0.0, 0.0, 0.02));
+    let last = s.last().unwrap();
+    assert_eq!(last.position, Vector3::new(0.06, 0.0, 0.02));
+    assert_eq!(last.time, t);
+    assert!(s.iter().all(|x| x.speed <= 0.025 + 1e-15 && x.line == 1));
+    // Samples 4 ms apart.
+    assert!((s[10].time - 0.04).abs() < 1e-15);
+}
+
+#[test]
+fn the_tool_stops_at_a_corner_and_runs_through_a_tangent_join() {
+    let o = PathOptions::default();
+    // Corner: two perpendicular lines take the two profiles' time, speed 0 at the corner.
+    let corner = program("G0 X0 Y0 Z0\nG1 X10 F600\nY10\n");
+    let lim = Limits::new(0.01, o.acceleration, o.jerk).unwrap();
+    let one = Profile::new(0.01, &lim).unwrap().duration();
+    let rapid = Profile::new(0.02, &Limits::new(0.25, 2.0, 20.0).unwrap()).unwrap();
+    let t = path::duration(&corner, &o).unwrap();
+    assert!((t - (rapid.duration() + 2.0 * one)).abs() < 1e-12);
+    // Tangent: a line into a quarter circle that starts along it is one run at the feed.
+    let tangent = program("G0 X0 Y0 Z0\nG1 X10 F600\nG3 X20 Y10 R10\n");
+    let length = 0.01 + 0.01 * PI / 2.0;
+    let t = path::duration(&tangent, &o).unwrap();
+    let run = Profile::new(length, &lim).unwrap().duration();
+    assert!((t - (rapid.duration() + run)).abs() < 1e-12);
+    let s = path::sample(&tangent, &o).unwrap();
+    let join = s.iter().find(|x| x.line == 3).expect("samples on the arc");
+    assert!((join.speed - 0.01).abs() < 1e-12, "{}", join.speed);
+    // A full circle (G2 with I) returns to its start.
+    let circle = program("G0 X10 Y0 Z0\nG2 X10 Y0 I5 F600\n");
+    let s = path::sample(&circle, &o).unwrap();
+    let end = s.last().unwrap().position;
+    assert!((end - Vector3::new(0.01, 0.0, 0.0)).norm() < 1e-9);
+    // Midway round the circle the tool is opposite the start.
+    let mid = path::duration(&circle, &o).unwrap()
+        - Profile::new(0.01 * PI, &lim).unwrap().duration() / 2.0;
+    let m = s
+        .iter()
+        .min_by(|a, b| (a.time - mid).abs().total_cmp(&(b.time - mid).abs()))
+        .unwrap();
+    assert!((m.position - Vector3::new(0.02, 0.0, 0.0)).norm() < 1e-4);
+}
+
+#[test]
+fn path_budgets_and_faults_are_typed() {
+    let p = program("G1 X60 F1500\n");
+    let o = PathOptions {
+        rate_hz: 0.0,
+        ..PathOptions::default()
+    };
+    assert!(path::sample(&p, &o).is_err());
+    // 900 m at 1 mm/min: far past MAX_PATH_SAMPLES.
+    let long = program("G1 X900000 F1\n");
+    let e = path::sample(&long, &PathOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("MAX_PATH_SAMPLES"), "{e}");
+    let still = program("G0 X0 Y0 Z20\n");
+    assert!(path::sample(&still, &PathOptions::default()).is_err());
+}
+
+#[test]
+fn a_slot_engages_zero_to_pi_at_its_depth_and_half_immersion_a_quarter() {
+    let cell = 2.0e-4;
+    let r = 0.008;
+    let mut z = ZMap::new(Vector2::new(0.0, -0.03), Vector2::new(0.1, 0.03), 0.0, cell).unwrap();
+    let flat = Cutter::Flat { radius: r };
+    let a = 0.002;
+    let _ = z
+        .cut(
+            &flat,
+            &Vector3::new(0.0, 0.0, -a),
+            &Vector3::new(0.05, 0.0, -a),
+        )
+        .unwrap();
+    let c = engagement::contact(&z, r, &Vector3::new(0.05, 0.0, -a), &Vector3::x());
+    let Some(engagement::Arc { entry, exit, depth }) = c.span() else {
+        panic!("{c:?}")
+    };
+    assert_eq!(c.arcs().len(), 1);
+    assert_eq!((entry, exit), (0.0, PI));
+    assert!((depth - a).abs() < 1e-12);
+    // A second pass beside the slot, offset by R to +y: the material left lies on the tool's
+    // +y side (left of the feed, phi in [0, pi/2]): up milling at half immersion.
+    let mut z2 = z.clone();
+    let _ = z2
+        .cut(&flat, &Vector3::new(0.0, r, -a), &Vector3::new(0.03, r, -a))
+        .unwrap();
+    let c = engagement::contact(&z2, r, &Vector3::new(0.03, r, -a), &Vector3::x());
+    let Some(engagement::Arc {
+        entry: entry2,
+        exit: exit2,
+        depth: depth2,
+    }) = c.span()
+    else {
+        panic!("{c:?}")
+    };
+    // One cell at the rim is ~sqrt(2 cell / R) = 0.22 rad at the thin end of the chip.
+    assert_eq!(entry2, 0.0);
+    assert!(
+        (exit2 - PI / 2.0).abs() < (2.0 * 1.75 * cell / r).sqrt(),
+        "{exit2}"
+    );
+    assert!((depth2 - a).abs() < 1e-12);
+    // Back along the groove already cut: only the walls beside the rim are seen, as two thin
+    // arcs at the ends (the probe circle lies 0.75 cell outside the cutter), no wider than
+    // acos(R / (R + 0.75 cell)) + one probe step each.
+    let c = engagement::contact(&z, r, &Vector3::new(0.02, 0.0, -a), &Vector3::x());
+    let sliver = (r / (r + 0.75 * cell)).acos() + PI / 180.0;
+    assert_eq!(c.arcs().len(), 2, "{c:?}");
+    assert_eq!(c.arcs()[0].entry, 0.0);
+    assert!(c.arcs()[0].exit <= sliver && c.arcs()[1].entry >= PI - sliver);
+    // Above the stock: air. Straight down into the stock: a plunge.
+    let c = engagement::contact(&z, r, &Vector3::new(0.02, 0.0, 0.001), &Vector3::x());
+    assert_eq!(c, Contact::Air);
+    let c = engagement::contact(&z, r, &Vector3::new(0.08, 0.0, -a), &-Vector3::z());
+    assert!(matches!(c, Contact::Plunge { depth } if (depth - a).abs() < 1e-12));
+}
+
+/// A job on the KR 300 with the workpiece placed under its TCP at the usual start joints:
+/// the workpiece z along the tool axis (TCP z reversed), its origin 20 mm below the tip.
+fn kr300_job() -> (Job, Vec<f64>) {
+    let robot = fixtures::kr300();
+    let q0 = vec![0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
+    let tcp = vjm::forward(&robot.model, &mut Data::new(&robot.model), &q0).unwrap();
+    let rotation = tcp.rotation * Setup::tool_down().inverse();
+    let origin = tcp.translation.vector - rotation * Vector3::new(0.0, 0.0, 0.02);
+    let setup = Setup {
+        placement: Isometry3::from_parts(Translation3::from(origin), rotation),
+        tool_orientation: Setup::tool_down(),
+        tool: Tool::new(0.016, 3, 0.0).unwrap(),
+        coefficients: Coefficients::AL7075_T6_CARBIDE,
+        stock: Stock {
+            min: Vector2::new(0.0, -0.03),
+            max: Vector2::new(0.08, 0.03),
+            top: 0.0,
+            cell: 5.0e-4,
+        },
+        path: PathOptions::default(),
+        ik: PoseIkOptions::default(),
+    };
+    (
+        Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap(),
+        q0,
+    )
+}
+
+const SLOT: &str = "G0 X-10 Y0 Z5\nS13000 M3\nG1 Z-2 F1500\nX70\nG0 Z5\n";
+
+#[test]
+fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
+    let (job, q0) = kr300_job();
+    let p = program(SLOT);
+    let r = job::run(&job, &p, &q0).unwrap();
+    // Mid-slot, at the feed: Altintas' slotting averages (2.14-2.16 of Manufacturing
+    // Automation), N = 3, a = 2 mm, c = 25 mm/s / (13000/60 rev/s x 3).
+    let k = Coefficients::AL7075_T6_CARBIDE;
+    let (n, a) = (3.0, 0.002);
+    let c = 0.025 / (13000.0 / 60.0 * 3.0);
+    let expected = Vector3::new(
+        -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
+        n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
+        n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
+    );
+    let mid = r
+        .samples
+        .iter()
+        .find(|s| s.path.line == 4 && s.path.position.x > 0.035)
+        .unwrap();
+    assert!((mid.feed_per_tooth - c).abs() < 1e-12 * c);
+    assert!(
+        (mid.force - expected).norm() < 1e-9 * expected.norm(),
+        "{} vs {expected}",
+        mid.force
+    );
+    // The tip deflects by tenths of a mm; the compensated tip lands within the IK tolerance,
+    // the uncompensated one is off by the deflection.
+    let d = mid.deflection.fixed_rows::<3>(0).norm();
+    assert!(d > 2e-5, "{d}");
+    let un = r.path_error(false);
+    let co = r.path_error(true);
+    assert!(un.max > 2e-5 && co.max < 1e-7, "{un:?} {co:?}");
+    // The uncompensated slot is shallower: material left on the floor (tool pushed up by
+    // the axial force), the compensated one cut as programmed to a micrometre.
+    let s_un = r.surface_error(&r.uncompensated);
+    let s_co = r.surface_error(&r.compensated);
+    assert!(s_un.max > 1e-5 && s_co.max < 1e-6, "{s_un:?} {s_co:?}");
+    // The nominal groove: depth 2 mm at its middle.
+    let (i, j) = ((0.04 / 5e-4) as usize, (0.03 / 5e-4) as usize);
+    assert!((r.nominal.height(i, j).unwrap() + 0.002).abs() < 1e-12);
+    // The pilot signal is the wrench 40 ms (10 samples) early.
+    let pilot = r.pilot_wrenches(0.04);
+    assert_eq!(pilot[0], r.samples[10].wrench);
+    assert_eq!(*pilot.last().unwrap(), r.samples.last().unwrap().wrench);
+    let lines = r.line_forces();
+    let slot = lines.iter().find(|l| l.line == 4).unwrap();
+    assert!(slot.max >= expected.norm() * (1.0 - 1e-9));
+}
+
+#[test]
+fn faults_name_their_program_line() {
+    let (job, q0) = kr300_job();
+    // The spindle never started.
+    let e = job::run(&job, &program("G0 X-10 Y0 Z5\nG1 Z-2 F1500\nX70\n"), &q0).unwrap_err();
+    assert!(matches!(e, JobError::SpindleOff { line: 3, .. }), "{e}");
+    assert!(e.to_string().starts_with("program line 3"), "{e}");
+    // A rapid through the stock.
+    let e = job::run(&job, &program("G0 X-10 Y0 Z-1\nS13000 M3\nG0 X70\n"), &q0).unwrap_err();
+    assert!(matches!(e, JobError::RapidInStock { line: 3, .. }), "{e}");
+    // Five metres away: out of reach at the line that goes there.
+    let e = job::run(&job, &program("S13000 M3\nG0 Z5\nG0 X5000\n"), &q0).unwrap_err();
+    assert!(
+        matches!(
+            e,
+            JobError::AtLine {
+                line: 3,
+                error: TickError::NotConverged { .. }
+                    | TickError::Singular { .. }
+                    | TickError::JointLimit { .. },
+                ..
+            }
+        ),
+        "{e}"
+    );
+    assert!(e.to_string().contains("program line 3"), "{e}");
+    // A seed of the wrong length.
+    assert!(matches!(
+        job::run(&job, &program(SLOT), &q0[..5]),
+        Err(JobError::Setup(_))
+    ));
+}
