@@ -271,3 +271,97 @@ fn faults_name_their_program_line() {
         Err(JobError::Setup(_))
     ));
 }
+
+#[test]
+fn the_compensated_gcode_reads_back_onto_the_commanded_path() {
+    let (job, q0) = kr300_job();
+    let p = program(SLOT);
+    let r = job::run(&job, &p, &q0).unwrap();
+    let text = deflect_core::io::job_out::compensated_gcode(&r, &p, 1e-6);
+    let back = gcode::from_str(
+        &text,
+        &GcodeOptions {
+            start: r.samples[0].commanded.translation.vector,
+            units: LengthUnit::Millimetre,
+        },
+    )
+    .unwrap();
+    // Far fewer blocks than samples, every commanded point within the tolerance (plus the
+    // 0.05 um of four decimals in mm) of the polyline read back.
+    assert!(
+        back.moves.len() < r.samples.len() / 10,
+        "{}",
+        back.moves.len()
+    );
+    let poly: Vec<Vector3<f64>> = back.moves.iter().map(|m| m.end).collect();
+    for s in &r.samples {
+        let c = s.commanded.translation.vector;
+        let d = poly
+            .windows(2)
+            .map(|w| {
+                let (a, b) = (w[0], w[1]);
+                let t = ((c - a).dot(&(b - a)) / (b - a).norm_squared().max(1e-30)).clamp(0.0, 1.0);
+                (c - (a + (b - a) * t)).norm()
+            })
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 1.0e-6 + 1.0e-7, "{d} at t = {}", s.path.time);
+    }
+    // The slot's floor is commanded below the programmed -2 mm (the arm is pushed up).
+    let deepest = poly.iter().map(|p| p.z).fold(f64::INFINITY, f64::min);
+    assert!(deepest < -0.002 - 1e-5, "{deepest}");
+    // The feeds are the program's, in mm/min.
+    assert!(text.contains("F1500.0"), "{text}");
+    let csv = deflect_core::io::job_out::samples_csv(&r, 0.04);
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header.len(), 12 + 12 + 3 + 3 + 6 + 3);
+    assert_eq!(lines.count(), r.samples.len());
+}
+
+#[test]
+fn a_points_csv_is_a_program_of_straight_moves_in_its_units() {
+    use deflect_core::io::points_csv;
+    use deflect_core::machining::Motion;
+    let o = GcodeOptions {
+        start: Vector3::zeros(),
+        units: LengthUnit::Millimetre,
+    };
+    let p = points_csv::from_str(
+        "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n0,0,5,0,0\n10,0,-2,1500,13000\n",
+        &o,
+    )
+    .unwrap();
+    assert_eq!(p.moves.len(), 2);
+    assert_eq!(p.moves[0].motion, Motion::Rapid);
+    assert_eq!(p.moves[1].motion, Motion::Linear);
+    assert_eq!(p.moves[1].end, Vector3::new(0.01, 0.0, -0.002));
+    assert!((p.moves[1].feed - 0.025).abs() < 1e-15);
+    assert!((p.moves[1].spindle - 13000.0 / 60.0).abs() < 1e-12);
+    assert_eq!((p.moves[0].line, p.moves[1].line), (2, 3));
+    let m =
+        points_csv::from_str("x_m,y_m,z_m,feed_m_s,spindle_rpm\n0.01,0,0,0.025,100\n", &o).unwrap();
+    assert_eq!(m.moves[0].end.x, 0.01);
+    // Faults: a missing spindle, an orientation column, a NaN, both units, out of range.
+    for (text, needle) in [
+        ("x_mm,y_mm,z_mm,feed_mm_min\n0,0,0,1\n", "spindle_rpm"),
+        (
+            "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm,qw\n0,0,0,1,1,1\n",
+            "qw",
+        ),
+        (
+            "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n0,nan,0,1,1\n",
+            "y_mm",
+        ),
+        (
+            "x_mm,x_m,y_mm,z_mm,feed_mm_min,spindle_rpm\n0,0,0,0,1,1\n",
+            "x_m",
+        ),
+        (
+            "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n0,0,0,-5,1\n",
+            "feed_mm_min",
+        ),
+    ] {
+        let e = points_csv::from_str(text, &o).unwrap_err().to_string();
+        assert!(e.contains(needle), "{e}");
+    }
+}

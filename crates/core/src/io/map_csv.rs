@@ -26,7 +26,7 @@ const DISP_COLUMNS: [(&str, bool); MAX_AXES] = [
 ];
 const AXIS_NAMES: [&str; MAX_AXES] = ["x", "y", "z", "mx", "my", "mz"];
 
-fn csv_err(e: &csv::Error) -> LoadError {
+pub(super) fn csv_err(e: &csv::Error) -> LoadError {
     LoadError::Csv {
         line: e.position().map(|p| p.line()),
         message: e.to_string(),
@@ -34,7 +34,7 @@ fn csv_err(e: &csv::Error) -> LoadError {
 }
 
 /// Refuses a header column outside `known` (a misspelt `dx` must not be dropped silently).
-fn check_columns(header: &csv::StringRecord, known: &[&str]) -> Result<(), LoadError> {
+pub(super) fn check_columns(header: &csv::StringRecord, known: &[&str]) -> Result<(), LoadError> {
     match header
         .iter()
         .find(|h| !known.iter().any(|k| h.eq_ignore_ascii_case(k)))
@@ -65,7 +65,9 @@ const STATIC_COLUMNS: [&str; 10] = [
 ];
 
 /// Header and records of a CSV text, fields trimmed.
-fn read_csv(text: &str) -> Result<(csv::StringRecord, Vec<csv::StringRecord>), LoadError> {
+pub(super) fn read_csv(
+    text: &str,
+) -> Result<(csv::StringRecord, Vec<csv::StringRecord>), LoadError> {
     super::check_size("CSV", text)?;
     let mut rdr = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -79,15 +81,15 @@ fn read_csv(text: &str) -> Result<(csv::StringRecord, Vec<csv::StringRecord>), L
     Ok((header, records))
 }
 
-fn column(header: &csv::StringRecord, name: &str) -> Option<usize> {
+pub(super) fn column(header: &csv::StringRecord, name: &str) -> Option<usize> {
     header.iter().position(|h| h.eq_ignore_ascii_case(name))
 }
 
-fn require(header: &csv::StringRecord, name: &'static str) -> Result<usize, LoadError> {
+pub(super) fn require(header: &csv::StringRecord, name: &'static str) -> Result<usize, LoadError> {
     column(header, name).ok_or(LoadError::MissingColumn { column: name })
 }
 
-fn number(
+pub(super) fn number(
     rec: &csv::StringRecord,
     col: usize,
     row: usize,

@@ -9,14 +9,18 @@
 //! | [`stiffness`] (`urdf`) | stiffness TOML `[[virtual_joint]]` | specs |
 //! | [`drive`] (`urdf`) | drive-train TOML `[[joint]]` + URDF masses | [`crate::drivetrain::Model`] |
 //! | [`gcode`] | ISO G-code (G0-G3, G17, G20/G21, G90/G91, F, S, M3/M5/M30) | [`crate::machining::Program`] |
+//! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
+//! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |
 //! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
 //! | [`map_json`] | versioned JSON of a map | [`crate::ComplianceMap`] |
 
 #[cfg(feature = "urdf")]
 pub mod drive;
 pub mod gcode;
+pub mod job_out;
 pub mod map_csv;
 pub mod map_json;
+pub mod points_csv;
 #[cfg(feature = "urdf")]
 pub mod stiffness;
 #[cfg(feature = "urdf")]
