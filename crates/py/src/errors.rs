@@ -98,6 +98,16 @@ fn tick_exception(e: TickError, message: String) -> PyErr {
     }
 }
 
+/// A machining job that failed: the class of the per-sample error (`ConvergenceError` for
+/// a pose out of reach, `SingularError`, `InputError`), the message naming the program line.
+pub fn job_err(e: deflect_core::JobError) -> PyErr {
+    match e {
+        deflect_core::JobError::Setup(b) => build_err(b),
+        deflect_core::JobError::AtLine { error, .. } => tick_exception(error, e.to_string()),
+        _ => InputError::new_err(e.to_string()),
+    }
+}
+
 /// A shape as Python prints it: `()`, `(6,)`, `(3, 6)`.
 pub fn shape_text(shape: &[usize]) -> String {
     match shape {

@@ -27,6 +27,7 @@ mod errors;
 mod field;
 mod identification;
 mod machining;
+mod machining_job;
 mod mechanism;
 mod motion;
 mod pickle;
@@ -68,5 +69,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     drivetrain::register(m)?;
     posture::register(m)?;
     machining::register(m)?;
+    machining_job::register(m)?;
     Ok(())
 }

@@ -25,7 +25,7 @@ use crate::scalars::{count, real};
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct GcodeProgram {
-    inner: Program,
+    pub(crate) inner: Program,
 }
 
 fn options(start: Option<&Bound<'_, PyAny>>, units: &str) -> PyResult<GcodeOptions> {
@@ -214,14 +214,7 @@ fn milling_force<'py>(
         or(helix, "helix", 0.0)?,
     )
     .map_err(build_err)?;
-    let k = match coefficients {
-        None => Coefficients::AL7075_T6_CARBIDE,
-        Some(c) => {
-            let v = vector(c, "coefficients", 6)?;
-            let at = |i: usize| v.get(i).copied().unwrap_or(f64::NAN);
-            Coefficients::new(at(0), at(1), at(2), at(3), at(4), at(5)).map_err(build_err)?
-        }
-    };
+    let k = self::coefficients(coefficients)?;
     let e = Engagement {
         entry: or(entry, "entry", 0.0)?,
         exit: or(exit, "exit", std::f64::consts::PI)?,
@@ -251,6 +244,18 @@ fn milling_force<'py>(
     let arr = Array2::from_shape_vec((angles.len(), 3), out)
         .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
     Ok(arr.into_pyarray(py).into_any())
+}
+
+/// `coefficients` as (k_tc, k_rc, k_ac, k_te, k_re, k_ae), default Al7075-T6 / carbide.
+pub(crate) fn coefficients(c: Option<&Bound<'_, PyAny>>) -> PyResult<Coefficients> {
+    match c {
+        None => Ok(Coefficients::AL7075_T6_CARBIDE),
+        Some(c) => {
+            let v = vector(c, "coefficients", 6)?;
+            let at = |i: usize| v.get(i).copied().unwrap_or(f64::NAN);
+            Coefficients::new(at(0), at(1), at(2), at(3), at(4), at(5)).map_err(build_err)
+        }
+    }
 }
 
 /// Adds the machining classes and functions to the module.

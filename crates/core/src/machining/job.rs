@@ -83,7 +83,8 @@ impl Setup {
         UnitQuaternion::from_axis_angle(&Vector3::x_axis(), core::f64::consts::PI)
     }
 
-    /// Checks the placement, tool, coefficients, path and IK options.
+    /// Checks the placement, stock (its cell budget, without allocating), tool,
+    /// coefficients, path and IK options.
     pub fn validate(&self) -> Result<(), BuildError> {
         let t = &self.placement;
         if let Some(index) = t
@@ -105,6 +106,8 @@ impl Setup {
             (z.z.abs() - 1.0).abs() <= 1.0e-6,
             "the TCP z axis along the workpiece z (2.5-D program)",
         )?;
+        let st = &self.stock;
+        ZMap::shape_for(st.min, st.max, st.top, st.cell)?;
         self.tool.validate()?;
         self.coefficients.validate()?;
         self.path.validate()?;
@@ -220,6 +223,17 @@ impl ErrorStats {
     }
 }
 
+/// A predicted part against the nominal one ([`Report::surface_error`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SurfaceError {
+    /// Height above the nominal part over the cells both cut \[m\] (> 0: material left).
+    pub floor: ErrorStats,
+    /// Area the nominal part has cut and the predicted one not \[m^2\].
+    pub material_left: f64,
+    /// Area the predicted part has cut and the nominal one not \[m^2\].
+    pub overcut: f64,
+}
+
 /// Force statistics of one program line.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LineForce {
@@ -252,6 +266,8 @@ pub struct Report {
     pub rate_hz: f64,
     /// Joints of the arm.
     pub dof: usize,
+    /// The stock's top \[m\].
+    pub top: f64,
 }
 
 impl Report {
@@ -268,24 +284,37 @@ impl Report {
         }))
     }
 
-    /// Height of a predicted part above the nominal one (> 0: material left) over the cells
-    /// either cut \[m\].
-    pub fn surface_error(&self, predicted: &ZMap) -> ErrorStats {
-        let top = self.nominal.heights().first().copied().unwrap_or(0.0);
-        let top = self
-            .nominal
-            .heights()
-            .iter()
-            .chain(predicted.heights())
-            .fold(top, |m, &h| m.max(h));
-        ErrorStats::of(
+    /// A predicted part against the nominal one: the floors (cells both cut, by more than
+    /// [`super::engagement::MIN_DEPTH`]: height above the nominal, > 0 where material is
+    /// left), and the walls' shift as the areas cut by one and not the other \[m^2\] (a
+    /// height map sees a wall moved sideways as a full-depth step; the areas measure it).
+    pub fn surface_error(&self, predicted: &ZMap) -> SurfaceError {
+        let cut = |h: f64| h < self.top - super::engagement::MIN_DEPTH;
+        let area = self.nominal.cell() * self.nominal.cell();
+        let (mut left, mut over) = (0usize, 0usize);
+        let floor = ErrorStats::of(
             self.nominal
                 .heights()
                 .iter()
                 .zip(predicted.heights())
-                .filter(|&(&n, &p)| n < top || p < top)
-                .map(|(n, p)| p - n),
-        )
+                .filter_map(|(&n, &p)| match (cut(n), cut(p)) {
+                    (true, true) => Some(p - n),
+                    (true, false) => {
+                        left += 1;
+                        None
+                    }
+                    (false, true) => {
+                        over += 1;
+                        None
+                    }
+                    (false, false) => None,
+                }),
+        );
+        SurfaceError {
+            floor,
+            material_left: left as f64 * area,
+            overcut: over as f64 * area,
+        }
     }
 
     /// The pilot-control signal of the annotated program (sec. 2.3 of Hähn and Weigold): the
@@ -578,6 +607,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         cell_updates,
         rate_hz: setup.path.rate_hz,
         dof,
+        top: st.top,
     })
 }
 

@@ -68,18 +68,15 @@ pub struct ZMap {
 }
 
 impl ZMap {
-    /// A flat stock over `[min, max]` (x, y) \[m\] with its top at `top` \[m\], cells of
-    /// `cell` \[m\] (the last row and column may reach past `max`).
-    ///
-    /// [`BuildError::InvalidParameter`] for non-finite bounds, `max <= min` or a cell that is
-    /// not finite and > 0; [`BuildError::Budget`] past [`MAX_CELLS`] or when the heights
-    /// cannot be allocated.
-    pub fn new(
+    /// The cells (along x, along y) of a stock over `[min, max]` (x, y) \[m\] with its top at
+    /// `top` \[m\] and cells of `cell` \[m\], checked as [`Self::new`] checks them, without
+    /// allocating: what a job validates before it runs.
+    pub fn shape_for(
         min: Vector2<f64>,
         max: Vector2<f64>,
         top: f64,
         cell: f64,
-    ) -> Result<Self, BuildError> {
+    ) -> Result<(usize, usize), BuildError> {
         for (what, v) in [
             ("stock min x", min.x),
             ("stock min y", min.y),
@@ -132,6 +129,23 @@ impl ZMap {
                 requested: cells,
             });
         }
+        Ok((nx, ny))
+    }
+
+    /// A flat stock over `[min, max]` (x, y) \[m\] with its top at `top` \[m\], cells of
+    /// `cell` \[m\] (the last row and column may reach past `max`).
+    ///
+    /// [`BuildError::InvalidParameter`] for non-finite bounds, `max <= min` or a cell that is
+    /// not finite and > 0; [`BuildError::Budget`] past [`MAX_CELLS`] or when the heights
+    /// cannot be allocated.
+    pub fn new(
+        min: Vector2<f64>,
+        max: Vector2<f64>,
+        top: f64,
+        cell: f64,
+    ) -> Result<Self, BuildError> {
+        let (nx, ny) = Self::shape_for(min, max, top, cell)?;
+        let cells = nx * ny;
         let mut heights = Vec::new();
         heights
             .try_reserve_exact(cells)

@@ -7,6 +7,8 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 from ._deflect import (
     AL7075_T6_CARBIDE,
     GcodeProgram,
+    MachiningJob,
+    MachiningResult,
     milling_force,
     commanded_pose,
     ComplianceMap,
@@ -60,6 +62,8 @@ from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
 __all__ = [
     "AL7075_T6_CARBIDE",
     "GcodeProgram",
+    "MachiningJob",
+    "MachiningResult",
     "milling_force",
     "commanded_pose",
     "ComplianceMap",

@@ -48,6 +48,8 @@ __all__ = [
     "MAX_AXES",
     "AL7075_T6_CARBIDE",
     "GcodeProgram",
+    "MachiningJob",
+    "MachiningResult",
     "milling_force",
     "DeflectError",
     "LoadError",
@@ -821,6 +823,106 @@ class GcodeProgram:
     @property
     def cutting_length(self) -> float:
         """Total length of the feed moves [m]."""
+
+@final
+class MachiningJob:
+    """A robot-machining job without its program: arm, workpiece placement, tool, material,
+    stock and how the program is driven (see the class docstring of the module)."""
+    def __new__(
+        cls,
+        robot: SerialRobot,
+        placement: _ArrayLike,
+        *,
+        stock_min: _ArrayLike,
+        stock_max: _ArrayLike,
+        stock_top: float = 0.0,
+        cell: float = 0.0005,
+        tool_orientation: Optional[_ArrayLike] = None,
+        diameter: float = 0.016,
+        flutes: int = 3,
+        helix: float = 0.0,
+        coefficients: Optional[_ArrayLike] = None,
+        rate_hz: float = 250.0,
+        acceleration: float = 2.0,
+        jerk: float = 20.0,
+        rapid_speed: float = 0.25,
+        corner_angle: float = 0.017453292519943295,
+    ) -> Self: ...
+    def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
+        """The offline pass: forces, deflection, compensated joints, the part three ways."""
+
+@final
+class MachiningResult:
+    """What ``MachiningJob.run`` predicts, SI, workpiece frame unless said."""
+    def __len__(self) -> int: ...
+    @property
+    def time(self) -> _FloatArray:
+        """Sample times (n,) [s]."""
+    @property
+    def line(self) -> npt.NDArray[np.uint64]:
+        """Program line of each sample (n,)."""
+    @property
+    def position(self) -> _FloatArray:
+        """Programmed tool tip (n, 3) [m]."""
+    @property
+    def engagement(self) -> _FloatArray:
+        """(n, 3): first entry, last exit [rad], mean depth [m]; NaN off the side-milling cut."""
+    @property
+    def feed_per_tooth(self) -> _FloatArray:
+        """Feed per tooth (n,) [m]."""
+    @property
+    def force(self) -> _FloatArray:
+        """Per-revolution force on the tool, nominal cut (n, 3) [N]."""
+    @property
+    def force_uncompensated(self) -> _FloatArray:
+        """Force the uncompensated tool feels where it is (n, 3) [N]."""
+    @property
+    def wrench(self) -> _FloatArray:
+        """TCP wrench (n, 6) [N, N m], base frame, about the tool tip."""
+    @property
+    def deflection(self) -> _FloatArray:
+        """Deflection [dp; dr] of the tip (n, 6) [m, rad], base frame."""
+    @property
+    def q(self) -> _FloatArray:
+        """Rigid pose-IK joints of the programmed path (n, dof)."""
+    @property
+    def q_commanded(self) -> _FloatArray:
+        """Compensated joints (n, dof): the axis-specific command."""
+    @property
+    def commanded(self) -> _FloatArray:
+        """Commanded poses (n, 4, 4), workpiece frame: the Cartesian command."""
+    @property
+    def actual_uncompensated(self) -> _FloatArray:
+        """Predicted tool tip without compensation (n, 3) [m]."""
+    @property
+    def actual_compensated(self) -> _FloatArray:
+        """Predicted tool tip with compensation (n, 3) [m]."""
+    @property
+    def nominal_surface(self) -> _FloatArray:
+        """The part as programmed, heights (ny, nx) [m]."""
+    @property
+    def uncompensated_surface(self) -> _FloatArray:
+        """The part the uncompensated arm cuts (ny, nx) [m]."""
+    @property
+    def compensated_surface(self) -> _FloatArray:
+        """The part the compensated arm cuts (ny, nx) [m]."""
+    @property
+    def surface_grid(self) -> Tuple[Tuple[float, float], float]:
+        """((x, y) of cell (0, 0)'s lower corner [m], cell edge [m])."""
+    @property
+    def plunge_samples(self) -> int:
+        """Samples plunging into material (no side-milling force there)."""
+    def path_error(self, part: str = "uncompensated") -> Tuple[float, float]:
+        """(max, rms) [m] of the predicted tip's distance from the program (feed moves)."""
+    def surface_error(self, part: str = "uncompensated") -> Dict[str, float]:
+        """Floors (``floor_max``, ``floor_rms`` [m], cells both cut, > 0: material left) and
+        walls (``material_left``, ``overcut`` [m^2]: areas cut by one part and not the other)."""
+    def pilot_wrenches(self, lead: float = 0.04) -> _FloatArray:
+        """Pilot-control wrenches (n, 6), base frame, ``lead`` [s] ahead."""
+    def compensated_gcode(self, tolerance: float = 1e-6) -> str:
+        """The compensated program as G-code text (mm)."""
+    def samples_csv(self, lead: float = 0.04) -> str:
+        """Every sample as CSV text, the pilot wrench ``lead`` [s] ahead."""
 
 def milling_force(
     diameter: float,

@@ -1,0 +1,420 @@
+//! The offline pass over a program (deflect-core's `machining::job`): `MachiningJob` (the arm,
+//! the workpiece placement, the tool, the material, the stock and how the program is driven)
+//! and `MachiningResult` (every sample as arrays, the three predicted parts, the compensated
+//! program). Thin: core runs the pass, with the GIL released.
+
+use deflect_core::io::job_out;
+use deflect_core::machining::Program;
+use deflect_core::machining::cutting::Tool;
+use deflect_core::machining::job::{self, Job, Report, Setup, Stock};
+use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::stock::ZMap;
+use deflect_core::mechanism::PoseIkOptions;
+use nalgebra::Vector2;
+use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
+use pyo3::prelude::*;
+
+use crate::InputError;
+use crate::arrays::{pose, put_pose, rotation, try_rows, vector};
+use crate::errors::{build_err, job_err};
+use crate::machining::{GcodeProgram, coefficients};
+use crate::scalars::{count, pair, real};
+use crate::vjm::SerialRobot;
+
+/// A robot-machining job without its program: the arm (a `SerialRobot`, its tip the tool
+/// tip), the workpiece frame in the robot's base frame (`placement`, 4x4), the TCP
+/// orientation in the workpiece frame (`tool_orientation`, 3x3; default the tool pointing
+/// down the workpiece z), a flat end mill (`diameter` [m], `flutes`, `helix` [rad]; default
+/// the 16 mm three-flute tool of Hähn and Weigold), the material (`coefficients` as in
+/// `milling_force`), the stock block (`stock_min`, `stock_max` (x, y) [m], `stock_top` [m],
+/// `cell` [m]), and how the program is driven: sampled at `rate_hz` (default 250, the 4 ms
+/// cycle), path `acceleration` [m/s^2] and `jerk` [m/s^3], `rapid_speed` [m/s] and the
+/// `corner_angle` [rad] driven through without a stop.
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct MachiningJob {
+    inner: Job,
+}
+
+#[pymethods]
+impl MachiningJob {
+    #[new]
+    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None),
+           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295)")]
+    #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
+    fn new(
+        robot: &SerialRobot,
+        placement: &Bound<'_, PyAny>,
+        stock_min: &Bound<'_, PyAny>,
+        stock_max: &Bound<'_, PyAny>,
+        stock_top: Option<&Bound<'_, PyAny>>,
+        cell: Option<&Bound<'_, PyAny>>,
+        tool_orientation: Option<&Bound<'_, PyAny>>,
+        diameter: Option<&Bound<'_, PyAny>>,
+        flutes: Option<&Bound<'_, PyAny>>,
+        helix: Option<&Bound<'_, PyAny>>,
+        coefficients: Option<&Bound<'_, PyAny>>,
+        rate_hz: Option<&Bound<'_, PyAny>>,
+        acceleration: Option<&Bound<'_, PyAny>>,
+        jerk: Option<&Bound<'_, PyAny>>,
+        rapid_speed: Option<&Bound<'_, PyAny>>,
+        corner_angle: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        // The documented defaults (shown in the text signature).
+        let or = |o: Option<&Bound<'_, PyAny>>, what: &str, default: f64| {
+            o.map_or(Ok(default), |o| real(o, what))
+        };
+        let flutes = match flutes {
+            Some(f) => u32::try_from(count(f, "flutes")?).unwrap_or(u32::MAX),
+            None => 3,
+        };
+        let (x0, y0) = pair(stock_min, "stock_min")?;
+        let (x1, y1) = pair(stock_max, "stock_max")?;
+        let d = PathOptions::default();
+        let setup = Setup {
+            placement: pose(placement, "placement")?,
+            tool_orientation: match tool_orientation {
+                Some(r) => rotation(r, "tool_orientation")?,
+                None => Setup::tool_down(),
+            },
+            tool: Tool::new(
+                or(diameter, "diameter", 0.016)?,
+                flutes,
+                or(helix, "helix", 0.0)?,
+            )
+            .map_err(build_err)?,
+            coefficients: self::coefficients(coefficients)?,
+            stock: Stock {
+                min: Vector2::new(x0, y0),
+                max: Vector2::new(x1, y1),
+                top: or(stock_top, "stock_top", 0.0)?,
+                cell: or(cell, "cell", 5e-4)?,
+            },
+            path: PathOptions {
+                rate_hz: or(rate_hz, "rate_hz", d.rate_hz)?,
+                acceleration: or(acceleration, "acceleration", d.acceleration)?,
+                jerk: or(jerk, "jerk", d.jerk)?,
+                rapid_speed: or(rapid_speed, "rapid_speed", d.rapid_speed)?,
+                corner_angle: or(corner_angle, "corner_angle", d.corner_angle)?,
+            },
+            ik: PoseIkOptions::default(),
+        };
+        let r = &robot.inner;
+        let inner = Job::new(r.model.clone(), &r.joint_limits, setup).map_err(build_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Runs the offline pass over `program` (a `GcodeProgram`) from the joints `seed` (dof,)
+    /// near its first pose (they pick the IK branch). Raises a `DeflectError` naming the
+    /// program line where a pose is out of reach (`ConvergenceError`), singular
+    /// (`SingularError`) or off the joint limits, the spindle is off in a cut or a rapid
+    /// runs into the stock (`InputError`).
+    fn run(
+        &self,
+        py: Python<'_>,
+        program: &GcodeProgram,
+        seed: &Bound<'_, PyAny>,
+    ) -> PyResult<MachiningResult> {
+        let seed = vector(seed, "seed", self.inner.model().dof())?;
+        let program = program.inner.clone();
+        let report = py
+            .detach(|| job::run(&self.inner, &program, &seed))
+            .map_err(job_err)?;
+        Ok(MachiningResult { report, program })
+    }
+
+    fn __repr__(&self) -> String {
+        let s = self.inner.setup();
+        format!(
+            "MachiningJob(dof={}, tool={} mm x {} flutes, cell={} mm, rate_hz={})",
+            self.inner.model().dof(),
+            s.tool.diameter * 1e3,
+            s.tool.flutes,
+            s.stock.cell * 1e3,
+            s.path.rate_hz
+        )
+    }
+}
+
+/// What `MachiningJob.run` predicts: every sample (arrays, SI, workpiece frame unless said),
+/// the part three ways, and the compensated program.
+#[pyclass(module = "deflect", frozen)]
+#[derive(Debug)]
+pub struct MachiningResult {
+    report: Report,
+    program: Program,
+}
+
+impl MachiningResult {
+    fn column<'py>(
+        &self,
+        py: Python<'py>,
+        f: impl Fn(&job::JobSample) -> f64,
+    ) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.report.samples.iter().map(f)).into_pyarray(py)
+    }
+
+    fn rows<'py>(
+        &self,
+        py: Python<'py>,
+        width: usize,
+        fill: impl Fn(&job::JobSample, &mut [f64]),
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.report.samples.len();
+        let mut out = try_rows(n, width, "the samples")?;
+        for (s, o) in self.report.samples.iter().zip(out.chunks_mut(width)) {
+            fill(s, o);
+        }
+        let a = Array2::from_shape_vec((n, width), out)
+            .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
+        Ok(a.into_pyarray(py))
+    }
+
+    fn surface<'py>(&self, py: Python<'py>, z: &ZMap) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let (nx, ny) = z.shape();
+        let a = Array2::from_shape_vec((ny, nx), z.heights().to_vec())
+            .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
+        Ok(a.into_pyarray(py))
+    }
+
+    fn which(&self, part: &str) -> PyResult<&ZMap> {
+        match part {
+            "uncompensated" => Ok(&self.report.uncompensated),
+            "compensated" => Ok(&self.report.compensated),
+            other => Err(InputError::new_err(format!(
+                "part must be \"uncompensated\" or \"compensated\", got {other:?}"
+            ))),
+        }
+    }
+}
+
+#[pymethods]
+impl MachiningResult {
+    fn __len__(&self) -> usize {
+        self.report.samples.len()
+    }
+
+    /// Sample times (n,) [s].
+    #[getter]
+    fn time<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |s| s.path.time)
+    }
+
+    /// Program line of each sample (n,).
+    #[getter]
+    fn line<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
+        Array1::from_iter(self.report.samples.iter().map(|s| s.path.line as u64)).into_pyarray(py)
+    }
+
+    /// Programmed tool tip (n, 3) [m].
+    #[getter]
+    fn position<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| o.copy_from_slice(s.path.position.as_slice()))
+    }
+
+    /// Engagement (n, 3): first entry, last exit [rad] and mean depth [m]; NaN where the
+    /// tool is not side milling (air, plunge).
+    #[getter]
+    fn engagement<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| match s.contact.span() {
+            Some(a) => o.copy_from_slice(&[a.entry, a.exit, a.depth]),
+            None => o.fill(f64::NAN),
+        })
+    }
+
+    /// Feed per tooth (n,) [m].
+    #[getter]
+    fn feed_per_tooth<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |s| s.feed_per_tooth)
+    }
+
+    /// Per-revolution force on the tool from the nominal cut (n, 3) [N].
+    #[getter]
+    fn force<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| o.copy_from_slice(s.force.as_slice()))
+    }
+
+    /// Force the uncompensated tool feels where it is (n, 3) [N].
+    #[getter]
+    fn force_uncompensated<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| {
+            o.copy_from_slice(s.force_uncompensated.as_slice())
+        })
+    }
+
+    /// TCP wrench (n, 6) [N, N m], base frame, about the tool tip.
+    #[getter]
+    fn wrench<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 6, |s, o| o.copy_from_slice(s.wrench.as_slice()))
+    }
+
+    /// Deflection [dp; dr] of the tip (n, 6) [m, rad], base frame.
+    #[getter]
+    fn deflection<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 6, |s, o| o.copy_from_slice(s.deflection.as_slice()))
+    }
+
+    /// Rigid pose-IK joints of the programmed path (n, dof).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.report.dof;
+        self.rows(py, n, |s, o| o.copy_from_slice(s.q.get(..n).unwrap_or(&[])))
+    }
+
+    /// Compensated joints (n, dof): the axis-specific command.
+    #[getter]
+    fn q_commanded<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let n = self.report.dof;
+        self.rows(py, n, |s, o| {
+            o.copy_from_slice(s.q_commanded.get(..n).unwrap_or(&[]))
+        })
+    }
+
+    /// Commanded poses (n, 4, 4), workpiece frame: the Cartesian command.
+    #[getter]
+    fn commanded<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+        let n = self.report.samples.len();
+        let mut a = Array3::zeros((n, 4, 4));
+        for (i, s) in self.report.samples.iter().enumerate() {
+            put_pose(&mut a, i, &s.commanded);
+        }
+        a.into_pyarray(py)
+    }
+
+    /// Predicted tool tip without compensation (n, 3) [m].
+    #[getter]
+    fn actual_uncompensated<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| {
+            o.copy_from_slice(s.actual_uncompensated.as_slice())
+        })
+    }
+
+    /// Predicted tool tip with compensation (n, 3) [m].
+    #[getter]
+    fn actual_compensated<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| {
+            o.copy_from_slice(s.actual_compensated.as_slice())
+        })
+    }
+
+    /// The part as programmed: heights (ny, nx) [m], row j at y = origin_y + (j + 0.5) cell.
+    #[getter]
+    fn nominal_surface<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.surface(py, &self.report.nominal)
+    }
+
+    /// The part the uncompensated arm cuts, (ny, nx) [m].
+    #[getter]
+    fn uncompensated_surface<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.surface(py, &self.report.uncompensated)
+    }
+
+    /// The part the compensated arm cuts, (ny, nx) [m].
+    #[getter]
+    fn compensated_surface<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.surface(py, &self.report.compensated)
+    }
+
+    /// Lower corner (x, y) of the surfaces' cell (0, 0) [m] and the cell edge [m].
+    #[getter]
+    fn surface_grid(&self) -> ((f64, f64), f64) {
+        let z = &self.report.nominal;
+        ((z.origin().x, z.origin().y), z.cell())
+    }
+
+    /// Samples plunging into material (no side-milling force modelled there).
+    #[getter]
+    fn plunge_samples(&self) -> usize {
+        self.report.plunge_samples
+    }
+
+    /// (max, rms) [m] of the predicted tip's distance from the program over the feed moves.
+    #[pyo3(signature = (part="uncompensated"))]
+    fn path_error(&self, part: &str) -> PyResult<(f64, f64)> {
+        self.which(part)?;
+        let e = self.report.path_error(part == "compensated");
+        Ok((e.max, e.rms))
+    }
+
+    /// The predicted part against the nominal one: `floor_max`, `floor_rms` [m] over the
+    /// cells both cut (height above nominal, > 0: material left) and the walls' shift as
+    /// `material_left` and `overcut` [m^2] (areas cut by one part and not the other).
+    #[pyo3(signature = (part="uncompensated"))]
+    fn surface_error(&self, part: &str) -> PyResult<std::collections::HashMap<&'static str, f64>> {
+        let e = self.report.surface_error(self.which(part)?);
+        Ok([
+            ("floor_max", e.floor.max),
+            ("floor_rms", e.floor.rms),
+            ("material_left", e.material_left),
+            ("overcut", e.overcut),
+        ]
+        .into_iter()
+        .collect())
+    }
+
+    /// The pilot-control signal (n, 6) [N, N m], base frame: each sample's TCP wrench `lead`
+    /// [s] ahead (the annotated program of Hähn and Weigold, sec. 2.3; they used 40 ms).
+    #[pyo3(signature = (lead=0.04))]
+    fn pilot_wrenches<'py>(
+        &self,
+        py: Python<'py>,
+        lead: f64,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        if !(lead.is_finite() && lead >= 0.0) {
+            return Err(InputError::new_err(format!(
+                "lead: expected >= 0 s, got {lead}"
+            )));
+        }
+        let w = self.report.pilot_wrenches(lead);
+        let mut out = try_rows(w.len(), 6, "the pilot wrenches")?;
+        for (o, v) in out.chunks_mut(6).zip(&w) {
+            o.copy_from_slice(v.as_slice());
+        }
+        let a = Array2::from_shape_vec((w.len(), 6), out)
+            .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
+        Ok(a.into_pyarray(py))
+    }
+
+    /// The compensated program as G-code text (mm), blocks kept within `tolerance` [m] of the
+    /// commanded path.
+    #[pyo3(signature = (tolerance=1e-6))]
+    fn compensated_gcode(&self, tolerance: f64) -> PyResult<String> {
+        let t = tolerance;
+        if !(t.is_finite() && t > 0.0) {
+            return Err(InputError::new_err(format!(
+                "tolerance: expected > 0 m, got {t}"
+            )));
+        }
+        Ok(job_out::compensated_gcode(&self.report, &self.program, t))
+    }
+
+    /// Every sample as CSV text (columns in deflect-core's `io::job_out::samples_csv`), the
+    /// pilot wrench `lead` [s] ahead.
+    #[pyo3(signature = (lead=0.04))]
+    fn samples_csv(&self, lead: f64) -> PyResult<String> {
+        if !(lead.is_finite() && lead >= 0.0) {
+            return Err(InputError::new_err(format!(
+                "lead: expected >= 0 s, got {lead}"
+            )));
+        }
+        Ok(job_out::samples_csv(&self.report, lead))
+    }
+
+    fn __repr__(&self) -> String {
+        let (u, c) = (self.report.path_error(false), self.report.path_error(true));
+        format!(
+            "MachiningResult({} samples, path error max {:.3} mm uncompensated, {:.3} mm compensated)",
+            self.report.samples.len(),
+            u.max * 1e3,
+            c.max * 1e3
+        )
+    }
+}
+
+/// Adds the classes to the module.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<MachiningJob>()?;
+    m.add_class::<MachiningResult>()?;
+    Ok(())
+}

@@ -1,0 +1,128 @@
+"""The offline pass over a program from Python: the slot's force against Altintas' closed
+form (numpy), the deflection against the independent numpy VJM chain, the compensated arm on
+the program, the compensated G-code read back, and every fault naming its program line."""
+
+import math
+
+import numpy as np
+import pytest
+
+import deflect
+from conftest import KR300_POSE, REPO
+
+SLOT = "G0 X-10 Y0 Z5\nS13000 M3\nG1 Z-2 F1500\nX70\nG0 Z5\n"
+
+
+def placement_under_tcp(robot):
+    """The workpiece frame 20 mm below the TCP at the start joints, its z along the tool
+    axis reversed (the TCP points down the workpiece z)."""
+    tcp = robot.forward(KR300_POSE)
+    down = np.diag([1.0, -1.0, -1.0])  # pi about x
+    rot = tcp[:3, :3] @ down.T
+    t = np.eye(4)
+    t[:3, :3] = rot
+    t[:3, 3] = tcp[:3, 3] - rot @ [0.0, 0.0, 0.02]
+    return t
+
+
+@pytest.fixture(scope="module")
+def slot_run(kr300):
+    job = deflect.MachiningJob(
+        kr300,
+        placement_under_tcp(kr300),
+        stock_min=(0.0, -0.03),
+        stock_max=(0.08, 0.03),
+        cell=5e-4,
+    )
+    program = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
+    return job.run(program, KR300_POSE)
+
+
+def test_the_slot_force_is_the_closed_form_and_the_deflection_the_numpy_chain(slot_run, kr300_ref):
+    r = slot_run
+    ktc, krc, kac, kte, kre, kae = deflect.AL7075_T6_CARBIDE
+    n, a = 3, 0.002
+    c = 0.025 / (13000 / 60 * 3)
+    expected = np.array(
+        [
+            -n * a * krc * c / 4 - n * a * kre / math.pi,
+            n * a * ktc * c / 4 + n * a * kte / math.pi,
+            n * a * kac * c / math.pi + n * a * kae / 2,
+        ]
+    )
+    mid = np.flatnonzero((r.line == 4) & (r.position[:, 0] > 0.035))[0]
+    np.testing.assert_allclose(r.force[mid], expected, rtol=1e-9)
+    np.testing.assert_allclose(r.engagement[mid], [0.0, math.pi, 0.002], rtol=1e-12)
+    # The deflection under the job's wrench at the job's joints, by the numpy chain.
+    ref = kr300_ref.deflection(r.q[mid], r.wrench[mid])
+    np.testing.assert_allclose(r.deflection[mid], ref, rtol=1e-9, atol=1e-15)
+    # The compensated arm lands on the program; the uncompensated one is off by tenths.
+    un_max, _ = r.path_error("uncompensated")
+    co_max, _ = r.path_error("compensated")
+    assert un_max > 2e-5 and co_max < 1e-7
+    s_un = r.surface_error("uncompensated")
+    s_co = r.surface_error("compensated")
+    assert s_un["floor_max"] > 1e-5 and s_co["floor_max"] < 1e-6
+    # The uncompensated groove is pushed sideways: a wall's worth of area cut on one side
+    # and left on the other; the compensated one matches to the cell.
+    assert s_un["material_left"] > 0 and s_co["material_left"] == s_co["overcut"] == 0
+    assert r.nominal_surface.shape == (120, 160)
+    assert r.commanded.shape == (len(r), 4, 4)
+    assert r.q_commanded.shape == (len(r), 6)
+
+
+def test_the_compensated_gcode_and_pilot_signal(slot_run):
+    r = slot_run
+    text = r.compensated_gcode(1e-6)
+    back = deflect.GcodeProgram.from_text(text, start=r.commanded[0, :3, 3])
+    assert 2 < len(back) < len(r) // 10
+    # The floor of the slot is commanded deeper than programmed.
+    assert back.end[:, 2].min() < -0.002 - 1e-5
+    pilot = r.pilot_wrenches(0.04)
+    np.testing.assert_array_equal(pilot[:-10], r.wrench[10:])
+    header = r.samples_csv(0.04).splitlines()[0].split(",")
+    assert header[:3] == ["time_s", "line", "x_m"] and "pilot_fz_n" in header
+    with pytest.raises(deflect.InputError, match="lead"):
+        r.pilot_wrenches(-1.0)
+    with pytest.raises(deflect.InputError, match="tolerance"):
+        r.compensated_gcode(float("nan"))
+
+
+def test_faults_name_the_program_line(kr300):
+    job = deflect.MachiningJob(
+        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03)
+    )
+    off = deflect.GcodeProgram.from_text("G0 X-10 Y0 Z5\nG1 Z-2 F1500\nX70\n", start=[0, 0, 0.02])
+    with pytest.raises(deflect.InputError, match="program line 3 .*spindle"):
+        job.run(off, KR300_POSE)
+    far = deflect.GcodeProgram.from_text("S13000 M3\nG0 Z5\nG0 X5000\n", start=[0, 0, 0.02])
+    with pytest.raises(deflect.DeflectError, match="program line 3"):
+        job.run(far, KR300_POSE)
+    with pytest.raises(deflect.InputError, match="seed"):
+        job.run(off, KR300_POSE[:5])
+    with pytest.raises(deflect.InputError, match="tool orientation"):
+        deflect.MachiningJob(
+            kr300, np.eye(4), stock_min=(0, 0), stock_max=(1, 1), tool_orientation=np.eye(3)[[1, 2, 0]]
+        )
+    with pytest.raises(deflect.InputError, match="cell"):
+        deflect.MachiningJob(kr300, np.eye(4), stock_min=(0, 0), stock_max=(1, 1), cell=0.0).run(
+            off, KR300_POSE
+        )
+    with pytest.raises(deflect.InputError, match="placement"):
+        deflect.MachiningJob(kr300, np.full((4, 4), np.nan), stock_min=(0, 0), stock_max=(1, 1))
+
+
+def test_the_shipped_program_runs(kr300):
+    job = deflect.MachiningJob(
+        kr300,
+        placement_under_tcp(kr300),
+        stock_min=(0.005, -0.015),
+        stock_max=(0.085, 0.045),
+        cell=1e-3,
+    )
+    program = deflect.GcodeProgram.from_file(REPO / "data" / "groove_and_pocket.nc", start=[0, 0, 0.02])
+    r = job.run(program, KR300_POSE)
+    assert r.plunge_samples > 0  # the pocket's plunge
+    # File lines of N50, N60 and the circles N100-N120.
+    assert set(np.unique(r.line).tolist()) >= {7, 8, 12, 13, 14}
+    assert r.path_error("compensated")[0] < 1e-7 < r.path_error("uncompensated")[0]
