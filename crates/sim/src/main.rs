@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use commands::{atlas, contour, fit, milling, reproduce, run, serial, static_test};
+use commands::{atlas, contour, fit, job, milling, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -58,6 +58,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Atlas(a) => Some(atlas::load(a)?),
         _ => None,
     };
+    let job_task = match command {
+        Command::Job(a) => Some(job::load(a)?),
+        _ => None,
+    };
     commands::prepare_out(out)?;
     match command {
         Command::Reproduce(a) => reproduce::reproduce(a, out),
@@ -73,6 +77,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Atlas(a) => match &atlas_task {
             Some(t) => atlas::atlas_cmd(a, t, out),
             None => Err(deflect_sim::SimError::new("atlas: inputs not loaded")),
+        },
+        Command::Job(a) => match &job_task {
+            Some(t) => job::job_cmd(a, t, out),
+            None => Err(deflect_sim::SimError::new("job: inputs not loaded")),
         },
     }
     .map_err(CliError::from)

@@ -3,7 +3,7 @@
 //! ([`Range`], shown in its `--help`) and the checks of the arguments before any work
 //! ([`Command::check`]); the two kinds of errors and their exit codes ([`CliError`]). Each
 //! subcommand's arguments have their file: `parallel` (`reproduce`, `run`), `milling`,
-//! `contour`, `serial`, `atlas`.
+//! `contour`, `serial`, `atlas`, `job`.
 //!
 //! The ranges keep every accepted command within a few minutes of run time and a few hundred
 //! MB of memory. Release build, measured on 2 cores: `milling` (the 16-body KR 300) at its
@@ -55,6 +55,7 @@ impl From<SimError> for CliError {
 
 mod atlas;
 mod contour;
+mod job;
 mod milling;
 mod parallel;
 /// The ranges of the numeric flags.
@@ -63,6 +64,7 @@ mod serial;
 
 pub use atlas::AtlasArgs;
 pub use contour::ContourArgs;
+pub use job::JobArgs;
 pub use milling::MillingArgs;
 pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
 pub use range::*;
@@ -133,6 +135,13 @@ pub enum Command {
     /// atlas.npz (compressed NumPy archive, SI units) and atlas.png (heat map of the best
     /// deflection).
     Atlas(AtlasArgs),
+    /// A machining job offline (the offline half of Hähn & Weigold's hybrid compensation): a
+    /// G-code program (or tool points CSV) driven at its feeds on an arm (default: the KR 300
+    /// R2500 and data/groove_and_pocket.nc, built in), the stock cut along it, the milling
+    /// force from the engagement, the arm's deflection and the compensated joints. Writes
+    /// job_compensated.nc, job_samples.csv, job_part.png (the part's deviation, with and
+    /// without compensation) and job_summary.{txt,json}.
+    Job(JobArgs),
 }
 
 /// `n` as a `u64` (saturating; usize is 64 bits or less on every supported target).
@@ -152,6 +161,7 @@ impl Command {
             Self::Contour(a) => a.check(),
             Self::Serial(a) => a.check(),
             Self::Atlas(a) => a.check(),
+            Self::Job(a) => a.check(),
         }
     }
 }

@@ -153,3 +153,23 @@ pub const TURN: Range = Range::closed("--turn", 0.0, 3.0, "rad");
 pub const ATLAS_POINTS: Range = Range::closed("--region", 1.0, 100.0, "points per axis");
 /// `atlas --angle-step` \[deg\].
 pub const ANGLE_STEP: Range = Range::closed("--angle-step", 0.1, 90.0, "deg");
+/// `job --cell`: z-map resolution.
+pub const CELL_MM: Range = Range::closed("--cell", 0.01, 10.0, "mm");
+/// `job --diameter`: end mill diameter.
+pub const DIAMETER_MM: Range = Range::closed("--diameter", 0.1, 200.0, "mm");
+/// `job --flutes`.
+pub const FLUTES: Range = Range::closed("--flutes", 1.0, 16.0, "");
+/// `job --helix`.
+pub const HELIX_DEG: Range = Range::closed("--helix", 0.0, 60.0, "deg");
+/// `job --rate`: sampling rate of the program.
+pub const RATE_HZ: Range = Range::closed("--rate", 1.0, 10000.0, "Hz");
+/// `job --acceleration`: path acceleration limit.
+pub const PATH_ACCELERATION: Range = Range::closed("--acceleration", 0.01, 100.0, "m/s^2");
+/// `job --jerk`: path jerk limit.
+pub const PATH_JERK: Range = Range::closed("--jerk", 0.1, 10000.0, "m/s^3");
+/// `job --rapid-speed`.
+pub const RAPID_SPEED: Range = Range::closed("--rapid-speed", 0.001, 10.0, "m/s");
+/// `job --tolerance`: decimation of the compensated program.
+pub const TOLERANCE_MM: Range = Range::closed("--tolerance", 1e-5, 1.0, "mm");
+/// `job --top`: stock top.
+pub const TOP_MM: Range = Range::closed("--top", -1000.0, 1000.0, "mm");

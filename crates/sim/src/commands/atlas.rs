@@ -5,47 +5,33 @@
 use std::path::Path;
 use std::time::Instant;
 
-use deflect_core::SerialRobot;
-use deflect_core::io::urdf;
 use deflect_core::posture::Reach;
 use deflect_sim::SimError;
 use deflect_sim::jobs::progress;
 use deflect_sim::scenes::serial::atlas::{self, AtlasTask};
-use deflect_sim::urdf_arm::{KR300_Q0, KR300_STIFFNESS, KR300_URDF};
+use deflect_sim::urdf_arm::KR300_Q0;
 use nalgebra::Vector3;
 
-use super::serial::{deepest_leaf, read_text};
+use super::serial::load_robot;
 use super::stdout;
 use crate::cli::{AtlasArgs, CliError};
 
 /// Reads the robot, checks the seed, builds the task.
 pub fn load(a: &AtlasArgs) -> Result<AtlasTask, CliError> {
-    const URDF: &str = "robot URDF";
-    const STIFF: &str = "stiffness TOML (deflect's virtual-joint format)";
-    let builtin = a.urdf.is_none();
-    let (urdf_text, stiff_text) = match (&a.urdf, &a.stiffness) {
-        (Some(u), Some(s)) => (
-            read_text("--urdf", u, URDF)?,
-            read_text("--stiffness", s, STIFF)?,
-        ),
-        _ => (KR300_URDF.to_string(), KR300_STIFFNESS.to_string()),
-    };
+    let loaded = load_robot(
+        a.urdf.as_deref(),
+        a.stiffness.as_deref(),
+        a.base.as_deref(),
+        a.tip.as_deref(),
+    )?;
+    let (robot, builtin) = (loaded.robot, loaded.builtin);
     let name = a
         .urdf
         .as_ref()
         .map_or("the built-in KR 300 URDF".to_string(), |p| {
             format!("--urdf {}", p.display())
         });
-    let parsed = urdf::parse(&urdf_text)
-        .map_err(|e| CliError::Failure(format!("{name}: not a valid {URDF}: {e}")))?;
-    let tip = match (&a.tip, builtin) {
-        (Some(t), _) => t.clone(),
-        (None, true) => "tcp".to_string(),
-        (None, false) => deepest_leaf(&parsed, a.base.as_deref())
-            .map_err(|e| CliError::Usage(format!("--tip: {e}")))?,
-    };
-    let robot = SerialRobot::from_str(&urdf_text, &stiff_text, a.base.as_deref(), &tip)
-        .map_err(|e| CliError::Failure(format!("{name}, tip {tip}: {e}")))?;
+    let tip = robot.tip_link.clone();
     let dof = robot.model.dof();
     if dof < 6 {
         return Err(CliError::Usage(format!(
@@ -76,11 +62,7 @@ pub fn load(a: &AtlasArgs) -> Result<AtlasTask, CliError> {
         .collect();
     Ok(AtlasTask {
         robot,
-        name: if builtin {
-            "KR 300 R2500".to_string()
-        } else {
-            parsed.name.clone()
-        },
+        name: loaded.name,
         xs: xa.points(),
         ys: ya.points(),
         z,

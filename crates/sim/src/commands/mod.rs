@@ -30,6 +30,7 @@ pub mod atlas;
 pub mod calibrate;
 pub mod contour;
 pub mod fit;
+pub mod job;
 pub mod milling;
 pub mod reproduce;
 pub mod run;

@@ -52,6 +52,58 @@ pub(crate) fn read_text(flag: &str, path: &Path, expected: &str) -> Result<Strin
     })
 }
 
+/// A robot read for `atlas` and `job`: the chain, its name for messages, whether it is the
+/// built-in KR 300.
+pub(crate) struct LoadedRobot {
+    pub robot: deflect_core::SerialRobot,
+    pub name: String,
+    pub builtin: bool,
+}
+
+/// Reads `--urdf`/`--stiffness` (default: the built-in KR 300) and builds the chain from
+/// `--base` to `--tip` (default "tcp" on the KR 300, else the URDF's deepest leaf); every
+/// error names the flag or the file.
+pub(crate) fn load_robot(
+    urdf_path: Option<&Path>,
+    stiffness_path: Option<&Path>,
+    base: Option<&str>,
+    tip: Option<&str>,
+) -> Result<LoadedRobot, CliError> {
+    const URDF: &str = "robot URDF";
+    const STIFF: &str = "stiffness TOML (deflect's virtual-joint format)";
+    let builtin = urdf_path.is_none();
+    let (urdf_text, stiff_text) = match (urdf_path, stiffness_path) {
+        (Some(u), Some(s)) => (
+            read_text("--urdf", u, URDF)?,
+            read_text("--stiffness", s, STIFF)?,
+        ),
+        _ => (KR300_URDF.to_string(), KR300_STIFFNESS.to_string()),
+    };
+    let name = urdf_path.map_or("the built-in KR 300 URDF".to_string(), |p| {
+        format!("--urdf {}", p.display())
+    });
+    let parsed = urdf::parse(&urdf_text)
+        .map_err(|e| CliError::Failure(format!("{name}: not a valid {URDF}: {e}")))?;
+    let tip = match (tip, builtin) {
+        (Some(t), _) => t.to_string(),
+        (None, true) => "tcp".to_string(),
+        (None, false) => {
+            deepest_leaf(&parsed, base).map_err(|e| CliError::Usage(format!("--tip: {e}")))?
+        }
+    };
+    let robot = deflect_core::SerialRobot::from_str(&urdf_text, &stiff_text, base, &tip)
+        .map_err(|e| CliError::Failure(format!("{name}, tip {tip}: {e}")))?;
+    Ok(LoadedRobot {
+        robot,
+        name: if builtin {
+            "KR 300 R2500".to_string()
+        } else {
+            parsed.name.clone()
+        },
+        builtin,
+    })
+}
+
 /// The deepest leaf link of the URDF (the default tip); an error naming the candidates if two
 /// are equally deep.
 pub(crate) fn deepest_leaf(robot: &urdf_rs::Robot, base: Option<&str>) -> Result<String, String> {

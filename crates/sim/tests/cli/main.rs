@@ -111,4 +111,5 @@ fn out_of_range(dir: &Path, args: &[&str], flag: &str, value: &str, range: &str)
 mod atlas;
 mod files;
 mod flags;
+mod job;
 mod serial;

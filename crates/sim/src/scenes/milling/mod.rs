@@ -19,11 +19,13 @@
 //!   correction after a transport delay and a first-order servo lag. The compensator uses the
 //!   identified values.
 //! * [`output`]: summary table, CSV, JSON, MCAP log and plots.
+//! * [`part_map`]: the machined part against the nominal one as a heat map (Fig. 10-13).
 
 pub mod arm;
 pub mod identification;
 pub mod options;
 pub mod output;
+pub mod part_map;
 pub mod run;
 pub mod sensor;
 

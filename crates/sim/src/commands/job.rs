@@ -1,0 +1,299 @@
+//! `job`: a machining job offline (deflect-core's `machining::job`) on the built-in KR 300 or
+//! the user's arm. [`load`] reads and checks the program, the arm, the placement and the
+//! stock before any work; [`job_cmd`] runs the pass, prints the summary and writes the
+//! compensated program, the samples, the part's heat map and the summary files.
+
+use std::fmt::Write as _;
+use std::path::Path;
+use std::time::Instant;
+
+use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::io::{job_out, points_csv};
+use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::job::{self, Job, Report, Setup, Stock};
+use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::{Motion, Program};
+use deflect_core::mechanism::PoseIkOptions;
+use deflect_core::units::LengthUnit;
+use deflect_sim::SimError;
+use deflect_sim::scenes::milling::part_map;
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
+
+use super::serial::{load_robot, read_text};
+use super::stdout;
+use crate::cli::{CliError, JobArgs};
+
+/// The built-in program: a groove, a ramp and a circular pocket (mm).
+const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.nc");
+/// The KR 300's defaults: the tool down over a table in front of it.
+const KR300_PLACEMENT: [f64; 6] = [2.45, 0.02, 0.92, 0.0, 0.0, std::f64::consts::PI];
+const KR300_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+/// Where the tool is before the program's first move, workpiece frame \[m\].
+const START: [f64; 3] = [0.0, 0.0, 0.02];
+
+/// Everything `job` needs, read and checked.
+pub struct JobTask {
+    job: Job,
+    program: Program,
+    program_name: String,
+    robot_name: String,
+    seed: Vec<f64>,
+}
+
+/// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
+fn default_stock(program: &Program, radius: f64) -> Option<(Vector2<f64>, Vector2<f64>)> {
+    let mut lo = Vector2::repeat(f64::INFINITY);
+    let mut hi = Vector2::repeat(f64::NEG_INFINITY);
+    for m in program.moves.iter().filter(|m| m.motion != Motion::Rapid) {
+        let r = m.radius();
+        for p in [m.start.xy(), m.end.xy()] {
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+        if let Motion::Arc { center, .. } = m.motion {
+            lo = lo.inf(&(center - Vector2::repeat(r)));
+            hi = hi.sup(&(center + Vector2::repeat(r)));
+        }
+    }
+    (lo.x.is_finite() && hi.x.is_finite())
+        .then(|| (lo - Vector2::repeat(radius), hi + Vector2::repeat(radius)))
+}
+
+/// Reads the program and the arm, checks the seed and the placement, builds the job.
+pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
+    let options = GcodeOptions {
+        start: Vector3::from(START),
+        units: LengthUnit::Millimetre,
+    };
+    let (program, program_name) = match (&a.program, &a.points) {
+        (Some(p), _) => {
+            let text = read_text("--program", p, "G-code program")?;
+            let program = gcode::from_str(&text, &options)
+                .map_err(|e| CliError::Failure(format!("--program {}: {e}", p.display())))?;
+            (program, p.display().to_string())
+        }
+        (None, Some(p)) => {
+            let text = read_text("--points", p, "tool points CSV")?;
+            let program = points_csv::from_str(&text, &options)
+                .map_err(|e| CliError::Failure(format!("--points {}: {e}", p.display())))?;
+            (program, p.display().to_string())
+        }
+        (None, None) => (
+            gcode::from_str(DEFAULT_PROGRAM, &options)
+                .map_err(|e| CliError::Failure(format!("built-in program: {e}")))?,
+            "data/groove_and_pocket.nc (built in)".to_string(),
+        ),
+    };
+    let loaded = load_robot(
+        a.urdf.as_deref(),
+        a.stiffness.as_deref(),
+        a.base.as_deref(),
+        a.tip.as_deref(),
+    )?;
+    let robot = loaded.robot;
+    let dof = robot.model.dof();
+    let seed = match (&a.seed, loaded.builtin) {
+        (Some(q), _) => q.clone(),
+        (None, _) => KR300_SEED.to_vec(),
+    };
+    if seed.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--seed: {} values; expected {dof}, one per joint of {}",
+            seed.len(),
+            loaded.name
+        )));
+    }
+    let p = a.placement.clone().unwrap_or(KR300_PLACEMENT.to_vec());
+    let [x, y, z, roll, pitch, yaw] = p.as_slice() else {
+        return Err(CliError::Usage(format!(
+            "--placement: {} values; expected 6",
+            p.len()
+        )));
+    };
+    let placement = Isometry3::from_parts(
+        Translation3::new(*x, *y, *z),
+        UnitQuaternion::from_euler_angles(*roll, *pitch, *yaw),
+    );
+    let radius = 0.5e-3 * a.diameter;
+    let (min, max) = match &a.stock {
+        Some(s) => match s.as_slice() {
+            [x0, y0, x1, y1] => (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3),
+            _ => return Err(CliError::Usage("--stock: expected 4 values".into())),
+        },
+        None => default_stock(&program, radius).ok_or_else(|| {
+            CliError::Failure(format!(
+                "{program_name}: no feed move (G1-G3) to size the stock from; give --stock"
+            ))
+        })?,
+    };
+    let coefficients = match &a.coefficients {
+        Some(c) => match c.as_slice() {
+            [tc, rc, ac, te, re, ae] => {
+                Coefficients::new(tc * 1e6, rc * 1e6, ac * 1e6, te * 1e3, re * 1e3, ae * 1e3)
+                    .map_err(|e| CliError::Usage(format!("--coefficients: {e}")))?
+            }
+            _ => return Err(CliError::Usage("--coefficients: expected 6 values".into())),
+        },
+        None => Coefficients::AL7075_T6_CARBIDE,
+    };
+    let setup = Setup {
+        placement,
+        tool_orientation: Setup::tool_down(),
+        tool: Tool::new(a.diameter * 1e-3, a.flutes, a.helix.to_radians())
+            .map_err(|e| CliError::Usage(format!("--diameter/--flutes/--helix: {e}")))?,
+        coefficients,
+        stock: Stock {
+            min,
+            max,
+            top: a.top * 1e-3,
+            cell: a.cell * 1e-3,
+        },
+        path: PathOptions {
+            rate_hz: a.rate,
+            acceleration: a.acceleration,
+            jerk: a.jerk,
+            rapid_speed: a.rapid_speed,
+            ..PathOptions::default()
+        },
+        ik: PoseIkOptions::default(),
+    };
+    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
+        .map_err(|e| CliError::Usage(format!("--stock/--cell and the job's settings: {e}")))?;
+    Ok(JobTask {
+        job,
+        program,
+        program_name,
+        robot_name: loaded.name,
+        seed,
+    })
+}
+
+/// The summary as text lines and JSON.
+fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
+    let (pu, pc) = (r.path_error(false), r.path_error(true));
+    let (su, sc) = (
+        r.surface_error(&r.uncompensated),
+        r.surface_error(&r.compensated),
+    );
+    let duration = r.samples.last().map_or(0.0, |s| s.path.time);
+    let fmax = r.samples.iter().map(|s| s.force.norm()).fold(0.0, f64::max);
+    let mut text = String::new();
+    let _ = writeln!(
+        text,
+        "job: {} on {}: {} samples at {} Hz over {duration:.2} s of program, in {wall:.2} s \
+         ({:.0} samples/s, {:.0} z-map cell updates/s); {} plunge samples (no side force)",
+        t.program_name,
+        t.robot_name,
+        r.samples.len(),
+        r.rate_hz,
+        r.samples.len() as f64 / wall.max(1e-9),
+        r.cell_updates as f64 / wall.max(1e-9),
+        r.plunge_samples
+    );
+    let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
+    let _ = writeln!(text, "line  samples  mean |F| [N]  max |F| [N]");
+    let lines = r.line_forces();
+    for l in lines.iter().filter(|l| l.max > 0.0) {
+        let _ = writeln!(
+            text,
+            "{:>4}  {:>7}  {:>12.1}  {:>11.1}",
+            l.line,
+            l.samples,
+            l.mean.norm(),
+            l.max
+        );
+    }
+    for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
+        let _ = writeln!(
+            text,
+            "{label:<13}  path error max {:.4} mm, RMS {:.4} mm; part floors max {:.4} mm, \
+             RMS {:.4} mm; walls {:.1} mm^2 left, {:.1} mm^2 overcut",
+            p.max * 1e3,
+            p.rms * 1e3,
+            s.floor.max * 1e3,
+            s.floor.rms * 1e3,
+            s.material_left * 1e6,
+            s.overcut * 1e6
+        );
+    }
+    let stats = |p: job::ErrorStats, s: job::SurfaceError| {
+        serde_json::json!({
+            "path_error_max_m": p.max, "path_error_rms_m": p.rms,
+            "floor_error_max_m": s.floor.max, "floor_error_rms_m": s.floor.rms,
+            "material_left_m2": s.material_left, "overcut_m2": s.overcut,
+        })
+    };
+    let json = serde_json::json!({
+        "program": t.program_name,
+        "robot": t.robot_name,
+        "samples": r.samples.len(),
+        "rate_hz": r.rate_hz,
+        "duration_s": duration,
+        "wall_time_s": wall,
+        "cell_updates": r.cell_updates,
+        "plunge_samples": r.plunge_samples,
+        "max_force_n": fmax,
+        "lines": lines.iter().map(|l| serde_json::json!({
+            "line": l.line, "samples": l.samples,
+            "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
+        })).collect::<Vec<_>>(),
+        "uncompensated": stats(pu, su),
+        "compensated": stats(pc, sc),
+    });
+    (text, json)
+}
+
+/// Runs the pass and writes its files.
+pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
+    let started = Instant::now();
+    let r = job::run(&t.job, &t.program, &t.seed)
+        .map_err(|e| SimError::new(format!("{}: {e}", t.program_name)))?;
+    let wall = started.elapsed().as_secs_f64();
+    let write = |name: &str, text: &str| {
+        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
+    };
+    write(
+        "job_compensated.nc",
+        &job_out::compensated_gcode(&r, &t.program, a.tolerance * 1e-3),
+    )?;
+    write(
+        "job_samples.csv",
+        &job_out::samples_csv(&r, a.lead_ms * 1e-3),
+    )?;
+    let png = out.join("job_part.png");
+    let label = |name: &str, part| {
+        let s = r.surface_error(part);
+        format!(
+            "{name}: floors max {:.3} mm, RMS {:.3} mm; walls {:.0} mm^2 left, {:.0} overcut",
+            s.floor.max * 1e3,
+            s.floor.rms * 1e3,
+            s.material_left * 1e6,
+            s.overcut * 1e6
+        )
+    };
+    let (lu, lc) = (
+        label("uncompensated", &r.uncompensated),
+        label("compensated offline", &r.compensated),
+    );
+    part_map::plot_part_deviation(
+        &png,
+        &format!(
+            "{} on {}: the part's height above the nominal one",
+            t.program_name, t.robot_name
+        ),
+        &r.nominal,
+        &[(&lu, &r.uncompensated), (&lc, &r.compensated)],
+        t.job.setup().stock.top,
+    )?;
+    let (text, json) = summary(t, &r, wall);
+    write("job_summary.txt", &text)?;
+    write(
+        "job_summary.json",
+        &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
+    )?;
+    stdout(format_args!(
+        "{text}outputs: {}/job_compensated.nc, job_samples.csv, job_part.png, \
+         job_summary.{{txt,json}}\n",
+        out.display()
+    ))
+}
