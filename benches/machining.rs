@@ -55,7 +55,10 @@ fn bench(c: &mut Criterion) {
         let mut z = ZMap::new(stock.min, stock.max, stock.top, stock.cell).unwrap();
         let mut cells = 0usize;
         for w in samples.windows(2) {
-            cells += z.cut(&cutter, &w[0].position, &w[1].position).unwrap().cells;
+            cells += z
+                .cut(&cutter, &w[0].position, &w[1].position)
+                .unwrap()
+                .cells;
         }
         cells
     };

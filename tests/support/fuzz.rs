@@ -350,7 +350,8 @@ pub fn kr300_robot() -> &'static SerialRobot {
 /// Target `gcode`: a G-code program read in mm from the origin and in inch from an offset
 /// start. Whatever reads is a continuous path of finite moves: each starts where the one
 /// before ended, arcs have a radius > 0 and a sweep in (0, 2 pi], `point(0)` and `point(1)`
-/// are the ends, feeds are finite (0 for rapids, > 0 otherwise).
+/// are the ends, feeds are finite (0 for rapids, > 0 otherwise), and `Program::validate`
+/// agrees.
 pub fn gcode(data: &[u8]) -> bool {
     let text = String::from_utf8_lossy(data);
     let mut loaded = false;
@@ -398,6 +399,10 @@ pub fn gcode(data: &[u8]) -> bool {
                 "line {}",
                 m.line
             );
+        }
+        // Whatever the reader accepts, the program's own check accepts.
+        if let Err(e) = program.validate() {
+            panic!("the reader's program fails Program::validate: {e}");
         }
         loaded |= !program.moves.is_empty();
     }

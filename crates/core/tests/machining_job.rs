@@ -372,3 +372,55 @@ fn a_points_csv_is_a_program_of_straight_moves_in_its_units() {
         assert!(e.contains(needle), "{e}");
     }
 }
+
+#[test]
+fn a_hand_built_program_is_checked_like_a_read_one() {
+    use deflect_core::machining::{Motion, Move, Program};
+    let line = |start: Vector3<f64>, end: Vector3<f64>| Move {
+        line: 1,
+        motion: Motion::Linear,
+        start,
+        end,
+        feed: 0.01,
+        spindle: 100.0,
+    };
+    let (a, b, c) = (
+        Vector3::zeros(),
+        Vector3::new(0.01, 0.0, 0.0),
+        Vector3::new(0.01, 0.01, 0.0),
+    );
+    let ok = Program {
+        moves: vec![line(a, b), line(b, c)],
+    };
+    ok.validate().unwrap();
+    let text = |p: &Program| p.validate().unwrap_err().to_string();
+    // A gap between moves, a negative feed, a NaN point, an arc that does not end where its
+    // sweep takes it: each names the move.
+    let mut gap = ok.clone();
+    gap.moves[1].start.x += 1e-6;
+    assert!(
+        text(&gap).contains("MAX_GAP") && text(&gap).contains("1"),
+        "{}",
+        text(&gap)
+    );
+    let mut feed = ok.clone();
+    feed.moves[0].feed = -1.0;
+    assert!(text(&feed).contains("feed"), "{}", text(&feed));
+    let mut nan = ok.clone();
+    nan.moves[1].end.y = f64::NAN;
+    assert!(text(&nan).contains("finite"), "{}", text(&nan));
+    let mut arc = ok.clone();
+    arc.moves[1].motion = Motion::Arc {
+        center: Vector2::new(0.01, 0.005),
+        sweep: PI / 2.0,
+    };
+    assert!(text(&arc).contains("ARC_TOLERANCE"), "{}", text(&arc));
+    // A half turn about the chord's midpoint is consistent.
+    arc.moves[1].motion = Motion::Arc {
+        center: Vector2::new(0.01, 0.005),
+        sweep: PI,
+    };
+    arc.validate().unwrap();
+    // The path refuses what validate refuses.
+    assert!(path::sample(&gap, &PathOptions::default()).is_err());
+}

@@ -3,8 +3,9 @@
 //! `machining::cutting`). Everything SI: m, m/s, rev/s, N.
 
 use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::io::points_csv;
 use deflect_core::machining::cutting::{self, Coefficients, Engagement, MAX_DISCS, Tool};
-use deflect_core::machining::{Motion, Program};
+use deflect_core::machining::{Motion, Move, Program};
 use deflect_core::motion::MAX_SAMPLES;
 use deflect_core::units::LengthUnit;
 use nalgebra::Vector3;
@@ -16,6 +17,10 @@ use crate::InputError;
 use crate::arrays::{try_rows, vector, vector_upto};
 use crate::errors::{build_err, load_err, tick_err};
 use crate::scalars::{count, real};
+
+/// One move as pickled: line, kind (0 rapid, 1 linear, 2 arc), start, end, arc centre (NaN
+/// for straight moves), sweep, feed, spindle.
+type MoveState = (usize, u8, [f64; 3], [f64; 3], [f64; 2], f64, f64, f64);
 
 /// A machining program read from ISO G-code: its moves as arrays, SI, workpiece frame.
 /// Supported: G0-G3 in G17 (arcs by I/J or R), G20/G21 (before the first length; mm
@@ -68,6 +73,98 @@ impl GcodeProgram {
         let o = options(start, units)?;
         let inner = gcode::from_str(text, &o).map_err(load_err)?;
         Ok(Self { inner })
+    }
+
+    /// Reads a tool points CSV file: one straight move per row from the previous point (the
+    /// first from `start`), columns `x_mm,y_mm,z_mm` (or `x_m,y_m,z_m`), `feed_mm_min` (or
+    /// `feed_m_s`; 0 for a rapid move) and `spindle_rpm`. `LoadError` naming the row.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, start=None))]
+    fn from_points_file(
+        path: std::path::PathBuf,
+        start: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
+        let o = options(start, "mm")?;
+        let inner = points_csv::from_path(&path, &o).map_err(load_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Same as `from_points_file`, from the CSV text.
+    #[staticmethod]
+    #[pyo3(signature = (text, *, start=None))]
+    fn from_points_text(text: &str, start: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+        let o = options(start, "mm")?;
+        let inner = points_csv::from_str(text, &o).map_err(load_err)?;
+        Ok(Self { inner })
+    }
+
+    /// Pickling and copy.deepcopy: the moves as plain values, rebuilt bit for bit and
+    /// checked (`Program::validate`).
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Vec<MoveState>,))> {
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        let state = slf
+            .get()
+            .inner
+            .moves
+            .iter()
+            .map(|m| {
+                let (kind, center, sweep) = match m.motion {
+                    Motion::Rapid => (0u8, [f64::NAN; 2], 0.0),
+                    Motion::Linear => (1, [f64::NAN; 2], 0.0),
+                    Motion::Arc { center, sweep } => (2, [center.x, center.y], sweep),
+                };
+                (
+                    m.line,
+                    kind,
+                    [m.start.x, m.start.y, m.start.z],
+                    [m.end.x, m.end.y, m.end.z],
+                    center,
+                    sweep,
+                    m.feed,
+                    m.spindle,
+                )
+            })
+            .collect();
+        Ok((rebuild, (state,)))
+    }
+
+    /// The program of a pickled state (see `__reduce__`), checked.
+    #[staticmethod]
+    fn _from_state(state: Vec<MoveState>) -> PyResult<Self> {
+        let moves = state
+            .into_iter()
+            .enumerate()
+            .map(|(i, (line, kind, start, end, center, sweep, feed, spindle))| {
+                let motion = match kind {
+                    0 => Motion::Rapid,
+                    1 => Motion::Linear,
+                    2 => Motion::Arc {
+                        center: nalgebra::Vector2::new(center[0], center[1]),
+                        sweep,
+                    },
+                    k => {
+                        return Err(InputError::new_err(format!(
+                            "pickled program, move {i}: kind {k}; expected 0 (rapid), 1 (linear) or 2 (arc)"
+                        )));
+                    }
+                };
+                Ok(Move {
+                    line,
+                    motion,
+                    start: Vector3::from(start),
+                    end: Vector3::from(end),
+                    feed,
+                    spindle,
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let inner = Program { moves };
+        inner.validate().map_err(build_err)?;
+        Ok(Self { inner })
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner == other.inner
     }
 
     fn __len__(&self) -> usize {

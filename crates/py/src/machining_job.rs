@@ -5,12 +5,13 @@
 
 use deflect_core::io::job_out;
 use deflect_core::machining::Program;
+use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::job::{self, Job, Report, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::stock::ZMap;
 use deflect_core::mechanism::PoseIkOptions;
-use nalgebra::Vector2;
+use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector2, Vector3};
 use numpy::ndarray::{Array1, Array2, Array3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
@@ -35,6 +36,46 @@ use crate::vjm::SerialRobot;
 #[derive(Debug)]
 pub struct MachiningJob {
     inner: Job,
+    /// The arm, kept for pickling.
+    robot: Py<SerialRobot>,
+}
+
+/// A job as pickled: the robot, the placement (translation, quaternion i j k w), the tool
+/// orientation (quaternion), the stock (min x, min y, max x, max y, top, cell), the tool
+/// (diameter, flutes, helix), the coefficients and the path options (rate, acceleration,
+/// jerk, rapid speed, corner angle).
+type JobState = (
+    Py<SerialRobot>,
+    [f64; 3],
+    [f64; 4],
+    [f64; 4],
+    [f64; 6],
+    (f64, u32, f64),
+    [f64; 6],
+    [f64; 5],
+);
+
+/// A unit quaternion from pickled coordinates, bit for bit (norm checked to 1e-12).
+fn unit(q: [f64; 4], what: &str) -> PyResult<UnitQuaternion<f64>> {
+    let q = Quaternion::new(q[3], q[0], q[1], q[2]);
+    let n = q.norm();
+    if (n - 1.0).abs() <= 1e-12 {
+        Ok(UnitQuaternion::new_unchecked(q))
+    } else {
+        Err(InputError::new_err(format!(
+            "pickled {what}: a unit quaternion expected, norm {n}"
+        )))
+    }
+}
+
+impl MachiningJob {
+    fn build(robot: Py<SerialRobot>, setup: Setup) -> PyResult<Self> {
+        let inner = {
+            let r = &robot.get().inner;
+            Job::new(r.model.clone(), &r.joint_limits, setup).map_err(build_err)?
+        };
+        Ok(Self { inner, robot })
+    }
 }
 
 #[pymethods]
@@ -44,7 +85,7 @@ impl MachiningJob {
            text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295)")]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
-        robot: &SerialRobot,
+        robot: Bound<'_, SerialRobot>,
         placement: &Bound<'_, PyAny>,
         stock_min: &Bound<'_, PyAny>,
         stock_max: &Bound<'_, PyAny>,
@@ -100,9 +141,77 @@ impl MachiningJob {
             },
             ik: PoseIkOptions::default(),
         };
-        let r = &robot.inner;
-        let inner = Job::new(r.model.clone(), &r.joint_limits, setup).map_err(build_err)?;
-        Ok(Self { inner })
+        Self::build(robot.unbind(), setup)
+    }
+
+    /// Pickling and copy.deepcopy: the robot and the setup as plain values, rebuilt bit for
+    /// bit and validated again.
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (JobState,))> {
+        let py = slf.py();
+        let rebuild = slf.get_type().getattr("_from_state")?;
+        let me = slf.get();
+        let s = me.inner.setup();
+        let c = &s.coefficients;
+        let q = |r: &UnitQuaternion<f64>| [r.i, r.j, r.k, r.w];
+        let state = (
+            me.robot.clone_ref(py),
+            s.placement.translation.vector.into(),
+            q(&s.placement.rotation),
+            q(&s.tool_orientation),
+            [
+                s.stock.min.x,
+                s.stock.min.y,
+                s.stock.max.x,
+                s.stock.max.y,
+                s.stock.top,
+                s.stock.cell,
+            ],
+            (s.tool.diameter, s.tool.flutes, s.tool.helix),
+            [c.k_tc, c.k_rc, c.k_ac, c.k_te, c.k_re, c.k_ae],
+            [
+                s.path.rate_hz,
+                s.path.acceleration,
+                s.path.jerk,
+                s.path.rapid_speed,
+                s.path.corner_angle,
+            ],
+        );
+        Ok((rebuild, (state,)))
+    }
+
+    /// The job of a pickled state (see `__reduce__`).
+    #[staticmethod]
+    fn _from_state(state: JobState) -> PyResult<Self> {
+        let (robot, t, pq, tq, st, (d, flutes, helix), k, p) = state;
+        let setup = Setup {
+            placement: Isometry3::from_parts(
+                Translation3::from(Vector3::from(t)),
+                unit(pq, "placement")?,
+            ),
+            tool_orientation: unit(tq, "tool orientation")?,
+            tool: Tool::new(d, flutes, helix).map_err(build_err)?,
+            coefficients: Coefficients::new(k[0], k[1], k[2], k[3], k[4], k[5])
+                .map_err(build_err)?,
+            stock: Stock {
+                min: Vector2::new(st[0], st[1]),
+                max: Vector2::new(st[2], st[3]),
+                top: st[4],
+                cell: st[5],
+            },
+            path: PathOptions {
+                rate_hz: p[0],
+                acceleration: p[1],
+                jerk: p[2],
+                rapid_speed: p[3],
+                corner_angle: p[4],
+            },
+            ik: PoseIkOptions::default(),
+        };
+        Self::build(robot, setup)
+    }
+
+    fn __eq__(&self, other: &Self) -> bool {
+        self.inner.setup() == other.inner.setup() && self.inner.model() == other.inner.model()
     }
 
     /// Runs the offline pass over `program` (a `GcodeProgram`) from the joints `seed` (dof,)

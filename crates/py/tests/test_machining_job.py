@@ -126,3 +126,41 @@ def test_the_shipped_program_runs(kr300):
     # File lines of N50, N60 and the circles N100-N120.
     assert set(np.unique(r.line).tolist()) >= {7, 8, 12, 13, 14}
     assert r.path_error("compensated")[0] < 1e-7 < r.path_error("uncompensated")[0]
+
+
+def test_programs_and_jobs_pickle_bit_for_bit(kr300):
+    import copy
+    import pickle
+
+    program = deflect.GcodeProgram.from_file(REPO / "data" / "groove_and_pocket.nc", start=[0, 0, 0.02])
+    back = pickle.loads(pickle.dumps(program))
+    assert back == program and len(back) == len(program)
+    np.testing.assert_array_equal(back.end, program.end)
+    np.testing.assert_array_equal(back.center, program.center)
+    job = deflect.MachiningJob(
+        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), helix=0.3
+    )
+    again = pickle.loads(pickle.dumps(job))
+    assert again == job and copy.deepcopy(job) == job
+    slot = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
+    np.testing.assert_array_equal(again.run(slot, KR300_POSE).q_commanded, job.run(slot, KR300_POSE).q_commanded)
+    # A tampered state is checked like any program: a gap between moves.
+    fn, (state,) = program.__reduce__()
+    state[3] = (state[3][0], state[3][1], (1.0, 1.0, 1.0), *state[3][3:])
+    with pytest.raises(deflect.InputError, match="MAX_GAP"):
+        fn(state)
+
+
+def test_a_points_csv_program_runs_like_its_gcode_twin(kr300):
+    job = deflect.MachiningJob(
+        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03)
+    )
+    points = deflect.GcodeProgram.from_points_text(
+        "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n-10,0,5,0,13000\n-10,0,-2,1500,13000\n70,0,-2,1500,13000\n",
+        start=[0.0, 0.0, 0.02],
+    )
+    gcode = deflect.GcodeProgram.from_text("S13000 M3\nG0 X-10 Y0 Z5\nG1 Z-2 F1500\nX70\n", start=[0.0, 0.0, 0.02])
+    a, b = job.run(points, KR300_POSE), job.run(gcode, KR300_POSE)
+    np.testing.assert_array_equal(a.force, b.force)
+    with pytest.raises(deflect.LoadError, match="spindle_rpm"):
+        deflect.GcodeProgram.from_points_text("x_mm,y_mm,z_mm,feed_mm_min\n0,0,0,1\n")

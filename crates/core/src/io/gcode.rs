@@ -38,19 +38,9 @@ use crate::units::LengthUnit;
 /// [`super::MAX_FILE_BYTES`] for typical lines anyway); refused before parsing.
 pub const MAX_PROGRAM_LINES: usize = 1_000_000;
 
-/// Largest coordinate, radius or offset \[m\] (1 km): a robot cell is metres.
-pub const MAX_COORDINATE: f64 = 1.0e3;
-
-/// Largest feed \[m/s\] (100 m/s = 6,000,000 mm/min).
-pub const MAX_FEED: f64 = 100.0;
-
-/// Largest spindle speed \[rpm\].
-pub const MAX_SPINDLE_RPM: f64 = 1.0e6;
-
-/// Tolerance on an `I`/`J` arc whose end is not exactly on the circle through its start: the
-/// radii may differ by 0.002 mm or 0.1 % of the radius, whichever is larger (LinuxCNC's
-/// rule); more is an error, not a silently moved centre.
-pub const ARC_TOLERANCE: (f64, f64) = (2.0e-6, 1.0e-3);
+// The limits every program holds, whatever its source (checked again by
+// `Program::validate`).
+pub use crate::machining::{ARC_TOLERANCE, MAX_COORDINATE, MAX_FEED, MAX_SPINDLE_RPM};
 
 /// Settings of the reader.
 #[derive(Debug, Clone, Copy, PartialEq)]

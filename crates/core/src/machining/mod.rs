@@ -21,4 +21,7 @@ mod program;
 pub mod stock;
 
 #[cfg(feature = "alloc")]
-pub use program::{MAX_MOVES, Motion, Move, Program};
+pub use program::{
+    ARC_TOLERANCE, MAX_COORDINATE, MAX_FEED, MAX_GAP, MAX_MOVES, MAX_SPINDLE_RPM, Motion, Move,
+    Program,
+};

@@ -134,6 +134,7 @@ impl Plan {
 
 fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
     options.validate()?;
+    program.validate()?;
     let cos_corner = ComplexField::cos(options.corner_angle);
     let mut p = Plan {
         segs: Vec::new(),

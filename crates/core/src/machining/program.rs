@@ -6,9 +6,29 @@ use alloc::vec::Vec;
 
 use nalgebra::{ComplexField, Vector2, Vector3};
 
+use crate::error::BuildError;
+
 /// Most moves one program holds: 500,000 (a finishing program of a large part; about 60 MB).
 /// The reader refuses a longer program with [`crate::LoadError::TooLarge`].
 pub const MAX_MOVES: usize = 500_000;
+
+/// Largest coordinate, radius or offset \[m\] (1 km): a robot cell is metres.
+pub const MAX_COORDINATE: f64 = 1.0e3;
+
+/// Largest feed \[m/s\] (100 m/s = 6,000,000 mm/min).
+pub const MAX_FEED: f64 = 100.0;
+
+/// Largest spindle speed \[rpm\].
+pub const MAX_SPINDLE_RPM: f64 = 1.0e6;
+
+/// Tolerance on an `I`/`J` arc whose end is not exactly on the circle through its start: the
+/// radii may differ by 0.002 mm or 0.1 % of the radius, whichever is larger (LinuxCNC's
+/// rule); more is an error, not a silently moved centre.
+pub const ARC_TOLERANCE: (f64, f64) = (2.0e-6, 1.0e-3);
+
+/// Largest gap between a move's start and the previous move's end \[m\] that
+/// [`Program::validate`] accepts (a program is one path).
+pub const MAX_GAP: f64 = 1.0e-9;
 
 /// How a move goes from its start to its end.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -114,6 +134,99 @@ pub struct Program {
 }
 
 impl Program {
+    /// Checks a program however it was made (read, built by hand, unpickled): at most
+    /// [`MAX_MOVES`] moves, lines >= 1, points finite within [`MAX_COORDINATE`], each move
+    /// starting where the one before ends (within [`MAX_GAP`]), feeds in `[0, MAX_FEED]`,
+    /// spindle speeds in `[0, MAX_SPINDLE_RPM / 60]` rev/s, arcs with `0 < |sweep| <= 2 pi`
+    /// whose end lies where the sweep takes the start (within [`ARC_TOLERANCE`]).
+    /// [`BuildError::InvalidEntry`] naming the move (its index) and what is wrong.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        if self.moves.len() > MAX_MOVES {
+            return Err(BuildError::Budget {
+                what: "program moves",
+                budget: "MAX_MOVES",
+                limit: MAX_MOVES,
+                requested: self.moves.len(),
+            });
+        }
+        let bad = |index: usize, value: f64, expected: &'static str| {
+            Err(BuildError::InvalidEntry {
+                what: "program moves (index: the move)",
+                index,
+                value,
+                expected,
+            })
+        };
+        let mut previous: Option<Vector3<f64>> = None;
+        for (i, m) in self.moves.iter().enumerate() {
+            if m.line == 0 {
+                return bad(i, 0.0, "a program line >= 1");
+            }
+            if let Some(v) = m
+                .start
+                .iter()
+                .chain(m.end.iter())
+                .find(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
+            {
+                return bad(
+                    i,
+                    *v,
+                    "start and end finite, within +-MAX_COORDINATE (1000 m)",
+                );
+            }
+            if let Some(p) = previous {
+                let gap = (m.start - p).norm();
+                if gap > MAX_GAP {
+                    return bad(
+                        i,
+                        gap,
+                        "a start within MAX_GAP (1e-9 m) of the previous end",
+                    );
+                }
+            }
+            previous = Some(m.end);
+            if !(0.0..=MAX_FEED).contains(&m.feed) {
+                return bad(i, m.feed, "a feed in [0, MAX_FEED] m/s");
+            }
+            if !(0.0..=MAX_SPINDLE_RPM / 60.0).contains(&m.spindle) {
+                return bad(
+                    i,
+                    m.spindle,
+                    "a spindle speed in [0, MAX_SPINDLE_RPM / 60] rev/s",
+                );
+            }
+            if let Motion::Arc { center, sweep } = m.motion {
+                if !(center
+                    .iter()
+                    .all(|v| v.is_finite() && v.abs() <= MAX_COORDINATE))
+                {
+                    return bad(
+                        i,
+                        center.x + center.y,
+                        "an arc centre finite, within 1000 m",
+                    );
+                }
+                let tau = core::f64::consts::TAU;
+                if !(sweep.is_finite() && sweep != 0.0 && ComplexField::abs(sweep) <= tau) {
+                    return bad(i, sweep, "an arc sweep with 0 < |sweep| <= 2 pi");
+                }
+                let r = m.radius();
+                let (sin, cos) = ComplexField::sin_cos(sweep);
+                let r0 = m.start.xy() - center;
+                let swept = center + Vector2::new(cos * r0.x - sin * r0.y, sin * r0.x + cos * r0.y);
+                let miss = (swept - m.end.xy()).norm();
+                if miss > ARC_TOLERANCE.0.max(ARC_TOLERANCE.1 * r) {
+                    return bad(
+                        i,
+                        miss,
+                        "an arc end where the sweep takes the start (within ARC_TOLERANCE)",
+                    );
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Total path length \[m\] of the feed moves (rapids excluded).
     pub fn cutting_length(&self) -> f64 {
         self.moves

@@ -1,7 +1,7 @@
 """Type stubs of the compiled extension ``deflect._deflect``."""
 
 from os import PathLike
-from typing import Any, Dict, List, NoReturn, Optional, Sequence, Tuple, Union, final
+from typing import Any, ClassVar, Dict, List, NoReturn, Optional, Sequence, Tuple, Union, final
 
 from typing_extensions import Self
 
@@ -792,6 +792,19 @@ class GcodeProgram:
         text: str, *, start: Optional[_ArrayLike] = None, units: str = "mm"
     ) -> "GcodeProgram":
         """Same as ``from_file``, from the program's text."""
+    @staticmethod
+    def from_points_file(path: _StrPath, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
+        """Tool points CSV: one straight move per row (x_mm/y_mm/z_mm or x_m/..., feed_mm_min
+        or feed_m_s, 0 for rapid, spindle_rpm)."""
+    @staticmethod
+    def from_points_text(text: str, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
+        """Same as ``from_points_file``, from the CSV text."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
+        """Pickling and copy.deepcopy: the moves as plain values, rebuilt bit for bit."""
+    @staticmethod
+    def _from_state(state: Any) -> "GcodeProgram": ...
+    def __eq__(self, value: object, /) -> bool: ...
+    __hash__: ClassVar[None]  # type: ignore[assignment]
     def __len__(self) -> int: ...
     @property
     def line(self) -> npt.NDArray[np.uint64]:
@@ -850,6 +863,12 @@ class MachiningJob:
     ) -> Self: ...
     def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
         """The offline pass: forces, deflection, compensated joints, the part three ways."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
+        """Pickling and copy.deepcopy: the robot and the setup, rebuilt bit for bit."""
+    @staticmethod
+    def _from_state(state: Any) -> "MachiningJob": ...
+    def __eq__(self, value: object, /) -> bool: ...
+    __hash__: ClassVar[None]  # type: ignore[assignment]
 
 @final
 class MachiningResult:
