@@ -470,12 +470,7 @@ impl MachiningResult {
         py: Python<'py>,
         lead: f64,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        if !(lead.is_finite() && lead >= 0.0) {
-            return Err(InputError::new_err(format!(
-                "lead: expected >= 0 s, got {lead}"
-            )));
-        }
-        let w = self.report.pilot_wrenches(lead);
+        let w = self.report.pilot_wrenches(checked_lead(lead)?);
         let mut out = try_rows(w.len(), 6, "the pilot wrenches")?;
         for (o, v) in out.chunks_mut(6).zip(&w) {
             o.copy_from_slice(v.as_slice());
@@ -502,12 +497,7 @@ impl MachiningResult {
     /// pilot wrench `lead` [s] ahead.
     #[pyo3(signature = (lead=0.04))]
     fn samples_csv(&self, lead: f64) -> PyResult<String> {
-        if !(lead.is_finite() && lead >= 0.0) {
-            return Err(InputError::new_err(format!(
-                "lead: expected >= 0 s, got {lead}"
-            )));
-        }
-        Ok(job_out::samples_csv(&self.report, lead))
+        Ok(job_out::samples_csv(&self.report, checked_lead(lead)?))
     }
 
     fn __repr__(&self) -> String {
@@ -518,6 +508,17 @@ impl MachiningResult {
             u.max * 1e3,
             c.max * 1e3
         )
+    }
+}
+
+/// A pilot lead \[s\]: finite and >= 0, else `InputError` naming it.
+fn checked_lead(lead: f64) -> PyResult<f64> {
+    if lead.is_finite() && lead >= 0.0 {
+        Ok(lead)
+    } else {
+        Err(InputError::new_err(format!(
+            "lead: expected >= 0 s, got {lead}"
+        )))
     }
 }
 

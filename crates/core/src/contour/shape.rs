@@ -1,9 +1,14 @@
 //! Distances to simple shapes, for judging recovered contours.
 
-use nalgebra::Vector2;
+use nalgebra::{SVector, Vector2};
 
-/// Distance \[m\] from `p` to the segment `a`-`b`.
-pub fn distance_to_segment(p: &Vector2<f64>, a: &Vector2<f64>, b: &Vector2<f64>) -> f64 {
+/// Distance \[m\] from `p` to the segment `a`-`b`, in any dimension (2-D contours, 3-D tool
+/// paths).
+pub fn distance_to_segment<const D: usize>(
+    p: &SVector<f64, D>,
+    a: &SVector<f64, D>,
+    b: &SVector<f64, D>,
+) -> f64 {
     let ab = b - a;
     let l2 = ab.norm_squared();
     let t = if l2 > 0.0 {

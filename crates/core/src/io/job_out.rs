@@ -16,8 +16,7 @@ use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use nalgebra::Vector3;
-
+use crate::contour::shape::distance_to_segment;
 use crate::error::LoadError;
 use crate::machining::Program;
 use crate::machining::job::Report;
@@ -25,18 +24,6 @@ use crate::machining::job::Report;
 /// Most samples one dropped run may hold before a block is written anyway (bounds the
 /// decimation's time to `O(n x 256)`).
 pub const MAX_DROPPED: usize = 256;
-
-/// Distance of `p` from the segment `a`-`b` \[m\].
-fn off_segment(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
-}
 
 /// The compensated program (see the module docs); `tolerance` \[m\] > 0 (1e-6 keeps the
 /// compensation to a micrometre). `program` must be the one the report was run on (for the
@@ -72,7 +59,7 @@ pub fn compensated_gcode(report: &Report, program: &Program, tolerance: f64) -> 
         });
         let within = k - anchor <= MAX_DROPPED
             && (anchor + 1..k)
-                .all(|j| point(j).is_some_and(|q| off_segment(&q, &a, &p) <= tolerance));
+                .all(|j| point(j).is_some_and(|q| distance_to_segment(&q, &a, &p) <= tolerance));
         if !within {
             keep.push(k - 1);
             anchor = k - 1;

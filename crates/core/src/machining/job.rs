@@ -33,6 +33,7 @@ use super::Program;
 use super::cutting::{self, Coefficients, Engagement, Tool};
 use super::engagement::{self, Contact};
 use super::path::{self, PathOptions, PathSample};
+pub use super::report::{ErrorStats, JobSample, LineForce, Report, SurfaceError};
 use super::stock::{Cutter, ZMap};
 use crate::error::{BuildError, JobError, TickError};
 use crate::mechanism::{PoseIkOptions, pose_ik};
@@ -162,206 +163,6 @@ impl Job {
     }
 }
 
-/// One sample of the offline pass. Positions and forces in the workpiece frame unless said.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct JobSample {
-    /// The programmed tool at this sample.
-    pub path: PathSample,
-    /// Where the nominal tool meets the nominal stock.
-    pub contact: Contact,
-    /// Feed per tooth \[m\] (horizontal speed / (spindle speed x flutes); 0 at rest).
-    pub feed_per_tooth: f64,
-    /// Per-revolution force on the tool from the nominal cut \[N\], workpiece frame.
-    pub force: Vector3<f64>,
-    /// The wrench on the TCP \[N, N m\], base frame, moment about the tip: what the
-    /// compensation is computed for.
-    pub wrench: Vector6,
-    /// Rigid pose-IK joints of the programmed pose \[rad or m\]; entries past the dof are 0.
-    pub q: [f64; MAX_DOF],
-    /// Deflection `[dp; dr]` of the tip at `q` under `wrench` \[m, rad\], base frame.
-    pub deflection: Vector6,
-    /// Compensated joints: the loaded tip reaches the programmed pose \[rad or m\].
-    pub q_commanded: [f64; MAX_DOF],
-    /// The Cartesian command: the rigid pose at `q_commanded`, workpiece frame.
-    pub commanded: Isometry3<f64>,
-    /// Predicted tip without compensation \[m\].
-    pub actual_uncompensated: Vector3<f64>,
-    /// Force the uncompensated tool feels where it is \[N\].
-    pub force_uncompensated: Vector3<f64>,
-    /// Predicted tip with compensation \[m\].
-    pub actual_compensated: Vector3<f64>,
-}
-
-/// Largest and root-mean-square values of a deviation \[m\].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ErrorStats {
-    /// Largest magnitude \[m\].
-    pub max: f64,
-    /// Root mean square \[m\].
-    pub rms: f64,
-    /// Entries counted.
-    pub count: usize,
-}
-
-impl ErrorStats {
-    fn of(values: impl Iterator<Item = f64>) -> Self {
-        let (mut s, mut n, mut m) = (0.0, 0usize, 0.0f64);
-        for v in values {
-            s += v * v;
-            n += 1;
-            m = m.max(v.abs());
-        }
-        Self {
-            max: m,
-            rms: if n > 0 {
-                nalgebra::ComplexField::sqrt(s / n as f64)
-            } else {
-                0.0
-            },
-            count: n,
-        }
-    }
-}
-
-/// A predicted part against the nominal one ([`Report::surface_error`]).
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct SurfaceError {
-    /// Height above the nominal part over the cells both cut \[m\] (> 0: material left).
-    pub floor: ErrorStats,
-    /// Area the nominal part has cut and the predicted one not \[m^2\].
-    pub material_left: f64,
-    /// Area the predicted part has cut and the nominal one not \[m^2\].
-    pub overcut: f64,
-}
-
-/// Force statistics of one program line.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LineForce {
-    /// Program line.
-    pub line: usize,
-    /// Samples on it.
-    pub samples: usize,
-    /// Mean force on the tool \[N\], workpiece frame.
-    pub mean: Vector3<f64>,
-    /// Largest force magnitude \[N\].
-    pub max: f64,
-}
-
-/// What the offline pass predicts.
-#[derive(Debug, Clone)]
-pub struct Report {
-    /// Every sample, in time order.
-    pub samples: Vec<JobSample>,
-    /// The part as programmed.
-    pub nominal: ZMap,
-    /// The part the uncompensated arm cuts.
-    pub uncompensated: ZMap,
-    /// The part the compensated arm cuts.
-    pub compensated: ZMap,
-    /// Samples that plunge into material (feed along the tool axis): no side-milling force.
-    pub plunge_samples: usize,
-    /// Z-map cells lowered over the three stocks (the material removal's work).
-    pub cell_updates: usize,
-    /// Sampling rate \[Hz\].
-    pub rate_hz: f64,
-    /// Joints of the arm.
-    pub dof: usize,
-    /// The stock's top \[m\].
-    pub top: f64,
-}
-
-impl Report {
-    /// Distance of the predicted tip from the programmed one over the feed moves \[m\]:
-    /// `compensated` false for the uncompensated arm.
-    pub fn path_error(&self, compensated: bool) -> ErrorStats {
-        ErrorStats::of(self.samples.iter().filter(|s| s.path.feed_move).map(|s| {
-            let a = if compensated {
-                s.actual_compensated
-            } else {
-                s.actual_uncompensated
-            };
-            (a - s.path.position).norm()
-        }))
-    }
-
-    /// A predicted part against the nominal one: the floors (cells both cut, by more than
-    /// [`super::engagement::MIN_DEPTH`]: height above the nominal, > 0 where material is
-    /// left), and the walls' shift as the areas cut by one and not the other \[m^2\] (a
-    /// height map sees a wall moved sideways as a full-depth step; the areas measure it).
-    pub fn surface_error(&self, predicted: &ZMap) -> SurfaceError {
-        let cut = |h: f64| h < self.top - super::engagement::MIN_DEPTH;
-        let area = self.nominal.cell() * self.nominal.cell();
-        let (mut left, mut over) = (0usize, 0usize);
-        let floor = ErrorStats::of(
-            self.nominal
-                .heights()
-                .iter()
-                .zip(predicted.heights())
-                .filter_map(|(&n, &p)| match (cut(n), cut(p)) {
-                    (true, true) => Some(p - n),
-                    (true, false) => {
-                        left += 1;
-                        None
-                    }
-                    (false, true) => {
-                        over += 1;
-                        None
-                    }
-                    (false, false) => None,
-                }),
-        );
-        SurfaceError {
-            floor,
-            material_left: left as f64 * area,
-            overcut: over as f64 * area,
-        }
-    }
-
-    /// The pilot-control signal of the annotated program (sec. 2.3 of Hähn and Weigold): the
-    /// TCP wrench at each sample's time plus `lead` \[s\] (the paper's program carried its
-    /// forces 40 ms early), the last wrench held at the end. `lead` is rounded to samples;
-    /// negative or non-finite leads count as 0.
-    pub fn pilot_wrenches(&self, lead: f64) -> Vec<Vector6> {
-        let shift = if lead.is_finite() && lead > 0.0 {
-            nalgebra::ComplexField::round(lead * self.rate_hz).min(usize::MAX as f64) as usize
-        } else {
-            0
-        };
-        let n = self.samples.len();
-        (0..n)
-            .filter_map(|k| {
-                self.samples
-                    .get(k.saturating_add(shift).min(n.saturating_sub(1)))
-                    .map(|s| s.wrench)
-            })
-            .collect()
-    }
-
-    /// The force per program line (lines with samples, in program order of first sample).
-    pub fn line_forces(&self) -> Vec<LineForce> {
-        let mut out: Vec<LineForce> = Vec::new();
-        for s in &self.samples {
-            match out.last_mut() {
-                Some(l) if l.line == s.path.line => {
-                    l.samples += 1;
-                    l.mean += s.force;
-                    l.max = l.max.max(s.force.norm());
-                }
-                _ => out.push(LineForce {
-                    line: s.path.line,
-                    samples: 1,
-                    mean: s.force,
-                    max: s.force.norm(),
-                }),
-            }
-        }
-        for l in &mut out {
-            l.mean /= l.samples as f64;
-        }
-        out
-    }
-}
-
 /// The force on the tool (workpiece frame) and the wrench about the tip (workpiece frame)
 /// for a contact: each engaged arc's per-revolution force acting at half its depth up the
 /// axis, plus the cutting torque about the axis; zero in air and for plunges.
@@ -419,7 +220,8 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     let dof = model.dof();
     let st = &setup.stock;
     let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
-    let (mut nominal, mut unc, mut comp) = (zmap()?, zmap()?, zmap()?);
+    let mut nominal = zmap()?;
+    let (mut unc, mut comp) = (Predicted::new(zmap()?), Predicted::new(zmap()?));
     let path = path::sample(program, &setup.path)?;
     let cutter = Cutter::Flat {
         radius: 0.5 * setup.tool.diameter,
@@ -451,11 +253,13 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     let to_base = setup.placement;
     let to_work = to_base.inverse();
     let (mut plunge_samples, mut cell_updates) = (0, 0);
-    let (mut prev_nom, mut prev_unc, mut prev_comp): (
-        Option<Vector3<f64>>,
-        Vector3<f64>,
-        Vector3<f64>,
-    ) = (None, Vector3::zeros(), Vector3::zeros());
+    let mut prev_nom: Option<Vector3<f64>> = None;
+    let frame = Frame {
+        job,
+        to_base,
+        to_work,
+        cutter,
+    };
     for s in &path {
         let at = |error: TickError| JobError::AtLine {
             line: s.line,
@@ -530,59 +334,19 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         let commanded = to_work * data.tcp;
         // 4. The predictions: the force where each tool is (lagged one sample), its
         // deflection, its cut.
-        let step = p - from;
-        let probe_unc = if prev_nom.is_some() {
-            prev_unc + step
-        } else {
-            p
+        let tick = Tick {
+            sample: s,
+            step: p - from,
+            feed_per_tooth: fz,
         };
-        let c_unc = engagement::contact(&unc, radius, &probe_unc, &s.direction);
-        let (force_unc, w_unc) = cut_force(setup, &c_unc, s, fz).map_err(at)?;
-        let d_unc = vjm::deflection(
-            model,
-            &mut data,
-            q.get(..dof).unwrap_or(&[]),
-            &rotate(&to_base, &w_unc),
-            Load::Exact,
-        )
-        .map_err(at)?;
-        let actual_unc =
-            to_work * Point3::from(target.translation.vector + d_unc.fixed_rows::<3>(0));
-        let probe_comp = if prev_nom.is_some() {
-            prev_comp + step
-        } else {
-            p
-        };
-        let c_comp = engagement::contact(&comp, radius, &probe_comp, &s.direction);
-        let (_, w_comp) = cut_force(setup, &c_comp, s, fz).map_err(at)?;
-        vjm::deflection(
-            model,
-            &mut data,
-            qc.get(..dof).unwrap_or(&[]),
-            &rotate(&to_base, &w_comp),
-            Load::Exact,
-        )
-        .map_err(at)?;
-        let actual_comp = to_work * Point3::from(data.tcp_deflected.translation.vector);
-        let (actual_unc, actual_comp) = (actual_unc.coords, actual_comp.coords);
-        let r_unc = unc
-            .cut(
-                &cutter,
-                &prev_nom.map_or(actual_unc, |_| prev_unc),
-                &actual_unc,
-            )
-            .map_err(at)?;
-        let r_comp = comp
-            .cut(
-                &cutter,
-                &prev_nom.map_or(actual_comp, |_| prev_comp),
-                &actual_comp,
-            )
-            .map_err(at)?;
-        cell_updates += removed.cells + r_unc.cells + r_comp.cells;
+        let q_rigid = q.get(..dof).unwrap_or(&[]);
+        let (force_unc, actual_unc, r_unc) =
+            unc.advance(&frame, &mut data, q_rigid, &tick).map_err(at)?;
+        let q_comp = qc.get(..dof).unwrap_or(&[]);
+        let (_, actual_comp, r_comp) =
+            comp.advance(&frame, &mut data, q_comp, &tick).map_err(at)?;
+        cell_updates += removed.cells + r_unc + r_comp;
         prev_nom = Some(p);
-        prev_unc = actual_unc;
-        prev_comp = actual_comp;
         samples.push(JobSample {
             path: *s,
             contact,
@@ -601,14 +365,70 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     Ok(Report {
         samples,
         nominal,
-        uncompensated: unc,
-        compensated: comp,
+        uncompensated: unc.stock,
+        compensated: comp.stock,
         plunge_samples,
         cell_updates,
         rate_hz: setup.path.rate_hz,
         dof,
         top: st.top,
     })
+}
+
+/// What every prediction shares: the job, the frames and the cutter.
+struct Frame<'a> {
+    job: &'a Job,
+    to_base: Isometry3<f64>,
+    to_work: Isometry3<f64>,
+    cutter: Cutter,
+}
+
+/// One sample as a prediction sees it: the programmed sample, the programmed step since the
+/// last one \[m\] and the feed per tooth \[m\].
+struct Tick<'a> {
+    sample: &'a PathSample,
+    step: Vector3<f64>,
+    feed_per_tooth: f64,
+}
+
+/// One predicted arm (uncompensated or compensated): its own stock and where its tool is.
+struct Predicted {
+    stock: ZMap,
+    tip: Option<Vector3<f64>>,
+}
+
+impl Predicted {
+    fn new(stock: ZMap) -> Self {
+        Self { stock, tip: None }
+    }
+
+    /// The arm at joints `q` for one sample: the force where its tool is (its last tip plus
+    /// the programmed step), the deflected tip under that force, the cut to it. Returns the
+    /// force \[N\] and the tip \[m\] (workpiece frame) and the cells lowered.
+    fn advance(
+        &mut self,
+        f: &Frame<'_>,
+        data: &mut Data,
+        q: &[f64],
+        t: &Tick<'_>,
+    ) -> Result<(Vector3<f64>, Vector3<f64>, usize), TickError> {
+        let s = t.sample;
+        let probe = self.tip.map_or(s.position, |tip| tip + t.step);
+        let radius = f.cutter.radius();
+        let contact = engagement::contact(&self.stock, radius, &probe, &s.direction);
+        let (force, wrench) = cut_force(&f.job.setup, &contact, s, t.feed_per_tooth)?;
+        vjm::deflection(
+            &f.job.model,
+            data,
+            q,
+            &rotate(&f.to_base, &wrench),
+            Load::Exact,
+        )?;
+        let tip = (f.to_work * Point3::from(data.tcp_deflected.translation.vector)).coords;
+        let removed = self.stock.cut(&f.cutter, &self.tip.unwrap_or(tip), &tip)?;
+        self.tip = Some(tip);
+        Ok((force, tip, removed.cells))
+    }
 }
 
 /// A wrench `[f; m]` turned by the rotation of `t` (the moment point moves with it).

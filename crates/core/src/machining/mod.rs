@@ -18,6 +18,8 @@ pub mod path;
 #[cfg(feature = "alloc")]
 mod program;
 #[cfg(feature = "alloc")]
+pub mod report;
+#[cfg(feature = "alloc")]
 pub mod stock;
 
 #[cfg(feature = "alloc")]
