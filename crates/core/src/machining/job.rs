@@ -163,16 +163,19 @@ impl Job {
     }
 }
 
-/// The force on the tool (workpiece frame) and the wrench about the tip (workpiece frame)
-/// for a contact: each engaged arc's per-revolution force acting at half its depth up the
-/// axis, plus the cutting torque about the axis; zero in air and for plunges.
-fn cut_force(
+/// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece
+/// frame) of a contact of `setup`'s tool moving along `feed` (workpiece frame, any length):
+/// each engaged arc's per-revolution force acting at half its depth up the axis, plus the
+/// cutting torque about the axis; zero in air, for plunges and without a horizontal feed.
+/// What the offline pass uses, and what a simulation calls with the contact where its tool
+/// really is.
+pub fn contact_wrench(
     setup: &Setup,
     contact: &Contact,
-    sample: &PathSample,
+    feed: &Vector3<f64>,
     feed_per_tooth: f64,
 ) -> Result<(Vector3<f64>, Vector6), TickError> {
-    let Some(frame) = cutting::tool_frame(&Vector3::z(), &sample.direction) else {
+    let Some(frame) = cutting::tool_frame(&Vector3::z(), feed) else {
         return Ok((Vector3::zeros(), Vector6::zeros()));
     };
     let (mut f_tool, mut m_tool) = (Vector3::zeros(), Vector3::zeros());
@@ -192,7 +195,9 @@ fn cut_force(
     Ok((f, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)))
 }
 
-fn feed_per_tooth(setup: &Setup, s: &PathSample) -> f64 {
+/// Feed per tooth \[m\] of `setup`'s tool at a path sample: horizontal speed over spindle
+/// speed times flutes (0 at rest or with the spindle off).
+pub fn feed_per_tooth(setup: &Setup, s: &PathSample) -> f64 {
     let v = s.speed * s.direction.xy().norm();
     let teeth = s.spindle * f64::from(setup.tool.flutes);
     if teeth > 0.0 { v / teeth } else { 0.0 }
@@ -293,7 +298,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
             plunge_samples += 1;
         }
         let fz = feed_per_tooth(setup, s);
-        let (force, wrench_w) = cut_force(setup, &contact, s, fz).map_err(at)?;
+        let (force, wrench_w) = contact_wrench(setup, &contact, &s.direction, fz).map_err(at)?;
         let wrench = rotate(&to_base, &wrench_w);
         // 1. The programmed pose and its rigid joints.
         let target = to_base * Isometry3::from_parts(Translation3::from(p), setup.tool_orientation);
@@ -416,7 +421,8 @@ impl Predicted {
         let probe = self.tip.map_or(s.position, |tip| tip + t.step);
         let radius = f.cutter.radius();
         let contact = engagement::contact(&self.stock, radius, &probe, &s.direction);
-        let (force, wrench) = cut_force(&f.job.setup, &contact, s, t.feed_per_tooth)?;
+        let (force, wrench) =
+            contact_wrench(&f.job.setup, &contact, &s.direction, t.feed_per_tooth)?;
         vjm::deflection(
             &f.job.model,
             data,

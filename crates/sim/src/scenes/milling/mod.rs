@@ -19,6 +19,8 @@
 //!   correction after a transport delay and a first-order servo lag. The compensator uses the
 //!   identified values.
 //! * [`output`]: summary table, CSV, JSON, MCAP log and plots.
+//! * [`program`]: the paper's validation on a machining program (engagement where the
+//!   simulated tool is; uncompensated, offline, Cartesian, hybrid, axis-specific).
 //! * [`part_map`]: the machined part against the nominal one as a heat map (Fig. 10-13).
 
 pub mod arm;
@@ -26,6 +28,7 @@ pub mod identification;
 pub mod options;
 pub mod output;
 pub mod part_map;
+pub mod program;
 pub mod run;
 pub mod sensor;
 

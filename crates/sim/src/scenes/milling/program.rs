@@ -1,0 +1,377 @@
+//! The paper's validation on a program (Hähn and Weigold 2020, sec. 3): the flexible KR 300
+//! follows a machining program sample by sample (4 ms cycles, 0.5 ms physics), and at every
+//! physics step the force on the tool is the mechanistic model's for the engagement read from
+//! the run's own z-map *where the simulated tool really is*, so a tool the force pushes away
+//! cuts less, as on the robot. Runs ([`ProgramMode`]): uncompensated; the offline compensated
+//! joints of deflect-core's `machining::job`; online Cartesian compensation; online Cartesian
+//! with pilot control from the offline forces (hybrid); online axis-specific. Each run's part is
+//! compared with the nominal one.
+
+use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
+use deflect_core::machining::engagement::{self, Contact};
+use deflect_core::machining::job::{self, Job, Report, SurfaceError};
+use deflect_core::machining::stock::{Cutter, ZMap};
+use deflect_core::vjm::{Model, Vector6};
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use serde::Serialize;
+
+use super::arm::MillingArm;
+use super::options::MillingOptions;
+use crate::SimError;
+use crate::noise::Noise;
+
+/// Which compensation a program run uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum ProgramMode {
+    /// The program's rigid joints.
+    Uncompensated,
+    /// The offline compensated joints (no sensor).
+    Offline,
+    /// Online Cartesian compensation, measured forces only.
+    Cartesian,
+    /// Online Cartesian compensation with pilot control from the offline forces.
+    Hybrid,
+    /// Online axis-specific compensation (measured forces, pilot control).
+    AxisSpecific,
+}
+
+impl ProgramMode {
+    /// Every mode, in the order the summary reports them.
+    pub const ALL: [Self; 5] = [
+        Self::Uncompensated,
+        Self::Offline,
+        Self::Cartesian,
+        Self::Hybrid,
+        Self::AxisSpecific,
+    ];
+
+    /// Short name for topics and files.
+    pub fn label(self) -> &'static str {
+        match self {
+            Self::Uncompensated => "uncompensated",
+            Self::Offline => "offline",
+            Self::Cartesian => "cartesian",
+            Self::Hybrid => "hybrid",
+            Self::AxisSpecific => "axis_specific",
+        }
+    }
+}
+
+/// One control cycle of a program run.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ProgramSample {
+    /// Time \[s\].
+    pub t: f64,
+    /// Program line.
+    pub line: usize,
+    /// Programmed tool tip, workpiece frame \[m\].
+    pub nominal: [f64; 3],
+    /// Simulated tool tip, workpiece frame \[m\].
+    pub actual: [f64; 3],
+    /// Force on the tool where it is, workpiece frame \[N\].
+    pub force: [f64; 3],
+    /// Axial depth of the engagement where the tool is \[m\] (0 in air).
+    pub depth: f64,
+    /// Distance of the tip from the programmed one across the feed \[mm\].
+    pub error_mm: f64,
+}
+
+/// Path-error metrics of a program run \[mm\] over the feed moves.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct ProgramMetrics {
+    /// Largest deviation across the feed while cutting.
+    pub max_mm: f64,
+    /// RMS deviation while cutting.
+    pub rms_mm: f64,
+    /// Largest deviation within 0.1 s of a cutter entry.
+    pub entry_max_mm: f64,
+    /// Largest deviation within 0.1 s of a cutter exit.
+    pub exit_max_mm: f64,
+}
+
+/// A finished program run.
+#[derive(Debug, Clone)]
+pub struct ProgramRun {
+    /// The compensation used.
+    pub mode: ProgramMode,
+    /// Path errors.
+    pub metrics: ProgramMetrics,
+    /// The part this run cut.
+    pub part: ZMap,
+    /// The part against the nominal one.
+    pub part_error: SurfaceError,
+    /// Per-cycle log.
+    pub samples: Vec<ProgramSample>,
+}
+
+/// Times \[s\] where the offline pass's tool enters (`true`) or leaves (`false`) the material.
+pub fn entries_and_exits(offline: &Report) -> Vec<(f64, bool)> {
+    let cutting = |c: &Contact| !c.arcs().is_empty();
+    offline
+        .samples
+        .windows(2)
+        .filter_map(|w| {
+            let (a, b) = (cutting(&w[0].contact), cutting(&w[1].contact));
+            (a != b).then_some((w[1].path.time, b))
+        })
+        .collect()
+}
+
+fn metrics(samples: &[ProgramSample], events: &[(f64, bool)], cutting: &[bool]) -> ProgramMetrics {
+    let near = |t: f64, entry: bool| {
+        events
+            .iter()
+            .any(|&(te, e)| e == entry && (t - te).abs() <= 0.1)
+    };
+    let (mut m, mut sum, mut n) = (ProgramMetrics::default(), 0.0, 0usize);
+    for (s, &c) in samples.iter().zip(cutting) {
+        if near(s.t, true) {
+            m.entry_max_mm = m.entry_max_mm.max(s.error_mm);
+        }
+        if near(s.t, false) {
+            m.exit_max_mm = m.exit_max_mm.max(s.error_mm);
+        }
+        if c {
+            m.max_mm = m.max_mm.max(s.error_mm);
+            sum += s.error_mm * s.error_mm;
+            n += 1;
+        }
+    }
+    m.rms_mm = (sum / n.max(1) as f64).sqrt();
+    m
+}
+
+/// A wrench `[f; m]` turned by `r`.
+fn rotate(r: &UnitQuaternion<f64>, w: &Vector6) -> Vector6 {
+    let f = r * w.fixed_rows::<3>(0).into_owned();
+    let m = r * w.fixed_rows::<3>(3).into_owned();
+    Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+}
+
+/// One run of `program` with `mode` on `arm`: `job` the offline pass's setup (placement, tool,
+/// material, stock, path at the control cycle), `offline` its report, the compensator using
+/// `model` (identified stiffnesses) and `calibration` (identified sensor).
+pub fn run_program(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+    job: &Job,
+    offline: &Report,
+    mode: ProgramMode,
+    model: &Model,
+    calibration: &SensorCalibration,
+) -> Result<ProgramRun, SimError> {
+    let setup = job.setup();
+    let (to_base, to_work) = (setup.placement, setup.placement.inverse());
+    let dof = arm.dof();
+    let first = offline
+        .samples
+        .first()
+        .ok_or_else(|| SimError::new("program run: the offline pass has no samples"))?;
+    let q_start: Vec<f64> = first.q.iter().take(dof).copied().collect();
+    let truth = opts.sensor.calibration(arm.sensor_to_tcp);
+    let mut sim = arm.sim(&q_start, 1.0, opts.dt)?;
+    let mut comp = match mode {
+        ProgramMode::Uncompensated | ProgramMode::Offline => None,
+        ProgramMode::Cartesian | ProgramMode::Hybrid | ProgramMode::AxisSpecific => {
+            let mut cfg = CompensatorConfig::paper(1.0 / offline.rate_hz, *calibration);
+            cfg.pilot = (mode != ProgramMode::Cartesian).then_some(opts.pilot);
+            if mode == ProgramMode::AxisSpecific {
+                cfg.output = CorrectionOutput::Joint;
+            }
+            let c = compensation::Model::new(model.clone(), cfg)
+                .map_err(|e| SimError::new(format!("compensator: {e}")))?;
+            let d = compensation::Data::new(&c);
+            Some((c, d))
+        }
+    };
+    let pilot = offline.pilot_wrenches(opts.estimate_lead);
+    let st = &setup.stock;
+    let mut part = ZMap::new(st.min, st.max, st.top, st.cell)
+        .map_err(|e| SimError::new(format!("stock: {e}")))?;
+    let cutter = Cutter::Flat {
+        radius: 0.5 * setup.tool.diameter,
+    };
+    let mut noise = Noise::new(opts.seed);
+    let dt = opts.dt;
+    let cycle = 1.0 / offline.rate_hz;
+    let sub = ((cycle / dt).round() as usize).max(1);
+    let mut ik = arm.ik_data(&q_start);
+    let mut queue: std::collections::VecDeque<Vec<f64>> =
+        std::iter::repeat_n(vec![0.0; dof], opts.delay_cycles).collect();
+    let mut lagged = vec![0.0; dof];
+    let alpha = dt / (opts.servo_tau + dt);
+    let mut dq_target = vec![0.0; dof];
+    let mut q_cmd = q_start.clone();
+    let mut tip_prev: Option<Vector3<f64>> = None;
+    let mut force_w = Vector3::zeros();
+    let mut depth = 0.0;
+    let mut samples = Vec::with_capacity(offline.samples.len());
+    let mut cutting = Vec::with_capacity(offline.samples.len());
+    let joints = |s: &job::JobSample| -> Vec<f64> {
+        let q = if mode == ProgramMode::Offline {
+            &s.q_commanded
+        } else {
+            &s.q
+        };
+        q.iter().take(dof).copied().collect()
+    };
+    for (k, s) in offline.samples.iter().enumerate() {
+        let next = offline.samples.get(k + 1).unwrap_or(s);
+        let (q_a, q_b) = (joints(s), joints(next));
+        let p_nom = s.path.position;
+        let dir_base = to_base.rotation * s.path.direction;
+        let v_nom = dir_base * s.path.speed;
+        // The sensor is read at the start of the cycle.
+        let tcp = sim.tcp_pose().translation.vector;
+        let tip = (to_work * Point3::from(tcp)).coords;
+        let f_base = to_base.rotation * force_w;
+        let reading = opts.sensor.reading(
+            &truth,
+            &arm.sensor_pose(&sim),
+            &tcp,
+            &f_base,
+            &mut noise,
+            1.0,
+        );
+        let d = tip - p_nom;
+        let across = d - s.path.direction * d.dot(&s.path.direction);
+        samples.push(ProgramSample {
+            t: s.path.time,
+            line: s.path.line,
+            nominal: p_nom.into(),
+            actual: tip.into(),
+            force: force_w.into(),
+            depth,
+            error_mm: across.norm() * 1e3,
+        });
+        cutting.push(s.path.feed_move && !s.contact.arcs().is_empty());
+        if let Some((c, data)) = comp.as_mut() {
+            let est = pilot.get(k).copied().unwrap_or_else(Vector6::zeros);
+            let out = compensation::step(c, data, &q_cmd, &reading, Some(&est), &v_nom)
+                .map_err(|e| SimError::new(format!("compensator step: {e}")))?;
+            if mode == ProgramMode::AxisSpecific {
+                for (dst, src) in dq_target.iter_mut().zip(out.dq.iter()) {
+                    *dst = *src;
+                }
+            } else {
+                let dp: Vector3<f64> = out.correction.fixed_rows::<3>(0).into_owned();
+                let dr: Vector3<f64> = out.correction.fixed_rows::<3>(3).into_owned();
+                let nominal = to_base
+                    * Isometry3::from_parts(Translation3::from(p_nom), setup.tool_orientation);
+                let target = Isometry3::from_parts(
+                    Translation3::from(nominal.translation.vector + dp),
+                    UnitQuaternion::from_scaled_axis(dr) * nominal.rotation,
+                );
+                let q_target = arm.ik(&mut ik, &target)?;
+                for ((d, a), b) in dq_target.iter_mut().zip(&q_target).zip(&q_a) {
+                    *d = a - b;
+                }
+            }
+        }
+        queue.push_back(dq_target.clone());
+        let dq_servo = queue.pop_front().unwrap_or_else(|| vec![0.0; dof]);
+        let fz = job::feed_per_tooth(setup, &s.path);
+        for j in 0..sub {
+            let u = j as f64 / sub as f64;
+            let q_prev = q_cmd.clone();
+            for ((((l, m), d), a), b) in lagged
+                .iter_mut()
+                .zip(&mut q_cmd)
+                .zip(&dq_servo)
+                .zip(&q_a)
+                .zip(&q_b)
+            {
+                *l += alpha * (d - *l);
+                *m = a + (b - a) * u + *l;
+            }
+            let qd: Vec<f64> = q_cmd
+                .iter()
+                .zip(&q_prev)
+                .map(|(a, b)| (a - b) / dt)
+                .collect();
+            // The force where the tool is: the engagement on this run's stock at the
+            // simulated tip, then the cut to it.
+            let tip = (to_work * Point3::from(sim.tcp_pose().translation.vector)).coords;
+            let contact = engagement::contact(&part, cutter.radius(), &tip, &s.path.direction);
+            let (f, w) = job::contact_wrench(setup, &contact, &s.path.direction, fz)
+                .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
+            force_w = f;
+            depth = contact.span().map_or(0.0, |a| a.depth);
+            let _ = part
+                .cut(&cutter, &tip_prev.unwrap_or(tip), &tip)
+                .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
+            tip_prev = Some(tip);
+            let w_base = rotate(&to_base.rotation, &w);
+            sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w_base));
+        }
+    }
+    let events = entries_and_exits(offline);
+    let part_error = offline.surface_error(&part);
+    Ok(ProgramRun {
+        mode,
+        metrics: metrics(&samples, &events, &cutting),
+        part,
+        part_error,
+        samples,
+    })
+}
+
+/// The KR 300's workpiece placement for the program scenario: a table in front of it, the
+/// workpiece frame's origin at (2.52, 0.07, 0.92) m, z up, x towards the robot; the tool points
+/// down from the joints [`PROGRAM_SEED`].
+pub fn kr300_placement() -> Isometry3<f64> {
+    Isometry3::new(
+        Vector3::new(2.52, 0.07, 0.92),
+        Vector3::new(0.0, 0.0, std::f64::consts::PI),
+    )
+}
+
+/// Joints near the start of a program on [`kr300_placement`]: the tool down over the table.
+pub const PROGRAM_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+
+/// Everything the program scenario produced.
+#[derive(Debug, Clone)]
+pub struct ProgramResult {
+    /// The offline pass (identified model, nominal forces).
+    pub offline: Report,
+    /// One run per mode, in [`ProgramMode::ALL`] order.
+    pub runs: Vec<ProgramRun>,
+    /// Wall-clock seconds.
+    pub wall_seconds: f64,
+}
+
+/// The scenario: identification of stiffnesses and sensor (as the groove scenario), the offline
+/// pass of `program` with the identified model (`setup`'s path sampled at the control cycle),
+/// then one rapier run per mode on worker threads (results do not depend on their number).
+pub fn milling_program(
+    opts: &MillingOptions,
+    program: &deflect_core::machining::Program,
+    setup: &job::Setup,
+    seed: &[f64],
+) -> Result<ProgramResult, SimError> {
+    let start = std::time::Instant::now();
+    let arm = MillingArm::kr300()?;
+    let stiffness = super::identification::identify_stiffness(&arm, opts, opts.jobs)?;
+    let identified: Vec<(usize, usize, f64)> = stiffness
+        .iter()
+        .map(|e| (e.spring, e.axis, e.k_frames))
+        .collect();
+    let model = arm.model_with(&identified)?;
+    let (calibration, _) = super::identification::identify_sensor_calibration(&arm, opts)?;
+    let mut setup = *setup;
+    setup.path.rate_hz = 1.0 / opts.cycle;
+    let job = Job::new(model.clone(), &arm.spec.robot.joint_limits, setup)
+        .map_err(|e| SimError::new(format!("machining job: {e}")))?;
+    let offline =
+        job::run(&job, program, seed).map_err(|e| SimError::new(format!("offline pass: {e}")))?;
+    let runs = crate::jobs::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
+        run_program(&arm, opts, &job, &offline, mode, &model, &calibration)
+    })?
+    .into_iter()
+    .collect::<Result<Vec<_>, _>>()?;
+    Ok(ProgramResult {
+        offline,
+        runs,
+        wall_seconds: start.elapsed().as_secs_f64(),
+    })
+}
