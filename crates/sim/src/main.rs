@@ -58,6 +58,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Atlas(a) => Some(atlas::load(a)?),
         _ => None,
     };
+    let milling_input = match command {
+        Command::Milling(a) => Some(milling::load(a)?),
+        _ => None,
+    };
     let job_task = match command {
         Command::Job(a) => Some(job::load(a)?),
         _ => None,
@@ -72,7 +76,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
             Some(arm) => serial::serial_cmd(a, arm, out),
             None => Err(deflect_sim::SimError::new("serial: inputs not loaded")),
         },
-        Command::Milling(a) => milling::milling_cmd(a, out),
+        Command::Milling(a) => match &milling_input {
+            Some(i) => milling::milling_cmd(a, i, out),
+            None => Err(deflect_sim::SimError::new("milling: inputs not loaded")),
+        },
         Command::Contour(a) => contour::contour_cmd(a, out),
         Command::Atlas(a) => match &atlas_task {
             Some(t) => atlas::atlas_cmd(a, t, out),

@@ -8,6 +8,33 @@ use super::{CliError, count};
 // Arguments of `milling` (help texts with their ranges in the `help` attributes).
 #[derive(clap::Args, Debug)]
 pub struct MillingArgs {
+    /// Machining program cut by the flexible KR 300 (G-code in the workpiece frame, mm per
+    /// G21), or `groove` for the straight groove with a prescribed force step (the scenario
+    /// before programs, which uses --feed, --force, --cut, --rise-ms and --estimate-error);
+    /// default: deflect's test workpiece (data/test_workpiece.nc, built in).
+    #[arg(long)]
+    pub program: Option<String>,
+    /// Stock XMIN,YMIN,XMAX,YMAX [mm], workpiece frame; default: 0,0,140,130 for the test
+    /// workpiece, else the feed moves' bounding box grown by the tool radius.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub stock: Option<Vec<f64>>,
+    /// The workpiece frame in the KR 300's base frame: x,y,z [m], roll,pitch,yaw [rad];
+    /// default: a table in front of it, 2.52,0.07,0.92,0,0,3.141592653589793.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub placement: Option<Vec<f64>>,
+    /// Joints near the program's first pose [rad] (they choose the IK branch); default
+    /// 0,-0.9,1.4,0,-0.5,0 (the tool down over the table).
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    pub q0: Option<Vec<f64>>,
+    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, help = CELL_MM.help(
+        "Z-map cell of the stock [mm]", "At most 2^24 cells (MAX_CELLS)"
+    ))]
+    pub cell: f64,
+    #[arg(long, default_value_t = 2, help = JOBS.help(
+        "Worker threads (one run each; results do not depend on it)",
+        "0 is refused"
+    ))]
+    pub jobs: usize,
     #[arg(long, default_value_t = 25.0, help = FEED.help("Feed speed [mm/s] (paper: 25)", ""))]
     pub feed: f64,
     #[arg(long, default_value_t = 550.0, help = FORCE.help(
@@ -67,6 +94,22 @@ impl MillingArgs {
         }
         LEAD_MS.check(self.lead_ms)?;
         ESTIMATE_ERROR.check(self.estimate_error)?;
+        CELL_MM.check(self.cell)?;
+        JOBS.check_int(count(self.jobs))?;
+        let list = |flag: &str, v: &Option<Vec<f64>>, n: usize, what: &str| match v {
+            Some(v) if v.len() != n || v.iter().any(|x| !x.is_finite()) => Err(CliError::Usage(
+                format!("{flag}: {v:?}; expected {n} finite values ({what})"),
+            )),
+            _ => Ok(()),
+        };
+        list("--stock", &self.stock, 4, "XMIN,YMIN,XMAX,YMAX [mm]")?;
+        list(
+            "--placement",
+            &self.placement,
+            6,
+            "x,y,z [m], roll,pitch,yaw [rad]",
+        )?;
+        list("--q0", &self.q0, 6, "one per joint of the KR 300 [rad]")?;
         ID_POSES.check_int(count(self.id_poses))
     }
 }

@@ -41,7 +41,10 @@ pub struct JobTask {
 }
 
 /// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
-fn default_stock(program: &Program, radius: f64) -> Option<(Vector2<f64>, Vector2<f64>)> {
+pub(crate) fn default_stock(
+    program: &Program,
+    radius: f64,
+) -> Option<(Vector2<f64>, Vector2<f64>)> {
     let mut lo = Vector2::repeat(f64::INFINITY);
     let mut hi = Vector2::repeat(f64::NEG_INFINITY);
     for m in program.moves.iter().filter(|m| m.motion != Motion::Rapid) {

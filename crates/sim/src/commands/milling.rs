@@ -1,16 +1,119 @@
-//! `milling`: the online force-based compensation of Hähn and Weigold (sec. 2.2-2.6, 3) in
-//! the milling scenario of [`deflect_sim::scenes::milling`], with the command line's feed, force,
-//! timing and noise settings; prints the summary table and writes its files.
+//! `milling`: the hybrid compensation of Hähn and Weigold (sec. 2.2-2.6, 3). By default the
+//! paper's validation: deflect's test workpiece (or `--program`) cut by the flexible KR 300
+//! five ways ([`deflect_sim::scenes::milling::program`]); `--program groove` runs the straight
+//! groove with a prescribed force step ([`deflect_sim::scenes::milling::run`]) with the
+//! command line's feed, force, timing and noise settings. Prints the summary table and writes
+//! its files.
 
+use std::fmt::Write as _;
 use std::path::Path;
 
+use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::machining::Program;
+use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::job::{Setup, Stock};
+use deflect_core::machining::path::PathOptions;
+use deflect_core::mechanism::PoseIkOptions;
+use deflect_core::units::LengthUnit;
 use deflect_sim::SimError;
-use deflect_sim::scenes::milling::{self, output};
+use deflect_sim::scenes::milling::program::{self, ProgramMode, ProgramResult};
+use deflect_sim::scenes::milling::{self, output, part_map};
+use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use crate::cli::MillingArgs;
+use super::job::default_stock;
+use super::serial::read_text;
+use crate::cli::{CliError, MillingArgs};
 
-/// The `milling` command (arguments checked by [`MillingArgs::check`]).
-pub fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
+/// deflect's test workpiece after the paper's (grooves, a ramp, a circular pocket).
+const TEST_WORKPIECE: &str = include_str!("../../../../data/test_workpiece.nc");
+/// Its stock [mm]: XMIN, YMIN, XMAX, YMAX.
+const TEST_STOCK_MM: [f64; 4] = [0.0, 0.0, 140.0, 130.0];
+
+/// What `milling` runs: the groove, or a program with its setup.
+pub enum MillingInput {
+    /// The straight groove with a prescribed force step.
+    Groove,
+    /// A program, its name, the job's setup and the start joints.
+    Program(Box<(Program, String, Setup, Vec<f64>)>),
+}
+
+/// Reads and checks the program, the stock and the placement before any work.
+pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
+    let options = GcodeOptions {
+        start: Vector3::new(0.0, 0.0, 0.02),
+        units: LengthUnit::Millimetre,
+    };
+    let (program, name, builtin) = match a.program.as_deref() {
+        Some("groove") => return Ok(MillingInput::Groove),
+        Some(path) => {
+            let p = Path::new(path);
+            let text = read_text("--program", p, "G-code program")?;
+            let program = gcode::from_str(&text, &options)
+                .map_err(|e| CliError::Failure(format!("--program {path}: {e}")))?;
+            (program, path.to_string(), false)
+        }
+        None => (
+            gcode::from_str(TEST_WORKPIECE, &options)
+                .map_err(|e| CliError::Failure(format!("built-in test workpiece: {e}")))?,
+            "data/test_workpiece.nc (built in)".to_string(),
+            true,
+        ),
+    };
+    let tool = Tool::new(0.016, 3, 0.0).map_err(|e| CliError::Failure(e.to_string()))?;
+    let (min, max) = match (&a.stock, builtin) {
+        (Some(_), _) | (None, true) => {
+            let s = a.stock.as_deref().unwrap_or(&TEST_STOCK_MM);
+            match s {
+                [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => {
+                    (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3)
+                }
+                _ => {
+                    return Err(CliError::Usage(format!(
+                        "--stock {s:?}: expected XMIN < XMAX and YMIN < YMAX [mm]"
+                    )));
+                }
+            }
+        }
+        (None, false) => default_stock(&program, 0.008).ok_or_else(|| {
+            CliError::Failure(format!(
+                "{name}: no feed move (G1-G3) to size the stock from; give --stock"
+            ))
+        })?,
+    };
+    let placement = match a.placement.as_deref() {
+        Some([x, y, z, r, p, w]) => Isometry3::from_parts(
+            Translation3::new(*x, *y, *z),
+            UnitQuaternion::from_euler_angles(*r, *p, *w),
+        ),
+        Some(_) => return Err(CliError::Usage("--placement: expected 6 values".into())),
+        None => program::kr300_placement(),
+    };
+    let setup = Setup {
+        placement,
+        tool_orientation: Setup::tool_down(),
+        tool,
+        coefficients: Coefficients::AL7075_T6_CARBIDE,
+        stock: Stock {
+            min,
+            max,
+            top: 0.0,
+            cell: a.cell * 1e-3,
+        },
+        path: PathOptions {
+            rate_hz: 1.0 / (a.cycle_ms * 1e-3),
+            ..PathOptions::default()
+        },
+        ik: PoseIkOptions::default(),
+    };
+    setup
+        .validate()
+        .map_err(|e| CliError::Usage(format!("--stock/--cell/--placement: {e}")))?;
+    let q0 = a.q0.clone().unwrap_or(program::PROGRAM_SEED.to_vec());
+    Ok(MillingInput::Program(Box::new((program, name, setup, q0))))
+}
+
+/// The options the command line sets.
+fn options(a: &MillingArgs) -> milling::MillingOptions {
     let mut opts = milling::MillingOptions::default();
     let dir = nalgebra::Vector3::from(opts.force).normalize();
     opts.force = (dir * a.force).into();
@@ -22,13 +125,170 @@ pub fn milling_cmd(a: &MillingArgs, out: &Path) -> Result<(), SimError> {
     opts.estimate_error = a.estimate_error;
     opts.seed = a.seed;
     opts.id_poses = a.id_poses;
-    let r = milling::milling(&opts)?;
-    let table = output::table(&r);
-    put!("{table}");
-    output::write_all(out, &r)?;
+    opts.jobs = a.jobs;
+    opts
+}
+
+/// The `milling` command (arguments checked by [`MillingArgs::check`], inputs by [`load`]).
+pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<(), SimError> {
+    let opts = options(a);
+    let MillingInput::Program(p) = input else {
+        let r = milling::milling(&opts)?;
+        let table = output::table(&r);
+        put!("{table}");
+        output::write_all(out, &r)?;
+        say!(
+            "wrote {}/milling_summary.{{txt,csv,json}}, milling.mcap, milling_error.png, milling_stiffness.png",
+            out.display()
+        );
+        return Ok(());
+    };
+    let (program, name, setup, q0) = p.as_ref();
+    let r = program::milling_program(&opts, program, setup, q0)?;
+    let text = program_table(name, &r);
+    put!("{text}");
+    let write = |file: &str, body: &str| {
+        std::fs::write(out.join(file), body)
+            .map_err(|e| SimError::file(&out.join(file), "write", e))
+    };
+    write("milling_summary.txt", &text)?;
+    write(
+        "milling_summary.json",
+        &serde_json::to_string_pretty(&program_json(name, &r))
+            .map_err(|e| SimError::new(e.to_string()))?,
+    )?;
+    write("milling_samples.csv", &program_csv(&r))?;
+    for run in &r.runs {
+        let e = &run.part_error;
+        let label = format!(
+            "{}: floors max {:.3} mm, RMS {:.3} mm; walls {:.0} mm^2 left, {:.0} overcut",
+            run.mode.label(),
+            e.floor.max * 1e3,
+            e.floor.rms * 1e3,
+            e.material_left * 1e6,
+            e.overcut * 1e6
+        );
+        part_map::plot_part_deviation(
+            &out.join(format!("milling_part_{}.png", run.mode.label())),
+            &format!("{name}, KR 300 in rapier: the part's height above the nominal one"),
+            &r.offline.nominal,
+            &[(&label, &run.part)],
+            setup.stock.top,
+        )?;
+    }
     say!(
-        "wrote {}/milling_summary.{{txt,csv,json}}, milling.mcap, milling_error.png, milling_stiffness.png",
+        "wrote {}/milling_summary.{{txt,json}}, milling_samples.csv, milling_part_<run>.png",
         out.display()
     );
     Ok(())
+}
+
+/// The table: per run the path errors and the part's, beside the paper's figures.
+fn program_table(name: &str, r: &ProgramResult) -> String {
+    let mut t = String::new();
+    let n = r.offline.samples.len();
+    let _ = writeln!(
+        t,
+        "milling: {name} on the flexible KR 300 R2500 (rapier), {n} cycles of {:.0} ms, five \
+         runs in {:.1} s wall time",
+        1e3 / r.offline.rate_hz,
+        r.wall_seconds
+    );
+    let fmax = r
+        .offline
+        .samples
+        .iter()
+        .map(|s| s.force.norm())
+        .fold(0.0, f64::max);
+    let _ = writeln!(
+        t,
+        "largest offline force on the tool: {fmax:.0} N (paper: up to 546 N)"
+    );
+    let _ = writeln!(
+        t,
+        "run              path max  RMS    entry  exit [mm] | floors max  RMS [mm] | walls left  overcut [mm^2]"
+    );
+    for run in &r.runs {
+        let (m, e) = (&run.metrics, &run.part_error);
+        let _ = writeln!(
+            t,
+            "{:<15}  {:>8.3}  {:.3}  {:.3}  {:.3}     | {:>10.3}  {:.3}    | {:>10.1}  {:.1}",
+            run.mode.label(),
+            m.max_mm,
+            m.rms_mm,
+            m.entry_max_mm,
+            m.exit_max_mm,
+            e.floor.max * 1e3,
+            e.floor.rms * 1e3,
+            e.material_left * 1e6,
+            e.overcut * 1e6
+        );
+    }
+    let by = |mode| r.runs.iter().find(|x| x.mode == mode).map(|x| x.metrics);
+    if let (Some(u), Some(c), Some(h)) = (
+        by(ProgramMode::Uncompensated),
+        by(ProgramMode::Cartesian),
+        by(ProgramMode::Hybrid),
+    ) {
+        let _ = writeln!(
+            t,
+            "paper (Fig. 10-12): 1.4 mm uncompensated -> 0.7 mm Cartesian -> 0.3 mm with pilot \
+             control, \"78 % and more\"\nhere: {:.2} mm -> {:.2} mm -> {:.2} mm, max deviation \
+             reduced by {:.0} % (Cartesian) and {:.0} % (hybrid)",
+            u.max_mm,
+            c.max_mm,
+            h.max_mm,
+            100.0 * (1.0 - c.max_mm / u.max_mm),
+            100.0 * (1.0 - h.max_mm / u.max_mm)
+        );
+    }
+    t
+}
+
+fn program_json(name: &str, r: &ProgramResult) -> serde_json::Value {
+    serde_json::json!({
+        "program": name,
+        "cycles": r.offline.samples.len(),
+        "rate_hz": r.offline.rate_hz,
+        "wall_seconds": r.wall_seconds,
+        "runs": r.runs.iter().map(|run| serde_json::json!({
+            "mode": run.mode.label(),
+            "metrics": run.metrics,
+            "floor_error_max_m": run.part_error.floor.max,
+            "floor_error_rms_m": run.part_error.floor.rms,
+            "material_left_m2": run.part_error.material_left,
+            "overcut_m2": run.part_error.overcut,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// Every run's cycles as CSV: mode, time, line, programmed and simulated tip, force, depth,
+/// error across the feed.
+fn program_csv(r: &ProgramResult) -> String {
+    let mut t = String::from(
+        "run,time_s,line,x_m,y_m,z_m,actual_x_m,actual_y_m,actual_z_m,fx_n,fy_n,fz_n,depth_m,error_mm\n",
+    );
+    for run in &r.runs {
+        for s in &run.samples {
+            let _ = writeln!(
+                t,
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                run.mode.label(),
+                s.t,
+                s.line,
+                s.nominal[0],
+                s.nominal[1],
+                s.nominal[2],
+                s.actual[0],
+                s.actual[1],
+                s.actual[2],
+                s.force[0],
+                s.force[1],
+                s.force[2],
+                s.depth,
+                s.error_mm
+            );
+        }
+    }
+    t
 }

@@ -196,3 +196,49 @@ fn every_range_is_in_the_help() {
         }
     }
 }
+
+#[test]
+fn milling_refuses_bad_programs_stocks_and_placements_before_any_work() {
+    let d = scratch("milling-program-refusals");
+    refused(
+        &d,
+        &["milling", "--stock", "1,2,3"],
+        2,
+        &["--stock", "expected 4"],
+    );
+    refused(
+        &d,
+        &["milling", "--stock", "10,0,0,10"],
+        2,
+        &["--stock", "XMIN < XMAX"],
+    );
+    refused(
+        &d,
+        &["milling", "--placement", "1,2,3,nan,0,0"],
+        2,
+        &["--placement", "expected 6 finite"],
+    );
+    refused(&d, &["milling", "--q0", "0,0"], 2, &["--q0", "expected 6"]);
+    out_of_range(
+        &d,
+        &["milling", "--cell", "100"],
+        "--cell",
+        "100",
+        "[0.01, 10] mm",
+    );
+    refused(&d, &["milling", "--jobs", "0"], 2, &["--jobs", "0"]);
+    let bad = d.join("bad.nc");
+    std::fs::write(&bad, "G1 X10 F100\nG2 X20 Y0 R1\n").unwrap();
+    refused(
+        &d,
+        &["milling", "--program", bad.to_str().unwrap()],
+        1,
+        &["--program", "bad.nc", "line 2"],
+    );
+    refused(
+        &d,
+        &["milling", "--program", d.join("none.nc").to_str().unwrap()],
+        2,
+        &["--program", "none.nc"],
+    );
+}

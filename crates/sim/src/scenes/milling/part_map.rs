@@ -2,8 +2,9 @@
 //! Fig. 10-13): per z-map cell, the predicted height minus the nominal one, red where
 //! material is left, blue where the tool cut too deep, white where they agree, grey where
 //! neither part was cut. One panel per predicted part, one colour scale for all: symmetric,
-//! saturating at the largest floor deviation (cells both parts cut), so a wall shifted
-//! sideways shows as a saturated band whatever its depth.
+//! saturating at the floors' deviation (cells both parts cut), so a wall shifted
+//! sideways shows as a saturated band whatever its depth. The scale saturates at the 99th
+//! percentile of the floors' deviation.
 
 use std::path::Path;
 
@@ -45,15 +46,24 @@ fn deviations(nominal: &ZMap, part: &ZMap, top: f64) -> Vec<Option<f64>> {
         .collect()
 }
 
-/// The largest deviation \[m\] over the cells both parts cut (the floors), at least 1 um.
+/// The colour scale's limit \[m\]: the 99th percentile of the deviation's magnitude over the
+/// cells both parts cut (the floors), at least 1 um. A percentile, not the maximum: a wall
+/// cell the shifted tool only grazed counts as cut in both and would set the scale to the
+/// full depth, washing out every floor.
 fn floor_limit(nominal: &ZMap, parts: &[(&str, &ZMap)], top: f64) -> f64 {
     let cut = |h: f64| h < top - MIN_DEPTH;
-    parts
+    let mut d: Vec<f64> = parts
         .iter()
         .flat_map(|(_, p)| nominal.heights().iter().zip(p.heights()))
         .filter(|&(&n, &p)| cut(n) && cut(p))
         .map(|(n, p)| (p - n).abs())
-        .fold(1.0e-6, f64::max)
+        .collect();
+    if d.is_empty() {
+        return 1.0e-6;
+    }
+    let k = ((d.len() - 1) as f64 * 0.99).round() as usize;
+    let (_, v, _) = d.select_nth_unstable_by(k, f64::total_cmp);
+    v.max(1.0e-6)
 }
 
 /// Draws the heat map of each of `parts` (label, predicted z-map) against `nominal` (same
@@ -66,7 +76,10 @@ pub fn plot_part_deviation(
     top: f64,
 ) -> Result<(), SimError> {
     let (nx, ny) = nominal.shape();
-    let root = canvas(path, (560 * parts.len().max(1) as u32 + 160, 560))?;
+    let root = canvas(
+        path,
+        ((560 * parts.len().max(1) as u32 + 160).max(900), 600),
+    )?;
     let (plot, side) = figure(&root, title, 18, &[])?;
     let (plot, side) = {
         let (w, _) = plot.dim_in_pixel();
