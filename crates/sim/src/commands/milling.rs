@@ -5,7 +5,6 @@
 //! command line's feed, force, timing and noise settings. Prints the summary table and writes
 //! its files.
 
-use std::fmt::Write as _;
 use std::path::Path;
 
 use deflect_core::io::gcode::{self, GcodeOptions};
@@ -16,7 +15,8 @@ use deflect_core::machining::path::PathOptions;
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
 use deflect_sim::SimError;
-use deflect_sim::scenes::milling::program::{self, ProgramMode, ProgramResult};
+use deflect_sim::scenes::milling::program;
+use deflect_sim::scenes::milling::program_output;
 use deflect_sim::scenes::milling::{self, output, part_map};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
@@ -145,7 +145,7 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
     };
     let (program, name, setup, q0) = p.as_ref();
     let r = program::milling_program(&opts, program, setup, q0)?;
-    let text = program_table(name, &r);
+    let text = program_output::table(name, &r);
     put!("{text}");
     let write = |file: &str, body: &str| {
         std::fs::write(out.join(file), body)
@@ -154,10 +154,11 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
     write("milling_summary.txt", &text)?;
     write(
         "milling_summary.json",
-        &serde_json::to_string_pretty(&program_json(name, &r))
+        &serde_json::to_string_pretty(&program_output::json(name, &r))
             .map_err(|e| SimError::new(e.to_string()))?,
     )?;
-    write("milling_samples.csv", &program_csv(&r))?;
+    write("milling_samples.csv", &program_output::csv(&r))?;
+    program_output::write_mcap(&out.join("milling.mcap"), name, &r)?;
     for run in &r.runs {
         let e = &run.part_error;
         let label = format!(
@@ -177,118 +178,8 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
         )?;
     }
     say!(
-        "wrote {}/milling_summary.{{txt,json}}, milling_samples.csv, milling_part_<run>.png",
+        "wrote {}/milling_summary.{{txt,json}}, milling_samples.csv, milling.mcap, milling_part_<run>.png",
         out.display()
     );
     Ok(())
-}
-
-/// The table: per run the path errors and the part's, beside the paper's figures.
-fn program_table(name: &str, r: &ProgramResult) -> String {
-    let mut t = String::new();
-    let n = r.offline.samples.len();
-    let _ = writeln!(
-        t,
-        "milling: {name} on the flexible KR 300 R2500 (rapier), {n} cycles of {:.0} ms, five \
-         runs in {:.1} s wall time",
-        1e3 / r.offline.rate_hz,
-        r.wall_seconds
-    );
-    let fmax = r
-        .offline
-        .samples
-        .iter()
-        .map(|s| s.force.norm())
-        .fold(0.0, f64::max);
-    let _ = writeln!(
-        t,
-        "largest offline force on the tool: {fmax:.0} N (paper: up to 546 N)"
-    );
-    let _ = writeln!(
-        t,
-        "run              path max  RMS    entry  exit [mm] | floors max  RMS [mm] | walls left  overcut [mm^2]"
-    );
-    for run in &r.runs {
-        let (m, e) = (&run.metrics, &run.part_error);
-        let _ = writeln!(
-            t,
-            "{:<15}  {:>8.3}  {:.3}  {:.3}  {:.3}     | {:>10.3}  {:.3}    | {:>10.1}  {:.1}",
-            run.mode.label(),
-            m.max_mm,
-            m.rms_mm,
-            m.entry_max_mm,
-            m.exit_max_mm,
-            e.floor.max * 1e3,
-            e.floor.rms * 1e3,
-            e.material_left * 1e6,
-            e.overcut * 1e6
-        );
-    }
-    let by = |mode| r.runs.iter().find(|x| x.mode == mode).map(|x| x.metrics);
-    if let (Some(u), Some(c), Some(h)) = (
-        by(ProgramMode::Uncompensated),
-        by(ProgramMode::Cartesian),
-        by(ProgramMode::Hybrid),
-    ) {
-        let _ = writeln!(
-            t,
-            "paper (Fig. 10-12): 1.4 mm uncompensated -> 0.7 mm Cartesian -> 0.3 mm with pilot \
-             control, \"78 % and more\"\nhere: {:.2} mm -> {:.2} mm -> {:.2} mm, max deviation \
-             reduced by {:.0} % (Cartesian) and {:.0} % (hybrid)",
-            u.max_mm,
-            c.max_mm,
-            h.max_mm,
-            100.0 * (1.0 - c.max_mm / u.max_mm),
-            100.0 * (1.0 - h.max_mm / u.max_mm)
-        );
-    }
-    t
-}
-
-fn program_json(name: &str, r: &ProgramResult) -> serde_json::Value {
-    serde_json::json!({
-        "program": name,
-        "cycles": r.offline.samples.len(),
-        "rate_hz": r.offline.rate_hz,
-        "wall_seconds": r.wall_seconds,
-        "runs": r.runs.iter().map(|run| serde_json::json!({
-            "mode": run.mode.label(),
-            "metrics": run.metrics,
-            "floor_error_max_m": run.part_error.floor.max,
-            "floor_error_rms_m": run.part_error.floor.rms,
-            "material_left_m2": run.part_error.material_left,
-            "overcut_m2": run.part_error.overcut,
-        })).collect::<Vec<_>>(),
-    })
-}
-
-/// Every run's cycles as CSV: mode, time, line, programmed and simulated tip, force, depth,
-/// error across the feed.
-fn program_csv(r: &ProgramResult) -> String {
-    let mut t = String::from(
-        "run,time_s,line,x_m,y_m,z_m,actual_x_m,actual_y_m,actual_z_m,fx_n,fy_n,fz_n,depth_m,error_mm\n",
-    );
-    for run in &r.runs {
-        for s in &run.samples {
-            let _ = writeln!(
-                t,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-                run.mode.label(),
-                s.t,
-                s.line,
-                s.nominal[0],
-                s.nominal[1],
-                s.nominal[2],
-                s.actual[0],
-                s.actual[1],
-                s.actual[2],
-                s.force[0],
-                s.force[1],
-                s.force[2],
-                s.depth,
-                s.error_mm
-            );
-        }
-    }
-    t
 }

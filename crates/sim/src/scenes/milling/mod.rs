@@ -21,6 +21,7 @@
 //! * [`output`]: summary table, CSV, JSON, MCAP log and plots.
 //! * [`program`]: the paper's validation on a machining program (engagement where the
 //!   simulated tool is; uncompensated, offline, Cartesian, hybrid, axis-specific).
+//! * [`program_output`]: the program scenario's table, JSON, CSV and MCAP log.
 //! * [`part_map`]: the machined part against the nominal one as a heat map (Fig. 10-13).
 
 pub mod arm;
@@ -29,6 +30,7 @@ pub mod options;
 pub mod output;
 pub mod part_map;
 pub mod program;
+pub mod program_output;
 pub mod run;
 pub mod sensor;
 
