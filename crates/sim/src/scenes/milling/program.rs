@@ -76,16 +76,17 @@ pub struct ProgramSample {
     pub error_mm: f64,
 }
 
-/// Path-error metrics of a program run \[mm\] over the feed moves.
+/// Path-error metrics of a program run \[mm\] over the samples in the material (feed moves
+/// whose nominal tool engages the stock).
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct ProgramMetrics {
     /// Largest deviation across the feed while cutting.
     pub max_mm: f64,
     /// RMS deviation while cutting.
     pub rms_mm: f64,
-    /// Largest deviation within 0.1 s of a cutter entry.
+    /// Largest deviation in the material within 0.1 s of a cutter entry.
     pub entry_max_mm: f64,
-    /// Largest deviation within 0.1 s of a cutter exit.
+    /// Largest deviation in the material within 0.1 s of a cutter exit.
     pub exit_max_mm: f64,
 }
 
@@ -124,11 +125,13 @@ fn metrics(samples: &[ProgramSample], events: &[(f64, bool)], cutting: &[bool]) 
             .any(|&(te, e)| e == entry && (t - te).abs() <= 0.1)
     };
     let (mut m, mut sum, mut n) = (ProgramMetrics::default(), 0.0, 0usize);
+    // Only samples in the material count: the error the part keeps (after an exit the
+    // path stops or retracts, and an error there cuts nothing).
     for (s, &c) in samples.iter().zip(cutting) {
-        if near(s.t, true) {
+        if c && near(s.t, true) {
             m.entry_max_mm = m.entry_max_mm.max(s.error_mm);
         }
-        if near(s.t, false) {
+        if c && near(s.t, false) {
             m.exit_max_mm = m.exit_max_mm.max(s.error_mm);
         }
         if c {
