@@ -35,7 +35,7 @@ SCENARIOS = {
          "--correction", "both"],
         "run_oc_gu_y-line_5g.mcap",
     ),
-    "milling": (["milling", "--cut", "0.2", "--id-poses", "1"], "milling.mcap"),
+    "milling": (["milling", "--program", "groove", "--cut", "0.2", "--id-poses", "1"], "milling.mcap"),
     "contour": (["contour", "--step-mm", "3"], "contour.mcap"),
     "serial": (["serial", "--scale", "0.2", "--ramp", "0.05"], "serial.mcap"),
 }

@@ -1,6 +1,6 @@
 """deflect-sim milling writes an MCAP log the Python `mcap` reader can read back.
 
-Runs the release binary (`cargo run --release -p deflect-sim -- milling --cut 0.4`, the KR 300
+Runs the release binary (`cargo run --release -p deflect-sim -- milling --program groove --cut 0.4`, the KR 300
 in rapier: about 10-20 s on 2 cores, most of it the identification's static tests) and checks channels, schemas, message counts and what the runs show:
 compensation reduces the path error, pilot control more so.
 """
@@ -25,7 +25,7 @@ def out_dir(tmp_path_factory):
     out = tmp_path_factory.mktemp("milling")
     cmd = [
         "cargo", "run", "--release", "--quiet", "-p", "deflect-sim", "--",
-        "milling", "--cut", "0.4", "--out", str(out),
+        "milling", "--program", "groove", "--cut", "0.4", "--out", str(out),
     ]
     res = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=1800)
     assert res.returncode == 0, res.stderr
