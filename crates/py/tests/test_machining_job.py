@@ -25,15 +25,16 @@ def placement_under_tcp(robot):
     return t
 
 
+def slot_job(kr300, **kwargs):
+    """The job of the slot tests: the workpiece under the TCP, stock 80 x 60 mm."""
+    return deflect.MachiningJob(
+        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), **kwargs
+    )
+
+
 @pytest.fixture(scope="module")
 def slot_run(kr300):
-    job = deflect.MachiningJob(
-        kr300,
-        placement_under_tcp(kr300),
-        stock_min=(0.0, -0.03),
-        stock_max=(0.08, 0.03),
-        cell=5e-4,
-    )
+    job = slot_job(kr300, cell=5e-4)
     program = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
     return job.run(program, KR300_POSE)
 
@@ -89,9 +90,7 @@ def test_the_compensated_gcode_and_pilot_signal(slot_run):
 
 
 def test_faults_name_the_program_line(kr300):
-    job = deflect.MachiningJob(
-        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03)
-    )
+    job = slot_job(kr300)
     off = deflect.GcodeProgram.from_text("G0 X-10 Y0 Z5\nG1 Z-2 F1500\nX70\n", start=[0, 0, 0.02])
     with pytest.raises(deflect.InputError, match="program line 3 .*spindle"):
         job.run(off, KR300_POSE)
@@ -137,9 +136,7 @@ def test_programs_and_jobs_pickle_bit_for_bit(kr300):
     assert back == program and len(back) == len(program)
     np.testing.assert_array_equal(back.end, program.end)
     np.testing.assert_array_equal(back.center, program.center)
-    job = deflect.MachiningJob(
-        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), helix=0.3
-    )
+    job = slot_job(kr300, helix=0.3)
     again = pickle.loads(pickle.dumps(job))
     assert again == job and copy.deepcopy(job) == job
     slot = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
@@ -152,9 +149,7 @@ def test_programs_and_jobs_pickle_bit_for_bit(kr300):
 
 
 def test_a_points_csv_program_runs_like_its_gcode_twin(kr300):
-    job = deflect.MachiningJob(
-        kr300, placement_under_tcp(kr300), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03)
-    )
+    job = slot_job(kr300)
     points = deflect.GcodeProgram.from_points_text(
         "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n-10,0,5,0,13000\n-10,0,-2,1500,13000\n70,0,-2,1500,13000\n",
         start=[0.0, 0.0, 0.02],

@@ -492,6 +492,35 @@ impl McapLog {
         Ok(())
     }
 
+    /// One run by the convention: its metadata record, a channel per `(topic, kind)` under its
+    /// prefix, the scene `lines` at t = 0 on the last topic (a `SceneUpdate`), then for each
+    /// sample its time and one message per other topic, in `topics` order.
+    pub fn write_run<S>(
+        &mut self,
+        info: &RunInfo,
+        topics: &[(&str, Kind)],
+        lines: &[Line],
+        samples: &[S],
+        messages: impl Fn(&S) -> (f64, Vec<Value>),
+    ) -> Result<(), SimError> {
+        self.run_metadata(info)?;
+        let prefix = info.prefix();
+        let mut channels = Vec::with_capacity(topics.len());
+        for (topic, kind) in topics {
+            channels.push(self.channel(&prefix, topic, *kind)?);
+        }
+        if let Some(ch) = channels.last() {
+            self.write(*ch, 0.0, &scene_update(0.0, lines))?;
+        }
+        for s in samples {
+            let (t, msgs) = messages(s);
+            for (ch, msg) in channels.iter().zip(&msgs) {
+                self.write(*ch, t, msg)?;
+            }
+        }
+        Ok(())
+    }
+
     /// Finishes the file; returns the number of messages written.
     pub fn finish(mut self) -> Result<usize, SimError> {
         if let Err(e) = self.w.finish() {

@@ -8,7 +8,7 @@ use serde_json::json;
 
 use super::{MillingOptions, MillingResult, Mode, Sample};
 use crate::SimError;
-use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
+use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo};
 use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
     present,
@@ -285,14 +285,7 @@ fn messages(run: &str, s: &Sample) -> [serde_json::Value; 10] {
 pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
     let mut log = McapLog::create(path)?;
     for run in &r.runs {
-        let info = run_info(r, run.mode);
-        log.run_metadata(&info)?;
-        let prefix = info.prefix();
         let name = run.mode.label();
-        let mut channels = Vec::new();
-        for (topic, kind) in TOPICS {
-            channels.push(log.channel(&prefix, topic, kind)?);
-        }
         let lines = [
             Line {
                 id: format!("{name}/nominal"),
@@ -307,14 +300,9 @@ pub fn write_mcap(path: &Path, r: &MillingResult) -> Result<usize, SimError> {
                 closed: false,
             },
         ];
-        if let Some(ch) = channels.last() {
-            log.write(*ch, 0.0, &scene_update(0.0, &lines))?;
-        }
-        for s in &run.samples {
-            for (ch, msg) in channels.iter().zip(messages(name, s)) {
-                log.write(*ch, s.t, &msg)?;
-            }
-        }
+        log.write_run(&run_info(r, run.mode), &TOPICS, &lines, &run.samples, |s| {
+            (s.t, messages(name, s).to_vec())
+        })?;
     }
     log.finish()
 }

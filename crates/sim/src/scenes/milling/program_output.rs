@@ -7,7 +7,7 @@ use std::path::Path;
 
 use super::program::{ProgramMode, ProgramResult, ProgramRun};
 use crate::SimError;
-use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
+use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo};
 use crate::plot_style::{Role, color};
 use plotters::style::Color as _;
 
@@ -165,14 +165,7 @@ fn run_info(name: &str, r: &ProgramResult, run: &ProgramRun) -> RunInfo {
 pub fn write_mcap(path: &Path, name: &str, r: &ProgramResult) -> Result<usize, SimError> {
     let mut log = McapLog::create(path)?;
     for run in &r.runs {
-        let info = run_info(name, r, run);
-        log.run_metadata(&info)?;
-        let prefix = info.prefix();
         let label = run.mode.label();
-        let mut channels = Vec::new();
-        for (topic, kind) in TOPICS {
-            channels.push(log.channel(&prefix, topic, kind)?);
-        }
         let lines = [
             Line {
                 id: format!("{label}/nominal"),
@@ -187,22 +180,23 @@ pub fn write_mcap(path: &Path, name: &str, r: &ProgramResult) -> Result<usize, S
                 closed: false,
             },
         ];
-        if let Some(ch) = channels.last() {
-            log.write(*ch, 0.0, &scene_update(0.0, &lines))?;
-        }
-        for s in &run.samples {
-            let t = s.t;
-            let messages = [
-                mcap_log::point(label, t, s.nominal),
-                mcap_log::point(label, t, s.actual),
-                mcap_log::force(label, t, s.force),
-                mcap_log::path_error(label, t, s.error_mm * 1e-3),
-                mcap_log::poses_in_frame(t, s.actual, IDENTITY),
-            ];
-            for (ch, msg) in channels.iter().zip(messages) {
-                log.write(*ch, t, &msg)?;
-            }
-        }
+        log.write_run(
+            &run_info(name, r, run),
+            &TOPICS,
+            &lines,
+            &run.samples,
+            |s| {
+                let t = s.t;
+                let msgs = vec![
+                    mcap_log::point(label, t, s.nominal),
+                    mcap_log::point(label, t, s.actual),
+                    mcap_log::force(label, t, s.force),
+                    mcap_log::path_error(label, t, s.error_mm * 1e-3),
+                    mcap_log::poses_in_frame(t, s.actual, IDENTITY),
+                ];
+                (t, msgs)
+            },
+        )?;
     }
     log.finish()
 }
