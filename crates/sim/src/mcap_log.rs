@@ -70,6 +70,10 @@ pub enum Kind {
     PilotControl,
     /// A state machine's state, `state` (text).
     TracerState,
+    /// The cutter's engagement with the material: axial `depth` \[m\], engaged angles
+    /// `entry_angle`, `exit_angle` \[rad\] (Altintas' immersion angles: clockwise from the
+    /// tool frame's +y with the feed along +x), number of engaged `arcs`.
+    Engagement,
     /// `foxglove.PosesInFrame`.
     PosesInFrame,
     /// `foxglove.SceneUpdate` (lines only).
@@ -77,7 +81,7 @@ pub enum Kind {
 }
 
 /// Every [`Kind`].
-pub const KINDS: [Kind; 11] = [
+pub const KINDS: [Kind; 12] = [
     Kind::Point,
     Kind::Pose,
     Kind::Force,
@@ -87,6 +91,7 @@ pub const KINDS: [Kind; 11] = [
     Kind::PathError,
     Kind::PilotControl,
     Kind::TracerState,
+    Kind::Engagement,
     Kind::PosesInFrame,
     Kind::SceneUpdate,
 ];
@@ -143,6 +148,7 @@ impl Kind {
             Self::PathError => "deflect.PathError",
             Self::PilotControl => "deflect.PilotControl",
             Self::TracerState => "deflect.TracerState",
+            Self::Engagement => "deflect.Engagement",
             Self::PosesInFrame => "foxglove.PosesInFrame",
             Self::SceneUpdate => "foxglove.SceneUpdate",
         }
@@ -205,6 +211,22 @@ impl Kind {
                     "state",
                     json!({"type": "string", "description": "tracer phase"}),
                 )],
+            ),
+            Self::Engagement => deflect_schema(
+                "engagement of the cutter with the material",
+                &[
+                    ("depth", num("m (axial depth, 0 in air)")),
+                    (
+                        "entry_angle",
+                        num("rad (first engaged immersion angle, clockwise from +y, feed +x)"),
+                    ),
+                    ("exit_angle", num("rad (last engaged angle)")),
+                    (
+                        "arcs",
+                        json!({"type": "integer", "minimum": 0,
+                                   "description": "1 (number of engaged arcs)"}),
+                    ),
+                ],
             ),
             Self::PosesInFrame => json!({
                 "title": "foxglove.PosesInFrame", "type": "object", "properties": {
@@ -294,6 +316,12 @@ pub fn path_error(run: &str, t: f64, distance: f64) -> Value {
 /// A `deflect.PilotControl` message.
 pub fn pilot(run: &str, t: f64, weight: f64) -> Value {
     json!({"timestamp": stamp(t), "run": run, "weight": weight})
+}
+
+/// A `deflect.Engagement` message: `depth` \[m\], `entry_angle`, `exit_angle` \[rad\], `arcs`.
+pub fn engagement(run: &str, t: f64, depth: f64, angles: [f64; 2], arcs: usize) -> Value {
+    json!({"timestamp": stamp(t), "run": run, "depth": depth, "entry_angle": angles[0],
+           "exit_angle": angles[1], "arcs": arcs})
 }
 
 /// A `deflect.TracerState` message.

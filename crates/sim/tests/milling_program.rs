@@ -6,6 +6,7 @@ use deflect_core::machining::job::{Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
+use deflect_sim::scenes::milling::MillingArm;
 use deflect_sim::scenes::milling::options::MillingOptions;
 use deflect_sim::scenes::milling::program::{self, ProgramMode};
 use nalgebra::{Vector2, Vector3};
@@ -41,7 +42,10 @@ fn a_short_groove_five_ways() {
     // a fraction of it; the command line's main thread has 8 MB).
     let r = std::thread::Builder::new()
         .stack_size(16 << 20)
-        .spawn(move || program::milling_program(&opts, &p, &setup, &program::PROGRAM_SEED))
+        .spawn(move || {
+            let arm = MillingArm::kr300()?;
+            program::milling_program(&opts, &arm, &p, &setup, &program::PROGRAM_SEED)
+        })
         .unwrap()
         .join()
         .unwrap()
@@ -81,6 +85,18 @@ fn a_short_groove_five_ways() {
     assert!(
         hyb.metrics.entry_max_mm < cart.metrics.entry_max_mm,
         "{:?}",
+        hyb.metrics
+    );
+    // At the exit (the stock ends at x = 30 mm, the groove at 40 mm) the force falls away:
+    // the Cartesian loop, lagging, keeps part of its correction; pilot control lets it go
+    // with the offline force.
+    assert_eq!(r.cuts.len(), 1, "{:?}", r.cuts);
+    assert!(
+        hyb.metrics.exit_max_mm < cart.metrics.exit_max_mm
+            && cart.metrics.exit_max_mm < un.metrics.exit_max_mm,
+        "{:?} {:?} {:?}",
+        un.metrics,
+        cart.metrics,
         hyb.metrics
     );
     assert!(hyb.metrics.rms_mm < cart.metrics.rms_mm);

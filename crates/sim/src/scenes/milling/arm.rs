@@ -1,5 +1,6 @@
-//! The milling robot: the 6-axis KUKA KR 300 R2500 of Hähn and Weigold (2020, Fig. 2 and
-//! Table 1) from deflect's `robots/` files, simulated by the serial testbed's flexible arm
+//! The milling robot: by default the 6-axis KUKA KR 300 R2500 of Hähn and Weigold (2020,
+//! Fig. 2 and Table 1) from deflect's `robots/` files, or any arm of a URDF and stiffness
+//! file, simulated by the serial testbed's flexible arm
 //! ([`crate::urdf_arm`]: one body per actuated joint and per virtual joint, spring joints,
 //! servo-driven motors), with its force/torque sensor frame, a rigid pose IK for the
 //! commanded path and the virtual-joint model rebuilt with identified stiffnesses.
@@ -27,9 +28,12 @@ pub struct SpringInfo {
 /// The milling robot (see the module docs).
 #[derive(Debug, Clone)]
 pub struct MillingArm {
+    /// Its name for tables and logs.
+    pub name: String,
     /// The arm: bodies and the library model of the same files.
     pub spec: ArmSpec,
-    /// The TCP in the force/torque sensor's frame (the URDF's fixed joints after `ft_sensor`).
+    /// The TCP in the force/torque sensor's frame: the URDF's fixed joints after a link
+    /// [`SENSOR_LINK`] on the chain, else the identity (the sensor at the TCP).
     pub sensor_to_tcp: Isometry3<f64>,
     /// The finite virtual joints, chain order.
     pub springs: Vec<SpringInfo>,
@@ -65,14 +69,33 @@ fn fixed_transform(robot: &urdf_rs::Robot, from: &str, to: &str) -> Result<Isome
     Err(format!("link '{to}' does not descend from '{from}'"))
 }
 
+/// The link whose frame is the force/torque sensor's, when the URDF has one.
+pub const SENSOR_LINK: &str = "ft_sensor";
+
 impl MillingArm {
     /// The built-in KR 300 R2500 (URDF and stiffness file of `robots/`), TCP at the tool tip,
     /// sensor at link `ft_sensor`.
     pub fn kr300() -> Result<Self, SimError> {
         let spec = urdf_arm::kr300()?;
         let parsed = urdf::parse(KR300_URDF)?;
-        let sensor_to_tcp = fixed_transform(&parsed, "ft_sensor", "tcp")
-            .map_err(|e| SimError::new(format!("KR 300 sensor frame: {e}")))?;
+        Self::from_spec("KR 300 R2500", spec, &parsed, "tcp")
+    }
+
+    /// Any arm: `spec` built from a URDF and stiffness file ([`urdf_arm::arm_spec`]), `parsed`
+    /// the same URDF, `tip` the TCP link. The sensor is at link [`SENSOR_LINK`] when the URDF
+    /// has it between a fixed-joint run and the tip, else at the TCP.
+    pub fn from_spec(
+        name: &str,
+        spec: ArmSpec,
+        parsed: &urdf_rs::Robot,
+        tip: &str,
+    ) -> Result<Self, SimError> {
+        let sensor_to_tcp = if parsed.links.iter().any(|l| l.name == SENSOR_LINK) {
+            fixed_transform(parsed, SENSOR_LINK, tip)
+                .map_err(|e| SimError::new(format!("{name}: sensor frame: {e}")))?
+        } else {
+            Isometry3::identity()
+        };
         let model = &spec.robot.model;
         let springs = model
             .elements()
@@ -98,6 +121,7 @@ impl MillingArm {
         let rigid = serial::Model::new(model.clone(), Payload::point(0.0, Vector3::zeros()))?
             .with_joint_limits(&spec.robot.joint_limits)?;
         Ok(Self {
+            name: name.to_string(),
             spec,
             sensor_to_tcp,
             springs,

@@ -67,16 +67,35 @@ fn stiffness_of(id: &StiffnessIdentification, spring: usize, axis: usize) -> (f6
         .unwrap_or((f64::NAN, f64::NAN))
 }
 
-/// The identification poses: the milling pose and two others across the workspace \[rad\].
-pub fn poses(q0: &[f64]) -> Vec<Vec<f64>> {
-    let offsets: [[f64; 6]; 3] = [
+/// Whether joints `q` lie within `limits` \[rad\].
+fn inside(q: &[f64], limits: &[(f64, f64)]) -> bool {
+    q.iter()
+        .zip(limits)
+        .all(|(&v, &(lo, hi))| v >= lo && v <= hi)
+}
+
+/// The identification poses: the milling pose `q0` and two others across the workspace
+/// \[rad\] (offsets on the first six joints, the second tried mirrored when it leaves
+/// `limits`; a pose outside both ways is left out, so an arm with narrow ranges may be
+/// identified from fewer poses).
+pub fn poses(q0: &[f64], limits: &[(f64, f64)]) -> Vec<Vec<f64>> {
+    const OFFSETS: [[f64; 6]; 3] = [
         [0.0; 6],
         [0.5, 0.15, -0.2, 0.6, -0.3, 0.8],
         [-0.6, -0.1, 0.25, -0.7, 0.35, -0.5],
     ];
-    offsets
+    OFFSETS
         .iter()
-        .map(|o| q0.iter().zip(o).map(|(q, d)| q + d).collect())
+        .filter_map(|o| {
+            [1.0, -1.0].iter().find_map(|sign| {
+                let q: Vec<f64> = q0
+                    .iter()
+                    .enumerate()
+                    .map(|(k, q)| q + sign * o.get(k).copied().unwrap_or(0.0))
+                    .collect();
+                inside(&q, limits).then_some(q)
+            })
+        })
         .collect()
 }
 
@@ -172,7 +191,7 @@ pub fn identify_stiffness(
     opts: &MillingOptions,
     jobs: usize,
 ) -> Result<Vec<JointEstimate>, SimError> {
-    let qs: Vec<Vec<f64>> = poses(&opts.q0)
+    let qs: Vec<Vec<f64>> = poses(&opts.q0, &arm.spec.robot.joint_limits)
         .into_iter()
         .take(opts.id_poses.clamp(1, 3))
         .collect();
@@ -253,6 +272,10 @@ pub fn identify_sensor_calibration(
                 if let Some(v) = q.get_mut(k) {
                     *v += d;
                 }
+            }
+            // Only orientations the arm can take (a narrow wrist gives fewer).
+            if !inside(&q, &arm.spec.robot.joint_limits) {
+                continue;
             }
             let tcp = arm.forward(&q)?;
             let sensor = tcp * s2t.inverse();

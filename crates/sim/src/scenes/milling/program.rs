@@ -8,7 +8,7 @@
 //! compared with the nominal one.
 
 use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
-use deflect_core::machining::engagement::{self, Contact};
+use deflect_core::machining::engagement;
 use deflect_core::machining::job::{self, Job, Report, SurfaceError};
 use deflect_core::machining::stock::{Cutter, ZMap};
 use deflect_core::vjm::{Model, Vector6};
@@ -72,6 +72,10 @@ pub struct ProgramSample {
     pub force: [f64; 3],
     /// Axial depth of the engagement where the tool is \[m\] (0 in air).
     pub depth: f64,
+    /// First entry and last exit angle of the engagement \[rad\] (0, 0 in air).
+    pub angles: [f64; 2],
+    /// Number of engaged arcs.
+    pub arcs: usize,
     /// Distance of the tip from the programmed one across the feed \[mm\].
     pub error_mm: f64,
 }
@@ -84,9 +88,11 @@ pub struct ProgramMetrics {
     pub max_mm: f64,
     /// RMS deviation while cutting.
     pub rms_mm: f64,
-    /// Largest deviation in the material within 0.1 s of a cutter entry.
+    /// Largest deviation in the material while a cutter enters it (the entry phase of a
+    /// [`Cut`]: the first tool radius of travel).
     pub entry_max_mm: f64,
-    /// Largest deviation in the material within 0.1 s of a cutter exit.
+    /// Largest deviation in the material while a cutter leaves it (the last tool radius of
+    /// travel of a [`Cut`], where the force falls away).
     pub exit_max_mm: f64,
 }
 
@@ -105,40 +111,66 @@ pub struct ProgramRun {
     pub samples: Vec<ProgramSample>,
 }
 
-/// Times \[s\] where the offline pass's tool enters (`true`) or leaves (`false`) the material.
-pub fn entries_and_exits(offline: &Report) -> Vec<(f64, bool)> {
-    let cutting = |c: &Contact| !c.arcs().is_empty();
-    offline
-        .samples
-        .windows(2)
-        .filter_map(|w| {
-            let (a, b) = (cutting(&w[0].contact), cutting(&w[1].contact));
-            (a != b).then_some((w[1].path.time, b))
-        })
-        .collect()
+/// One cut of the offline pass: the tool in the material from `entry` to `exit` \[s\].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Cut {
+    /// Time the tool enters the material \[s\].
+    pub entry: f64,
+    /// Time it leaves \[s\].
+    pub exit: f64,
+    /// Time the cutter takes to travel its radius at the cut's feed \[s\]: how long the
+    /// engagement builds up after the entry and falls away before the exit.
+    pub phase: f64,
 }
 
-fn metrics(samples: &[ProgramSample], events: &[(f64, bool)], cutting: &[bool]) -> ProgramMetrics {
-    let near = |t: f64, entry: bool| {
-        events
-            .iter()
-            .any(|&(te, e)| e == entry && (t - te).abs() <= 0.1)
-    };
+/// The cuts of the offline pass with a steady part, the tool in the material at least twice
+/// the entry phase (tool radius over the cut's feed): the tool grazing a wall it has cut
+/// (light, intermittent engagement of the pocket's last turns) has no entry or exit whose
+/// error the compensation could cause, so it is not counted as one.
+pub fn cuts(offline: &Report, radius: f64) -> Vec<Cut> {
+    let mut out = Vec::new();
+    let mut open: Option<(f64, f64)> = None;
+    for s in &offline.samples {
+        let cutting = !s.contact.arcs().is_empty();
+        open = match (open, cutting) {
+            (None, true) => Some((s.path.time, s.path.speed)),
+            (Some((t0, v)), true) => Some((t0, v.max(s.path.speed))),
+            (Some((t0, v)), false) => {
+                let phase = radius / v.max(f64::MIN_POSITIVE);
+                if s.path.time - t0 >= 2.0 * phase {
+                    out.push(Cut {
+                        entry: t0,
+                        exit: s.path.time,
+                        phase,
+                    });
+                }
+                None
+            }
+            (None, false) => None,
+        };
+    }
+    out
+}
+
+fn metrics(samples: &[ProgramSample], cuts: &[Cut], cutting: &[bool]) -> ProgramMetrics {
     let (mut m, mut sum, mut n) = (ProgramMetrics::default(), 0.0, 0usize);
     // Only samples in the material count: the error the part keeps (after an exit the
     // path stops or retracts, and an error there cuts nothing).
     for (s, &c) in samples.iter().zip(cutting) {
-        if c && near(s.t, true) {
-            m.entry_max_mm = m.entry_max_mm.max(s.error_mm);
+        if !c {
+            continue;
         }
-        if c && near(s.t, false) {
-            m.exit_max_mm = m.exit_max_mm.max(s.error_mm);
+        for cut in cuts {
+            if s.t >= cut.entry && s.t <= cut.entry + cut.phase {
+                m.entry_max_mm = m.entry_max_mm.max(s.error_mm);
+            }
+            if s.t >= cut.exit - cut.phase && s.t <= cut.exit {
+                m.exit_max_mm = m.exit_max_mm.max(s.error_mm);
+            }
         }
-        if c {
-            m.max_mm = m.max_mm.max(s.error_mm);
-            sum += s.error_mm * s.error_mm;
-            n += 1;
-        }
+        m.max_mm = m.max_mm.max(s.error_mm);
+        sum += s.error_mm * s.error_mm;
+        n += 1;
     }
     m.rms_mm = (sum / n.max(1) as f64).sqrt();
     m
@@ -207,7 +239,7 @@ pub fn run_program(
     let mut q_cmd = q_start.clone();
     let mut tip_prev: Option<Vector3<f64>> = None;
     let mut force_w = Vector3::zeros();
-    let mut depth = 0.0;
+    let mut engaged: Option<(f64, [f64; 2], usize)> = None;
     let mut samples = Vec::with_capacity(offline.samples.len());
     let mut cutting = Vec::with_capacity(offline.samples.len());
     let joints = |s: &job::JobSample| -> Vec<f64> {
@@ -244,7 +276,9 @@ pub fn run_program(
             nominal: p_nom.into(),
             actual: tip.into(),
             force: force_w.into(),
-            depth,
+            depth: engaged.map_or(0.0, |e| e.0),
+            angles: engaged.map_or([0.0; 2], |e| e.1),
+            arcs: engaged.map_or(0, |e| e.2),
             error_mm: across.norm() * 1e3,
         });
         cutting.push(s.path.feed_move && !s.contact.arcs().is_empty());
@@ -299,7 +333,9 @@ pub fn run_program(
             let (f, w) = job::contact_wrench(setup, &contact, &s.path.direction, fz)
                 .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
             force_w = f;
-            depth = contact.span().map_or(0.0, |a| a.depth);
+            engaged = contact
+                .span()
+                .map(|a| (a.depth, [a.entry, a.exit], contact.arcs().len()));
             let _ = part
                 .cut(&cutter, &tip_prev.unwrap_or(tip), &tip)
                 .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
@@ -308,11 +344,11 @@ pub fn run_program(
             sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w_base));
         }
     }
-    let events = entries_and_exits(offline);
+    let cuts = cuts(offline, cutter.radius());
     let part_error = offline.surface_error(&part);
     Ok(ProgramRun {
         mode,
-        metrics: metrics(&samples, &events, &cutting),
+        metrics: metrics(&samples, &cuts, &cutting),
         part,
         part_error,
         samples,
@@ -341,8 +377,13 @@ pub const PROGRAM_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
 /// Everything the program scenario produced.
 #[derive(Debug, Clone)]
 pub struct ProgramResult {
+    /// The arm's name.
+    pub robot: String,
     /// The offline pass (identified model, nominal forces).
     pub offline: Report,
+    /// The offline pass's cuts, whose first and last tool radius of travel are the entry
+    /// and exit phases of the metrics.
+    pub cuts: Vec<Cut>,
     /// One run per mode, in [`ProgramMode::ALL`] order.
     pub runs: Vec<ProgramRun>,
     /// Wall-clock seconds.
@@ -354,19 +395,19 @@ pub struct ProgramResult {
 /// then one rapier run per mode on worker threads (results do not depend on their number).
 pub fn milling_program(
     opts: &MillingOptions,
+    arm: &MillingArm,
     program: &deflect_core::machining::Program,
     setup: &job::Setup,
     seed: &[f64],
 ) -> Result<ProgramResult, SimError> {
     let start = std::time::Instant::now();
-    let arm = MillingArm::kr300()?;
-    let stiffness = super::identification::identify_stiffness(&arm, opts, opts.jobs)?;
+    let stiffness = super::identification::identify_stiffness(arm, opts, opts.jobs)?;
     let identified: Vec<(usize, usize, f64)> = stiffness
         .iter()
         .map(|e| (e.spring, e.axis, e.k_frames))
         .collect();
     let model = arm.model_with(&identified)?;
-    let (calibration, _) = super::identification::identify_sensor_calibration(&arm, opts)?;
+    let (calibration, _) = super::identification::identify_sensor_calibration(arm, opts)?;
     let mut setup = *setup;
     setup.path.rate_hz = 1.0 / opts.cycle;
     let job = Job::new(model.clone(), &arm.spec.robot.joint_limits, setup)
@@ -380,11 +421,13 @@ pub fn milling_program(
         ..opts.clone()
     };
     let runs = crate::jobs::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
-        run_program(&arm, &run_opts, &job, &offline, mode, &model, &calibration)
+        run_program(arm, &run_opts, &job, &offline, mode, &model, &calibration)
     })?
     .into_iter()
     .collect::<Result<Vec<_>, _>>()?;
     Ok(ProgramResult {
+        robot: arm.name.clone(),
+        cuts: cuts(&offline, setup.tool.diameter / 2.0),
         offline,
         runs,
         wall_seconds: start.elapsed().as_secs_f64(),

@@ -18,8 +18,9 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
     let n = r.offline.samples.len();
     let _ = writeln!(
         t,
-        "milling: {name} on the flexible KR 300 R2500 (rapier), {n} cycles of {:.0} ms, five \
-         runs in {:.1} s wall time",
+        "milling: {name} on the flexible {} (rapier), {n} cycles of {:.0} ms, five runs in \
+         {:.1} s wall time",
+        r.robot,
         1e3 / r.offline.rate_hz,
         r.wall_seconds
     );
@@ -53,6 +54,12 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
             e.overcut * 1e6
         );
     }
+    let _ = writeln!(
+        t,
+        "entry, exit: the largest deviation over the first and the last tool radius of travel \
+         of each of the {} cuts (tool in the material at least twice that long)",
+        r.cuts.len()
+    );
     let by = |mode| r.runs.iter().find(|x| x.mode == mode).map(|x| x.metrics);
     if let (Some(u), Some(c), Some(h)) = (
         by(ProgramMode::Uncompensated),
@@ -62,11 +69,15 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
         let _ = writeln!(
             t,
             "paper (Fig. 10-12): 1.4 mm uncompensated -> 0.7 mm Cartesian -> 0.3 mm with pilot \
-             control, \"78 % and more\"\nhere: {:.2} mm -> {:.2} mm -> {:.2} mm, max deviation \
+             control at the cutter exits, \"78 % and more\"\nhere: max {:.2} mm -> {:.2} mm -> \
+             {:.2} mm, at the cutter exits {:.2} mm -> {:.2} mm -> {:.2} mm; max deviation \
              reduced by {:.0} % (Cartesian) and {:.0} % (hybrid)",
             u.max_mm,
             c.max_mm,
             h.max_mm,
+            u.exit_max_mm,
+            c.exit_max_mm,
+            h.exit_max_mm,
             100.0 * (1.0 - c.max_mm / u.max_mm),
             100.0 * (1.0 - h.max_mm / u.max_mm)
         );
@@ -78,9 +89,11 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
 pub fn json(name: &str, r: &ProgramResult) -> serde_json::Value {
     serde_json::json!({
         "program": name,
+        "robot": r.robot,
         "cycles": r.offline.samples.len(),
         "rate_hz": r.offline.rate_hz,
         "wall_seconds": r.wall_seconds,
+        "cuts": r.cuts,
         "runs": r.runs.iter().map(|run| serde_json::json!({
             "mode": run.mode.label(),
             "metrics": run.metrics,
@@ -92,17 +105,18 @@ pub fn json(name: &str, r: &ProgramResult) -> serde_json::Value {
     })
 }
 
-/// Every run's cycles as CSV: mode, time, line, programmed and simulated tip, force, depth,
-/// error across the feed.
+/// Every run's cycles as CSV: mode, time, line, programmed and simulated tip, force, the
+/// engagement (depth, first entry and last exit angle, arcs), error across the feed.
 pub fn csv(r: &ProgramResult) -> String {
     let mut t = String::from(
-        "run,time_s,line,x_m,y_m,z_m,actual_x_m,actual_y_m,actual_z_m,fx_n,fy_n,fz_n,depth_m,error_mm\n",
+        "run,time_s,line,x_m,y_m,z_m,actual_x_m,actual_y_m,actual_z_m,fx_n,fy_n,fz_n,depth_m,\
+         entry_rad,exit_rad,arcs,error_mm\n",
     );
     for run in &r.runs {
         for s in &run.samples {
             let _ = writeln!(
                 t,
-                "{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
+                "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 run.mode.label(),
                 s.t,
                 s.line,
@@ -116,6 +130,9 @@ pub fn csv(r: &ProgramResult) -> String {
                 s.force[1],
                 s.force[2],
                 s.depth,
+                s.angles[0],
+                s.angles[1],
+                s.arcs,
                 s.error_mm
             );
         }
@@ -124,10 +141,11 @@ pub fn csv(r: &ProgramResult) -> String {
 }
 
 /// Topics per run, as `/milling/<run>/<topic>`, and their message types.
-pub const TOPICS: [(&str, Kind); 6] = [
+pub const TOPICS: [(&str, Kind); 7] = [
     ("nominal", Kind::Point),
     ("actual", Kind::Point),
     ("process_force", Kind::Force),
+    ("engagement", Kind::Engagement),
     ("error", Kind::PathError),
     ("tcp_pose", Kind::PosesInFrame),
     ("paths", Kind::SceneUpdate),
@@ -146,8 +164,7 @@ fn run_info(name: &str, r: &ProgramResult, run: &ProgramRun) -> RunInfo {
     RunInfo {
         scenario: "milling".into(),
         run: run.mode.label().into(),
-        robot: "KUKA KR 300 R2500 (robots/ URDF and stiffness file) as a flexible arm in rapier"
-            .into(),
+        robot: format!("{} as a flexible arm in rapier", r.robot),
         motion: format!(
             "{name}: {} cycles of {:.1} ms, positions in the workpiece frame",
             r.offline.samples.len(),
@@ -191,6 +208,7 @@ pub fn write_mcap(path: &Path, name: &str, r: &ProgramResult) -> Result<usize, S
                     mcap_log::point(label, t, s.nominal),
                     mcap_log::point(label, t, s.actual),
                     mcap_log::force(label, t, s.force),
+                    mcap_log::engagement(label, t, s.depth, s.angles, s.arcs),
                     mcap_log::path_error(label, t, s.error_mm * 1e-3),
                     mcap_log::poses_in_frame(t, s.actual, IDENTITY),
                 ];
