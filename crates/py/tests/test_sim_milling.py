@@ -90,3 +90,69 @@ def test_other_outputs(out_dir):
     for name in ["milling_error.png", "milling_stiffness.png"]:
         assert (out_dir / name).stat().st_size > 10_000
     assert (out_dir / "milling_summary.csv").read_text().startswith("run,max_mm")
+
+
+# A user's arm and tool: the UR5 of example-robot-data with deflect's assumed stiffness file,
+# a 1 mm slot with a 6 mm two-flute mill through a 30 mm block (about 6 s in release).
+SLOT = """(1 mm slot, 6 mm two-flute mill)
+G21 G90
+G0 X-8 Y10 Z5
+S18000 M3
+G1 Z-1 F600
+X38
+G0 Z5
+M30
+"""
+
+
+@pytest.fixture(scope="module")
+def ur5_out(tmp_path_factory):
+    from conftest import ur5_urdf
+
+    out = tmp_path_factory.mktemp("milling_ur5")
+    program = out / "slot.nc"
+    program.write_text(SLOT)
+    cmd = [
+        "cargo", "run", "--release", "--quiet", "-p", "deflect-sim", "--", "milling",
+        "--urdf", str(ur5_urdf()), "--stiffness", str(REPO / "robots/ur5/ur5_stiffness.toml"),
+        "--tip", "tool0", "--placement", "0.55,0.10,0.17,0,0,0",
+        "--q0=0,-1.2,1.8,-2.17,-1.57,0", "--program", str(program), "--stock", "0,0,30,20",
+        "--diameter", "6", "--flutes", "2", "--out", str(out),
+    ]
+    res = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=1800)
+    assert res.returncode == 0, res.stderr
+    return out
+
+
+def test_a_users_arm_tool_and_program(ur5_out):
+    s = json.loads((ur5_out / "milling_summary.json").read_text())
+    assert s["robot"] == "ur5"
+    m = {r["mode"]: r["metrics"] for r in s["runs"]}
+    assert list(m) == ["uncompensated", "offline", "cartesian", "hybrid", "axis_specific"]
+    # One cut from the block's edge at x = 0 to its end at x = 30 mm.
+    assert len(s["cuts"]) == 1
+    cut = s["cuts"][0]
+    # The phase is the radius over the feed. In the material from the centre at -3.375 mm
+    # (the probes three quarters of a 0.5 mm cell outside the cutter meet x = 0) until it
+    # passes the block's end at 30 mm (the side probes leave the walls): 33.375 mm at 10 mm/s.
+    assert cut["phase"] == pytest.approx(0.003 / 0.010, rel=1e-9)
+    assert cut["exit"] - cut["entry"] == pytest.approx(3.3375, abs=0.01)
+    # The UR5 bends by tenths of a millimetre under the slot's tens of newtons; the offline
+    # compensation takes nearly all of it, the online loops most of it.
+    assert m["uncompensated"]["max_mm"] > 0.2
+    assert m["offline"]["max_mm"] < 0.1 * m["uncompensated"]["max_mm"]
+    for mode in ("cartesian", "hybrid", "axis_specific"):
+        assert m[mode]["rms_mm"] < 0.5 * m["uncompensated"]["rms_mm"], (mode, m)
+
+
+def test_the_engagement_is_logged(ur5_out):
+    _, msgs = read(ur5_out / "milling.mcap")
+    eng = [d for topic, _, d in msgs if topic == "/milling/offline/engagement"]
+    assert eng and set(eng[0]) == {"timestamp", "run", "depth", "entry_angle", "exit_angle", "arcs"}
+    cutting = [d for d in eng if d["arcs"] > 0]
+    # Mid-slot: the full front half engaged (0..pi) at the programmed 1 mm depth.
+    mid = cutting[len(cutting) // 2]
+    assert mid["depth"] == pytest.approx(1e-3, abs=2e-5)
+    assert mid["entry_angle"] == pytest.approx(0.0, abs=0.05)
+    assert mid["exit_angle"] == pytest.approx(3.14159, abs=0.05)
+    assert all(d["depth"] == 0 and d["arcs"] == 0 for d in eng[:10])

@@ -102,9 +102,39 @@ fn one_line(msg: &str) -> String {
         .join("; ")
 }
 
+/// clap's own outcome: help and version as clap prints them (exit 0); a usage error as the
+/// one `error: ...` line of every other refusal (clap's usage block and help hint dropped, the
+/// missing or wrong flags kept), exit 2.
+fn clap_exit(e: &clap::Error) -> std::process::ExitCode {
+    use clap::error::ErrorKind;
+    use std::io::Write;
+    if matches!(
+        e.kind(),
+        ErrorKind::DisplayHelp
+            | ErrorKind::DisplayVersion
+            | ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand
+    ) {
+        // Nothing more can be reported if stdout or stderr itself fails.
+        let _ = e.print();
+        return std::process::ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+    }
+    let text = e.to_string();
+    let body = text.split("\n\nUsage:").next().unwrap_or(&text);
+    let body = body
+        .split("\n\nFor more information")
+        .next()
+        .unwrap_or(body);
+    let body = body.trim().trim_start_matches("error:").trim();
+    let _ = writeln!(std::io::stderr(), "error: {}", one_line(body));
+    std::process::ExitCode::from(2)
+}
+
 fn main() -> std::process::ExitCode {
     install_panic_hook();
-    let cli = Cli::parse();
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => return clap_exit(&e),
+    };
     let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| execute(&cli)));
     let panicked = PANIC.lock().ok().and_then(|mut p| p.take());
     let error = match (result, panicked) {

@@ -29,7 +29,7 @@ pub struct AtlasArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         default_value = "0,0,-1"
     )]
     pub tool_axis: Vec<f64>,
@@ -38,7 +38,7 @@ pub struct AtlasArgs {
     #[arg(
         long,
         value_delimiter = ',',
-        allow_negative_numbers = true,
+        allow_hyphen_values = true,
         default_value = "-386.1,386.1,0,0,0,0"
     )]
     pub wrench: Vec<f64>,
@@ -49,7 +49,7 @@ pub struct AtlasArgs {
     pub angle_step: f64,
     /// IK seed [rad], comma-separated, one per joint: a posture near the work; default the
     /// KR 300's milling pose, else the middle of the joint limits.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub seed: Option<Vec<f64>>,
     #[arg(long, default_value_t = 2, help = JOBS.help(
         "Worker threads (one grid row each; results do not depend on it)",

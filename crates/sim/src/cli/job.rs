@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use super::range::*;
-use super::{CliError, count};
+use super::{CliError, ToolArgs, count};
 
 // Arguments of `job` (help texts with their ranges in the `help` attributes).
 #[derive(clap::Args, Debug)]
@@ -34,16 +34,16 @@ pub struct JobArgs {
     pub tip: Option<String>,
     /// Joints near the program's first pose [rad], comma-separated (they choose the IK
     /// branch); default for the KR 300: 0,-0.9,1.4,0,-0.5,0 (the tool down over the table).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub seed: Option<Vec<f64>>,
     /// The workpiece frame in the robot's base frame: x,y,z [m], roll,pitch,yaw [rad] (URDF
     /// convention, Rz(yaw) Ry(pitch) Rx(roll)); the tool points down its z. Default for the
     /// KR 300: a table in front of it, 2.45,0.02,0.92,0,0,3.141592653589793.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub placement: Option<Vec<f64>>,
     /// Stock block in the workpiece frame: XMIN,YMIN,XMAX,YMAX [mm]; default: the bounding
     /// box of the feed moves grown by the tool radius.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub stock: Option<Vec<f64>>,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, help = TOP_MM.help(
         "Stock top in the workpiece frame [mm]", "CAM's usual zero"
@@ -53,21 +53,8 @@ pub struct JobArgs {
         "Z-map cell [mm]", "At most 2^24 cells (MAX_CELLS)"
     ))]
     pub cell: f64,
-    #[arg(long, default_value_t = 16.0, allow_negative_numbers = true, help = DIAMETER_MM.help(
-        "Flat end mill diameter [mm]", "Default: the 16 mm tool of Hähn and Weigold"
-    ))]
-    pub diameter: f64,
-    #[arg(long, default_value_t = 3, help = FLUTES.help("Flutes", ""))]
-    pub flutes: u32,
-    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, help = HELIX_DEG.help(
-        "Helix angle [deg]", "The per-revolution force does not depend on it"
-    ))]
-    pub helix: f64,
-    /// Cutting and edge coefficients of the material: k_tc,k_rc,k_ac [N/mm^2],
-    /// k_te,k_re,k_ae [N/mm]; default Al7075-T6 with a carbide tool (Zhang et al. 2021,
-    /// Table 5), a stand-in for the paper's AW2017.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
-    pub coefficients: Option<Vec<f64>>,
+    #[command(flatten)]
+    pub tool: ToolArgs,
     #[arg(long, default_value_t = 250.0, allow_negative_numbers = true, help = RATE_HZ.help(
         "Sampling rate of the program [Hz]", "Default: the 4 ms RSI cycle of the paper"
     ))]
@@ -99,9 +86,7 @@ impl JobArgs {
     pub fn check(&self) -> Result<(), CliError> {
         TOP_MM.check(self.top)?;
         CELL_MM.check(self.cell)?;
-        DIAMETER_MM.check(self.diameter)?;
-        FLUTES.check_int(self.flutes)?;
-        HELIX_DEG.check(self.helix)?;
+        self.tool.check()?;
         RATE_HZ.check(self.rate)?;
         PATH_ACCELERATION.check(self.acceleration)?;
         PATH_JERK.check(self.jerk)?;
@@ -125,12 +110,6 @@ impl JobArgs {
             "x,y,z [m], roll,pitch,yaw [rad]",
         )?;
         list("--stock", &self.stock, 4, "XMIN,YMIN,XMAX,YMAX [mm]")?;
-        list(
-            "--coefficients",
-            &self.coefficients,
-            6,
-            "k_tc,k_rc,k_ac [N/mm^2], k_te,k_re,k_ae [N/mm]",
-        )?;
         if let Some(s) = &self.stock
             && let [x0, y0, x1, y1] = s.as_slice()
             && !(x1 > x0 && y1 > y0)

@@ -2,13 +2,15 @@
 
 use deflect_sim::scenes::parallel::params;
 
+use std::path::PathBuf;
+
 use super::range::*;
-use super::{CliError, count};
+use super::{CliError, ToolArgs, count};
 
 // Arguments of `milling` (help texts with their ranges in the `help` attributes).
 #[derive(clap::Args, Debug)]
 pub struct MillingArgs {
-    /// Machining program cut by the flexible KR 300 (G-code in the workpiece frame, mm per
+    /// Machining program cut by the flexible arm (G-code in the workpiece frame, mm per
     /// G21), or `groove` for the straight groove with a prescribed force step (the scenario
     /// before programs, which uses --feed, --force, --cut, --rise-ms and --estimate-error);
     /// default: deflect's test workpiece (data/test_workpiece.nc, built in).
@@ -16,16 +18,34 @@ pub struct MillingArgs {
     pub program: Option<String>,
     /// Stock XMIN,YMIN,XMAX,YMAX [mm], workpiece frame; default: 0,0,140,130 for the test
     /// workpiece, else the feed moves' bounding box grown by the tool radius.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub stock: Option<Vec<f64>>,
-    /// The workpiece frame in the KR 300's base frame: x,y,z [m], roll,pitch,yaw [rad];
-    /// default: a table in front of it, 2.52,0.07,0.92,0,0,3.141592653589793.
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    /// Robot URDF (a regular file of at most 16 MiB) for programs; default: the KR 300 R2500
+    /// built into deflect-sim. Needs --stiffness, --placement and --q0. The force/torque
+    /// sensor is at a link named ft_sensor if the URDF has one, else at the TCP.
+    #[arg(long, requires_all = ["stiffness", "placement", "q0"])]
+    pub urdf: Option<PathBuf>,
+    /// Stiffness TOML of the virtual joints (deflect's format); default: the KR 300's.
+    #[arg(long, requires = "urdf")]
+    pub stiffness: Option<PathBuf>,
+    /// Base link of the chain (default: the URDF's root).
+    #[arg(long, requires = "urdf")]
+    pub base: Option<String>,
+    /// Tip link: the tool tip; default "tcp" for the KR 300, else the URDF's deepest leaf.
+    #[arg(long, requires = "urdf")]
+    pub tip: Option<String>,
+    /// The workpiece frame in the arm's base frame: x,y,z [m], roll,pitch,yaw [rad] (the tool
+    /// points down its z); default for the KR 300: a table in front of it,
+    /// 2.52,0.07,0.92,0,0,3.141592653589793.
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub placement: Option<Vec<f64>>,
-    /// Joints near the program's first pose [rad] (they choose the IK branch); default
+    /// Joints near the program's first pose [rad], one per joint (they choose the IK branch;
+    /// the stiffness identification's first pose with --urdf); default for the KR 300
     /// 0,-0.9,1.4,0,-0.5,0 (the tool down over the table).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub q0: Option<Vec<f64>>,
+    #[command(flatten)]
+    pub tool: ToolArgs,
     #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, help = CELL_MM.help(
         "Z-map cell of the stock [mm]", "At most 2^24 cells (MAX_CELLS)"
     ))]
@@ -109,7 +129,14 @@ impl MillingArgs {
             6,
             "x,y,z [m], roll,pitch,yaw [rad]",
         )?;
-        list("--q0", &self.q0, 6, "one per joint of the KR 300 [rad]")?;
+        if let Some(q) = &self.q0
+            && q.iter().any(|x| !x.is_finite())
+        {
+            return Err(CliError::Usage(format!(
+                "--q0: {q:?}; expected finite joint angles [rad]"
+            )));
+        }
+        self.tool.check()?;
         ID_POSES.check_int(count(self.id_poses))
     }
 }

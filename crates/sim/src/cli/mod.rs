@@ -61,6 +61,7 @@ mod parallel;
 /// The ranges of the numeric flags.
 mod range;
 mod serial;
+mod tool;
 
 pub use atlas::AtlasArgs;
 pub use contour::ContourArgs;
@@ -69,6 +70,7 @@ pub use milling::MillingArgs;
 pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
 pub use range::*;
 pub use serial::{ModelArg, SerialArgs};
+pub use tool::ToolArgs;
 
 // The command line.
 #[derive(Parser, Debug)]

@@ -29,7 +29,7 @@ pub struct SerialArgs {
     /// Start joints [rad], comma-separated, one per actuated joint; default: the KR 300's
     /// milling pose, else the most dexterous pose of the grid {-1, -0.5, 0, 0.5, 1}^n rad
     /// inside the joint limits (largest smallest singular value of the Jacobian).
-    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub q0: Option<Vec<f64>>,
     #[arg(long, allow_negative_numbers = true, help = PAYLOAD_MASS.help(
         "Payload and tool mass [kg], a cube of aluminium (2700 kg/m^3) centred on the tool \

@@ -21,7 +21,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::serial::{load_robot, read_text};
 use super::stdout;
-use crate::cli::{CliError, JobArgs};
+use crate::cli::{CliError, JobArgs, ToolArgs};
 
 /// The built-in program: a groove, a ramp and a circular pocket (mm).
 const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.nc");
@@ -117,7 +117,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         Translation3::new(*x, *y, *z),
         UnitQuaternion::from_euler_angles(*roll, *pitch, *yaw),
     );
-    let radius = 0.5e-3 * a.diameter;
+    let radius = 0.5e-3 * a.tool.diameter;
     let (min, max) = match &a.stock {
         Some(s) => match s.as_slice() {
             [x0, y0, x1, y1] => (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3),
@@ -129,21 +129,11 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             ))
         })?,
     };
-    let coefficients = match &a.coefficients {
-        Some(c) => match c.as_slice() {
-            [tc, rc, ac, te, re, ae] => {
-                Coefficients::new(tc * 1e6, rc * 1e6, ac * 1e6, te * 1e3, re * 1e3, ae * 1e3)
-                    .map_err(|e| CliError::Usage(format!("--coefficients: {e}")))?
-            }
-            _ => return Err(CliError::Usage("--coefficients: expected 6 values".into())),
-        },
-        None => Coefficients::AL7075_T6_CARBIDE,
-    };
+    let (tool, coefficients) = tool_and_material(&a.tool)?;
     let setup = Setup {
         placement,
         tool_orientation: Setup::tool_down(),
-        tool: Tool::new(a.diameter * 1e-3, a.flutes, a.helix.to_radians())
-            .map_err(|e| CliError::Usage(format!("--diameter/--flutes/--helix: {e}")))?,
+        tool,
         coefficients,
         stock: Stock {
             min,
@@ -299,4 +289,20 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
          job_summary.{{txt,json}}\n",
         out.display()
     ))
+}
+
+/// The cutter and the material of `--diameter/--flutes/--helix` and `--coefficients` (ranges
+/// checked by [`crate::cli::ToolArgs::check`]; the core's checks name what else is wrong).
+pub(crate) fn tool_and_material(a: &ToolArgs) -> Result<(Tool, Coefficients), CliError> {
+    let tool = Tool::new(a.diameter * 1e-3, a.flutes, a.helix.to_radians())
+        .map_err(|e| CliError::Usage(format!("--diameter/--flutes/--helix: {e}")))?;
+    let coefficients = match a.coefficients.as_deref() {
+        Some(&[tc, rc, ac, te, re, ae]) => {
+            Coefficients::new(tc * 1e6, rc * 1e6, ac * 1e6, te * 1e3, re * 1e3, ae * 1e3)
+                .map_err(|e| CliError::Usage(format!("--coefficients: {e}")))?
+        }
+        Some(_) => return Err(CliError::Usage("--coefficients: expected 6 values".into())),
+        None => Coefficients::AL7075_T6_CARBIDE,
+    };
+    Ok((tool, coefficients))
 }

@@ -9,7 +9,6 @@ use std::path::Path;
 
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::Program;
-use deflect_core::machining::cutting::{Coefficients, Tool};
 use deflect_core::machining::job::{Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::mechanism::PoseIkOptions;
@@ -17,11 +16,11 @@ use deflect_core::units::LengthUnit;
 use deflect_sim::SimError;
 use deflect_sim::scenes::milling::program;
 use deflect_sim::scenes::milling::program_output;
-use deflect_sim::scenes::milling::{self, output, part_map};
+use deflect_sim::scenes::milling::{self, MillingArm, output, part_map};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::job::default_stock;
-use super::serial::read_text;
+use super::job::{default_stock, tool_and_material};
+use super::serial::{load_arm, read_text};
 use crate::cli::{CliError, MillingArgs};
 
 /// deflect's test workpiece after the paper's (grooves, a ramp, a circular pocket).
@@ -33,8 +32,22 @@ const TEST_STOCK_MM: [f64; 4] = [0.0, 0.0, 140.0, 130.0];
 pub enum MillingInput {
     /// The straight groove with a prescribed force step.
     Groove,
-    /// A program, its name, the job's setup and the start joints.
-    Program(Box<(Program, String, Setup, Vec<f64>)>),
+    /// A program with its arm and setup.
+    Program(Box<ProgramInput>),
+}
+
+/// A program run's inputs, checked.
+pub struct ProgramInput {
+    /// The program.
+    pub program: Program,
+    /// Its name in the outputs.
+    pub name: String,
+    /// The job's setup (placement, tool, material, stock, path).
+    pub setup: Setup,
+    /// Joints near the first pose \[rad\].
+    pub q0: Vec<f64>,
+    /// The arm.
+    pub arm: MillingArm,
 }
 
 /// Reads and checks the program, the stock and the placement before any work.
@@ -44,6 +57,13 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         units: LengthUnit::Millimetre,
     };
     let (program, name, builtin) = match a.program.as_deref() {
+        Some("groove") if a.urdf.is_some() => {
+            return Err(CliError::Usage(
+                "--program groove runs the paper's KR 300 with a prescribed force; --urdf \
+                 applies to programs"
+                    .into(),
+            ));
+        }
         Some("groove") => return Ok(MillingInput::Groove),
         Some(path) => {
             let p = Path::new(path);
@@ -59,7 +79,45 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
             true,
         ),
     };
-    let tool = Tool::new(0.016, 3, 0.0).map_err(|e| CliError::Failure(e.to_string()))?;
+    let (tool, coefficients) = tool_and_material(&a.tool)?;
+    let files = load_arm(
+        a.urdf.as_deref(),
+        a.stiffness.as_deref(),
+        a.base.as_deref(),
+        a.tip.as_deref(),
+    )?;
+    let robot = &files.spec.robot;
+    let dof = robot.model.dof();
+    if dof < 6 {
+        return Err(CliError::Failure(format!(
+            "{}, tip {}: the chain has {dof} actuated joints; the machining job's pose IK \
+             (the tool down the workpiece's z) needs at least 6",
+            files.urdf_name, files.tip
+        )));
+    }
+    let q0 = a.q0.clone().unwrap_or(program::PROGRAM_SEED.to_vec());
+    if q0.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
+            q0.len(),
+            robot.joint_names.join(", ")
+        )));
+    }
+    for (k, (&q, &(lo, hi))) in q0.iter().zip(&robot.joint_limits).enumerate() {
+        if q < lo || q > hi {
+            return Err(CliError::Usage(format!(
+                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
+                robot.joint_names.get(k).map_or("?", String::as_str)
+            )));
+        }
+    }
+    let arm_name = if files.builtin {
+        "KR 300 R2500".to_string()
+    } else {
+        files.parsed.name.clone()
+    };
+    let arm = MillingArm::from_spec(&arm_name, files.spec, &files.parsed, &files.tip)
+        .map_err(|e| CliError::Failure(format!("{}: {}", files.urdf_name, e.0)))?;
     let (min, max) = match (&a.stock, builtin) {
         (Some(_), _) | (None, true) => {
             let s = a.stock.as_deref().unwrap_or(&TEST_STOCK_MM);
@@ -74,7 +132,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
                 }
             }
         }
-        (None, false) => default_stock(&program, 0.008).ok_or_else(|| {
+        (None, false) => default_stock(&program, tool.diameter / 2.0).ok_or_else(|| {
             CliError::Failure(format!(
                 "{name}: no feed move (G1-G3) to size the stock from; give --stock"
             ))
@@ -92,7 +150,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         placement,
         tool_orientation: Setup::tool_down(),
         tool,
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
+        coefficients,
         stock: Stock {
             min,
             max,
@@ -108,8 +166,13 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
     setup
         .validate()
         .map_err(|e| CliError::Usage(format!("--stock/--cell/--placement: {e}")))?;
-    let q0 = a.q0.clone().unwrap_or(program::PROGRAM_SEED.to_vec());
-    Ok(MillingInput::Program(Box::new((program, name, setup, q0))))
+    Ok(MillingInput::Program(Box::new(ProgramInput {
+        program,
+        name,
+        setup,
+        q0,
+        arm,
+    })))
 }
 
 /// The options the command line sets.
@@ -143,8 +206,24 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
         );
         return Ok(());
     };
-    let (program, name, setup, q0) = p.as_ref();
-    let r = program::milling_program(&opts, program, setup, q0)?;
+    let ProgramInput {
+        program,
+        name,
+        setup,
+        q0,
+        arm,
+    } = p.as_ref();
+    // An arm of the user's is identified at its start joints (the KR 300 at the paper's
+    // milling pose, as in the groove scenario).
+    let opts = if a.urdf.is_none() {
+        opts
+    } else {
+        milling::MillingOptions {
+            q0: q0.clone(),
+            ..opts
+        }
+    };
+    let r = program::milling_program(&opts, arm, program, setup, q0)?;
     let text = program_output::table(name, &r);
     put!("{text}");
     let write = |file: &str, body: &str| {
@@ -171,7 +250,10 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
         );
         part_map::plot_part_deviation(
             &out.join(format!("milling_part_{}.png", run.mode.label())),
-            &format!("{name}, KR 300 in rapier: the part's height above the nominal one"),
+            &format!(
+                "{name}, {} in rapier: the part's height above the nominal one",
+                r.robot
+            ),
             &r.offline.nominal,
             &[(&label, &run.part)],
             setup.stock.top,

@@ -184,45 +184,79 @@ fn dexterous_pose(spec: &ArmSpec, reach: f64) -> Option<Vec<f64>> {
     best.filter(|(s, _)| *s > 1e-6).map(|(_, q)| q)
 }
 
-/// Reads and checks the arm, the start pose and the settings before any work.
-pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
+/// An arm read for the rapier scenes (`serial`, `milling`): its bodies and model, the parsed
+/// URDF, the TCP link, its name in messages (the flag and file) and whether it is built in.
+pub(crate) struct ArmFiles {
+    pub spec: ArmSpec,
+    pub parsed: urdf_rs::Robot,
+    pub tip: String,
+    pub urdf_name: String,
+    pub builtin: bool,
+}
+
+/// Reads `--urdf`/`--stiffness` (default: the built-in KR 300) and builds the arm from
+/// `--base` to `--tip` (default "tcp" on the KR 300, else the URDF's deepest leaf); each file
+/// is checked alone first, so that an error names the file it is in.
+pub(crate) fn load_arm(
+    urdf_path: Option<&Path>,
+    stiffness_path: Option<&Path>,
+    base: Option<&str>,
+    tip: Option<&str>,
+) -> Result<ArmFiles, CliError> {
     const URDF: &str = "robot URDF";
     const STIFF: &str = "stiffness TOML (deflect's virtual-joint format)";
-    let builtin = a.urdf.is_none();
-    let urdf_text = match &a.urdf {
+    let builtin = urdf_path.is_none();
+    let urdf_text = match urdf_path {
         Some(p) => read_text("--urdf", p, URDF)?,
         None => KR300_URDF.to_string(),
     };
-    let stiff_text = match &a.stiffness {
+    let stiff_text = match stiffness_path {
         Some(p) => read_text("--stiffness", p, STIFF)?,
         None => KR300_STIFFNESS.to_string(),
     };
-    let urdf_name = a
-        .urdf
-        .as_ref()
-        .map_or("the built-in KR 300 URDF".to_string(), |p| {
-            format!("--urdf {}", p.display())
-        });
-    let stiff_name = a
-        .stiffness
-        .as_ref()
-        .map_or("the built-in KR 300 stiffness file".to_string(), |p| {
-            format!("--stiffness {}", p.display())
-        });
-    // Each file alone first, so that an error names the file it is in.
+    let urdf_name = urdf_path.map_or("the built-in KR 300 URDF".to_string(), |p| {
+        format!("--urdf {}", p.display())
+    });
+    let stiff_name = stiffness_path.map_or("the built-in KR 300 stiffness file".to_string(), |p| {
+        format!("--stiffness {}", p.display())
+    });
     let parsed = urdf::parse(&urdf_text)
         .map_err(|e| CliError::Failure(format!("{urdf_name}: not a valid {URDF}: {e}")))?;
     stiffness::from_str(&stiff_text)
         .map_err(|e| CliError::Failure(format!("{stiff_name}: not a valid {STIFF}: {e}")))?;
-    let tip = match (&a.tip, builtin) {
-        (Some(t), _) => t.clone(),
+    let tip = match (tip, builtin) {
+        (Some(t), _) => t.to_string(),
         (None, true) => "tcp".to_string(),
-        (None, false) => deepest_leaf(&parsed, a.base.as_deref())
-            .map_err(|e| CliError::Usage(format!("--tip: {e}")))?,
+        (None, false) => {
+            deepest_leaf(&parsed, base).map_err(|e| CliError::Usage(format!("--tip: {e}")))?
+        }
     };
-    let spec = arm_spec(&urdf_text, &stiff_text, a.base.as_deref(), &tip).map_err(|e| {
+    let spec = arm_spec(&urdf_text, &stiff_text, base, &tip).map_err(|e| {
         CliError::Failure(format!("{urdf_name} with {stiff_name}, tip {tip}: {}", e.0))
     })?;
+    Ok(ArmFiles {
+        spec,
+        parsed,
+        tip,
+        urdf_name,
+        builtin,
+    })
+}
+
+/// Reads and checks the arm, the start pose and the settings before any work.
+pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
+    let ArmFiles {
+        spec,
+        tip,
+        urdf_name,
+        builtin,
+        ..
+    } = load_arm(
+        a.urdf.as_deref(),
+        a.stiffness.as_deref(),
+        a.base.as_deref(),
+        a.tip.as_deref(),
+    )?;
     let model = &spec.robot.model;
     let dof = model.dof();
     if dof < 6 {

@@ -242,3 +242,123 @@ fn milling_refuses_bad_programs_stocks_and_placements_before_any_work() {
         &["--program", "none.nc"],
     );
 }
+
+#[test]
+fn milling_checks_the_arm_tool_and_material_before_any_work() {
+    let d = scratch("milling-arm-refusals");
+    let urdf = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/kr300/kr300_r2500.urdf"
+    );
+    let stiff = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../robots/kr300/kr300_r2500_stiffness.toml"
+    );
+    // A user's arm needs its stiffness, where the workpiece is and joints near it.
+    refused(&d, &["milling", "--urdf", urdf], 2, &["--stiffness"]);
+    refused(
+        &d,
+        &["milling", "--urdf", urdf, "--stiffness", stiff],
+        2,
+        &["--placement", "--q0"],
+    );
+    let arm = [
+        "milling",
+        "--urdf",
+        urdf,
+        "--stiffness",
+        stiff,
+        "--tip",
+        "tcp",
+        "--placement",
+        "2.52,0.07,0.92,0,0,3.14159",
+    ];
+    let with = |extra: &[&'static str]| -> Vec<&str> { arm.iter().chain(extra).copied().collect() };
+    refused(
+        &d,
+        &with(&["--q0", "0,-0.9,1.4,0,-0.5"]),
+        2,
+        &["--q0", "5 values given", "expected 6", "a1, a2"],
+    );
+    refused(
+        &d,
+        &with(&["--q0", "0,-0.9,1.4,0,-0.5,9"]),
+        2,
+        &["--q0", "joint 5", "outside its limits"],
+    );
+    refused(
+        &d,
+        &with(&["--q0", "0,-0.9,1.4,0,-0.5,0", "--program", "groove"]),
+        2,
+        &["--program groove", "--urdf"],
+    );
+    refused(
+        &d,
+        &with(&["--q0", "0,-0.9,1.4,0,-0.5,0", "--tip", "nowhere"]),
+        2,
+        &["--tip"],
+    );
+    refused(
+        &d,
+        &["milling", "--coefficients", "1,2,3"],
+        2,
+        &["--coefficients", "3 values", "expected 6"],
+    );
+    refused(
+        &d,
+        &["milling", "--material", "700,170,220,28,27,nan"],
+        2,
+        &["--coefficients", "not finite"],
+    );
+    refused(
+        &d,
+        &["milling", "--material", "-700,170,220,28,27,1"],
+        2,
+        &["--coefficients"],
+    );
+    out_of_range(
+        &d,
+        &["milling", "--diameter", "0"],
+        "--diameter",
+        "0",
+        "[0.1, 200] mm",
+    );
+    out_of_range(
+        &d,
+        &["milling", "--flutes", "17"],
+        "--flutes",
+        "17",
+        "[1, 16]",
+    );
+}
+
+#[test]
+fn comma_lists_may_start_with_a_minus_sign() {
+    // clap reads "-0.1,0,..." as a flag unless the list takes hyphen values: a q0, a
+    // placement or a wrench starting with a negative number must parse, and its checks run.
+    let d = scratch("negative-lists");
+    refused(
+        &d,
+        &["serial", "--q0", "-0.1,0,0"],
+        2,
+        &["--q0", "3 values given"],
+    );
+    refused(
+        &d,
+        &["milling", "--placement", "-2.5,0.07,nan,0,0,0"],
+        2,
+        &["--placement", "expected 6 finite"],
+    );
+    refused(
+        &d,
+        &["milling", "--stock", "-10,-10,-20,10"],
+        2,
+        &["--stock", "XMIN < XMAX"],
+    );
+    refused(
+        &d,
+        &["job", "--placement=-2.45,0.02,0.92,0,0"],
+        2,
+        &["--placement", "5 values"],
+    );
+}
