@@ -51,6 +51,19 @@
 // Invert the linearized deflection `C(q) w`.
 #define DEFLECT_SERIAL_LINEARIZED 1
 
+// IK task: the full pose (6 rows; at least 6 joints). The default with 6 or more joints.
+#define DEFLECT_TASK_POSE 0
+
+// IK task: position and tool axis (5 rows; the spin about the TCP's z is free). The default
+// with 5 joints.
+#define DEFLECT_TASK_POSITION_AND_AXIS 1
+
+// IK task: position and the spin about the tool axis (4 rows; a SCARA).
+#define DEFLECT_TASK_POSITION_AND_SPIN 2
+
+// IK task: position only (3 rows). The default with 3 or 4 joints.
+#define DEFLECT_TASK_POSITION 3
+
 // File force unit: newton.
 #define DEFLECT_FORCE_UNIT_NEWTON 0
 
@@ -281,8 +294,11 @@ typedef struct DeflectSerialTick {
   double position_error;
   // Orientation error left [rad].
   double orientation_error;
-  // Estimated smallest singular value of the joint Jacobian at the command.
+  // Estimated smallest singular value of the task's joint Jacobian at the command.
   double sigma_min;
+  // Rotation left about the axes the task leaves free [rad] (0 for the full pose):
+  // what an arm with fewer joints cannot correct.
+  double free_rotation;
 } DeflectSerialTick;
 
 // Path limits of a motion: speed [m/s], acceleration [m/s^2], jerk [m/s^3], each finite
@@ -538,13 +554,15 @@ DeflectStatus deflect_dalembert_step(struct DeflectDalembert *corrector,
                                      const double *acceleration,
                                      struct DeflectCorrectedTick2 *out);
 
-// Creates a corrector for `robot` (6..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
-// limits are copied in) carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
+// Creates a corrector for `robot` (3..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
+// limits are copied in; the IK task the joints control: the pose with 6 or more, position
+// and tool axis with 5, position with 3 or 4, see `deflect_serial_dalembert_set_task`)
+// carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
 // `DEFLECT_SERIAL_LINEARIZED`), warm-started from `seed[seed_len]` (the joints the motion
 // starts from; `seed_len` must be the dof). Pose IK: 20 iterations, 1e-8 m and 1e-8 rad.
 // Init time: allocates the handle. On failure `*out` is NULL.
 //
-// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 6
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 3
 // joints), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (negative mass,
 // asymmetric inertia, unknown model) or `DEFLECT_ERR_SINGULAR` (inertia not positive
 // semi-definite).
@@ -578,6 +596,16 @@ void deflect_serial_dalembert_destroy(struct DeflectSerialDalembert *corrector);
 DeflectStatus deflect_serial_dalembert_set_loads(struct DeflectSerialDalembert *corrector,
                                                  int32_t link_inertia,
                                                  const double *gravity);
+
+// Sets the IK task (`DEFLECT_TASK_*`): what the corrector makes the loaded TCP reach, the
+// rest reported in the tick's `free_rotation`. Init time (rebuilds the model); the warm
+// start is kept. Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT` (unknown task)
+// or `DEFLECT_ERR_WRONG_LENGTH` (more task rows than the robot has joints).
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread.
+DeflectStatus deflect_serial_dalembert_set_task(struct DeflectSerialDalembert *corrector,
+                                                int32_t task);
 
 // Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
 // that does not continue the last one. Returns `DEFLECT_ERR_NULL`,

@@ -260,11 +260,9 @@ impl Task<'_> {
             Err(_) => return Err(Reach::OutOfReach),
         };
         let q = sol.q.get(..dof).unwrap_or(&[]);
-        let outside = q
-            .iter()
-            .zip(self.limits)
-            .any(|(v, (lo, hi))| *v < *lo || *v > *hi);
-        if outside {
+        if crate::mechanism::check_limits(q, self.limits, crate::mechanism::JOINT_LIMIT_TOLERANCE)
+            .is_err()
+        {
             return Err(Reach::JointLimit);
         }
         // The pose IK succeeded: a failing deflection is the spring-angle guard (or an

@@ -445,3 +445,118 @@ fn link_inertia_and_gravity_match_the_core() {
         deflect_serial_robot_destroy(robot);
     }
 }
+
+#[test]
+fn an_arm_with_fewer_joints_corrects_its_task_and_reports_the_rest() {
+    use deflect_core::dalembert::serial;
+    let (urdf, toml) = (
+        repo("robots/scara/scara4.urdf"),
+        repo("robots/scara/scara4_stiffness.toml"),
+    );
+    let mut robot = ptr::null_mut();
+    let mut err = [0 as c_char; 256];
+    let q0 = [0.4, -1.1, 0.08, 0.3];
+    let p = DeflectPayload {
+        mass: 1.5,
+        com: [0.0, 0.0, 0.03],
+        inertia: [0.0; 9],
+    };
+    // SAFETY: NUL-terminated strings, live handles, readable inputs, writable outputs.
+    unsafe {
+        assert_eq!(
+            deflect_serial_robot_load(
+                urdf.as_ptr(),
+                toml.as_ptr(),
+                c"tcp".as_ptr(),
+                &mut robot,
+                err.as_mut_ptr(),
+                err.len(),
+            ),
+            DEFLECT_OK
+        );
+        let mut c = ptr::null_mut();
+        assert_eq!(
+            deflect_serial_dalembert_create(robot, &p, DEFLECT_SERIAL_EXACT, q0.as_ptr(), 4, &mut c),
+            DEFLECT_OK,
+            "a 4-axis SCARA is accepted"
+        );
+        assert_eq!(
+            deflect_serial_dalembert_set_task(c, DEFLECT_TASK_POSE),
+            DEFLECT_ERR_WRONG_LENGTH
+        );
+        assert_eq!(
+            deflect_serial_dalembert_set_task(c, 42),
+            DEFLECT_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            deflect_serial_dalembert_set_task(ptr::null_mut(), DEFLECT_TASK_POSITION),
+            DEFLECT_ERR_NULL
+        );
+        assert_eq!(
+            deflect_serial_dalembert_set_task(c, DEFLECT_TASK_POSITION_AND_SPIN),
+            DEFLECT_OK
+        );
+        // The core corrector of the same arm and task, tick for tick.
+        let core_robot = deflect_core::SerialRobot::from_path(
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/scara/scara4.urdf"),
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../robots/scara/scara4_stiffness.toml"),
+            "tcp",
+        )
+        .unwrap();
+        let base = serial::Model::new(
+            core_robot.model.clone(),
+            serial::Payload::point(1.5, nalgebra::Vector3::new(0.0, 0.0, 0.03)),
+        )
+        .unwrap()
+        .with_joint_limits(&core_robot.joint_limits)
+        .unwrap();
+        let core_model = base
+            .clone()
+            .with_ik_options(deflect_core::mechanism::PoseIkOptions {
+                task: deflect_core::mechanism::Task::POSITION_AND_SPIN,
+                ..*base.ik_options()
+            })
+            .unwrap();
+        let mut core_data = serial::Data::new(&core_model);
+        core_data.set_seed(&q0);
+        let start = deflect_core::vjm::forward(
+            &core_robot.model,
+            &mut deflect_core::vjm::Data::new(&core_robot.model),
+            &q0,
+        )
+        .unwrap();
+        let mut s = deflect_core::motion::PoseState::at_rest(0.0, start);
+        s.acceleration = nalgebra::Vector3::new(30.0, -20.0, 0.0);
+        let want = serial::step(&core_model, &mut core_data, &s, None).unwrap();
+        let m: [[f64; 4]; 4] = s.pose.to_homogeneous().transpose().into();
+        let mut pose = [0.0; 16];
+        for (o, v) in pose.iter_mut().zip(m.iter().flatten()) {
+            *o = *v;
+        }
+        let state = DeflectPoseState {
+            t: 0.0,
+            pose,
+            velocity: [0.0; 3],
+            acceleration: [30.0, -20.0, 0.0],
+            angular_velocity: [0.0; 3],
+            angular_acceleration: [0.0; 3],
+        };
+        let mut tick = DeflectSerialTick::default();
+        assert_eq!(
+            deflect_serial_dalembert_step(c, &state, ptr::null(), &mut tick),
+            DEFLECT_OK
+        );
+        for (a, b) in tick.joints.iter().zip(&want.joints) {
+            assert!((a - b).abs() < 1e-12, "{:?} {:?}", tick.joints, want.joints);
+        }
+        // 1.5 kg at 3.6 g sideways: the quill and arms bend; the command differs from the
+        // start by the correction, and the tool's tilt (which a SCARA cannot correct) is
+        // reported.
+        assert!((tick.joints[0] - q0[0]).abs() > 1e-6);
+        assert_eq!(tick.free_rotation, want.diagnostics.free_rotation);
+        assert!(tick.free_rotation > 1e-6, "{}", tick.free_rotation);
+        deflect_serial_dalembert_destroy(c);
+        deflect_serial_robot_destroy(robot);
+    }
+}

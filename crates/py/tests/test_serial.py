@@ -191,14 +191,68 @@ def test_bad_inputs_are_typed_errors(ur5):
         deflect.DalembertCorrector(cmap, ur5)
 
 
-def test_arms_with_fewer_than_six_joints_are_refused(tmp_path):
+def so101_urdf():
+    """The SO-101 URDF of example-robot-data (a test dependency)."""
+    return ur5_urdf().parents[2] / "so_arm_description" / "urdf" / "so101.urdf"
+
+
+def test_arms_with_fewer_than_six_joints_correct_what_they_control(tmp_path):
+    # The KR 300 cut at link_3: three joints, the TCP position only.
     urdf = REPO / "robots" / "kr300" / "kr300_r2500.urdf"
     toml = tmp_path / "s.toml"
     toml.write_text('[[virtual_joint]]\njoint = "a1"\nk = [1e6, 1e6, 1e6]\n')
     robot = deflect.SerialRobot.from_urdf(urdf, toml, "link_3")
-    assert robot.dof < 6
+    assert robot.dof == 3
+    assert deflect.SerialDalembertCorrector(robot, 1.0).task == "position"
+    # Six rows on three joints, or an unknown task, are refused naming them.
     with pytest.raises(deflect.InputError, match="6"):
-        deflect.SerialDalembertCorrector(robot, 1.0)
+        deflect.SerialDalembertCorrector(robot, 1.0, task="pose")
+    with pytest.raises(deflect.InputError, match="task = 'wrist'"):
+        deflect.SerialDalembertCorrector(robot, 1.0, task="wrist")
+    two = deflect.SerialRobot.from_urdf(urdf, toml, "link_2")
+    with pytest.raises(deflect.InputError, match="at least 3"):
+        deflect.SerialDalembertCorrector(two, 1.0)
+
+
+def test_the_so101_lands_its_loaded_gripper_on_the_position_and_reports_the_rest():
+    toml = REPO / "robots" / "so101" / "so101_stiffness.toml"
+    robot = deflect.SerialRobot.from_urdf(so101_urdf(), toml, tip_link="gripper_frame_link")
+    ref = NumpyChain(so101_urdf(), toml, "gripper_frame_link")
+    q0 = np.array([-1.0, 0.5, 0.5, -1.0, 0.0])
+    # At this pose the five joints control the position and the spin about the gripper axis,
+    # not its tilt out of the arm's plane.
+    corr = deflect.SerialDalembertCorrector(robot, 0.05, com=[0, 0, 0.02], seed=q0)
+    assert corr.task == "position_and_spin"
+    import pickle
+
+    assert pickle.loads(pickle.dumps(corr)).task == "position_and_spin"
+    assert deflect.SerialDalembertCorrector(robot, 0.05, seed=q0, task="position").task == "position"
+    start = robot.forward(q0)
+    pose = start.copy()
+    # A desired turn of 0.2 rad about the base's vertical: part of it is spin (controlled), the
+    # rest tilt (left, reported).
+    turn = axis_angle([0.0, 0.0, 1.0], 0.2)
+    pose[:3, :3] = turn @ start[:3, :3]
+    pose[:3, 3] += [0.01, -0.01, 0.005]
+    tick = corr.step(pose, acceleration=[8.0, -5.0, 3.0])
+    q = tick["joints"]
+    rigid, d = ref.forward(q), ref.deflection(q, tick["wrench"])
+    angle = np.linalg.norm(d[3:])
+    turn_d = axis_angle(d[3:] if angle > 0 else [0, 0, 1], angle)
+    loaded = homogeneous(turn_d @ rigid[:3, :3], rigid[:3, 3] + d[:3])
+    # The independent chain puts the loaded gripper on the desired position, its spin about
+    # the gripper axis on the desired one; what is left is the tilt, as reported.
+    assert np.linalg.norm(loaded[:3, 3] - pose[:3, 3]) < 1e-7
+    rel = loaded[:3, :3].T @ pose[:3, :3]
+    # Its rotation vector (log map), in the loaded gripper's frame.
+    angle = math.acos(min(1.0, (np.trace(rel) - 1) / 2))
+    skew = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
+    rv = angle / (2 * math.sin(angle)) * skew
+    assert abs(rv[2]) < 1e-6
+    assert tick["free_rotation"] == pytest.approx(np.linalg.norm(rv[:2]), rel=1e-9)
+    assert tick["free_rotation"] > 0.01
+    # 50 g at a few m/s^2 on 30-60 N m/rad servos: tenths of a millimetre, all corrected.
+    assert np.linalg.norm(tick["deflection"][:3]) > 1e-5
 
 
 @pytest.mark.parametrize(

@@ -11,6 +11,8 @@ use crate::SimError;
 /// Index of the rotation about the joint frame's x axis among a generic joint's six
 /// coordinates (`LinX, LinY, LinZ, AngX, AngY, AngZ`).
 pub const ANG_X: usize = 3;
+/// Index of the translation along x (see [`ANG_X`]).
+pub const LIN_X: usize = 0;
 /// Index of the rotation about y (see [`ANG_X`]).
 pub const ANG_Y: usize = 4;
 /// Index of the rotation about z (see [`ANG_X`]).

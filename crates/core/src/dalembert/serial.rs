@@ -1,4 +1,5 @@
-//! The D'Alembert corrector for any serial arm, in 6-D: the inertial wrench of the payload and
+//! The D'Alembert corrector for any serial arm, in 6-D (or the task an arm with fewer joints
+//! controls: position, position and tool axis; [`Task`]): the inertial wrench of the payload and
 //! tool (Paksoy, Dede and Kiper 2025, Eq. 3-5, with the moment part the five-bar's
 //! translations do not need) through the virtual-joint deflection (Hähn and Weigold, Eq. 2-9,
 //! exact or linearized) to the joints at which the loaded arm lands on the desired pose.
@@ -31,7 +32,10 @@
 use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use crate::error::{BuildError, TickError, check_finite, check_output};
-use crate::mechanism::pose_ik::{PoseIkOptions, pose_ik};
+use crate::mechanism::pose_ik::{
+    PoseIkOptions, Task, pose_ik, task_gram, task_jacobian, task_vector,
+};
+use crate::mechanism::{JOINT_LIMIT_TOLERANCE, check_limits};
 use crate::motion::PoseState;
 use crate::vjm::{self, Deflection, Load, MAX_DOF, Vector6};
 
@@ -120,29 +124,37 @@ pub struct Model {
     ik: PoseIkOptions,
     link_inertia: bool,
     gravity: Vector3<f64>,
+    limit_tolerance: f64,
 }
 
 impl Model {
-    /// The corrector of `chain` (at least 6 joints: a pose has 6 components) carrying
-    /// `payload`; no joint limits, the exact model, default IK settings, the payload's wrench
-    /// only (as in the paper; see [`Self::with_link_inertia`]), no gravity.
+    /// The corrector of `chain` (at least 3 joints) carrying `payload`; no joint limits, the
+    /// exact model, default IK settings with the task the joints can control
+    /// ([`Task::for_dof`]: the pose with 6 or more, position and tool axis with 5, position
+    /// with 3 or 4; choose another with [`Self::with_ik_options`]), the payload's wrench only
+    /// (as in the paper; see [`Self::with_link_inertia`]), no gravity.
     pub fn new(chain: vjm::Model, payload: Payload) -> Result<Self, BuildError> {
-        if chain.dof() < 6 {
+        if chain.dof() < 3 {
             return Err(BuildError::DofMismatch {
-                what: "6-D pose correction (needs at least 6 joints)",
-                expected: 6,
+                what: "TCP position correction (needs at least 3 joints)",
+                expected: 3,
                 got: chain.dof(),
             });
         }
         payload.validate()?;
+        let ik = PoseIkOptions {
+            task: Task::for_dof(chain.dof()),
+            ..PoseIkOptions::default()
+        };
         Ok(Self {
             chain,
             limits: [(f64::NEG_INFINITY, f64::INFINITY); MAX_DOF],
             payload,
             deflection: Deflection::Exact,
-            ik: PoseIkOptions::default(),
+            ik,
             link_inertia: false,
             gravity: Vector3::zeros(),
+            limit_tolerance: JOINT_LIMIT_TOLERANCE,
         })
     }
 
@@ -182,7 +194,9 @@ impl Model {
     }
 
     /// Joint limits `(lower, upper)` \[rad or m\] per joint (one per joint, lower < upper;
-    /// infinite bounds allowed): a command outside them is [`TickError::JointLimit`].
+    /// infinite bounds allowed): a command more than the limit tolerance
+    /// ([`JOINT_LIMIT_TOLERANCE`] unless [`Self::with_limit_tolerance`] says otherwise) outside
+    /// them is [`TickError::JointLimit`]; one within it is commanded as computed.
     pub fn with_joint_limits(mut self, limits: &[(f64, f64)]) -> Result<Self, BuildError> {
         if limits.len() != self.chain.dof() {
             return Err(BuildError::WrongLength {
@@ -205,6 +219,25 @@ impl Model {
         Ok(self)
     }
 
+    /// Slack on the joint limits \[rad or m\], finite and >= 0 (default
+    /// [`JOINT_LIMIT_TOLERANCE`], 1e-6: a motion starting on a limit lands past it by the
+    /// IK's rounding; 0 compares exactly).
+    pub fn with_limit_tolerance(mut self, tolerance: f64) -> Result<Self, BuildError> {
+        crate::error::param(
+            "joint limit tolerance",
+            tolerance,
+            tolerance >= 0.0,
+            ">= 0 (rad or m)",
+        )?;
+        self.limit_tolerance = tolerance;
+        Ok(self)
+    }
+
+    /// Slack on the joint limits \[rad or m\].
+    pub fn limit_tolerance(&self) -> f64 {
+        self.limit_tolerance
+    }
+
     /// The deflection model to invert (default [`Deflection::Exact`]).
     #[must_use]
     pub fn with_deflection(mut self, deflection: Deflection) -> Self {
@@ -212,9 +245,16 @@ impl Model {
         self
     }
 
-    /// IK settings (validated).
+    /// IK settings (validated), with the task: at most as many rows as the chain has joints.
     pub fn with_ik_options(mut self, ik: PoseIkOptions) -> Result<Self, BuildError> {
         ik.validate()?;
+        if ik.task.rank() > self.chain.dof() {
+            return Err(BuildError::DofMismatch {
+                what: "IK task rows (3 position + the controlled rotations) against the joints",
+                expected: ik.task.rank(),
+                got: self.chain.dof(),
+            });
+        }
         self.ik = ik;
         Ok(self)
     }
@@ -302,8 +342,11 @@ impl Data {
 pub struct Diagnostics {
     /// Position error of the predicted loaded pose \[m\] (within the IK tolerance).
     pub position_error: f64,
-    /// Orientation error of the predicted loaded pose \[rad\].
+    /// Orientation error of the predicted loaded pose in the controlled rotations \[rad\].
     pub orientation_error: f64,
+    /// Rotation of the predicted loaded pose about the axes the task leaves free \[rad\]
+    /// (0 for the full pose): what the arm cannot correct.
+    pub free_rotation: f64,
     /// Estimated smallest singular value of the joint Jacobian at the command.
     pub sigma_min: f64,
 }
@@ -347,13 +390,16 @@ fn solve(
     )
 }
 
-/// `Jt (J Jt + lambda^2 I)^-1 x` over the first `dof` columns of `data.jacobian`.
-fn dls_solve(data: &vjm::Data, dof: usize, x: &Vector6, lambda2: f64) -> Option<[f64; MAX_DOF]> {
-    let j = &data.jacobian;
-    let mut g = nalgebra::Matrix6::identity() * lambda2;
-    for col in j.column_iter().take(dof) {
-        g.ger(1.0, &col, &col, 1.0);
-    }
+/// `Jt (J Jt + lambda^2 I)^-1 x` over the first `dof` columns of `j`, a task's rows
+/// ([`task_gram`]: the rows it leaves free decoupled).
+fn dls_solve(
+    j: &nalgebra::SMatrix<f64, 6, MAX_DOF>,
+    task: Task,
+    dof: usize,
+    x: &Vector6,
+    lambda2: f64,
+) -> Option<[f64; MAX_DOF]> {
+    let g = task_gram(j, task, dof) + nalgebra::Matrix6::identity() * lambda2;
     let y = g.cholesky()?.solve(x);
     let mut out = [0.0; MAX_DOF];
     for (o, col) in out.iter_mut().zip(j.column_iter()).take(dof) {
@@ -364,7 +410,7 @@ fn dls_solve(data: &vjm::Data, dof: usize, x: &Vector6, lambda2: f64) -> Option<
 
 /// The tick's joint rates and accelerations from the desired TCP motion, at `q` (the warm
 /// start): `qd = J^+ [v; w]`, `qdd = J^+ ([a; alpha] - Jd qd)` (damped least squares with the
-/// IK's damping), into `data.qd` and `data.qdd`.
+/// IK's damping, over the task's rows), into `data.qd` and `data.qdd`.
 fn joint_motion(
     model: &Model,
     data: &mut Data,
@@ -378,14 +424,28 @@ fn joint_motion(
         what: "joint Jacobian (joint rates of the link inertia)",
         sigma_min: 0.0,
     };
+    // The task's rows only: an arm with fewer joints follows the position (and the rotations
+    // it controls), and its joint rates are those of that motion, not a least-squares
+    // compromise with the rotation it cannot make.
+    // (The full pose stays in the base frame, the same least squares without the turn.)
+    let task = model.ik.task;
+    let full = task == Task::POSE;
+    let rotation = data.vjm.tcp.rotation;
+    let rows = |x: Vector6| {
+        if full {
+            x
+        } else {
+            task_vector(&x, &rotation, task)
+        }
+    };
+    let j = if full {
+        data.vjm.jacobian
+    } else {
+        task_jacobian(&data.vjm.jacobian, &rotation, task, dof)
+    };
     let (v, w) = (desired.velocity, desired.angular_velocity);
-    data.qd = dls_solve(
-        &data.vjm,
-        dof,
-        &Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z),
-        lambda2,
-    )
-    .ok_or(singular)?;
+    let twist = rows(Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z));
+    data.qd = dls_solve(&j, task, dof, &twist, lambda2).ok_or(singular)?;
     let bias = vjm::tcp_acceleration_bias(
         &model.chain,
         &mut data.vjm,
@@ -393,8 +453,8 @@ fn joint_motion(
         data.qd.get(..dof).unwrap_or(&[]),
     )?;
     let (a, al) = (desired.acceleration, desired.angular_acceleration);
-    let x = Vector6::new(a.x, a.y, a.z, al.x, al.y, al.z) - bias;
-    data.qdd = dls_solve(&data.vjm, dof, &x, lambda2).ok_or(singular)?;
+    let x = rows(Vector6::new(a.x, a.y, a.z, al.x, al.y, al.z) - bias);
+    data.qdd = dls_solve(&j, task, dof, &x, lambda2).ok_or(singular)?;
     check_output("joint rates", &data.qd)?;
     check_output("joint accelerations", &data.qdd)
 }
@@ -468,18 +528,11 @@ pub fn step(
         solution = solve(model, data, pose, q.get(..dof).unwrap_or(&[]), &wrench, arm)?;
         solution.iterations += iterations;
     }
-    for (joint, (&value, &(lower, upper))) in
-        solution.q.iter().zip(&model.limits).take(dof).enumerate()
-    {
-        if value < lower || value > upper {
-            return Err(TickError::JointLimit {
-                joint,
-                value,
-                lower,
-                upper,
-            });
-        }
-    }
+    check_limits(
+        solution.q.get(..dof).unwrap_or(&[]),
+        model.joint_limits(),
+        model.limit_tolerance,
+    )?;
     // The rigid pose of the command (the loaded evaluation left the rigid TCP in data).
     let commanded = data.vjm.tcp;
     data.earliest = data.earlier;
@@ -497,6 +550,7 @@ pub fn step(
         diagnostics: Diagnostics {
             position_error: solution.position_error,
             orientation_error: solution.orientation_error,
+            free_rotation: solution.free_rotation,
             sigma_min: solution.sigma_min,
         },
     })

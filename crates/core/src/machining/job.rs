@@ -39,9 +39,7 @@ use crate::error::{BuildError, JobError, TickError};
 use crate::mechanism::{PoseIkOptions, pose_ik};
 use crate::vjm::{self, Data, Load, MAX_DOF, Model, Vector6};
 
-/// Slack on the joint limits \[rad or m\]: a pose IK solution that rounding puts this far past
-/// a limit still counts as inside.
-pub const JOINT_LIMIT_TOLERANCE: f64 = 1.0e-9;
+pub use crate::mechanism::JOINT_LIMIT_TOLERANCE;
 
 /// The stock: a block over `[min, max]` (x, y) with its top at `top`, workpiece frame \[m\],
 /// resolved in square cells of `cell` \[m\] (see [`super::stock::MAX_CELLS`]).
@@ -204,17 +202,7 @@ pub fn feed_per_tooth(setup: &Setup, s: &PathSample) -> f64 {
 }
 
 fn in_limits(q: &[f64], limits: &[(f64, f64)]) -> Result<(), TickError> {
-    for (joint, (&value, &(lower, upper))) in q.iter().zip(limits).enumerate() {
-        if !(value >= lower - JOINT_LIMIT_TOLERANCE && value <= upper + JOINT_LIMIT_TOLERANCE) {
-            return Err(TickError::JointLimit {
-                joint,
-                value,
-                lower,
-                upper,
-            });
-        }
-    }
-    Ok(())
+    crate::mechanism::check_limits(q, limits, JOINT_LIMIT_TOLERANCE)
 }
 
 /// Runs the offline pass (see the module docs) from the joints `seed` near the first pose

@@ -16,12 +16,14 @@
 //!   the task is the rigid TCP position; IK by bounded damped least squares from a seed, in a
 //!   [`crate::vjm::Data`] workspace.
 
+pub mod limits;
 mod parallel;
 pub mod pose_ik;
 mod serial;
 
+pub use limits::{JOINT_LIMIT_TOLERANCE, check_limits};
 pub use parallel::{DEFAULT_MIN_SIGMA, PAPER_HALF_WIDTH, PAPER_LINK, ParallelRobot2};
-pub use pose_ik::{PoseIkOptions, PoseIkSolution, pose_ik};
+pub use pose_ik::{PoseIkOptions, PoseIkSolution, Task, largest_task, pose_ik};
 pub use serial::{IkOptions, SerialArm};
 
 use nalgebra::{SMatrix, SVector};

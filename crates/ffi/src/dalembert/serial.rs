@@ -4,6 +4,7 @@
 //! which the loaded arm reaches the desired pose, every servo tick.
 
 use deflect_core::dalembert::serial::{self, Payload};
+use deflect_core::mechanism::{PoseIkOptions, Task};
 use deflect_core::motion::PoseState;
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::Vector6;
@@ -21,6 +22,16 @@ use crate::status::{
 pub const DEFLECT_SERIAL_EXACT: i32 = 0;
 /// Invert the linearized deflection `C(q) w`.
 pub const DEFLECT_SERIAL_LINEARIZED: i32 = 1;
+
+/// IK task: the full pose (6 rows; at least 6 joints). The default with 6 or more joints.
+pub const DEFLECT_TASK_POSE: i32 = 0;
+/// IK task: position and tool axis (5 rows; the spin about the TCP's z is free). The default
+/// with 5 joints.
+pub const DEFLECT_TASK_POSITION_AND_AXIS: i32 = 1;
+/// IK task: position and the spin about the tool axis (4 rows; a SCARA).
+pub const DEFLECT_TASK_POSITION_AND_SPIN: i32 = 2;
+/// IK task: position only (3 rows). The default with 3 or 4 joints.
+pub const DEFLECT_TASK_POSITION: i32 = 3;
 
 /// Payload and tool beyond the TCP.
 #[repr(C)]
@@ -53,8 +64,11 @@ pub struct DeflectSerialTick {
     pub position_error: f64,
     /// Orientation error left \[rad\].
     pub orientation_error: f64,
-    /// Estimated smallest singular value of the joint Jacobian at the command.
+    /// Estimated smallest singular value of the task's joint Jacobian at the command.
     pub sigma_min: f64,
+    /// Rotation left about the axes the task leaves free \[rad\] (0 for the full pose):
+    /// what an arm with fewer joints cannot correct.
+    pub free_rotation: f64,
 }
 
 /// The serial-arm D'Alembert corrector: the robot's chain and URDF joint limits, the payload,
@@ -77,13 +91,15 @@ fn seed_of(q: &[f64], dof: usize) -> Result<&[f64], DeflectStatus> {
     Ok(q)
 }
 
-/// Creates a corrector for `robot` (6..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
-/// limits are copied in) carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
+/// Creates a corrector for `robot` (3..=`DEFLECT_MAX_DOF` joints; its chain and URDF joint
+/// limits are copied in; the IK task the joints control: the pose with 6 or more, position
+/// and tool axis with 5, position with 3 or 4, see `deflect_serial_dalembert_set_task`)
+/// carrying `payload`, inverting `model` (`DEFLECT_SERIAL_EXACT` or
 /// `DEFLECT_SERIAL_LINEARIZED`), warm-started from `seed[seed_len]` (the joints the motion
 /// starts from; `seed_len` must be the dof). Pose IK: 20 iterations, 1e-8 m and 1e-8 rad.
 /// Init time: allocates the handle. On failure `*out` is NULL.
 ///
-/// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 6
+/// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH` (seed length, or fewer than 3
 /// joints), `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_INVALID_ARGUMENT` (negative mass,
 /// asymmetric inertia, unknown model) or `DEFLECT_ERR_SINGULAR` (inertia not positive
 /// semi-definite).
@@ -181,6 +197,41 @@ pub unsafe extern "C" fn deflect_serial_dalembert_set_loads(
     })
 }
 
+/// Sets the IK task (`DEFLECT_TASK_*`): what the corrector makes the loaded TCP reach, the
+/// rest reported in the tick's `free_rotation`. Init time (rebuilds the model); the warm
+/// start is kept. Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT` (unknown task)
+/// or `DEFLECT_ERR_WRONG_LENGTH` (more task rows than the robot has joints).
+///
+/// # Safety
+/// `corrector` is NULL or a live handle not used by another thread.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn deflect_serial_dalembert_set_task(
+    corrector: *mut DeflectSerialDalembert,
+    task: i32,
+) -> DeflectStatus {
+    guard(|| {
+        // SAFETY: NULL or a live handle by contract.
+        let c = unsafe { handle_mut(corrector)? };
+        let task = match task {
+            DEFLECT_TASK_POSE => Task::POSE,
+            DEFLECT_TASK_POSITION_AND_AXIS => Task::POSITION_AND_AXIS,
+            DEFLECT_TASK_POSITION_AND_SPIN => Task::POSITION_AND_SPIN,
+            DEFLECT_TASK_POSITION => Task::POSITION,
+            _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
+        };
+        let ik = PoseIkOptions {
+            task,
+            ..*c.model.ik_options()
+        };
+        c.model = c
+            .model
+            .clone()
+            .with_ik_options(ik)
+            .map_err(|_| DEFLECT_ERR_WRONG_LENGTH)?;
+        Ok(())
+    })
+}
+
 /// Restarts the warm start from joints `q[q_len]` (`q_len` = dof): call it before a motion
 /// that does not continue the last one. Returns `DEFLECT_ERR_NULL`,
 /// `DEFLECT_ERR_WRONG_LENGTH` or `DEFLECT_ERR_NON_FINITE`.
@@ -254,6 +305,7 @@ pub unsafe extern "C" fn deflect_serial_dalembert_step(
             position_error: t.diagnostics.position_error,
             orientation_error: t.diagnostics.orientation_error,
             sigma_min: t.diagnostics.sigma_min,
+            free_rotation: t.diagnostics.free_rotation,
         };
         // SAFETY: non-null (checked), writable by contract.
         unsafe { write(out, tick) }

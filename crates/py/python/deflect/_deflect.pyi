@@ -472,10 +472,12 @@ class CorrectedPoses:
     iterations: npt.NDArray[np.uint32]
     position_error: _FloatArray
     orientation_error: _FloatArray
+    free_rotation: _FloatArray
 
 @final
 class SerialDalembertCorrector:
-    """The 6-D D'Alembert corrector for a serial arm (a SerialRobot with >= 6 joints)."""
+    """The D'Alembert corrector for a serial arm (a SerialRobot with >= 3 joints): the pose,
+    or the task an arm with fewer joints controls."""
     def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
         """Pickling and ``copy.deepcopy``: its configuration; the copy starts from ``seed``."""
     def __new__(
@@ -492,6 +494,7 @@ class SerialDalembertCorrector:
         seed: Optional[_ArrayLike] = None,
         link_inertia: bool = False,
         gravity: Optional[_ArrayLike] = None,
+        task: str = "auto",
     ) -> Self: ...
     @property
     def dof(self) -> int: ...
@@ -501,6 +504,8 @@ class SerialDalembertCorrector:
     def link_inertia(self) -> bool: ...
     @property
     def gravity(self) -> _FloatArray: ...
+    @property
+    def task(self) -> str: ...
     @property
     def mass(self) -> float: ...
     @property

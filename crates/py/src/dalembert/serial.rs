@@ -4,7 +4,7 @@
 use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use deflect_core::dalembert::serial::{self, Payload};
-use deflect_core::mechanism::pose_ik::PoseIkOptions;
+use deflect_core::mechanism::pose_ik::{PoseIkOptions, Task, largest_task};
 use deflect_core::motion::PoseState;
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::Vector6;
@@ -54,7 +54,12 @@ fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
 /// cancels the links' own inertial loads (`-m a_c`, `-(I alpha + omega x I omega)` of every
 /// URDF `<inertial>`, from the joint rates of the motion; default off, as in the paper);
 /// `gravity` (3,) [m/s^2], base frame (default zero): the weights then load the springs too,
-/// so the command also cancels the static sag.
+/// so the command also cancels the static sag. `task`: what the corrector makes the loaded
+/// TCP reach: `"pose"` (6 or more joints), `"position_and_axis"` (the spin about the TCP's z
+/// free), `"position_and_spin"` (a SCARA), `"position"`, or `"auto"` (default: with a `seed`,
+/// the largest of these the arm controls there, non-singular; without, the pose with 6 or
+/// more joints, position and axis with 5, position with 3 or 4); the rotation left about the
+/// free axes is reported per tick (`free_rotation` [rad]).
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct SerialDalembertCorrector {
@@ -96,8 +101,10 @@ pub struct CorrectedPoses {
     iterations: Py<PyArray1<u32>>,
     /// Position error left per tick [m], (N,).
     position_error: Py<PyArray1<f64>>,
-    /// Orientation error left per tick [rad], (N,).
+    /// Orientation error left per tick in the controlled rotations [rad], (N,).
     orientation_error: Py<PyArray1<f64>>,
+    /// Rotation left about the axes the task leaves free [rad], (N,) (0 for the pose).
+    free_rotation: Py<PyArray1<f64>>,
 }
 
 fn tick_dict<'py>(py: Python<'py>, t: &serial::Tick, dof: usize) -> PyResult<Bound<'py, PyDict>> {
@@ -111,13 +118,14 @@ fn tick_dict<'py>(py: Python<'py>, t: &serial::Tick, dof: usize) -> PyResult<Bou
     d.set_item("position_error", t.diagnostics.position_error)?;
     d.set_item("orientation_error", t.diagnostics.orientation_error)?;
     d.set_item("sigma_min", t.diagnostics.sigma_min)?;
+    d.set_item("free_rotation", t.diagnostics.free_rotation)?;
     Ok(d)
 }
 
 #[pymethods]
 impl SerialDalembertCorrector {
     #[new]
-    #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None, link_inertia=false, gravity=None))]
+    #[pyo3(signature = (robot, mass, com=None, inertia=None, model="exact", joint_limits=None, max_iterations=20, position_tolerance=1e-8, orientation_tolerance=1e-8, seed=None, link_inertia=false, gravity=None, task="auto"))]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: &Bound<'_, SerialRobot>,
@@ -132,6 +140,7 @@ impl SerialDalembertCorrector {
         seed: Option<&Bound<'_, PyAny>>,
         link_inertia: bool,
         gravity: Option<&Bound<'_, PyAny>>,
+        task: &str,
     ) -> PyResult<Self> {
         let handle = robot;
         let robot = robot.get();
@@ -168,10 +177,38 @@ impl SerialDalembertCorrector {
                     .collect()
             }
         };
+        let seed = match seed {
+            Some(s) => {
+                let q = vector(s, "seed", dof)?;
+                if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                    return Err(InputError::new_err(format!("seed[{i}] is not finite")));
+                }
+                Some(q)
+            }
+            None => None,
+        };
+        let task = match (task, &seed) {
+            ("auto", Some(q)) => largest_task(&chain, &mut deflect_core::vjm::Data::new(&chain), q)
+                .map_err(|e| tick_err_at(format_args!("task='auto' at the seed"), e))?,
+            ("auto", None) => Task::for_dof(dof),
+            (task, _) => match task {
+                "pose" => Task::POSE,
+                "position_and_axis" => Task::POSITION_AND_AXIS,
+                "position_and_spin" => Task::POSITION_AND_SPIN,
+                "position" => Task::POSITION,
+                other => {
+                    return Err(InputError::new_err(format!(
+                        "task = '{other}': expected 'auto', 'pose', 'position_and_axis', \
+                     'position_and_spin' or 'position'"
+                    )));
+                }
+            },
+        };
         let ik = PoseIkOptions {
             max_iterations,
             position_tolerance,
             orientation_tolerance,
+            task,
             ..PoseIkOptions::default()
         };
         let g = vec3(gravity, "gravity")?;
@@ -185,37 +222,31 @@ impl SerialDalembertCorrector {
             .and_then(|m| m.with_gravity(g))
             .map_err(build_err)?;
         let mut data = serial::Data::new(&model);
-        let seed = match seed {
-            Some(s) => {
-                let q = vector(s, "seed", dof)?;
-                if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-                    return Err(InputError::new_err(format!("seed[{i}] is not finite")));
-                }
-                data.set_seed(&q);
-                Some(q)
-            }
-            None => None,
-        };
+        if let Some(q) = &seed {
+            data.set_seed(q);
+        }
         let p = &model.payload();
         let inertia: [[f64; 3]; 3] = core::array::from_fn(|r| {
             core::array::from_fn(|c| p.inertia.get((r, c)).copied().unwrap_or(f64::NAN))
         });
-        let config = (
-            handle,
-            mass,
-            [p.com.x, p.com.y, p.com.z],
-            inertia,
-            model_name(model.deflection()),
-            limits,
-            max_iterations,
-            position_tolerance,
-            orientation_tolerance,
-            seed,
-            link_inertia,
-            [g.x, g.y, g.z],
-        )
-            .into_pyobject(handle.py())?
-            .unbind();
+        // The constructor's positional arguments (more than pyo3's tuples of 12 convert).
+        let py = handle.py();
+        let args: Vec<Bound<'_, PyAny>> = vec![
+            handle.clone().into_any(),
+            mass.into_pyobject(py)?.into_any(),
+            [p.com.x, p.com.y, p.com.z].into_pyobject(py)?.into_any(),
+            inertia.into_pyobject(py)?.into_any(),
+            model_name(model.deflection()).into_pyobject(py)?.into_any(),
+            limits.into_pyobject(py)?.into_any(),
+            max_iterations.into_pyobject(py)?.into_any(),
+            position_tolerance.into_pyobject(py)?.into_any(),
+            orientation_tolerance.into_pyobject(py)?.into_any(),
+            seed.into_pyobject(py)?.into_any(),
+            pyo3::types::PyBool::new(py, link_inertia).to_owned().into_any(),
+            [g.x, g.y, g.z].into_pyobject(py)?.into_any(),
+            model.ik_options().task.name().into_pyobject(py)?.into_any(),
+        ];
+        let config = pyo3::types::PyTuple::new(py, args)?.unbind();
         Ok(Self {
             model,
             data: Mutex::new(data),
@@ -255,6 +286,12 @@ impl SerialDalembertCorrector {
     #[getter]
     fn gravity<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.model.gravity().as_slice().to_pyarray(py)
+    }
+    /// What the corrector controls: 'pose', 'position_and_axis', 'position_and_spin' or
+    /// 'position' (the resolved task when constructed with 'auto').
+    #[getter]
+    fn task(&self) -> &'static str {
+        self.model.ik_options().task.name()
     }
     /// Payload mass [kg].
     #[getter]
@@ -369,6 +406,7 @@ impl SerialDalembertCorrector {
             let mut iterations = Array1::<u32>::zeros(n);
             let mut pos_err = Array1::zeros(n);
             let mut ori_err = Array1::zeros(n);
+            let mut free = Array1::zeros(n);
             for (i, s) in states.iter().enumerate() {
                 let p = process
                     .as_ref()
@@ -396,13 +434,24 @@ impl SerialDalembertCorrector {
                 if let Some(x) = ori_err.get_mut(i) {
                     *x = tick.diagnostics.orientation_error;
                 }
+                if let Some(x) = free.get_mut(i) {
+                    *x = tick.diagnostics.free_rotation;
+                }
             }
             Ok((
-                t, desired, commanded, joints, wrench, deflection, iterations, pos_err, ori_err,
+                t,
+                desired,
+                commanded,
+                joints,
+                wrench,
+                deflection,
+                iterations,
+                [pos_err, ori_err, free],
             ))
         });
-        let (t, desired, commanded, joints, wrench, deflection, iterations, pos_err, ori_err) =
+        let (t, desired, commanded, joints, wrench, deflection, iterations, errors) =
             result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
+        let [pos_err, ori_err, free] = errors;
         Ok(CorrectedPoses {
             t: t.to_pyarray(py).unbind(),
             desired: desired.to_pyarray(py).unbind(),
@@ -413,6 +462,7 @@ impl SerialDalembertCorrector {
             iterations: iterations.to_pyarray(py).unbind(),
             position_error: pos_err.to_pyarray(py).unbind(),
             orientation_error: ori_err.to_pyarray(py).unbind(),
+            free_rotation: free.to_pyarray(py).unbind(),
         })
     }
 

@@ -69,7 +69,7 @@ pub use job::JobArgs;
 pub use milling::MillingArgs;
 pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
 pub use range::*;
-pub use serial::{ModelArg, SerialArgs};
+pub use serial::{ModelArg, SerialArgs, TaskArg};
 pub use tool::ToolArgs;
 
 // The command line.

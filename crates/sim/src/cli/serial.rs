@@ -63,11 +63,31 @@ pub struct SerialArgs {
     /// Deflection model the corrector inverts.
     #[arg(long, value_enum, default_value_t = ModelArg::Exact)]
     pub model: ModelArg,
+    /// What the IK controls; auto: the largest of pose, position-and-axis, position-and-spin,
+    /// position that has no more rows than the arm has joints and is not singular at the
+    /// start joints (the pose on a 6-axis arm).
+    #[arg(long, value_enum, default_value_t = TaskArg::Auto)]
+    pub task: TaskArg,
     #[arg(long, default_value_t = 2, help = JOBS.help(
         "Worker threads (one run each; results do not depend on it)",
         "0 is refused"
     ))]
     pub jobs: usize,
+}
+
+// What the serial corrector's IK controls.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq)]
+pub enum TaskArg {
+    // The largest task the arm controls at the start joints.
+    Auto,
+    // Position and orientation (6 or more joints).
+    Pose,
+    // Position and the tool axis; the spin about it is free (5 or more joints).
+    PositionAndAxis,
+    // Position and the spin about the tool axis (a SCARA; 4 or more joints).
+    PositionAndSpin,
+    // Position only.
+    Position,
 }
 
 // Deflection model of the serial corrector.

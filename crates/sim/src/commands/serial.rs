@@ -7,6 +7,7 @@ use std::path::Path;
 
 use deflect_core::dalembert::serial::Payload;
 use deflect_core::io::{stiffness, urdf};
+use deflect_core::mechanism::{Task, largest_task};
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data};
 use deflect_sim::SimError;
@@ -17,7 +18,7 @@ use deflect_sim::urdf_arm::{
 use nalgebra::{Matrix3, Vector3};
 
 use super::input_file;
-use crate::cli::{CliError, ModelArg, SerialArgs};
+use crate::cli::{CliError, ModelArg, SerialArgs, TaskArg};
 
 /// Largest input file read \[bytes\].
 const MAX_FILE: u64 = 16 << 20;
@@ -142,33 +143,64 @@ pub(crate) fn deepest_leaf(robot: &urdf_rs::Robot, base: Option<&str>) -> Result
     }
 }
 
-/// The most dexterous pose of the grid {-1, -0.5, 0, 0.5, 1}^n inside the limits: the
-/// largest smallest singular value of the position-scaled Jacobian. At most 6 joints are
-/// searched (5^6 poses); further joints stay at 0 (or the middle of their limits).
+/// Margin of a default start joint from its limits \[rad or m\]: 5 % of the range, at most
+/// 0.1 (a motion from a pose on a limit leaves the range at once when it moves that joint
+/// outwards: the Unitree Z1's elbow, range [0, 2.967], at 0).
+fn margin((lo, hi): (f64, f64)) -> f64 {
+    let range = hi - lo;
+    if range.is_finite() {
+        (0.05 * range).min(0.1)
+    } else {
+        0.1
+    }
+}
+
+/// The most dexterous pose of the grid {-1, -0.5, 0, 0.5, 1}^n inside the limits less a
+/// [`margin`]: the largest smallest singular value of the position-scaled Jacobian. At most 6
+/// joints are searched (5^6 poses); further joints sit in the middle of their limits (or the
+/// margin inside a one-sided range, or 0 in an unbounded one).
 fn dexterous_pose(spec: &ArmSpec, reach: f64) -> Option<Vec<f64>> {
     let robot = &spec.robot;
     let n = robot.model.dof();
     let mut data = Data::new(&robot.model);
     let grid = [-1.0, -0.5, 0.0, 0.5, 1.0];
     let searched = n.min(6);
-    let mid = |(lo, hi): (f64, f64)| {
-        if lo.is_finite() && hi.is_finite() {
-            0.5 * (lo + hi)
-        } else {
-            0.0f64.clamp(lo, hi)
-        }
+    let mid = |(lo, hi): (f64, f64)| match (lo.is_finite(), hi.is_finite()) {
+        (true, true) => 0.5 * (lo + hi),
+        (true, false) => (lo + margin((lo, hi))).max(0.0),
+        (false, true) => (hi - margin((lo, hi))).min(0.0),
+        (false, false) => 0.0,
     };
     let mut q: Vec<f64> = robot.joint_limits.iter().map(|&l| mid(l)).collect();
-    let mut best: Option<(f64, Vec<f64>)> = None;
-    for code in 0..grid.len().pow(searched as u32) {
-        let mut c = code;
-        let mut inside = true;
-        for (k, qk) in q.iter_mut().enumerate().take(searched) {
-            *qk = grid.get(c % grid.len()).copied().unwrap_or(0.0);
-            c /= grid.len();
+    // Per searched joint: the grid's values inside its range less the margin, or five evenly
+    // spaced over that interior when fewer fit (a quill's 0.15 m stroke, a narrow wrist).
+    let candidates: Vec<Vec<f64>> = (0..searched)
+        .map(|k| {
             let (lo, hi) = robot.joint_limits.get(k).copied().unwrap_or((-1e9, 1e9));
-            inside &= *qk >= lo && *qk <= hi;
+            let m = margin((lo, hi));
+            let (a, b) = (lo + m, hi - m);
+            let inside: Vec<f64> = grid
+                .iter()
+                .copied()
+                .filter(|v| *v >= a && *v <= b)
+                .collect();
+            if inside.len() >= 2 || !(a.is_finite() && b.is_finite()) || a > b {
+                inside
+            } else {
+                (0..5).map(|i| a + (b - a) * f64::from(i) / 4.0).collect()
+            }
+        })
+        .collect();
+    let mut best: Option<(f64, Vec<f64>)> = None;
+    let combos: usize = candidates.iter().map(Vec::len).product();
+    for code in 0..combos {
+        let mut c = code;
+        for (qk, cands) in q.iter_mut().zip(&candidates) {
+            let len = cands.len().max(1);
+            *qk = cands.get(c % len).copied().unwrap_or(0.0);
+            c /= len;
         }
+        let inside = true;
         if !inside || vjm::joint_jacobian(&robot.model, &mut data, &q).is_err() {
             continue;
         }
@@ -259,10 +291,10 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
     )?;
     let model = &spec.robot.model;
     let dof = model.dof();
-    if dof < 6 {
+    if dof < 3 {
         return Err(CliError::Failure(format!(
-            "{urdf_name}, tip {tip}: the chain has {dof} actuated joints; the 6-D pose \
-             correction needs at least 6"
+            "{urdf_name}, tip {tip}: the chain has {dof} actuated joints; the correction needs \
+             at least 3 (the TCP position)"
         )));
     }
     // Summed link lengths: the motion's size and the dexterity's length scale.
@@ -303,11 +335,34 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
             )));
         }
     }
+    let task = match a.task {
+        TaskArg::Pose => Task::POSE,
+        TaskArg::PositionAndAxis => Task::POSITION_AND_AXIS,
+        TaskArg::PositionAndSpin => Task::POSITION_AND_SPIN,
+        TaskArg::Position => Task::POSITION,
+        TaskArg::Auto => largest_task(model, &mut data, &q0).map_err(|e| {
+            CliError::Usage(format!(
+                "--q0: the start joints are singular for {urdf_name} ({e}); give others"
+            ))
+        })?,
+    };
+    if task.rank() > dof {
+        return Err(CliError::Usage(format!(
+            "--task {}: {} rows for a {dof}-joint arm; choose one with at most {dof}",
+            task.name().replace('_', "-"),
+            task.rank()
+        )));
+    }
     let links_mass: f64 = spec.bodies.iter().map(|b| b.inertia.mass).sum();
     let mass = match (a.payload_mass, builtin) {
         (Some(m), _) => m,
         (None, true) => 150.0,
-        (None, false) if links_mass > 0.0 => (0.1 * links_mass * 10.0).round() / 10.0,
+        // 10 % of the links, to two significant digits (0.03 kg on a hobby arm).
+        (None, false) if links_mass > 0.0 => {
+            let m = 0.1 * links_mass;
+            let unit = 10f64.powf(m.log10().floor() - 1.0);
+            (m / unit).round() * unit
+        }
         (None, false) => {
             return Err(CliError::Usage(format!(
                 "--payload-mass: {urdf_name} has no link masses to take 10 % of; give the \
@@ -347,6 +402,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
             ModelArg::Linearized => Deflection::Linearized,
         },
         link_inertia: !a.payload_only && spec.robot.model.mass_count() > 0,
+        task,
     };
     // The motions must be plannable and reachable (rigid IK along them) before the runs.
     serial::check_motions(&spec, &options).map_err(|e| {

@@ -7,17 +7,21 @@
 //!   spring [`STIFF_RATIO`] times the joint's stiffest), and stiffness-proportional structural
 //!   damping `beta k`. For small angles the three rotations are the virtual joint's `M / k`,
 //!   so the arm's static compliance is deflect-core's `J K^-1 J^T` (a test checks it to 1 %).
-//! * **Actuated joints** are revolute multibody joints (exact angle coordinate). The link
+//! * **Actuated joints** are revolute or prismatic multibody joints (exact coordinate). The link
 //!   hangs on its motor through a drive spring of stiffness [`ServoParams::drive_ratio`] times
 //!   the arm's stiffest virtual joint (gearbox and shaft, nearly rigid: the compliance under
 //!   test is the virtual joints'), with relative damping. Each motor is a rotor of reflected
 //!   inertia under a discrete PD position loop with velocity and acceleration feed-forward at
 //!   the simulation rate, integrated implicitly with the drive spring's reaction: the five-bar
 //!   scene's servo ([`crate::scenes::parallel::robot`]). Its gains come from a bandwidth and a loop stiffness
-//!   [`ServoParams::kp_ratio`] times the stiffest virtual joint.
+//!   [`ServoParams::kp_ratio`] times the stiffest virtual joint. A prismatic joint's motor and
+//!   drive take the same constants read per metre (loop and drive stiffness in N/m, reflected
+//!   mass in kg: a screw of 1 m/rad), so its loop has the same bandwidth.
 //! * The URDF links' mass properties sit on the body after the link's last spring (the
 //!   proximal part of a link split by an in-link spring is lumped distally); bodies that carry
-//!   no link get a small mass ([`ServoParams::filler_mass`]). A payload adds to the last body.
+//!   no link get a small mass ([`ServoParams::filler_mass`], at most 3 % of the links' total
+//!   so that a hobby arm of a few hundred grams is not made heavier than its model). A
+//!   payload adds to the last body.
 //!   Gravity is off: a robot's static sag under its own weight is calibrated out in practice,
 //!   and the scenarios study inertial and process loads.
 
@@ -28,7 +32,7 @@ use rapier3d_f64::prelude::*;
 
 use super::spec::{ArmSpec, Inertia, Piece, RIGID};
 use crate::SimError;
-use crate::rapier_util::{ANG_X, ANG_Y, ANG_Z, new_world, pose_na, set_spring};
+use crate::rapier_util::{ANG_X, ANG_Y, ANG_Z, LIN_X, new_world, pose_na, set_spring};
 
 /// A rigid axis among a virtual joint's three free rotations gets this many times the joint's
 /// stiffest finite stiffness.
@@ -51,7 +55,8 @@ pub struct ServoParams {
     pub drive_zeta: f64,
     /// Stiffness-proportional damping of the virtual joints, `c = beta k` \[s\].
     pub beta: f64,
-    /// Mass of a body that carries no URDF link \[kg\] (inertia of a 5 cm sphere).
+    /// Mass of a body that carries no URDF link \[kg\] (inertia of a 5 cm sphere), at most
+    /// 3 % of the links' total mass.
     pub filler_mass: f64,
     /// Time step \[s\].
     pub dt: f64,
@@ -90,6 +95,8 @@ pub struct FlexSerialArm {
     actuated: Vec<usize>,
     /// Joint axis of each actuated joint in its body frame.
     axes: Vec<Vector3<f64>>,
+    /// Whether each actuated joint is prismatic (its coordinate a length).
+    prismatic: Vec<bool>,
     /// Body index and attachment (in the previous body) of each virtual joint, chain order.
     springs: Vec<(usize, Isometry3<f64>)>,
     q0: Vec<f64>,
@@ -169,7 +176,7 @@ impl FlexSerialArm {
                 Piece::Spring { k, .. } => {
                     k.iter().copied().filter(|v| *v < RIGID).reduce(f64::max)
                 }
-                Piece::Revolute { .. } => None,
+                Piece::Revolute { .. } | Piece::Prismatic { .. } => None,
             })
             .fold(0.0f64, f64::max);
         if k_max <= 0.0 || k_max.is_nan() {
@@ -184,6 +191,12 @@ impl FlexSerialArm {
         let k_drive = servo.drive_ratio * k_max;
         let c_drive = 2.0 * servo.drive_zeta * (k_drive * j_motor).sqrt();
 
+        let links: f64 = spec.bodies.iter().map(|b| b.inertia.mass).sum();
+        let filler = if links > 0.0 {
+            servo.filler_mass.min(0.03 * links)
+        } else {
+            servo.filler_mass
+        };
         let mut world = new_world(Vector::ZERO, servo.dt);
         let mut parent = world.insert_body(RigidBodyBuilder::fixed());
         let mut at = Isometry3::identity();
@@ -206,7 +219,7 @@ impl FlexSerialArm {
                 );
             }
             if inertia.mass <= 0.0 {
-                let m = servo.filler_mass;
+                let m = filler;
                 inertia = Inertia {
                     mass: m,
                     com: Vector3::zeros(),
@@ -270,6 +283,34 @@ impl FlexSerialArm {
                     };
                     (b.attach, Isometry3::identity(), locked, springs)
                 }
+                Piece::Prismatic { axis, .. } => {
+                    let q = q0.get(qi).copied().unwrap_or(0.0);
+                    qi += 1;
+                    let align = UnitQuaternion::rotation_between(&Vector3::x(), axis)
+                        .unwrap_or_else(|| {
+                            UnitQuaternion::from_axis_angle(
+                                &Vector3::z_axis(),
+                                core::f64::consts::PI,
+                            )
+                        });
+                    let align = Isometry3::from_parts(Translation3::identity(), align);
+                    let slide = Isometry3::from_parts(
+                        Translation3::from(axis.into_inner() * q),
+                        UnitQuaternion::identity(),
+                    );
+                    actuated.push(index);
+                    axes.push(axis.into_inner());
+                    (
+                        b.attach * slide * align,
+                        align,
+                        JointAxesMask::LIN_Y
+                            | JointAxesMask::LIN_Z
+                            | JointAxesMask::ANG_X
+                            | JointAxesMask::ANG_Y
+                            | JointAxesMask::ANG_Z,
+                        vec![(LIN_X, k_drive, 0.0)],
+                    )
+                }
             };
             at *= match &b.piece {
                 Piece::Revolute { axis, .. } => {
@@ -280,6 +321,13 @@ impl FlexSerialArm {
                                 axis,
                                 q0.get(qi.saturating_sub(1)).copied().unwrap_or(0.0),
                             ),
+                        )
+                }
+                Piece::Prismatic { axis, .. } => {
+                    b.attach
+                        * Translation3::from(
+                            axis.into_inner()
+                                * q0.get(qi.saturating_sub(1)).copied().unwrap_or(0.0),
                         )
                 }
                 Piece::Spring { .. } => b.attach,
@@ -311,7 +359,7 @@ impl FlexSerialArm {
                     .map(|(_, _, c)| match &b.piece {
                         // The drive's damping `c (w_link - w_motor)`: the link part is
                         // implicit here, the motor part an explicit torque ([`Self::apply`]).
-                        Piece::Revolute { .. } => c_drive,
+                        Piece::Revolute { .. } | Piece::Prismatic { .. } => c_drive,
                         Piece::Spring { .. } => *c * damping_scale,
                     })
                     .collect();
@@ -328,12 +376,22 @@ impl FlexSerialArm {
             .iter()
             .map(|&angle| Motor { angle, speed: 0.0 })
             .collect();
+        let prismatic = actuated
+            .iter()
+            .map(|&b| {
+                matches!(
+                    spec.bodies.get(b).map(|x| &x.piece),
+                    Some(Piece::Prismatic { .. })
+                )
+            })
+            .collect();
         Ok(Self {
             world,
             bodies,
             joints,
             actuated,
             axes,
+            prismatic,
             springs: spring_bodies,
             q0: q0.to_vec(),
             motors,
@@ -413,8 +471,13 @@ impl FlexSerialArm {
                 continue;
             };
             let Some(link) = mb.link(id) else { continue };
+            let coord = if self.prismatic.get(k).copied().unwrap_or(false) {
+                LIN_X
+            } else {
+                ANG_X
+            };
             if let (Some(qk), Some(wk)) = (q.get_mut(k), w.get_mut(k)) {
-                *qk += link.joint().coords()[ANG_X];
+                *qk += link.joint().coords()[coord];
                 *wk = mb.joint_velocity(link).get(0).copied().unwrap_or(0.0);
             }
         }
@@ -440,26 +503,39 @@ impl FlexSerialArm {
                 continue;
             };
             let rest = m.angle - self.q0.get(k).copied().unwrap_or(0.0);
-            set_spring(&mut self.world, *h, ANG_X, self.k_drive, rest);
-            // The motor's part of the relative drive damping, `+c w_motor` about the joint
-            // axis (world frame), reacted by the body before (the link's part, `-c w_link`,
-            // is rapier's implicit joint damping).
+            let prismatic = self.prismatic.get(k).copied().unwrap_or(false);
+            set_spring(
+                &mut self.world,
+                *h,
+                if prismatic { LIN_X } else { ANG_X },
+                self.k_drive,
+                rest,
+            );
+            // The motor's part of the relative drive damping, `+c v_motor` along or about the
+            // joint axis (world frame), reacted by the body before (the link's part,
+            // `-c v_link`, is rapier's implicit joint damping); a force pair acts at the
+            // joint's origin, so it carries no moment.
             let body = self.bodies.get(b).copied();
-            let axis_w = body
-                .map(|h| self.pose_of(h).rotation * self.axes.get(k).copied().unwrap_or_default())
-                .unwrap_or_default();
+            let frame = body
+                .map(|h| self.pose_of(h))
+                .unwrap_or_else(Isometry3::identity);
+            let axis_w = frame.rotation * self.axes.get(k).copied().unwrap_or_default();
             let t = axis_w * (self.c_drive * m.speed);
-            let torque = Vector::new(t.x, t.y, t.z);
-            if let Some(rb) = body.and_then(|h| self.world.bodies.get_mut(h)) {
-                rb.add_torque(torque, false);
-            }
-            if b > 0
-                && let Some(rb) = self
-                    .bodies
-                    .get(b - 1)
-                    .and_then(|h| self.world.bodies.get_mut(*h))
-            {
-                rb.add_torque(-torque, false);
+            let v = Vector::new(t.x, t.y, t.z);
+            let at = frame.translation.vector;
+            let at = Vector::new(at.x, at.y, at.z);
+            let mut push = |h: Option<RigidBodyHandle>, sign: f64| {
+                if let Some(rb) = h.and_then(|h| self.world.bodies.get_mut(h)) {
+                    if prismatic {
+                        rb.add_force_at_point(v * sign, at, false);
+                    } else {
+                        rb.add_torque(v * sign, false);
+                    }
+                }
+            };
+            push(body, 1.0);
+            if b > 0 {
+                push(self.bodies.get(b - 1).copied(), -1.0);
             }
         }
         if let (Some(w), Some(last)) = (wrench, self.bodies.last().copied()) {

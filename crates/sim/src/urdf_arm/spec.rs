@@ -76,6 +76,13 @@ pub enum Piece {
         /// Joint axis in the joint frame.
         axis: Unit<Vector3<f64>>,
     },
+    /// An actuated prismatic joint along the unit `axis` (body frame); built at `q0` \[m\].
+    Prismatic {
+        /// URDF joint name.
+        name: String,
+        /// Joint axis in the joint frame.
+        axis: Unit<Vector3<f64>>,
+    },
     /// A virtual joint: stiffnesses about the body frame's x, y, z \[N m/rad\] (`inf` or
     /// >= [`RIGID`]: rigid about that axis; at least one is finite).
     Spring {
@@ -137,7 +144,7 @@ fn link_inertia(link: &urdf_rs::Link) -> Inertia {
 
 /// Reads the arm from the URDF and stiffness texts; the chain runs from the URDF root (or
 /// `base_link`) to `tip_link`. Both files are validated by deflect-core first (the error names
-/// what is wrong). Prismatic joints are not supported by the testbed.
+/// what is wrong). Revolute, continuous, prismatic and fixed joints are built.
 pub fn arm_spec(
     urdf_text: &str,
     stiffness_text: &str,
@@ -251,11 +258,24 @@ pub fn arm_spec(
                 });
                 offset = Isometry3::identity();
             }
+            urdf_rs::JointType::Prismatic => {
+                let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
+                bodies.push(Body {
+                    piece: Piece::Prismatic {
+                        name: j.name.clone(),
+                        axis,
+                    },
+                    attach: offset,
+                    inertia: Inertia::zero(),
+                    links: Vec::new(),
+                });
+                offset = Isometry3::identity();
+            }
             urdf_rs::JointType::Fixed => {}
             ref other => {
                 return Err(SimError::new(format!(
-                    "joint '{}': the testbed builds revolute, continuous and fixed joints only, \
-                     not {}",
+                    "joint '{}': the testbed builds revolute, continuous, prismatic and fixed \
+                     joints only, not {}",
                     j.name,
                     format!("{other:?}").to_lowercase()
                 )));

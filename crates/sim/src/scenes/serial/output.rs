@@ -42,11 +42,15 @@ pub fn table(r: &SerialResult) -> String {
     let _ = writeln!(
         s,
         "serial testbed: {} in rapier ({} bodies; static compliance vs J K^-1 J^T: {:.2} % \
-         max rel. error), payload {:.1} kg, {:.2} g peak, {} model, corrector cancels the {}",
+         max rel. error), payload {} kg, {:.2} g peak, {} model, corrector cancels the {}",
         o.robot,
         r.bodies,
         r.static_rel_error * 100.0,
-        o.payload.mass,
+        if o.payload.mass < 1.0 {
+            format!("{:.3}", o.payload.mass)
+        } else {
+            format!("{:.1}", o.payload.mass)
+        },
         o.motion.g,
         match o.model {
             deflect_core::vjm::Deflection::Exact => "exact",
@@ -58,6 +62,15 @@ pub fn table(r: &SerialResult) -> String {
             "payload's inertial wrench only"
         }
     );
+    if o.task != deflect_core::mechanism::Task::POSE {
+        let _ = writeln!(
+            s,
+            "task: {} ({} joints; the rotations the task leaves free are not corrected: the \
+             rot columns show them)",
+            o.task.name(),
+            o.q0.len()
+        );
+    }
     let q0: Vec<String> = o.q0.iter().map(|q| format!("{q:.3}")).collect();
     let _ = writeln!(
         s,

@@ -2,6 +2,7 @@
 //! reachability, each path with and without the corrector, the evaluation.
 
 use deflect_core::dalembert::serial::{self, Payload};
+use deflect_core::mechanism::{PoseIkOptions, Task};
 use deflect_core::motion::PoseState;
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::{self, Data, Vector6};
@@ -34,6 +35,26 @@ pub struct SerialOptions {
     /// Whether the corrector also cancels the links' own inertial loads (deflect-core's
     /// `serial::Model::with_link_inertia`), from the URDF's inertials; off, only the payload's.
     pub link_inertia: bool,
+    /// What the IK controls (the pose; position and tool axis, position and spin, or position
+    /// on an arm with fewer than six joints), corrected and uncorrected alike.
+    #[serde(serialize_with = "task_json")]
+    pub task: Task,
+}
+
+fn task_json<S: serde::Serializer>(t: &Task, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(t.name())
+}
+
+/// The serial corrector of `spec`'s chain with its joint limits and `task`, carrying
+/// `payload`.
+fn corrector(spec: &ArmSpec, payload: Payload, task: Task) -> Result<serial::Model, SimError> {
+    let model = serial::Model::new(spec.robot.model.clone(), payload)?
+        .with_joint_limits(&spec.robot.joint_limits)?;
+    let ik = PoseIkOptions {
+        task,
+        ..*model.ik_options()
+    };
+    Ok(model.with_ik_options(ik)?)
 }
 
 fn payload_json<S: serde::Serializer>(p: &Payload, s: S) -> Result<S::Ok, S::Error> {
@@ -132,9 +153,14 @@ fn pose7(p: &Isometry3<f64>) -> [f64; 7] {
     [t.x, t.y, t.z, q.w, q.i, q.j, q.k]
 }
 
+/// Damping multiplier of the static check (as the milling identification's static tests).
+const STATIC_DAMPING: f64 = 30.0;
+
 /// The rapier arm's static TCP deflection against `J K^-1 J^T w` at `q0`: the largest
-/// relative difference over forces of 100 N along x, y, z and moments of 20 N m, the six
-/// loads on up to `jobs` threads.
+/// relative difference over forces of 100 N along x, y, z and moments of 20 N m (both times
+/// the softest virtual-joint stiffness over 5000 N m/rad on an arm with a softer one, so the
+/// springs turn by milliradians, where `J K^-1 J^T` holds), the six loads on up to `jobs`
+/// threads.
 pub fn static_check(
     spec: &ArmSpec,
     q0: &[f64],
@@ -143,14 +169,25 @@ pub fn static_check(
 ) -> Result<f64, SimError> {
     let model = &spec.robot.model;
     let c = vjm::compliance(model, &mut Data::new(model), q0)?;
+    let k_min = spec
+        .bodies
+        .iter()
+        .filter_map(|b| match &b.piece {
+            crate::urdf_arm::Piece::Spring { k, .. } => k.iter().copied().reduce(f64::min),
+            _ => None,
+        })
+        .fold(f64::INFINITY, f64::min);
+    let scale = (k_min / 5000.0).min(1.0);
     let loads: Vec<usize> = (0..6).collect();
     let errors = crate::jobs::parallel_map(&loads, jobs, |&k| {
         let mut w = Vector6::zeros();
         if let Some(x) = w.get_mut(k) {
-            *x = if k < 3 { 100.0 } else { 20.0 };
+            *x = scale * if k < 3 { 100.0 } else { 20.0 };
         }
-        let mut arm = FlexSerialArm::new(spec, q0, None, servo, 1.0)?;
-        let d = arm.static_deflection(&w, 5000);
+        // Damped 30x to settle within the steps (static readings do not depend on damping):
+        // a soft hobby arm rings for seconds at its structural 2 %.
+        let mut arm = FlexSerialArm::new(spec, q0, None, servo, STATIC_DAMPING)?;
+        let d = arm.static_deflection(&w, 20_000);
         let want = c * w;
         Ok::<f64, SimError>((d - want).norm() / want.norm().max(f64::MIN_POSITIVE))
     })?;
@@ -178,11 +215,11 @@ pub fn plan(
 pub fn check_motions(spec: &ArmSpec, opts: &SerialOptions) -> Result<(), SimError> {
     let model = &spec.robot.model;
     let start = vjm::forward(model, &mut Data::new(model), &opts.q0)?;
-    let rigid = serial::Model::new(
-        model.clone(),
+    let rigid = corrector(
+        spec,
         Payload::point(0.0, nalgebra::Vector3::zeros()),
-    )?
-    .with_joint_limits(&spec.robot.joint_limits)?;
+        opts.task,
+    )?;
     for path in [PathKind::Line, PathKind::Circle] {
         let states = plan(path, &start, &opts.motion, 1.0 / opts.servo.dt)?;
         let mut data = serial::Data::new(&rigid);
@@ -219,8 +256,7 @@ pub fn run(
     } else {
         Payload::point(0.0, nalgebra::Vector3::zeros())
     };
-    let corrector = serial::Model::new(model.clone(), payload)?
-        .with_joint_limits(&spec.robot.joint_limits)?
+    let corrector = corrector(spec, payload, opts.task)?
         .with_deflection(opts.model)
         .with_link_inertia(corrected && opts.link_inertia);
     let mut data = serial::Data::new(&corrector);
