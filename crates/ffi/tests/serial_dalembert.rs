@@ -476,7 +476,14 @@ fn an_arm_with_fewer_joints_corrects_its_task_and_reports_the_rest() {
         );
         let mut c = ptr::null_mut();
         assert_eq!(
-            deflect_serial_dalembert_create(robot, &p, DEFLECT_SERIAL_EXACT, q0.as_ptr(), 4, &mut c),
+            deflect_serial_dalembert_create(
+                robot,
+                &p,
+                DEFLECT_SERIAL_EXACT,
+                q0.as_ptr(),
+                4,
+                &mut c
+            ),
             DEFLECT_OK,
             "a 4-axis SCARA is accepted"
         );
@@ -499,8 +506,7 @@ fn an_arm_with_fewer_joints_corrects_its_task_and_reports_the_rest() {
         // The core corrector of the same arm and task, tick for tick.
         let core_robot = deflect_core::SerialRobot::from_path(
             Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/scara/scara4.urdf"),
-            Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../robots/scara/scara4_stiffness.toml"),
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../../robots/scara/scara4_stiffness.toml"),
             "tcp",
         )
         .unwrap();

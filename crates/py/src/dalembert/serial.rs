@@ -242,7 +242,9 @@ impl SerialDalembertCorrector {
             position_tolerance.into_pyobject(py)?.into_any(),
             orientation_tolerance.into_pyobject(py)?.into_any(),
             seed.into_pyobject(py)?.into_any(),
-            pyo3::types::PyBool::new(py, link_inertia).to_owned().into_any(),
+            pyo3::types::PyBool::new(py, link_inertia)
+                .to_owned()
+                .into_any(),
             [g.x, g.y, g.z].into_pyobject(py)?.into_any(),
             model.ik_options().task.name().into_pyobject(py)?.into_any(),
         ];
