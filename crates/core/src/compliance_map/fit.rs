@@ -170,7 +170,7 @@ pub struct NodeFit {
 
 /// Groups coordinates into grid lines: returns the line centres (means, computed relative to
 /// the lowest value so that equal coordinates give exactly that value) and each value's line.
-fn cluster(
+pub(crate) fn cluster(
     values: &[f64],
     axis: &'static str,
     tolerance: f64,
@@ -261,6 +261,67 @@ pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, Bu
         });
     }
     Ok((cx, cy, nodes))
+}
+
+/// The least-squares lines `disp_d = slope F + offset` (Eq. 13, `A = [F_k 1]`, centred form)
+/// of one node and force axis over its readings `(F_k, displacement_k)`, for the first `nd`
+/// displacement axes, and the 2-norm condition number of `A` (at least 2 readings of
+/// distinct forces: the caller checks).
+pub(crate) fn fit_lines(
+    group: &[(f64, [f64; MAX_AXES])],
+    nd: usize,
+) -> (f64, [LineStats; MAX_AXES]) {
+    let k = group.len() as f64;
+    let f_mean = group.iter().map(|m| m.0).sum::<f64>() / k;
+    let sxx: f64 = group.iter().map(|m| (m.0 - f_mean) * (m.0 - f_mean)).sum();
+    // Condition number of A = [F 1]: eigenvalues of A^T A = [[sum F^2, sum F], [sum F, k]].
+    let (a, b, c) = (
+        group.iter().map(|m| m.0 * m.0).sum::<f64>(),
+        group.iter().map(|m| m.0).sum::<f64>(),
+        k,
+    );
+    // hypot, not sqrt of the squares: (a - c)^2 overflows for forces above ~1e77 N.
+    let lmax = 0.5 * (a + c + nalgebra::ComplexField::hypot(a - c, 2.0 * b));
+    // det(A^T A) = k * sum (F - mean)^2, computed without cancellation.
+    let lmin = k * sxx / lmax;
+    let mut lines = [LineStats {
+        slope: 0.0,
+        offset: 0.0,
+        rms: 0.0,
+        r_squared: 1.0,
+    }; MAX_AXES];
+    for (d, line) in lines.iter_mut().enumerate().take(nd) {
+        let disp = |m: &(f64, [f64; MAX_AXES])| m.1.get(d).copied().unwrap_or(0.0);
+        let d_mean = group.iter().map(disp).sum::<f64>() / k;
+        let sxy: f64 = group
+            .iter()
+            .map(|m| (m.0 - f_mean) * (disp(m) - d_mean))
+            .sum();
+        let slope = sxy / sxx;
+        let offset = d_mean - slope * f_mean;
+        let ss_res: f64 = group
+            .iter()
+            .map(|m| {
+                let r = disp(m) - (slope * m.0 + offset);
+                r * r
+            })
+            .sum();
+        let ss_tot: f64 = group
+            .iter()
+            .map(|m| (disp(m) - d_mean) * (disp(m) - d_mean))
+            .sum();
+        *line = LineStats {
+            slope,
+            offset,
+            rms: sqrt(ss_res / k),
+            r_squared: if ss_tot > 0.0 {
+                1.0 - ss_res / ss_tot
+            } else {
+                1.0
+            },
+        };
+    }
+    (sqrt(lmax / lmin), lines)
 }
 
 /// Fits a compliance map from static tests (Eq. 10-13).
@@ -388,68 +449,28 @@ pub fn fit(
                     levels: rows.len(),
                 });
             }
-            let group: Vec<&Measurement> =
-                rows.iter().filter_map(|r| measurements.get(*r)).collect();
-            let k = group.len() as f64;
-            let f_mean = group.iter().map(|m| m.force).sum::<f64>() / k;
-            let sxx: f64 = group
+            let group: Vec<(f64, [f64; MAX_AXES])> = rows
                 .iter()
-                .map(|m| (m.force - f_mean) * (m.force - f_mean))
-                .sum();
-            // Condition number of A = [F 1]: eigenvalues of A^T A = [[sum F^2, sum F], [sum F, k]].
-            let (a, b, c) = (
-                group.iter().map(|m| m.force * m.force).sum::<f64>(),
-                group.iter().map(|m| m.force).sum::<f64>(),
-                k,
-            );
-            // hypot, not sqrt of the squares: (a - c)^2 overflows for forces above ~1e77 N.
-            let lmax = 0.5 * (a + c + nalgebra::ComplexField::hypot(a - c, 2.0 * b));
-            // det(A^T A) = k * sum (F - mean)^2, computed without cancellation.
-            let lmin = k * sxx / lmax;
+                .filter_map(|r| measurements.get(*r))
+                .map(|m| (m.force, m.displacement))
+                .collect();
+            let (condition, lines) = fit_lines(&group, nd);
             if let Some(slot) = nfit.condition.get_mut(f) {
-                *slot = sqrt(lmax / lmin);
+                *slot = condition;
             }
             if let Some(slot) = nfit.samples.get_mut(f) {
                 *slot = group.len();
             }
-            for d in 0..nd {
-                let disp = |m: &Measurement| m.displacement.get(d).copied().unwrap_or(0.0);
-                let d_mean = group.iter().map(|m| disp(m)).sum::<f64>() / k;
-                let sxy: f64 = group
-                    .iter()
-                    .map(|m| (m.force - f_mean) * (disp(m) - d_mean))
-                    .sum();
-                let slope = sxy / sxx;
-                let offset = d_mean - slope * f_mean;
-                let ss_res: f64 = group
-                    .iter()
-                    .map(|m| {
-                        let r = disp(m) - (slope * m.force + offset);
-                        r * r
-                    })
-                    .sum();
-                let ss_tot: f64 = group
-                    .iter()
-                    .map(|m| (disp(m) - d_mean) * (disp(m) - d_mean))
-                    .sum();
+            for (d, line) in lines.iter().enumerate().take(nd) {
                 let idx = node * block + d * nf + f;
                 if let Some(s) = slopes.get_mut(idx) {
-                    *s = slope;
+                    *s = line.slope;
                 }
                 if let Some(o) = offsets.get_mut(idx) {
-                    *o = offset;
+                    *o = line.offset;
                 }
                 if let Some(l) = nfit.lines.get_mut(d * nf + f) {
-                    *l = LineStats {
-                        slope,
-                        offset,
-                        rms: sqrt(ss_res / k),
-                        r_squared: if ss_tot > 0.0 {
-                            1.0 - ss_res / ss_tot
-                        } else {
-                            1.0
-                        },
-                    };
+                    *l = *line;
                 }
             }
         }

@@ -22,7 +22,14 @@ pub(crate) struct Axis<'a> {
 pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, BuildError> {
     if nodes.len() < 2 {
         return Err(BuildError::TooFew {
-            what: if axis == "x" { "x nodes" } else { "y nodes" },
+            what: match axis {
+                "x" => "x nodes",
+                "y" => "y nodes",
+                "axis 0" => "axis 0 nodes",
+                "axis 1" => "axis 1 nodes",
+                "axis 2" => "axis 2 nodes",
+                _ => "axis 3 nodes",
+            },
             needed: 2,
             got: nodes.len(),
         });

@@ -54,6 +54,8 @@ mod field;
 mod fit;
 #[cfg(feature = "alloc")]
 mod map;
+#[cfg(feature = "alloc")]
+mod nd;
 
 #[cfg(feature = "alloc")]
 pub use cross_validation::{CrossValidation, HeldOutNode, HoldOutAxis, leave_one_node_out};
@@ -66,6 +68,8 @@ pub use fit::{FitOptions, LineStats, Measurement, NodeFit, fit, two_point_displa
 pub use interp::{BatchError, BatchSummary};
 #[cfg(feature = "alloc")]
 pub use map::ComplianceMap;
+#[cfg(feature = "alloc")]
+pub use nd::{GridMap, GridMeasurement, MAX_GRID_DIMS, MAX_GRID_NODES, fit_grid};
 pub use view::ComplianceMapView;
 
 use crate::error::{Placement, TickError};

@@ -191,6 +191,13 @@ pub enum BuildError {
         /// Node y \[m\].
         y: f64,
     },
+    /// A node of an N-D grid has no data: its coordinates, the first `dims` of `node`.
+    MissingGridNode {
+        /// Node coordinates (unused entries 0).
+        node: [f64; 4],
+        /// Grid dimensions.
+        dims: usize,
+    },
     /// Two-point input: the measurement points coincide or the spacing is not positive.
     BadTwoPoint {
         /// The spacing |P_u P_l| given \[m\].
@@ -357,6 +364,16 @@ impl fmt::Display for BuildError {
                 write!(f, "row {row} repeats the node of row {previous_row}")
             }
             Self::MissingNode { x, y } => write!(f, "grid node ({x}, {y}) m has no data"),
+            Self::MissingGridNode { node, dims } => {
+                write!(f, "grid node (")?;
+                for (k, v) in node.iter().take(*dims).enumerate() {
+                    if k > 0 {
+                        write!(f, ", ")?;
+                    }
+                    write!(f, "{v}")?;
+                }
+                write!(f, ") has no data")
+            }
             Self::BadTwoPoint { spacing } => write!(
                 f,
                 "two-point input: spacing |P_u P_l| = {spacing} m must be positive and finite"
