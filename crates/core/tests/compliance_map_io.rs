@@ -139,11 +139,28 @@ fn loader_and_view_rejections() {
     );
 
     let json = map_json::to_string(&map).unwrap();
-    let v2 = json.replacen("\"format_version\": 1", "\"format_version\": 2", 1);
+    let v3 = json.replacen("\"format_version\": 1", "\"format_version\": 3", 1);
     assert_eq!(
-        map_json::from_str(&v2).unwrap_err(),
-        LoadError::UnsupportedVersion { found: 2 }
+        map_json::from_str(&v3).unwrap_err(),
+        LoadError::UnsupportedVersion { found: 3 }
     );
+    // A version-1 body labelled 2 is read as a grid map and refused for its missing axes.
+    let v2 = json.replacen("\"format_version\": 1", "\"format_version\": 2", 1);
+    assert!(matches!(
+        map_json::from_str(&v2).unwrap_err(),
+        LoadError::Json { .. }
+    ));
+    // The 2-D map as a version-2 grid map reads back as the same map, and the grid reader
+    // reads version 1 as the same grid.
+    let grid = deflect_core::compliance_map::GridMap::from_map(&map);
+    let text = map_json::grid_to_string(&grid).unwrap();
+    assert!(text.contains("\"format_version\": 2") && text.contains("\"name\": \"y\""));
+    let back = map_json::from_str(&text).unwrap();
+    assert_eq!(back.slopes(), map.slopes());
+    assert_eq!(back.offsets(), map.offsets());
+    assert_eq!(back.x(), map.x());
+    assert_eq!(map_json::grid_from_str(&json).unwrap(), grid);
+    assert_eq!(map_json::grid_from_str(&text).unwrap(), grid);
     let mm = json.replacen("\"position\": \"m\"", "\"position\": \"mm\"", 1);
     assert!(matches!(
         map_json::from_str(&mm).unwrap_err(),

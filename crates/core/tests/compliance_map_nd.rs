@@ -315,3 +315,21 @@ fn refusals_are_typed() {
         .unwrap_err();
     assert_eq!(e.row, 1);
 }
+
+#[test]
+fn a_3d_map_round_trips_through_json_version_2_bit_for_bit() {
+    use deflect_core::io::map_json;
+    let axes = vec![axis(0.0, 3), axis(0.1, 4), axis(0.5, 3)];
+    let map = map_with(axes, 2, 3, |p, c| {
+        1e-6 * noise(c + (p[2] * 1e4) as usize) / 3.0
+    })
+    .with_options(QueryOptions {
+        interpolation: Interpolation::Bicubic,
+        out_of_grid: OutOfGrid::Clamp,
+    });
+    let text = map_json::grid_to_string(&map).unwrap();
+    assert!(text.contains("\"format_version\": 2"));
+    assert_eq!(map_json::grid_from_str(&text).unwrap(), map);
+    // A 3-D grid is not a 2-D compliance map.
+    assert!(map_json::from_str(&text).is_err());
+}

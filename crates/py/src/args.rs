@@ -41,7 +41,7 @@ extractors!(
     /// Counts ([`crate::scalars::count`]).
     count: crate::scalars::count => usize {
         bias_samples, g_level, iterations, max_approach_steps, max_bisections, max_iterations,
-        max_jam_steps, max_steps, moving_average_window, window,
+        max_jam_steps, max_steps, moving_average_window, n_displacement, n_force, window,
     }
 );
 

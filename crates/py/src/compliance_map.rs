@@ -20,17 +20,17 @@ use crate::batch;
 use crate::errors::{build_err, load_err, shape_error, tick_err};
 use crate::field::DisplacementField;
 
-fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
+pub(crate) fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
     match s.to_ascii_lowercase().as_str() {
-        "bilinear" | "linear" => Ok(Interpolation::Bilinear),
+        "bilinear" | "linear" | "multilinear" => Ok(Interpolation::Bilinear),
         "bicubic" | "cubic" => Ok(Interpolation::Bicubic),
         _ => Err(InputError::new_err(format!(
-            "interpolation must be \"bilinear\" or \"bicubic\", got {s:?}"
+            "interpolation must be \"bilinear\" (\"multilinear\") or \"bicubic\" (\"cubic\"), got {s:?}"
         ))),
     }
 }
 
-fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
+pub(crate) fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
     match s.to_ascii_lowercase().as_str() {
         "error" => Ok(OutOfGrid::Error),
         "clamp" => Ok(OutOfGrid::Clamp),
@@ -41,14 +41,14 @@ fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
     }
 }
 
-fn interpolation_name(i: Interpolation) -> &'static str {
+pub(crate) fn interpolation_name(i: Interpolation) -> &'static str {
     match i {
         Interpolation::Bicubic => "bicubic",
         _ => "bilinear",
     }
 }
 
-fn out_of_grid_name(o: OutOfGrid) -> &'static str {
+pub(crate) fn out_of_grid_name(o: OutOfGrid) -> &'static str {
     match o {
         OutOfGrid::Clamp => "clamp",
         OutOfGrid::Extrapolate => "extrapolate",

@@ -25,6 +25,7 @@ mod dalembert;
 mod drivetrain;
 mod errors;
 mod field;
+mod grid_map;
 mod identification;
 mod machining;
 mod machining_job;
@@ -61,6 +62,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     compensation::register(m)?;
     identification::register(m)?;
     compliance_map::register(m)?;
+    grid_map::register(m)?;
     field::register(m)?;
     motion::register(m)?;
     mechanism::register(m)?;

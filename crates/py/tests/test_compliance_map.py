@@ -204,8 +204,8 @@ def test_bad_input_raises_value_error_subclasses(oc, tmp_path):
         deflect.ComplianceMap.from_csv(bad)
     with pytest.raises(deflect.LoadError, match="cannot read"):
         deflect.ComplianceMap.from_csv(tmp_path / "absent.csv")
-    with pytest.raises(deflect.LoadError, match="format_version 2"):
-        deflect.ComplianceMap.from_json(oc.to_json().replace('"format_version": 1', '"format_version": 2'))
+    with pytest.raises(deflect.LoadError, match="format_version 3"):
+        deflect.ComplianceMap.from_json(oc.to_json().replace('"format_version": 1', '"format_version": 3'))
     pos, axis, force, disp = synthetic_tests(oc)
     keep = ~((axis == 1) & (force > 50) & (pos[:, 0] == pos[0, 0]) & (pos[:, 1] == pos[0, 1]))
     with pytest.raises(deflect.InputError, match="1 distinct force level"):

@@ -284,7 +284,7 @@ impl fmt::Display for LoadError {
             Self::Json { message } => write!(f, "JSON: {message}"),
             Self::UnsupportedVersion { found } => write!(
                 f,
-                "compliance map format_version {found} is not supported (expected 1)"
+                "compliance map format_version {found} is not supported (expected 1 or 2)"
             ),
             Self::UnexpectedUnits { quantity, found } => {
                 write!(f, "JSON map records {quantity} in {found:?}; expected SI")

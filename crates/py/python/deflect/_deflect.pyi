@@ -31,6 +31,10 @@ MAX_SEEDS: int
 MAX_DIRECTIONS: int
 #: Most force (and displacement) axes of a compliance map.
 MAX_AXES: int
+#: Most grid dimensions of a GridMap.
+MAX_GRID_DIMS: int
+#: Most nodes of a GridMap.
+MAX_GRID_NODES: int
 #: Cutting and edge coefficients of Al7075-T6 with a carbide end mill: (k_tc, k_rc, k_ac)
 #: [N/m^2], (k_te, k_re, k_ae) [N/m] (Table 5 of Zhang et al., CJME 34, 2021).
 AL7075_T6_CARBIDE: Tuple[float, float, float, float, float, float]
@@ -46,6 +50,8 @@ __all__ = [
     "MAX_SEEDS",
     "MAX_DIRECTIONS",
     "MAX_AXES",
+    "MAX_GRID_DIMS",
+    "MAX_GRID_NODES",
     "AL7075_T6_CARBIDE",
     "GcodeProgram",
     "MachiningJob",
@@ -69,6 +75,7 @@ __all__ = [
     "identify_stiffness_from_frames",
     "identify_sensor",
     "ComplianceMap",
+    "GridMap",
     "DisplacementField",
     "Trajectory",
     "plan_line",
@@ -167,6 +174,87 @@ class SerialRobot:
 def commanded_pose(target: _ArrayLike, deflection: _ArrayLike) -> _FloatArray:
     """(4, 4) pose to command so that the deflected TCP lands on ``target``, a rigid transform
     (finite, bottom row 0 0 0 1, a proper rotation within 1e-9; ``InputError`` otherwise)."""
+
+@final
+class GridMap:
+    """Compliance map over a grid of 1-4 dimensions (task-space x, y, z [m] or joint angles
+    [rad]): the per-node lines of Paksoy et al. 2025 (Eq. 9-13) blended multilinearly (Eq. 14
+    in N-D) or by a C1 cubic Hermite interpolation. ``slopes``/``offsets`` have the shape
+    (n_0, ..., n_{N-1}, n_displacement, n_force). JSON ``format_version`` 2 (version 1, a 2-D
+    map, is read too)."""
+
+    def __new__(
+        cls,
+        axes: Sequence[_ArrayLike],
+        n_force: int,
+        n_displacement: int,
+        slopes: _ArrayLike,
+        offsets: _ArrayLike,
+        *,
+        names: Optional[Sequence[str]] = None,
+        interpolation: str = "multilinear",
+        out_of_grid: str = "error",
+    ) -> Self: ...
+    @staticmethod
+    def fit(
+        points: _ArrayLike,
+        force_axis: _ArrayLike,
+        force: _ArrayLike,
+        displacement: _ArrayLike,
+        *,
+        names: Optional[Sequence[str]] = None,
+        n_force: Optional[int] = None,
+        position_tolerance: float = 1e-6,
+        interpolation: str = "multilinear",
+        out_of_grid: str = "error",
+    ) -> "GridMap":
+        """Eq. 10-13 at every node of the N-D grid of the readings' distinct coordinates."""
+    @staticmethod
+    def from_map(map: ComplianceMap) -> "GridMap": ...
+    def to_json(self) -> str: ...
+    def save_json(self, path: _StrPath) -> None: ...
+    @staticmethod
+    def from_json(source: Union[str, PathLike]) -> "GridMap": ...
+    def __reduce__(self) -> Tuple[Any, Tuple[str]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+    def with_options(
+        self, interpolation: Optional[str] = None, out_of_grid: Optional[str] = None
+    ) -> "GridMap": ...
+    def displacement(
+        self,
+        point: _ArrayLike,
+        force: _ArrayLike,
+        *,
+        interpolation: Optional[str] = None,
+        out_of_grid: Optional[str] = None,
+    ) -> _FloatArray: ...
+    def displacement_batch(
+        self,
+        P: _ArrayLike,
+        F: _ArrayLike,
+        *,
+        interpolation: Optional[str] = None,
+        out_of_grid: Optional[str] = None,
+    ) -> _FloatArray: ...
+    @property
+    def dims(self) -> int: ...
+    @property
+    def names(self) -> List[str]: ...
+    @property
+    def axes(self) -> List[_FloatArray]: ...
+    @property
+    def n_force(self) -> int: ...
+    @property
+    def n_displacement(self) -> int: ...
+    @property
+    def interpolation(self) -> str: ...
+    @property
+    def out_of_grid(self) -> str: ...
+    @property
+    def slopes(self) -> _FloatArray: ...
+    @property
+    def offsets(self) -> _FloatArray: ...
 
 @final
 class ComplianceMap:
