@@ -114,6 +114,11 @@ typedef struct DeflectComplianceMap DeflectComplianceMap;
 // `deflect_dalembert_destroy`. Not thread-safe: one thread at a time.
 typedef struct DeflectDalembert DeflectDalembert;
 
+// A compliance map over a grid of 1-4 dimensions. Opaque; create with
+// `deflect_grid_map_from_json` or `deflect_grid_map_load_json`, free with
+// `deflect_grid_map_destroy`.
+typedef struct DeflectGridMap DeflectGridMap;
+
 // A planned pose motion. Opaque; create with `deflect_pose_motion_line`, free with
 // `deflect_pose_motion_destroy`. Read-only after creation.
 typedef struct DeflectPoseMotion DeflectPoseMotion;
@@ -635,6 +640,75 @@ DeflectStatus deflect_serial_dalembert_step(struct DeflectSerialDalembert *corre
                                             const struct DeflectPoseState *desired,
                                             const double *process,
                                             struct DeflectSerialTick *out);
+
+// Loads a grid map from deflect's versioned JSON text (`format_version` 2 with 1-4 named
+// axes, or a 2-D map of version 1; SI units, with its query options). Init time: allocates.
+// On failure `*out` is NULL and `err` receives the message.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT` (not UTF-8) or
+// `DEFLECT_ERR_LOAD`.
+//
+// # Safety
+// `text` is NULL or NUL-terminated; `out` is NULL or writable; `err` is NULL or writable for
+// `err_len` bytes.
+DeflectStatus deflect_grid_map_from_json(const char *text,
+                                         struct DeflectGridMap **out,
+                                         char *err,
+                                         size_t err_len);
+
+// `deflect_grid_map_from_json` on the contents of the file at `path`.
+//
+// # Safety
+// As `deflect_grid_map_from_json`, with `path` for `text`.
+DeflectStatus deflect_grid_map_load_json(const char *path,
+                                         struct DeflectGridMap **out,
+                                         char *err,
+                                         size_t err_len);
+
+// Frees a grid map handle. NULL is a no-op.
+//
+// # Safety
+// `map` is NULL or a live handle, not used afterwards.
+void deflect_grid_map_destroy(struct DeflectGridMap *map);
+
+// Writes the map's grid dimensions to `*dims`, force axes to `*n_force` and displacement
+// axes to `*n_displacement` (any may be NULL).
+//
+// # Safety
+// `map` is NULL or a live handle; the outputs are NULL or writable.
+DeflectStatus deflect_grid_map_shape(const struct DeflectGridMap *map,
+                                     size_t *dims,
+                                     size_t *n_force,
+                                     size_t *n_displacement);
+
+// Sets the map's query options: `interpolation` is `DEFLECT_INTERPOLATION_BILINEAR`
+// (multilinear in N-D) or `_BICUBIC` (cubic Hermite), `out_of_grid` `DEFLECT_OUT_OF_GRID_*`.
+// Returns `DEFLECT_ERR_NULL` or `DEFLECT_ERR_INVALID_ARGUMENT`.
+//
+// # Safety
+// `map` is NULL or a live handle not read by another thread meanwhile.
+DeflectStatus deflect_grid_map_set_options(struct DeflectGridMap *map,
+                                           int32_t interpolation,
+                                           int32_t out_of_grid);
+
+// Displacement `out[out_len]` [m | rad] at `point[point_len]` (one coordinate per grid
+// axis) under `force[force_len]` [N | N m], with the map's options. `status` (may be NULL)
+// receives `DEFLECT_QUERY_INSIDE`, `_CLAMPED` or `_EXTRAPOLATED`. Per tick: no allocation.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH`, `DEFLECT_ERR_NON_FINITE` or
+// `DEFLECT_ERR_OUT_OF_GRID`.
+//
+// # Safety
+// `map` is NULL or a live handle; `point` holds `point_len` doubles, `force` `force_len`,
+// `out` `out_len` writable doubles; `status` is NULL or writable.
+DeflectStatus deflect_grid_map_displacement(const struct DeflectGridMap *map,
+                                            const double *point,
+                                            size_t point_len,
+                                            const double *force,
+                                            size_t force_len,
+                                            double *out,
+                                            size_t out_len,
+                                            int32_t *status);
 
 // Loads a compliance map from CSV text in the layout of the paper's coefficient tables
 // (Paksoy et al., Tables II/III: columns `x_mm, y_mm` (or `x_m, y_m`, or `x, y` in

@@ -333,3 +333,51 @@ fn a_3d_map_round_trips_through_json_version_2_bit_for_bit() {
     // A 3-D grid is not a 2-D compliance map.
     assert!(map_json::from_str(&text).is_err());
 }
+
+#[test]
+fn a_csv_of_static_tests_names_its_grid_axes_and_converts_units() {
+    use deflect_core::error::LoadError;
+    use deflect_core::io::grid_csv;
+    use deflect_core::units::{ForceUnit, LengthUnit};
+    // A serial arm's compliance over its elbow angles q2, q3 (degrees), displacements in mm,
+    // forces in N: dx = (1e-3 mm/N * (1 + q2 [rad])) F, dy = 2e-3 mm/N F + 0.01 mm.
+    let mut text = String::from("q2_deg, q3_deg, force_axis, force, dx, dy\n");
+    for q2 in [10.0, 20.0, 40.0] {
+        for q3 in [-30.0, 0.0] {
+            for f in [-100.0, 100.0] {
+                let s = 1e-3 * (1.0 + f64::to_radians(q2));
+                text += &format!("{q2}, {q3}, x, {f}, {}, {}\n", s * f, 2e-3 * f + 0.01);
+            }
+        }
+    }
+    let map =
+        grid_csv::fit_static_str(&text, ForceUnit::Newton, LengthUnit::Millimetre, None, 1e-9)
+            .unwrap();
+    assert_eq!(map.names(), ["q2", "q3"]);
+    assert!((map.axes()[0][1] - 20f64.to_radians()).abs() < 1e-15);
+    let mut d = [0.0; 2];
+    map.displacement(&[30f64.to_radians(), -15f64.to_radians()], &[50.0], &mut d)
+        .unwrap();
+    // Linear in q2 between its nodes: exact multilinear; SI out.
+    let want = 1e-6 * (1.0 + 30f64.to_radians()) * 50.0;
+    assert!((d[0] - want).abs() < 1e-18, "{d:?}");
+    assert!((d[1] - (2e-6 * 50.0 + 1e-5)).abs() < 1e-18, "{d:?}");
+    // Refusals name the column or the row.
+    let bad = text.replacen("q3_deg", "q3", 1);
+    assert_eq!(
+        grid_csv::fit_static_str(&bad, ForceUnit::Newton, LengthUnit::Metre, None, 1e-9)
+            .unwrap_err(),
+        LoadError::UnknownColumn {
+            column: "q3".into()
+        }
+    );
+    let bad = text.replacen("10, -30, x, -100", "10, -30, x, oops", 1);
+    assert!(matches!(
+        grid_csv::fit_static_str(&bad, ForceUnit::Newton, LengthUnit::Metre, None, 1e-9)
+            .unwrap_err(),
+        LoadError::BadNumber {
+            row: 0,
+            column: "force"
+        }
+    ));
+}

@@ -50,6 +50,7 @@ pub mod status;
 
 pub mod compensation;
 pub mod dalembert;
+pub mod grid_map;
 pub mod map;
 pub mod motion;
 pub mod pose_motion;
@@ -61,6 +62,7 @@ pub use boundary::deflect_test_panic;
 pub use compensation::*;
 pub use dalembert::parallel::*;
 pub use dalembert::serial::*;
+pub use grid_map::*;
 pub use map::*;
 pub use motion::*;
 pub use pose_motion::*;

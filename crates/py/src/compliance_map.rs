@@ -56,7 +56,7 @@ pub(crate) fn out_of_grid_name(o: OutOfGrid) -> &'static str {
     }
 }
 
-fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit)> {
+pub(crate) fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit)> {
     let f = ForceUnit::parse(force_unit).ok_or_else(|| {
         InputError::new_err(format!(
             "force_unit must be \"N\" or \"kgf\", got {force_unit:?}"

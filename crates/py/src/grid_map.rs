@@ -6,7 +6,7 @@ use deflect_core::compliance_map::{
     self as cm, FitOptions, GridMap as CoreGrid, GridMeasurement, MAX_AXES, MAX_GRID_DIMS,
     QueryOptions,
 };
-use deflect_core::io::map_json;
+use deflect_core::io::{grid_csv, map_json};
 use numpy::ndarray::{Array2, ArrayD, IxDyn};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
@@ -16,6 +16,7 @@ use crate::args;
 use crate::arrays::{array_dyn, check_count, indices, matrix, try_rows, vector_upto};
 use crate::compliance_map::{
     ComplianceMap, interpolation_name, out_of_grid_name, parse_interpolation, parse_out_of_grid,
+    units,
 };
 use crate::errors::{build_err, load_err, shape_error, tick_err, tick_err_at};
 
@@ -230,6 +231,35 @@ impl GridMap {
         };
         let inner =
             cm::fit_grid(names_or_default(names, dims), &readings, &options).map_err(build_err)?;
+        let q = QueryOptions {
+            interpolation: parse_interpolation(interpolation)?,
+            out_of_grid: parse_out_of_grid(out_of_grid)?,
+        };
+        Ok(Self {
+            inner: inner.with_options(q),
+        })
+    }
+
+    /// Fits a map from a CSV of static tests on a grid whose axes the columns name: one to four
+    /// `<name>_<unit>` columns (unit `m`, `mm`, `rad` or `deg`: `x_mm, y_mm, z_mm` for a
+    /// Delta, `q2_deg, q3_deg` for an arm's elbow), `force_axis` (0.. or x, y, z, mx, my, mz),
+    /// `force` [force_unit], displacement columns `dx, dy, dz` [length_unit], `rx, ry, rz`
+    /// [rad]. Any other column is refused by name.
+    #[staticmethod]
+    #[pyo3(signature = (path, force_unit="N", length_unit="mm", n_force=None, position_tolerance=1e-6,
+        interpolation="multilinear", out_of_grid="error"))]
+    fn fit_csv(
+        path: std::path::PathBuf,
+        force_unit: &str,
+        length_unit: &str,
+        #[pyo3(from_py_with = args::opt_count::n_force)] n_force: Option<usize>,
+        #[pyo3(from_py_with = args::real::position_tolerance)] position_tolerance: f64,
+        interpolation: &str,
+        out_of_grid: &str,
+    ) -> PyResult<Self> {
+        let (f, l) = units(force_unit, length_unit)?;
+        let inner = grid_csv::fit_static_path(&path, f, l, n_force, position_tolerance)
+            .map_err(load_err)?;
         let q = QueryOptions {
             interpolation: parse_interpolation(interpolation)?,
             out_of_grid: parse_out_of_grid(out_of_grid)?,

@@ -127,3 +127,29 @@ def test_bad_input_is_named():
     with pytest.raises(deflect.InputError, match="interpolation"):
         m.displacement([axes[0][1], axes[1][1]], [1.0, 0.0], interpolation="spline")
     assert m.displacement([axes[0][1], 99.0], [1.0, 0.0], out_of_grid="clamp").shape == (3,)
+
+
+def test_a_csv_names_the_axes(tmp_path):
+    # A Delta's workspace in mm, displacements in mm: dz = 2e-3 mm/N (1 + z/0.1 m) F.
+    rows = ["x_mm,y_mm,z_mm,force_axis,force,dx,dy,dz"]
+    for x in (-50, 0, 50):
+        for y in (-50, 50):
+            for z in (-400, -300):
+                for axis in ("x", "y", "z"):
+                    for f in (-10.0, 10.0):
+                        dz = 2e-3 * (1 + z / 1000 / 0.1) * f if axis == "z" else 0.0
+                        rows.append(f"{x},{y},{z},{axis},{f},0,0,{dz}")
+    path = tmp_path / "delta.csv"
+    path.write_text("\n".join(rows) + "\n")
+    m = deflect.GridMap.fit_csv(path)
+    assert m.names == ["x", "y", "z"] and m.n_force == 3 and m.n_displacement == 3
+    np.testing.assert_allclose(m.axes[2], [-0.4, -0.3])
+    got = m.displacement([0.01, 0.0, -0.35], [0, 0, 5.0])
+    assert got[2] == pytest.approx(2e-6 * (1 - 3.5) * 5.0, rel=1e-12)
+    (tmp_path / "bad.csv").write_text("x_mm,yy,force_axis,force,dx\n")
+    with pytest.raises(deflect.LoadError, match="yy"):
+        deflect.GridMap.fit_csv(tmp_path / "bad.csv")
+    # Force axis x never loaded at one node: named, not "no data".
+    (tmp_path / "gap.csv").write_text("\n".join(r for r in rows if not r.startswith("-50,-50,-400,x")) + "\n")
+    with pytest.raises(deflect.LoadError, match=r"\(-0.05, -0.05, -0.4\), force axis 0"):
+        deflect.GridMap.fit_csv(tmp_path / "gap.csv")

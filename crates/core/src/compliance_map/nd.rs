@@ -534,6 +534,18 @@ pub fn fit_grid(
             });
         }
     }
+    let mut measured = vec![false; nodes];
+    for n in &node_of {
+        if let Some(m) = measured.get_mut(*n) {
+            *m = true;
+        }
+    }
+    if let Some(node) = measured.iter().position(|m| !*m) {
+        return Err(BuildError::MissingGridNode {
+            node: coordinates(node),
+            dims,
+        });
+    }
     let block = nd * nf;
     let mut slopes = vec![0.0; nodes * block];
     let mut offsets = vec![0.0; nodes * block];
@@ -548,17 +560,10 @@ pub fn fit_grid(
                 pos += 1;
             }
             let rows = order.get(begin..pos).unwrap_or(&[]);
-            if rows.is_empty() && f == 0 {
-                return Err(BuildError::MissingGridNode {
+            if rows.len() < 2 {
+                return Err(BuildError::TooFewGridForceLevels {
                     node: coordinates(node),
                     dims,
-                });
-            }
-            if rows.len() < 2 {
-                let c = coordinates(node);
-                return Err(BuildError::TooFewForceLevels {
-                    node_x: c.first().copied().unwrap_or(0.0),
-                    node_y: c.get(1).copied().unwrap_or(0.0),
                     force_axis: f,
                     levels: rows.len(),
                 });

@@ -191,6 +191,17 @@ pub enum BuildError {
         /// Node y \[m\].
         y: f64,
     },
+    /// Fewer than 2 distinct force levels for one line fit at a node of an N-D grid.
+    TooFewGridForceLevels {
+        /// Node coordinates (the first `dims`; unused entries 0).
+        node: [f64; 4],
+        /// Grid dimensions.
+        dims: usize,
+        /// Force axis.
+        force_axis: usize,
+        /// Distinct levels found.
+        levels: usize,
+    },
     /// A node of an N-D grid has no data: its coordinates, the first `dims` of `node`.
     MissingGridNode {
         /// Node coordinates (unused entries 0).
@@ -364,6 +375,25 @@ impl fmt::Display for BuildError {
                 write!(f, "row {row} repeats the node of row {previous_row}")
             }
             Self::MissingNode { x, y } => write!(f, "grid node ({x}, {y}) m has no data"),
+            Self::TooFewGridForceLevels {
+                node,
+                dims,
+                force_axis,
+                levels,
+            } => {
+                write!(f, "grid node (")?;
+                for (k, v) in node.iter().take(*dims).enumerate() {
+                    if k > 0 {
+                        write!(f, ", ")?;
+                    }
+                    write!(f, "{v}")?;
+                }
+                write!(
+                    f,
+                    "), force axis {force_axis}: {levels} distinct force level(s); a line fit \
+                     needs at least 2"
+                )
+            }
             Self::MissingGridNode { node, dims } => {
                 write!(f, "grid node (")?;
                 for (k, v) in node.iter().take(*dims).enumerate() {

@@ -12,11 +12,13 @@
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
 //! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |
 //! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
-//! | [`map_json`] | versioned JSON of a map | [`crate::ComplianceMap`] |
+//! | [`map_json`] | versioned JSON of a map (version 2: an N-D grid map) | [`crate::ComplianceMap`], [`crate::compliance_map::GridMap`] |
+//! | [`grid_csv`] | static tests on a 1-4 D grid, axes named by their columns | [`crate::compliance_map::GridMap`] |
 
 #[cfg(feature = "urdf")]
 pub mod drive;
 pub mod gcode;
+pub mod grid_csv;
 pub mod job_out;
 pub mod map_csv;
 pub mod map_json;

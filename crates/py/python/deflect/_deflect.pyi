@@ -210,6 +210,17 @@ class GridMap:
     ) -> "GridMap":
         """Eq. 10-13 at every node of the N-D grid of the readings' distinct coordinates."""
     @staticmethod
+    def fit_csv(
+        path: _StrPath,
+        force_unit: str = "N",
+        length_unit: str = "mm",
+        n_force: Optional[int] = None,
+        position_tolerance: float = 1e-6,
+        interpolation: str = "multilinear",
+        out_of_grid: str = "error",
+    ) -> "GridMap":
+        """Static tests from CSV whose ``<name>_<m|mm|rad|deg>`` columns name the grid axes."""
+    @staticmethod
     def from_map(map: ComplianceMap) -> "GridMap": ...
     def to_json(self) -> str: ...
     def save_json(self, path: _StrPath) -> None: ...
