@@ -155,6 +155,45 @@ impl<const J: usize> DisplacementModel<2, J> for ComplianceMap {
     }
 }
 
+/// A 3-D grid map over the task space `(x, y, z)` with 3 force and 3 displacement axes (a
+/// Delta robot's), queried with its default options.
+#[cfg(feature = "alloc")]
+impl<const J: usize> DisplacementModel<3, J> for crate::compliance_map::GridMap {
+    type Data = ();
+
+    fn new_data(&self) {}
+
+    fn check(&self) -> Result<(), BuildError> {
+        if self.dims() != 3 {
+            return Err(BuildError::InvalidParameter {
+                what: "grid dimensions of a task-space map for a 3-D corrector",
+                value: self.dims() as f64,
+                expected: "3 (x, y, z)",
+            });
+        }
+        if self.n_force() != 3 || self.n_displacement() != 3 {
+            return Err(BuildError::MapDimension {
+                expected: 3,
+                n_force: self.n_force(),
+                n_displacement: self.n_displacement(),
+            });
+        }
+        Ok(())
+    }
+
+    fn displacement(
+        &self,
+        _data: &mut (),
+        position: &nalgebra::Vector3<f64>,
+        _q: &SVector<f64, J>,
+        force: &nalgebra::Vector3<f64>,
+    ) -> Result<(nalgebra::Vector3<f64>, Placement), TickError> {
+        let mut out = [0.0; 3];
+        let placement = self.displacement(position.as_slice(), force.as_slice(), &mut out)?;
+        Ok((nalgebra::Vector3::from(out), placement))
+    }
+}
+
 /// What the paper's corrector reports beyond the common [`Tick`] fields.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Diagnostics {

@@ -1,5 +1,5 @@
 //! Static tests on an N-D grid from CSV (`std`), fitted into a
-//! [`GridMap`](crate::compliance_map::GridMap) (Eq. 10-13 per node): the grid's axes are named
+//! [`crate::compliance_map::GridMap`] (Eq. 10-13 per node): the grid's axes are named
 //! by their columns.
 //!
 //! One reading a row. Columns:

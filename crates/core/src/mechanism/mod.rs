@@ -12,15 +12,18 @@
 //! Implementations:
 //! * [`ParallelRobot2`]: the paper's 2-DoF planar parallel robot, `Mechanism<2, 2>`,
 //!   closed-form IK/FK.
+//! * [`Delta`]: the 3-DoF Delta robot of Clavel, `Mechanism<3, 3>`, closed-form IK/FK.
 //! * [`SerialArm`]: a [`crate::vjm::Model`] (serial arm with `J` joints), `Mechanism<3, J>`:
 //!   the task is the rigid TCP position; IK by bounded damped least squares from a seed, in a
 //!   [`crate::vjm::Data`] workspace.
 
+mod delta;
 pub mod limits;
 mod parallel;
 pub mod pose_ik;
 mod serial;
 
+pub use delta::{DELTA_MIN_SIGMA, Delta};
 pub use limits::{JOINT_LIMIT_TOLERANCE, check_limits};
 pub use parallel::{DEFAULT_MIN_SIGMA, PAPER_HALF_WIDTH, PAPER_LINK, ParallelRobot2};
 pub use pose_ik::{PoseIkOptions, PoseIkSolution, Task, largest_task, pose_ik};
