@@ -114,6 +114,11 @@ typedef struct DeflectComplianceMap DeflectComplianceMap;
 // `deflect_dalembert_destroy`. Not thread-safe: one thread at a time.
 typedef struct DeflectDalembert DeflectDalembert;
 
+// The D'Alembert corrector of a Delta robot: geometry, its own copy of the 3-D map,
+// settings and the last tick's joints. Opaque; create with `deflect_delta_corrector_create`,
+// free with `deflect_delta_corrector_destroy`. Not thread-safe: one thread at a time.
+typedef struct DeflectDeltaCorrector DeflectDeltaCorrector;
+
 // A compliance map over a grid of 1-4 dimensions. Opaque; create with
 // `deflect_grid_map_from_json` or `deflect_grid_map_load_json`, free with
 // `deflect_grid_map_destroy`.
@@ -223,6 +228,41 @@ typedef struct DeflectCycleOutput {
   // 1 if the rate limit acted this cycle.
   uint8_t rate_limited;
 } DeflectCycleOutput;
+
+// Geometry of a Delta robot [m] and its singularity threshold [m/rad].
+typedef struct DeflectDelta {
+  // Radius of the circle of the actuated joints [m].
+  double base_radius;
+  // Radius of the circle of the platform joints [m].
+  double platform_radius;
+  // Arm length [m].
+  double arm;
+  // Forearm (parallelogram) length [m].
+  double forearm;
+  // Smallest allowed Jacobian singular value [m/rad] (default 0.010).
+  double min_sigma;
+} DeflectDelta;
+
+// One corrected tick of the Delta's D'Alembert corrector.
+typedef struct DeflectCorrectedTick3 {
+  // Desired (planned) platform centre [m].
+  double desired[3];
+  // Commanded point [m]: desired minus the predicted displacement.
+  double commanded[3];
+  // Joint command [rad]: inverse kinematics of `commanded`.
+  double joints[3];
+  // D'Alembert force -m* a [N].
+  double force[3];
+  // Predicted displacement at the commanded point [m].
+  double displacement[3];
+  // Fixed-point iterations done (0 = the paper's one-shot update).
+  uint32_t iterations;
+  // |c_k - c_(k-1)| of the last fixed-point iteration [m] (0 without iterations).
+  double fixed_point_residual;
+  // Worst placement of the map queries: `DEFLECT_QUERY_INSIDE`, `_CLAMPED` or
+  // `_EXTRAPOLATED`.
+  int32_t placement;
+} DeflectCorrectedTick3;
 
 // Geometry of the paper's 2-DoF planar parallel robot (Paksoy et al., section 4.1).
 typedef struct DeflectParallelRobot2 {
@@ -507,6 +547,66 @@ DeflectStatus deflect_compensator_step(struct DeflectCompensator *compensator,
                                        const double *estimated,
                                        const double *feed_velocity,
                                        struct DeflectCycleOutput *out);
+
+// Writes deflect's pick-and-place Delta (base radius 0.2 m, platform 0.045 m, arm 0.35 m,
+// forearm 0.8 m, threshold 0.010 m/rad) to `*out`.
+//
+// # Safety
+// `out` is NULL or writable.
+DeflectStatus deflect_delta_pick_and_place(struct DeflectDelta *out);
+
+// Inverse kinematics of `delta`: the joints `q[3]` [rad] putting the platform centre on
+// `p[3]` [m] (elbows out). Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT` (bad
+// geometry), `DEFLECT_ERR_NON_FINITE` or `DEFLECT_ERR_OUT_OF_WORKSPACE`.
+//
+// # Safety
+// `delta` is NULL or readable; `p` holds 3 doubles; `q` is NULL or holds 3 writable doubles.
+DeflectStatus deflect_delta_ik(const struct DeflectDelta *delta, const double *p, double *q);
+
+// Forward kinematics of `delta`: the platform centre `p[3]` [m] at joints `q[3]` [rad].
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_INVALID_ARGUMENT`, `DEFLECT_ERR_NON_FINITE`,
+// `DEFLECT_ERR_OUT_OF_WORKSPACE` (cannot be assembled) or `DEFLECT_ERR_SINGULAR`.
+//
+// # Safety
+// `delta` is NULL or readable; `q` holds 3 doubles; `p` is NULL or holds 3 writable doubles.
+DeflectStatus deflect_delta_fk(const struct DeflectDelta *delta, const double *q, double *p);
+
+// Creates the D'Alembert corrector of `delta` (NULL = the pick-and-place Delta) with the 3-D
+// grid map `map` (copied in; 3 axes over x, y, z with 3 force and 3 displacement axes) and
+// mass parameter `mass` m* [kg]; fixed-point settings as `deflect_dalembert_create`. Init
+// time: allocates. On failure `*out` is NULL.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_MAP_DIMENSION` or
+// `DEFLECT_ERR_INVALID_ARGUMENT`.
+//
+// # Safety
+// `delta` is NULL or readable; `map` is NULL or a live handle; `out` is NULL or writable.
+DeflectStatus deflect_delta_corrector_create(const struct DeflectDelta *delta,
+                                             const struct DeflectGridMap *map,
+                                             double mass,
+                                             uint32_t fixed_point_iterations,
+                                             double tolerance,
+                                             struct DeflectDeltaCorrector **out);
+
+// Frees a Delta corrector. NULL is a no-op.
+//
+// # Safety
+// `corrector` is NULL or a live handle, not used afterwards.
+void deflect_delta_corrector_destroy(struct DeflectDeltaCorrector *corrector);
+
+// One tick: desired platform centre `desired[3]` [m] with planned acceleration
+// `acceleration[3]` [m/s^2]; the result to `*out`. Per tick: no allocation, bounded time.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE`, `DEFLECT_ERR_OUT_OF_GRID`,
+// `DEFLECT_ERR_OUT_OF_WORKSPACE` or `DEFLECT_ERR_SINGULAR`.
+//
+// # Safety
+// `corrector` is NULL or a live handle not used by another thread; `desired` and
+// `acceleration` hold 3 doubles; `out` is NULL or writable.
+DeflectStatus deflect_delta_corrector_step(struct DeflectDeltaCorrector *corrector,
+                                           const double *desired,
+                                           const double *acceleration,
+                                           struct DeflectCorrectedTick3 *out);
 
 // Writes the geometry of the paper's robot (L = 0.150 m, pivots 0.090 m from the centre,
 // singularity threshold 0.020 m/rad) to `*out`.

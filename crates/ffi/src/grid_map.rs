@@ -25,6 +25,13 @@ pub struct DeflectGridMap {
     map: GridMap,
 }
 
+impl DeflectGridMap {
+    /// The map (for the correctors that copy it in).
+    pub(crate) fn map(&self) -> &GridMap {
+        &self.map
+    }
+}
+
 /// Loads a grid map from deflect's versioned JSON text (`format_version` 2 with 1-4 named
 /// axes, or a 2-D map of version 1; SI units, with its query options). Init time: allocates.
 /// On failure `*out` is NULL and `err` receives the message.

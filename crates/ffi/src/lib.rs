@@ -60,6 +60,7 @@ mod boundary;
 
 pub use boundary::deflect_test_panic;
 pub use compensation::*;
+pub use dalembert::delta::*;
 pub use dalembert::parallel::*;
 pub use dalembert::serial::*;
 pub use grid_map::*;

@@ -153,3 +153,91 @@ fn a_3d_map_answers_as_the_core() {
         assert!(msg.contains("JSON"), "{msg}");
     }
 }
+
+#[test]
+fn a_delta_and_its_corrector_answer_as_the_core() {
+    use deflect_core::dalembert::parallel;
+    use deflect_core::mechanism::Delta;
+    use nalgebra::Vector3;
+    let axes = vec![vec![-0.4, 0.4], vec![-0.4, 0.4], vec![-1.0, -0.5]];
+    let slopes = [1e-6, 0.0, 0.0, 0.0, 1e-6, 0.0, 0.0, 0.0, 2e-6].repeat(8);
+    let names = ["x", "y", "z"].map(String::from).to_vec();
+    let core_map = GridMap::new(axes, names, 3, 3, slopes, vec![0.0; 72]).unwrap();
+    let text = CString::new(map_json::grid_to_string(&core_map).unwrap()).unwrap();
+    // SAFETY: writable outputs, readable inputs of the stated sizes, live handles.
+    unsafe {
+        let mut d = DeflectDelta {
+            base_radius: 0.0,
+            platform_radius: 0.0,
+            arm: 0.0,
+            forearm: 0.0,
+            min_sigma: 0.0,
+        };
+        assert_eq!(deflect_delta_pick_and_place(&mut d), DEFLECT_OK);
+        let p = [0.1, -0.05, -0.8];
+        let (mut q, mut back) = ([0.0; 3], [0.0; 3]);
+        assert_eq!(deflect_delta_ik(&d, p.as_ptr(), q.as_mut_ptr()), DEFLECT_OK);
+        assert_eq!(
+            deflect_delta_fk(&d, q.as_ptr(), back.as_mut_ptr()),
+            DEFLECT_OK
+        );
+        let core = Delta::pick_and_place();
+        assert_eq!(Vector3::from(q), core.ik(&Vector3::from(p)).unwrap());
+        for (a, b) in back.iter().zip(&p) {
+            assert!((a - b).abs() < 1e-12);
+        }
+        assert_eq!(
+            deflect_delta_ik(&d, [0.0, 0.0, -1.5].as_ptr(), q.as_mut_ptr()),
+            DEFLECT_ERR_OUT_OF_WORKSPACE
+        );
+        assert_eq!(
+            deflect_delta_ik(ptr::null(), p.as_ptr(), q.as_mut_ptr()),
+            DEFLECT_ERR_NULL
+        );
+        let bad = DeflectDelta { forearm: 0.1, ..d };
+        assert_eq!(
+            deflect_delta_ik(&bad, p.as_ptr(), q.as_mut_ptr()),
+            DEFLECT_ERR_INVALID_ARGUMENT
+        );
+        let mut m = ptr::null_mut();
+        let mut err = [0 as c_char; 256];
+        assert_eq!(
+            deflect_grid_map_from_json(text.as_ptr(), &mut m, err.as_mut_ptr(), err.len()),
+            DEFLECT_OK
+        );
+        let mut c = ptr::null_mut();
+        assert_eq!(
+            deflect_delta_corrector_create(&d, m, 1.5, 0, 0.0, &mut c),
+            DEFLECT_OK
+        );
+        let a = [0.0, 0.0, -8.0 * 9.81];
+        let mut tick = DeflectCorrectedTick3::default();
+        assert_eq!(
+            deflect_delta_corrector_step(c, p.as_ptr(), a.as_ptr(), &mut tick),
+            DEFLECT_OK
+        );
+        let model = parallel::Model::new(core, core_map, 1.5).unwrap();
+        let mut data = parallel::Data::new(&model);
+        let want = parallel::step(&model, &mut data, &Vector3::from(p), &Vector3::from(a)).unwrap();
+        assert_eq!(Vector3::from(tick.joints), want.joints);
+        assert_eq!(Vector3::from(tick.commanded), want.commanded);
+        assert_eq!(tick.placement, DEFLECT_QUERY_INSIDE);
+        // Out of the map's grid: a status; NULLs: statuses.
+        assert_eq!(
+            deflect_delta_corrector_step(c, [0.1, 0.0, -0.45].as_ptr(), a.as_ptr(), &mut tick),
+            DEFLECT_ERR_OUT_OF_GRID
+        );
+        assert_eq!(
+            deflect_delta_corrector_step(c, p.as_ptr(), a.as_ptr(), ptr::null_mut()),
+            DEFLECT_ERR_NULL
+        );
+        let mut none = ptr::null_mut();
+        assert_eq!(
+            deflect_delta_corrector_create(&d, ptr::null(), 1.5, 0, 0.0, &mut none),
+            DEFLECT_ERR_NULL
+        );
+        assert!(none.is_null());
+        deflect_delta_corrector_destroy(c);
+        deflect_grid_map_destroy(m);
+    }
+}

@@ -22,7 +22,8 @@ macro_rules! extractors {
 extractors!(
     /// Real scalars ([`crate::scalars::real`]).
     real: crate::scalars::real => f64 {
-        contact_force, cutoff_hz, dt, edge_angle, extension, half_width,
+        arm, base_radius, contact_force, cutoff_hz, dt, edge_angle, extension, forearm,
+        half_width, platform_radius,
         jam_force, jam_margin, link, lowpass_cutoff_hz, mass, max_condition, max_correction,
         max_rate, max_turn, min_motion_fraction, min_sigma, min_step_fraction, orientation_tolerance,
         position_tolerance, ramp, rate_hz, step, threshold, tolerance, torque_deadband,

@@ -66,6 +66,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     field::register(m)?;
     motion::register(m)?;
     mechanism::register(m)?;
+    mechanism::register_delta(m)?;
     dalembert::register(m)?;
     pose_motion::register(m)?;
     drivetrain::register(m)?;

@@ -99,3 +99,138 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<ParallelRobot2>()?;
     Ok(())
 }
+
+fn vec3(a: &Bound<'_, PyAny>, what: &str) -> PyResult<nalgebra::Vector3<f64>> {
+    Ok(nalgebra::Vector3::from_column_slice(&vector(a, what, 3)?))
+}
+
+/// The constructor arguments of `Delta`, as pickled.
+type DeltaArgs = (f64, f64, f64, f64, f64);
+
+/// The 3-DoF Delta robot of Clavel: base joint circle radius `base_radius`, platform joint
+/// circle radius `platform_radius`, arm and forearm lengths [m]; `min_sigma` [m/rad] the
+/// singularity threshold. Task point `p = (x, y, z)` [m]: the platform centre, base frame z up
+/// (the platform below, z < 0); joints `q` [rad]: each arm's angle from the horizontal,
+/// positive downwards; working mode "elbows out".
+#[pyclass(module = "deflect", frozen, eq)]
+#[derive(Debug, PartialEq)]
+pub struct Delta {
+    pub(crate) inner: deflect_core::mechanism::Delta,
+}
+
+#[pymethods]
+impl Delta {
+    #[new]
+    #[pyo3(signature = (base_radius, platform_radius, arm, forearm, min_sigma=deflect_core::mechanism::DELTA_MIN_SIGMA),
+           text_signature = "(base_radius, platform_radius, arm, forearm, min_sigma=0.01)")]
+    fn new(
+        #[pyo3(from_py_with = args::real::base_radius)] base_radius: f64,
+        #[pyo3(from_py_with = args::real::platform_radius)] platform_radius: f64,
+        #[pyo3(from_py_with = args::real::arm)] arm: f64,
+        #[pyo3(from_py_with = args::real::forearm)] forearm: f64,
+        #[pyo3(from_py_with = args::real::min_sigma)] min_sigma: f64,
+    ) -> PyResult<Self> {
+        let inner = deflect_core::mechanism::Delta::new(base_radius, platform_radius, arm, forearm)
+            .and_then(|d| d.with_min_sigma(min_sigma))
+            .map_err(build_err)?;
+        Ok(Self { inner })
+    }
+    /// deflect's pick-and-place Delta: base radius 0.2 m, platform 0.045 m, arm 0.35 m,
+    /// forearm 0.8 m.
+    #[staticmethod]
+    fn pick_and_place() -> Self {
+        Self {
+            inner: deflect_core::mechanism::Delta::pick_and_place(),
+        }
+    }
+    /// Pickling and `copy.deepcopy`: the constructor arguments, an exact round trip.
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, pyo3::types::PyType>, DeltaArgs)> {
+        let d = &slf.get().inner;
+        Ok((
+            slf.get_type(),
+            (
+                d.base_radius(),
+                d.platform_radius(),
+                d.arm(),
+                d.forearm(),
+                d.min_sigma(),
+            ),
+        ))
+    }
+    /// Joints `q` (3,) [rad] that put the platform centre on `p` (3,) [m]; InputError out of
+    /// reach.
+    fn ik<'py>(
+        &self,
+        py: Python<'py>,
+        p: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let q = self.inner.ik(&vec3(p, "p")?).map_err(tick_err)?;
+        Ok(q.as_slice().to_pyarray(py))
+    }
+    /// Platform centre `p` (3,) [m] of joints `q` (3,) [rad] (the lower of the two
+    /// assemblies); InputError when the arms cannot be assembled.
+    fn fk<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let p = self.inner.fk(&vec3(q, "q")?).map_err(tick_err)?;
+        Ok(p.as_slice().to_pyarray(py))
+    }
+    /// Jacobian `dp/dq` (3, 3) [m/rad] at `q`; SingularError below `min_sigma`.
+    fn jacobian<'py>(
+        &self,
+        py: Python<'py>,
+        q: &Bound<'py, PyAny>,
+    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        let j = self
+            .inner
+            .jacobian(&mut (), &vec3(q, "q")?)
+            .map_err(tick_err)?;
+        Ok(matrix_to_py(py, &j))
+    }
+    /// Smallest singular value of the Jacobian at `q` [m/rad].
+    fn singularity_distance(&self, q: &Bound<'_, PyAny>) -> PyResult<f64> {
+        self.inner
+            .singularity_distance(&mut (), &vec3(q, "q")?)
+            .map_err(tick_err)
+    }
+    /// Base joint circle radius [m].
+    #[getter]
+    fn base_radius(&self) -> f64 {
+        self.inner.base_radius()
+    }
+    /// Platform joint circle radius [m].
+    #[getter]
+    fn platform_radius(&self) -> f64 {
+        self.inner.platform_radius()
+    }
+    /// Arm length [m].
+    #[getter]
+    fn arm(&self) -> f64 {
+        self.inner.arm()
+    }
+    /// Forearm length [m].
+    #[getter]
+    fn forearm(&self) -> f64 {
+        self.inner.forearm()
+    }
+    fn __repr__(&self) -> String {
+        let d = &self.inner;
+        format!(
+            "Delta(base_radius={}, platform_radius={}, arm={}, forearm={}, min_sigma={})",
+            d.base_radius(),
+            d.platform_radius(),
+            d.arm(),
+            d.forearm(),
+            d.min_sigma()
+        )
+    }
+}
+
+/// Adds the Delta robot to the module.
+pub fn register_delta(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Delta>()
+}

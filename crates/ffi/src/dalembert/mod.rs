@@ -1,6 +1,7 @@
 //! The D'Alembert correctors of deflect-core's `dalembert` module: [`parallel`] (the paper's
-//! five-bar with a compliance map) and [`serial`] (any serial arm in 6-D through its
+//! five-bar with a compliance map), [`delta`] (a Delta robot with a 3-D map) and [`serial`] (any serial arm in 6-D through its
 //! virtual-joint model). Each handle holds the core's `Model` and `Data`.
 
+pub mod delta;
 pub mod parallel;
 pub mod serial;

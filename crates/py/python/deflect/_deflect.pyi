@@ -76,6 +76,8 @@ __all__ = [
     "identify_sensor",
     "ComplianceMap",
     "GridMap",
+    "Delta",
+    "DeltaCorrector",
     "DisplacementField",
     "Trajectory",
     "plan_line",
@@ -507,6 +509,50 @@ def plan_pose(
     rate_hz: Optional[float] = 2000.0,
 ) -> PoseTrajectory:
     """linear (v [m/s], a [m/s^2], j [m/s^3]), angular (w [rad/s], alpha [rad/s^2], [rad/s^3])."""
+
+@final
+class Delta:
+    """The 3-DoF Delta robot of Clavel: platform centre p (3,) [m] (z up, platform below),
+    joints q (3,) [rad] (arm angles from the horizontal, positive down), elbows out."""
+
+    def __new__(
+        cls,
+        base_radius: float,
+        platform_radius: float,
+        arm: float,
+        forearm: float,
+        min_sigma: float = 0.01,
+    ) -> Self: ...
+    @staticmethod
+    def pick_and_place() -> "Delta": ...
+    def __reduce__(self) -> Tuple[Any, Tuple[float, float, float, float, float]]: ...
+    def __eq__(self, value: object, /) -> bool: ...
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+    def ik(self, p: _ArrayLike) -> _FloatArray: ...
+    def fk(self, q: _ArrayLike) -> _FloatArray: ...
+    def jacobian(self, q: _ArrayLike) -> _FloatArray: ...
+    def singularity_distance(self, q: _ArrayLike) -> float: ...
+    @property
+    def base_radius(self) -> float: ...
+    @property
+    def platform_radius(self) -> float: ...
+    @property
+    def arm(self) -> float: ...
+    @property
+    def forearm(self) -> float: ...
+
+@final
+class DeltaCorrector:
+    """The paper's D'Alembert corrector on a Delta from a 3-D compliance map (GridMap over
+    x, y, z with 3 force and 3 displacement axes)."""
+
+    def __new__(
+        cls, grid_map: GridMap, delta: Delta, mass: float, iterations: int = 0, tolerance: float = 0.0
+    ) -> Self: ...
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]: ...
+    @property
+    def mass(self) -> float: ...
+    def step(self, position: _ArrayLike, acceleration: _ArrayLike) -> Dict[str, Any]: ...
 
 @final
 class ParallelRobot2:

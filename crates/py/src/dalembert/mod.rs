@@ -4,11 +4,13 @@
 
 use pyo3::prelude::*;
 
+pub mod delta;
 pub mod parallel;
 pub mod serial;
 
 /// Adds both corrector classes to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     parallel::register(m)?;
+    delta::register(m)?;
     serial::register(m)
 }
