@@ -89,6 +89,7 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
             Some(t) => job::job_cmd(a, t, out),
             None => Err(deflect_sim::SimError::new("job: inputs not loaded")),
         },
+        Command::Delta(a) => commands::delta::delta_cmd(a, out),
     }
     .map_err(CliError::from)
 }

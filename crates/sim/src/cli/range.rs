@@ -173,3 +173,11 @@ pub const RAPID_SPEED: Range = Range::closed("--rapid-speed", 0.001, 10.0, "m/s"
 pub const TOLERANCE_MM: Range = Range::closed("--tolerance", 1e-5, 1.0, "mm");
 /// `job --top`: stock top.
 pub const TOP_MM: Range = Range::closed("--top", -1000.0, 1000.0, "mm");
+/// Peak acceleration of the Delta's move.
+pub const DELTA_G: Range = Range::closed("--g", 1.0, 15.0, "g");
+/// The Delta's payload.
+pub const DELTA_PAYLOAD: Range = Range::closed("--payload-mass", 0.0, 10.0, "kg");
+/// Static-test grid nodes per axis.
+pub const DELTA_NODES: Range = Range::closed("--nodes", 2.0, 6.0, "");
+/// Static-test force.
+pub const DELTA_TEST_FORCE: Range = Range::closed("--test-force", 1.0, 500.0, "N");

@@ -29,6 +29,7 @@ macro_rules! put {
 pub mod atlas;
 pub mod calibrate;
 pub mod contour;
+pub mod delta;
 pub mod fit;
 pub mod job;
 pub mod milling;

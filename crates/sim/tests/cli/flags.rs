@@ -362,3 +362,25 @@ fn comma_lists_may_start_with_a_minus_sign() {
         &["--placement", "5 values"],
     );
 }
+
+#[test]
+fn delta_flags_are_checked_before_any_work() {
+    let d = scratch("delta-refusals");
+    out_of_range(&d, &["delta", "--g", "20"], "--g", "20", "[1, 15] g");
+    out_of_range(&d, &["delta", "--nodes", "1"], "--nodes", "1", "[2, 6]");
+    out_of_range(
+        &d,
+        &["delta", "--payload-mass", "-1"],
+        "--payload-mass",
+        "-1",
+        "[0, 10] kg",
+    );
+    out_of_range(
+        &d,
+        &["delta", "--test-force", "0"],
+        "--test-force",
+        "0",
+        "[1, 500] N",
+    );
+    refused(&d, &["delta", "--jobs", "0"], 2, &["--jobs", "0"]);
+}
