@@ -5,17 +5,12 @@
 
 use std::ffi::c_char;
 
-use deflect_core::compliance_map::{GridMap, Interpolation, OutOfGrid, QueryOptions};
+use deflect_core::compliance_map::GridMap;
 use deflect_core::io::map_json;
 
 use crate::boundary::{c_str, destroy, guard, handle, handle_mut, load, slice, slice_mut, write};
-use crate::map::{
-    DEFLECT_INTERPOLATION_BICUBIC, DEFLECT_INTERPOLATION_BILINEAR, DEFLECT_OUT_OF_GRID_CLAMP,
-    DEFLECT_OUT_OF_GRID_ERROR, DEFLECT_OUT_OF_GRID_EXTRAPOLATE,
-};
-use crate::status::{
-    DEFLECT_ERR_INVALID_ARGUMENT, DeflectStatus, load_failure, placement_code, tick_status,
-};
+use crate::map::query_options;
+use crate::status::{DeflectStatus, load_failure, placement_code, tick_status};
 
 /// A compliance map over a grid of 1-4 dimensions. Opaque; create with
 /// `deflect_grid_map_from_json` or `deflect_grid_map_load_json`, free with
@@ -137,21 +132,10 @@ pub unsafe extern "C" fn deflect_grid_map_set_options(
     guard(|| {
         // SAFETY: live handle or NULL by contract.
         let m = unsafe { handle_mut(map) }?;
-        let interpolation = match interpolation {
-            DEFLECT_INTERPOLATION_BILINEAR => Interpolation::Bilinear,
-            DEFLECT_INTERPOLATION_BICUBIC => Interpolation::Bicubic,
-            _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
-        };
-        let out_of_grid = match out_of_grid {
-            DEFLECT_OUT_OF_GRID_ERROR => OutOfGrid::Error,
-            DEFLECT_OUT_OF_GRID_CLAMP => OutOfGrid::Clamp,
-            DEFLECT_OUT_OF_GRID_EXTRAPOLATE => OutOfGrid::Extrapolate,
-            _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
-        };
-        m.map = m.map.clone().with_options(QueryOptions {
-            interpolation,
-            out_of_grid,
-        });
+        m.map = m
+            .map
+            .clone()
+            .with_options(query_options(interpolation, out_of_grid)?);
         Ok(())
     })
 }

@@ -33,6 +33,26 @@ pub const DEFLECT_OUT_OF_GRID_ERROR: i32 = 0;
 pub const DEFLECT_OUT_OF_GRID_CLAMP: i32 = 1;
 /// Outside the map's grid: extrapolate linearly from the boundary.
 pub const DEFLECT_OUT_OF_GRID_EXTRAPOLATE: i32 = 2;
+/// The query options of the codes `DEFLECT_INTERPOLATION_*` and `DEFLECT_OUT_OF_GRID_*`;
+/// `DEFLECT_ERR_INVALID_ARGUMENT` for an unknown code.
+pub(crate) fn query_options(interpolation: i32, out_of_grid: i32) -> Result<QueryOptions, i32> {
+    let interpolation = match interpolation {
+        DEFLECT_INTERPOLATION_BILINEAR => Interpolation::Bilinear,
+        DEFLECT_INTERPOLATION_BICUBIC => Interpolation::Bicubic,
+        _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
+    };
+    let out_of_grid = match out_of_grid {
+        DEFLECT_OUT_OF_GRID_ERROR => OutOfGrid::Error,
+        DEFLECT_OUT_OF_GRID_CLAMP => OutOfGrid::Clamp,
+        DEFLECT_OUT_OF_GRID_EXTRAPOLATE => OutOfGrid::Extrapolate,
+        _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
+    };
+    Ok(QueryOptions {
+        interpolation,
+        out_of_grid,
+    })
+}
+
 /// A compliance map (per-node force-displacement lines over an (x, y) grid). Opaque; create
 /// with `deflect_compliance_map_from_paper_csv`, `_load_paper_csv`, `_from_json` or
 /// `_load_json`, free with `deflect_compliance_map_destroy`.
@@ -197,21 +217,8 @@ pub unsafe extern "C" fn deflect_compliance_map_set_options(
     guard(|| {
         // SAFETY: live handle or NULL by contract.
         let m = unsafe { handle_mut(map) }?;
-        let interpolation = match interpolation {
-            DEFLECT_INTERPOLATION_BILINEAR => Interpolation::Bilinear,
-            DEFLECT_INTERPOLATION_BICUBIC => Interpolation::Bicubic,
-            _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
-        };
-        let out_of_grid = match out_of_grid {
-            DEFLECT_OUT_OF_GRID_ERROR => OutOfGrid::Error,
-            DEFLECT_OUT_OF_GRID_CLAMP => OutOfGrid::Clamp,
-            DEFLECT_OUT_OF_GRID_EXTRAPOLATE => OutOfGrid::Extrapolate,
-            _ => return Err(DEFLECT_ERR_INVALID_ARGUMENT),
-        };
-        m.map.set_options(QueryOptions {
-            interpolation,
-            out_of_grid,
-        });
+        m.map
+            .set_options(query_options(interpolation, out_of_grid)?);
         Ok(())
     })
 }

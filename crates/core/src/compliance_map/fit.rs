@@ -263,6 +263,34 @@ pub(crate) fn grid_of(measurements: &[Measurement], tol: f64) -> Result<Grid, Bu
     Ok((cx, cy, nodes))
 }
 
+/// Reading indices `0..n` sorted by `key(row)` = (node, force axis, force), then row, so that
+/// each (node, force axis) group is contiguous; a repeated key is
+/// [`BuildError::DuplicateMeasurement`] naming both rows.
+pub(crate) fn grouped_order(
+    n: usize,
+    key: impl Fn(usize) -> (usize, usize, f64),
+) -> Result<Vec<usize>, BuildError> {
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|a, b| {
+        let (ka, kb) = (key(*a), key(*b));
+        ka.0.cmp(&kb.0)
+            .then(ka.1.cmp(&kb.1))
+            .then(ka.2.total_cmp(&kb.2))
+            .then(a.cmp(b))
+    });
+    for w in order.windows(2) {
+        if let [a, b] = w
+            && key(*a) == key(*b)
+        {
+            return Err(BuildError::DuplicateMeasurement {
+                row: *b,
+                previous_row: *a,
+            });
+        }
+    }
+    Ok(order)
+}
+
 /// The least-squares lines `disp_d = slope F + offset` (Eq. 13, `A = [F_k 1]`, centred form)
 /// of one node and force axis over its readings `(F_k, displacement_k)`, for the first `nd`
 /// displacement axes, and the 2-norm condition number of `A` (at least 2 readings of
@@ -378,7 +406,6 @@ pub fn fit(
     let (cx, cy, nodes) = grid_of(measurements, tol)?;
     let (nx, ny) = (cx.len(), cy.len());
     let node_of = |r: usize| nodes.get(r).copied().unwrap_or(0);
-    // Rows sorted by (node, force axis, force, row): groups are contiguous.
     let key = |r: usize| {
         let m = measurements.get(r);
         (
@@ -387,24 +414,7 @@ pub fn fit(
             m.map_or(0.0, |m| m.force),
         )
     };
-    let mut order: Vec<usize> = (0..measurements.len()).collect();
-    order.sort_by(|a, b| {
-        let (ka, kb) = (key(*a), key(*b));
-        ka.0.cmp(&kb.0)
-            .then(ka.1.cmp(&kb.1))
-            .then(ka.2.total_cmp(&kb.2))
-            .then(a.cmp(b))
-    });
-    for w in order.windows(2) {
-        if let [a, b] = w
-            && key(*a) == key(*b)
-        {
-            return Err(BuildError::DuplicateMeasurement {
-                row: *b,
-                previous_row: *a,
-            });
-        }
-    }
+    let order = grouped_order(measurements.len(), key)?;
     let block = nd * nf;
     let mut slopes = vec![0.0; nx * ny * block];
     let mut offsets = vec![0.0; nx * ny * block];

@@ -18,7 +18,7 @@ use alloc::string::{String, ToString};
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::fit::{FitOptions, cluster, fit_lines};
+use super::fit::{FitOptions, cluster, fit_lines, grouped_order};
 use super::grid::{Axis, Stencil, check_axis};
 use super::view::check_counts;
 use super::{ComplianceMap, MAX_AXES, MAX_MEASUREMENTS, QueryOptions};
@@ -507,7 +507,6 @@ pub fn fit_grid(
         }
         out
     };
-    // Rows sorted by (node, force axis, force, row): groups are contiguous.
     let key = |r: usize| {
         let m = measurements.get(r);
         (
@@ -516,24 +515,7 @@ pub fn fit_grid(
             m.map_or(0.0, |m| m.force),
         )
     };
-    let mut order: Vec<usize> = (0..measurements.len()).collect();
-    order.sort_by(|a, b| {
-        let (ka, kb) = (key(*a), key(*b));
-        ka.0.cmp(&kb.0)
-            .then(ka.1.cmp(&kb.1))
-            .then(ka.2.total_cmp(&kb.2))
-            .then(a.cmp(b))
-    });
-    for w in order.windows(2) {
-        if let [a, b] = w
-            && key(*a) == key(*b)
-        {
-            return Err(BuildError::DuplicateMeasurement {
-                row: *b,
-                previous_row: *a,
-            });
-        }
-    }
+    let order = grouped_order(measurements.len(), key)?;
     let mut measured = vec![false; nodes];
     for n in &node_of {
         if let Some(m) = measured.get_mut(*n) {

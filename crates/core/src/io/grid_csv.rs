@@ -17,24 +17,13 @@
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use super::map_csv::{column, number, read_csv, require};
-use crate::compliance_map::{
-    FitOptions, GridMap, GridMeasurement, MAX_AXES, MAX_GRID_DIMS, fit_grid,
-};
+use super::map_csv::{displacement_columns, displacements, force_of, number, read_csv, require};
+use crate::compliance_map::{FitOptions, GridMap, GridMeasurement, MAX_GRID_DIMS, fit_grid};
 use crate::error::LoadError;
 use crate::units::{ForceUnit, LengthUnit};
 
-/// Displacement columns and whether they are lengths (else radians).
-const DISP_COLUMNS: [(&str, bool); MAX_AXES] = [
-    ("dx", true),
-    ("dy", true),
-    ("dz", true),
-    ("rx", false),
-    ("ry", false),
-    ("rz", false),
-];
-/// Force axis names accepted in `force_axis`.
-const FORCE_AXES: [&str; MAX_AXES] = ["x", "y", "z", "mx", "my", "mz"];
+/// The fixed (non-axis) columns.
+const FIXED: [&str; 8] = ["force_axis", "force", "dx", "dy", "dz", "rx", "ry", "rz"];
 /// Grid-axis column units and their scale to SI.
 const UNITS: [(&str, f64); 4] = [
     ("_mm", 1e-3),
@@ -66,13 +55,9 @@ pub fn fit_static_str(
     position_tolerance: f64,
 ) -> Result<GridMap, LoadError> {
     let (header, records) = read_csv(text)?;
-    let fixed: Vec<&str> = ["force_axis", "force"]
-        .into_iter()
-        .chain(DISP_COLUMNS.iter().map(|(n, _)| *n))
-        .collect();
     let mut axes: Vec<(usize, String, f64)> = Vec::new();
     for (c, h) in header.iter().enumerate() {
-        if fixed.iter().any(|k| h.eq_ignore_ascii_case(k)) {
+        if FIXED.iter().any(|k| h.eq_ignore_ascii_case(k)) {
             continue;
         }
         match axis_column(h) {
@@ -98,46 +83,23 @@ pub fn fit_static_str(
         });
     }
     let (ca, cf) = (require(&header, "force_axis")?, require(&header, "force")?);
-    let disp: Vec<(usize, &'static str, bool)> = DISP_COLUMNS
-        .iter()
-        .filter_map(|(name, is_len)| column(&header, name).map(|c| (c, *name, *is_len)))
-        .collect();
-    if disp.is_empty() {
-        return Err(LoadError::MissingColumn { column: "dx" });
-    }
+    let disp = displacement_columns(&header)?;
     let length = length_unit.to_metre();
     let newton = force_unit.to_newton();
     const AXIS: [&str; MAX_GRID_DIMS] =
         ["grid axis 0", "grid axis 1", "grid axis 2", "grid axis 3"];
     let mut readings = Vec::with_capacity(records.len());
     for (row, rec) in records.iter().enumerate() {
-        let text = rec.get(ca).unwrap_or("");
-        let force_axis = text
-            .parse::<usize>()
-            .ok()
-            .or_else(|| FORCE_AXES.iter().position(|n| n.eq_ignore_ascii_case(text)))
-            .filter(|a| *a < MAX_AXES)
-            .ok_or(LoadError::BadNumber {
-                row,
-                column: "force_axis",
-            })?;
-        let f_scale = if force_axis >= 3 {
-            newton * length
-        } else {
-            newton
-        };
+        let (force_axis, force) = force_of(rec, (ca, cf), row, newton, length)?;
         let mut point = [0.0; MAX_GRID_DIMS];
         for (slot, ((c, _, scale), what)) in point.iter_mut().zip(axes.iter().zip(AXIS)) {
             *slot = number(rec, *c, row, what)? * scale;
         }
-        let mut d = [0.0; MAX_AXES];
-        for (slot, (c, name, is_len)) in d.iter_mut().zip(&disp) {
-            *slot = number(rec, *c, row, name)? * if *is_len { length } else { 1.0 };
-        }
+        let d = displacements(rec, &disp, row, length)?;
         readings.push(GridMeasurement {
             point,
             force_axis,
-            force: number(rec, cf, row, "force")? * f_scale,
+            force,
             displacement: d,
         });
     }

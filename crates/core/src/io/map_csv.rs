@@ -205,6 +205,58 @@ pub fn from_str(
     Ok(ComplianceMap::new(gx, gy, 2, 2, slopes, offsets)?)
 }
 
+/// The displacement columns present, in the order `dx, dy, dz, rx, ry, rz`, with whether each
+/// is a length (else radians); at least one.
+pub(super) fn displacement_columns(
+    header: &csv::StringRecord,
+) -> Result<Vec<(usize, &'static str, bool)>, LoadError> {
+    let disp: Vec<(usize, &'static str, bool)> = DISP_COLUMNS
+        .iter()
+        .filter_map(|(name, is_len)| column(header, name).map(|c| (c, *name, *is_len)))
+        .collect();
+    if disp.is_empty() {
+        return Err(LoadError::MissingColumn { column: "dx" });
+    }
+    Ok(disp)
+}
+
+/// A row's loaded force axis (`0..6` or `x, y, z, mx, my, mz`) and force level in SI (`newton`
+/// per file unit; moments also `length` per file unit), from columns `(axis, force)`.
+pub(super) fn force_of(
+    rec: &csv::StringRecord,
+    (ca, cf): (usize, usize),
+    row: usize,
+    newton: f64,
+    length: f64,
+) -> Result<(usize, f64), LoadError> {
+    let text = rec.get(ca).unwrap_or("");
+    let axis = text
+        .parse::<usize>()
+        .ok()
+        .or_else(|| AXIS_NAMES.iter().position(|n| n.eq_ignore_ascii_case(text)))
+        .filter(|a| *a < MAX_AXES)
+        .ok_or(LoadError::BadNumber {
+            row,
+            column: "force_axis",
+        })?;
+    let scale = if axis >= 3 { newton * length } else { newton };
+    Ok((axis, number(rec, cf, row, "force")? * scale))
+}
+
+/// A row's displacements in SI from the `columns` of [`displacement_columns`].
+pub(super) fn displacements(
+    rec: &csv::StringRecord,
+    columns: &[(usize, &'static str, bool)],
+    row: usize,
+    length: f64,
+) -> Result<[f64; MAX_AXES], LoadError> {
+    let mut d = [0.0; MAX_AXES];
+    for (slot, (c, name, is_len)) in d.iter_mut().zip(columns) {
+        *slot = number(rec, *c, row, name)? * if *is_len { length } else { 1.0 };
+    }
+    Ok(d)
+}
+
 /// Fits a map (Eq. 10-13, see [`fit()`]) from a CSV of static tests, one reading a row:
 ///
 /// * `x`, `y`: node position (`length_unit`);
@@ -226,45 +278,18 @@ pub fn fit_static_str(
     check_columns(&header, &STATIC_COLUMNS)?;
     let (cx, cy) = (require(&header, "x")?, require(&header, "y")?);
     let (ca, cf) = (require(&header, "force_axis")?, require(&header, "force")?);
-    let disp: Vec<(usize, &'static str, bool)> = DISP_COLUMNS
-        .iter()
-        .filter_map(|(name, is_len)| column(&header, name).map(|c| (c, *name, *is_len)))
-        .collect();
-    if disp.is_empty() {
-        return Err(LoadError::MissingColumn { column: "dx" });
-    }
+    let disp = displacement_columns(&header)?;
     let length = length_unit.to_metre();
     let newton = force_unit.to_newton();
     let mut ms = Vec::with_capacity(records.len());
     for (row, rec) in records.iter().enumerate() {
-        let axis_text = rec.get(ca).unwrap_or("");
-        let force_axis = axis_text
-            .parse::<usize>()
-            .ok()
-            .or_else(|| {
-                AXIS_NAMES
-                    .iter()
-                    .position(|n| n.eq_ignore_ascii_case(axis_text))
-            })
-            .filter(|a| *a < MAX_AXES)
-            .ok_or(LoadError::BadNumber {
-                row,
-                column: "force_axis",
-            })?;
-        let f_scale = if force_axis >= 3 {
-            newton * length
-        } else {
-            newton
-        };
-        let mut d = [0.0; MAX_AXES];
-        for (slot, (c, name, is_len)) in d.iter_mut().zip(&disp) {
-            *slot = number(rec, *c, row, name)? * if *is_len { length } else { 1.0 };
-        }
+        let (force_axis, force) = force_of(rec, (ca, cf), row, newton, length)?;
+        let d = displacements(rec, &disp, row, length)?;
         ms.push(Measurement {
             x: number(rec, cx, row, "x")? * length,
             y: number(rec, cy, row, "y")? * length,
             force_axis,
-            force: number(rec, cf, row, "force")? * f_scale,
+            force,
             displacement: d,
         });
     }
