@@ -84,7 +84,7 @@ pub fn array_dyn<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyA
 /// The numbers of a float64 1-D numpy array, a list or a tuple of Python floats and ints,
 /// read directly (the common per-call inputs: no numpy round trip). `None` for anything
 /// else, which then goes through numpy's conversion and its checks.
-fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
+pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
     if let Ok(a) = o.cast::<PyArray1<f64>>() {
         // `to_vec` copies under the GIL without registering a borrow: rust-numpy's borrow
         // tracking costs more than the copy of a few entries (measured ~0.2 us per array).

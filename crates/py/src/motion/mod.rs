@@ -373,17 +373,25 @@ fn plan_line(
     j_max: &Bound<'_, PyAny>,
     #[pyo3(from_py_with = args::opt_real::rate_hz)] rate_hz: Option<f64>,
 ) -> PyResult<Trajectory> {
-    // The dimension is checked before anything is copied.
-    let sa = float_array(start, "start")?;
-    let d = sa.len();
-    if sa.ndim() != 1 || !(1..=MAX_DIM).contains(&d) {
-        return Err(shape_error(
-            "start",
-            &format!("(d,) with 1 <= d <= {MAX_DIM}"),
-            sa.shape(),
-        ));
-    }
-    let s = vector(start, "start", d)?;
+    // A list, tuple or float64 vector of 1..=8 numbers is read directly (numpy's asarray
+    // would cost more than the plan); anything else goes through numpy, the dimension
+    // checked before anything is copied.
+    let s = match crate::arrays::fast_vector(start) {
+        Some(v) if (1..=MAX_DIM).contains(&v.len()) => v,
+        _ => {
+            let sa = float_array(start, "start")?;
+            let d = sa.len();
+            if sa.ndim() != 1 || !(1..=MAX_DIM).contains(&d) {
+                return Err(shape_error(
+                    "start",
+                    &format!("(d,) with 1 <= d <= {MAX_DIM}"),
+                    sa.shape(),
+                ));
+            }
+            vector(start, "start", d)?
+        }
+    };
+    let d = s.len();
     let e = vector(end, "end", d)?;
     let pts = Array2::from_shape_vec((2, d), [s, e].concat())
         .map_err(|e| InputError::new_err(e.to_string()))?;
