@@ -30,6 +30,14 @@ pub(crate) fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
     }
 }
 
+/// The query options of the Python names (`interpolation`, `out_of_grid`), each checked.
+pub(crate) fn query_options(interpolation: &str, out_of_grid: &str) -> PyResult<QueryOptions> {
+    Ok(QueryOptions {
+        interpolation: parse_interpolation(interpolation)?,
+        out_of_grid: parse_out_of_grid(out_of_grid)?,
+    })
+}
+
 pub(crate) fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
     match s.to_ascii_lowercase().as_str() {
         "error" => Ok(OutOfGrid::Error),
@@ -82,10 +90,7 @@ pub struct ComplianceMap {
 
 impl ComplianceMap {
     fn wrap(mut inner: CoreMap, interpolation: &str, out_of_grid: &str) -> PyResult<Self> {
-        inner.set_options(QueryOptions {
-            interpolation: parse_interpolation(interpolation)?,
-            out_of_grid: parse_out_of_grid(out_of_grid)?,
-        });
+        inner.set_options(query_options(interpolation, out_of_grid)?);
         Ok(Self { inner })
     }
 

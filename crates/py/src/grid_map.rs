@@ -13,10 +13,10 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{array_dyn, check_count, indices, matrix, try_rows, vector_upto};
+use crate::arrays::{array_dyn, check_count, indices, matrix, try_copy, try_rows, vector_upto};
 use crate::compliance_map::{
     ComplianceMap, interpolation_name, out_of_grid_name, parse_interpolation, parse_out_of_grid,
-    units,
+    query_options, units,
 };
 use crate::errors::{build_err, load_err, shape_error, tick_err, tick_err_at};
 
@@ -151,12 +151,8 @@ impl GridMap {
             o,
         )
         .map_err(build_err)?;
-        let options = QueryOptions {
-            interpolation: parse_interpolation(interpolation)?,
-            out_of_grid: parse_out_of_grid(out_of_grid)?,
-        };
         Ok(Self {
-            inner: inner.with_options(options),
+            inner: inner.with_options(query_options(interpolation, out_of_grid)?),
         })
     }
 
@@ -231,12 +227,8 @@ impl GridMap {
         };
         let inner =
             cm::fit_grid(names_or_default(names, dims), &readings, &options).map_err(build_err)?;
-        let q = QueryOptions {
-            interpolation: parse_interpolation(interpolation)?,
-            out_of_grid: parse_out_of_grid(out_of_grid)?,
-        };
         Ok(Self {
-            inner: inner.with_options(q),
+            inner: inner.with_options(query_options(interpolation, out_of_grid)?),
         })
     }
 
@@ -260,12 +252,8 @@ impl GridMap {
         let (f, l) = units(force_unit, length_unit)?;
         let inner = grid_csv::fit_static_path(&path, f, l, n_force, position_tolerance)
             .map_err(load_err)?;
-        let q = QueryOptions {
-            interpolation: parse_interpolation(interpolation)?,
-            out_of_grid: parse_out_of_grid(out_of_grid)?,
-        };
         Ok(Self {
-            inner: inner.with_options(q),
+            inner: inner.with_options(query_options(interpolation, out_of_grid)?),
         })
     }
 
@@ -383,14 +371,30 @@ impl GridMap {
                 &fshape,
             ));
         }
-        let forces: Vec<f64> = f.as_array().iter().copied().collect();
-        let points: Vec<f64> = p.iter().copied().collect();
-        let map = self.inner.clone().with_options(o);
-        // A single force row broadcasts over the points (core reads n_force entries so).
-        let _ = single;
+        // float64 C-contiguous arguments are read in place, others copied fallibly. A single
+        // force row (n_force entries) broadcasts over the points in the core.
+        let (fa, pa) = (f.as_array(), p.view());
+        let (f_copy, p_copy);
+        let forces = match fa.as_slice() {
+            Some(v) => v,
+            None => {
+                f_copy = try_copy(&fa, "F")?;
+                &f_copy[..]
+            }
+        };
+        let points = match pa.as_slice() {
+            Some(v) => v,
+            None => {
+                p_copy = try_copy(&pa, "P")?;
+                &p_copy[..]
+            }
+        };
         let mut out = try_rows(n, nd, "the batch's result")?;
-        py.detach(|| map.displacement_batch(&points, &forces, &mut out))
-            .map_err(|e| self.query_err(Some(e.row), e.error))?;
+        py.detach(|| {
+            self.inner
+                .displacement_batch_with(points, forces, &mut out, o)
+        })
+        .map_err(|e| self.query_err(Some(e.row), e.error))?;
         let arr =
             Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
         Ok(arr.into_pyarray(py))

@@ -39,6 +39,8 @@ def test_multilinear_is_scipys_regular_grid_interpolator(dims):
     want = ref(P)
     scale = np.abs(node_values).max()
     assert np.abs(got - want).max() <= 1e-15 * scale, np.abs(got - want).max() / scale
+    # A strided (Fortran-order) batch is copied, and answers the same.
+    np.testing.assert_array_equal(m.displacement_batch(np.asfortranarray(P), force), got)
     # Single queries are the batch's rows.
     for k in range(5):
         np.testing.assert_array_equal(m.displacement(P[k], force), got[k])

@@ -315,6 +315,17 @@ impl GridMap {
         forces: &[f64],
         out: &mut [f64],
     ) -> Result<super::BatchSummary, super::BatchError> {
+        self.displacement_batch_with(points, forces, out, self.options)
+    }
+
+    /// [`Self::displacement_batch`] with explicit `options`.
+    pub fn displacement_batch_with(
+        &self,
+        points: &[f64],
+        forces: &[f64],
+        out: &mut [f64],
+        options: QueryOptions,
+    ) -> Result<super::BatchSummary, super::BatchError> {
         let (dims, nf, nd) = (self.dims(), self.n_force, self.n_displacement);
         let shape = |what, expected, got| super::BatchError {
             row: 0,
@@ -347,7 +358,7 @@ impl GridMap {
                 forces.get(row * nf..(row + 1) * nf).unwrap_or(&[])
             };
             let place = self
-                .displacement(p, f, o)
+                .displacement_with(p, f, o, options)
                 .map_err(|error| super::BatchError { row, error })?;
             summary.count(place);
         }
