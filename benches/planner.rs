@@ -1,7 +1,8 @@
 //! The jerk-limited planner natively against ruckig's Rust port (`rsruckig`, a dev-dependency
 //! of this bench only), each called as its own documentation calls it: ruckig's `Ruckig`,
 //! `InputParameter` and `Trajectory` built and the input filled once, `calculate` per plan;
-//! deflect's `Limits` built once, `Trajectory::line` per plan (the profile solve alone too).
+//! deflect's `Limits` built once, `Trajectory::line` per plan, and one trajectory re-planned
+//! in place per plan (`replan_line`, ruckig's habit); the profile solve alone too.
 //! A 1-D move, and the paper's 150 mm y-line (x held: per-axis and path limits coincide).
 //! `cargo bench --bench planner`.
 
@@ -59,6 +60,19 @@ fn bench(c: &mut Criterion) {
             .duration()
         })
     });
+    // ruckig's own habit: one trajectory object, re-planned in place per move.
+    let mut mine = ours.clone();
+    group.bench_function("1d/deflect_replan_line", |b| {
+        b.iter(|| {
+            mine.replan_line(
+                black_box(Vector1::new(0.05)),
+                black_box(Vector1::new(0.35)),
+                &limits,
+            )
+            .unwrap();
+            mine.duration()
+        })
+    });
     group.bench_function("1d/deflect_profile_solve", |b| {
         b.iter(|| Profile::new(black_box(0.3), &limits).unwrap().duration())
     });
@@ -85,6 +99,19 @@ fn bench(c: &mut Criterion) {
             )
             .unwrap()
             .duration()
+        })
+    });
+    let mut mine2 = ours2.clone();
+    group.bench_function("2d_y_line/deflect_replan_line", |b| {
+        b.iter(|| {
+            mine2
+                .replan_line(
+                    black_box(Vector2::new(0.22, -0.075)),
+                    black_box(Vector2::new(0.22, 0.075)),
+                    &limits,
+                )
+                .unwrap();
+            mine2.duration()
         })
     });
     group.finish();

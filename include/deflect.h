@@ -928,6 +928,20 @@ DeflectStatus deflect_trajectory2_line(const double *start,
                                        const struct DeflectLimits *limits,
                                        struct DeflectTrajectory2 **out);
 
+// Re-plans `trajectory` in place as `deflect_trajectory2_line(start, end, limits)` would
+// plan it (the same result bit for bit), for a controller that plans move after move into
+// one handle: no allocation, the limits validated once (ruckig's `calculate(input,
+// trajectory)` habit). Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` or
+// `DEFLECT_ERR_INVALID_ARGUMENT`; on failure the trajectory is unchanged.
+//
+// # Safety
+// `trajectory` is NULL or a live handle not used elsewhere during the call; `start`, `end`
+// hold 2 doubles; `limits` is NULL or readable.
+DeflectStatus deflect_trajectory2_replan_line(struct DeflectTrajectory2 *trajectory,
+                                              const double *start,
+                                              const double *end,
+                                              const struct DeflectLimits *limits);
+
 // Plans rest-to-rest motions through `n_points` points (2..32) given as `points[2 *
 // n_points] = x0, y0, x1, y1, ...` [m], stopping at each. Returns `DEFLECT_ERR_NULL`,
 // `DEFLECT_ERR_WRONG_LENGTH` (too few or too many points), `DEFLECT_ERR_NON_FINITE` or

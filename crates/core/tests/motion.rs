@@ -373,6 +373,29 @@ fn validation_errors() {
 }
 
 #[test]
+fn replan_line_refuses_as_line_does_and_leaves_the_plan() {
+    let l = lim(1.2, 25.0, 600.0);
+    let mut tr = Trajectory::line(Vector2::new(0.0, 0.0), Vector2::new(0.1, 0.0), &l).unwrap();
+    let kept = tr.clone();
+    let bad = Limits { v_max: -1.0, ..l };
+    for (s, e, lm) in [
+        (Vector2::new(0.0, f64::NAN), Vector2::new(0.1, 0.0), l),
+        (Vector2::new(0.0, 0.0), Vector2::new(f64::INFINITY, 0.0), l),
+        (Vector2::new(0.0, 0.0), Vector2::new(0.2, 0.0), bad),
+        // Equal points validate the limits too (no profile is solved).
+        (Vector2::new(0.3, 0.0), Vector2::new(0.3, 0.0), bad),
+    ] {
+        let want = Trajectory::line(s, e, &lm).unwrap_err();
+        assert_eq!(tr.replan_line(s, e, &lm).unwrap_err(), want);
+        assert_eq!(tr, kept);
+    }
+    assert!(matches!(
+        tr.replan_line(Vector2::new(0.0, 0.0), Vector2::new(0.0, f64::NAN), &l),
+        Err(BuildError::NonFinite { index: 3, .. })
+    ));
+}
+
+#[test]
 fn zero_length_segments_are_skipped() {
     let l = lim(1.0, 10.0, 100.0);
     let a = Vector2::new(0.0, 0.0);
@@ -411,6 +434,26 @@ proptest! {
         prop_assert!(p.duration() >= length / v * (1.0 - 1e-12));
         prop_assert!(p.duration() >= 2.0 * (length / a).sqrt() * (1.0 - 1e-12));
         prop_assert!(p.duration() >= 2.0 * (4.0 * length / j).cbrt() * (1.0 - 1e-9));
+    }
+
+    /// Re-planning in place is `line` bit for bit, whatever the trajectory held before
+    /// (a polyline of several segments, or a rest), including equal points.
+    #[test]
+    fn replan_line_equals_line(
+        before in prop::collection::vec(prop::array::uniform3(-0.5f64..0.5), 2..6),
+        start in prop::array::uniform3(-0.5f64..0.5),
+        end in prop::array::uniform3(-0.5f64..0.5),
+        same in any::<bool>(),
+        v in 0.05f64..2.0,
+        a in 1.0f64..50.0,
+        j in 10.0f64..1e4,
+    ) {
+        let l = lim(v, a, j);
+        let before: Vec<Vector3<f64>> = before.iter().map(|p| Vector3::from(*p)).collect();
+        let mut tr = Trajectory::polyline(&before, &lim(1.0, 10.0, 100.0)).unwrap();
+        let (s, e) = (Vector3::from(start), if same { Vector3::from(start) } else { Vector3::from(end) });
+        tr.replan_line(s, e, &l).unwrap();
+        prop_assert_eq!(&tr, &Trajectory::line(s, e, &l).unwrap());
     }
 
     #[test]

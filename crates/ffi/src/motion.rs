@@ -5,7 +5,7 @@ use deflect_core::BuildError;
 use deflect_core::motion::{Limits, State, Trajectory, paper_limits};
 use nalgebra::Vector2;
 
-use crate::boundary::{array, destroy, guard, handle, load, slice, write};
+use crate::boundary::{array, destroy, guard, handle, handle_mut, load, slice, write};
 use crate::status::{
     DEFLECT_ERR_NULL, DEFLECT_ERR_WRONG_LENGTH, DeflectStatus, build_failure, build_status,
     tick_status,
@@ -133,6 +133,43 @@ pub unsafe extern "C" fn deflect_trajectory2_line(
     };
     // SAFETY: forwarded caller contract for `out`.
     unsafe { load(out, std::ptr::null_mut(), 0, make) }
+}
+
+/// Re-plans `trajectory` in place as `deflect_trajectory2_line(start, end, limits)` would
+/// plan it (the same result bit for bit), for a controller that plans move after move into
+/// one handle: no allocation, the limits validated once (ruckig's `calculate(input,
+/// trajectory)` habit). Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_NON_FINITE` or
+/// `DEFLECT_ERR_INVALID_ARGUMENT`; on failure the trajectory is unchanged.
+///
+/// # Safety
+/// `trajectory` is NULL or a live handle not used elsewhere during the call; `start`, `end`
+/// hold 2 doubles; `limits` is NULL or readable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn deflect_trajectory2_replan_line(
+    trajectory: *mut DeflectTrajectory2,
+    start: *const f64,
+    end: *const f64,
+    limits: *const DeflectLimits,
+) -> DeflectStatus {
+    guard(|| {
+        // SAFETY: pointers valid (or NULL) by contract.
+        let (tr, a, b, l) = unsafe {
+            (
+                handle_mut(trajectory)?,
+                array::<2>(start)?,
+                array::<2>(end)?,
+                handle(limits)?,
+            )
+        };
+        let lim = Limits {
+            v_max: l.v_max,
+            a_max: l.a_max,
+            j_max: l.j_max,
+        };
+        tr.trajectory
+            .replan_line(Vector2::from(a), Vector2::from(b), &lim)
+            .map_err(|e| build_status(&e))
+    })
 }
 
 /// Plans rest-to-rest motions through `n_points` points (2..32) given as `points[2 *

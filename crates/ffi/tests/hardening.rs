@@ -141,6 +141,37 @@ fn tick_count_of_an_absurd_motion_is_a_budget_error() {
     let s = unsafe { deflect_trajectory2_line(a.as_ptr(), b.as_ptr(), &sub, &mut t2) };
     assert_eq!(s, DEFLECT_ERR_INVALID_ARGUMENT);
     assert!(t2.is_null());
+    // Re-planning in place refuses the same limits, a NaN point and a NULL handle, and leaves
+    // the plan as it was.
+    let mut before = 0.0;
+    // SAFETY: live handle, writable output.
+    assert_eq!(
+        unsafe { deflect_trajectory2_duration(traj, &mut before) },
+        DEFLECT_OK
+    );
+    let nan = [f64::NAN, 0.0];
+    // SAFETY: arrays of 2, readable limits; the handle is live or NULL.
+    unsafe {
+        assert_eq!(
+            deflect_trajectory2_replan_line(traj, a.as_ptr(), b.as_ptr(), &sub),
+            DEFLECT_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            deflect_trajectory2_replan_line(traj, nan.as_ptr(), b.as_ptr(), &limits),
+            DEFLECT_ERR_NON_FINITE
+        );
+        assert_eq!(
+            deflect_trajectory2_replan_line(ptr::null_mut(), a.as_ptr(), b.as_ptr(), &limits),
+            DEFLECT_ERR_NULL
+        );
+    }
+    let mut after = 0.0;
+    // SAFETY: live handle, writable output.
+    assert_eq!(
+        unsafe { deflect_trajectory2_duration(traj, &mut after) },
+        DEFLECT_OK
+    );
+    assert_eq!(after.to_bits(), before.to_bits());
     // SAFETY: handle from line, freed once.
     unsafe { deflect_trajectory2_destroy(traj) };
 }

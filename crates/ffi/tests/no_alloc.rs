@@ -153,6 +153,14 @@ fn per_tick_calls_do_not_allocate() {
                 DEFLECT_OK
             );
         }
+        // Re-planning the handle in place allocates nothing: back and forth, then the move.
+        let (a, b) = ([0.222132, -0.075], [0.222132, 0.075]);
+        for (from, to) in [(b, a), (a, b)] {
+            assert_eq!(
+                deflect_trajectory2_replan_line(traj, from.as_ptr(), to.as_ptr(), &lim),
+                DEFLECT_OK
+            );
+        }
         assert_eq!(
             deflect_trajectory2_tick_count(traj, 2000.0, &mut n),
             DEFLECT_OK

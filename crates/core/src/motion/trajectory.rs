@@ -115,6 +115,75 @@ impl<const N: usize> Trajectory<N> {
         Self::polyline(&[start, end], limits)
     }
 
+    /// Re-plans this trajectory as [`Self::line`]`(start, end, limits)` in place, bit for bit
+    /// the same result: ruckig's habit (`calculate(input, &mut trajectory)`), for a caller
+    /// that plans move after move into one trajectory it owns. A trajectory keeps room for
+    /// [`MAX_SEGMENTS`] segments inline (4.5-8 KB), and moving that out of [`Self::line`] is
+    /// most of its time; here nothing moves and the limits are validated once. On error
+    /// `self` is unchanged.
+    ///
+    /// ```
+    /// use deflect_core::motion::{Limits, Trajectory};
+    /// use nalgebra::Vector1;
+    /// let lim = Limits::new(1.2, 25.0, 600.0)?;
+    /// let mut traj = Trajectory::line(Vector1::new(0.0), Vector1::new(0.0), &lim)?;
+    /// traj.replan_line(Vector1::new(0.05), Vector1::new(0.35), &lim)?;
+    /// assert_eq!(traj, Trajectory::line(Vector1::new(0.05), Vector1::new(0.35), &lim)?);
+    /// # Ok::<(), Box<dyn std::error::Error>>(())
+    /// ```
+    pub fn replan_line(
+        &mut self,
+        start: SVector<f64, N>,
+        end: SVector<f64, N>,
+        limits: &Limits,
+    ) -> Result<(), BuildError> {
+        for (index, p) in [&start, &end].into_iter().enumerate() {
+            if let Some(axis) = p.iter().position(|c| !c.is_finite()) {
+                return Err(BuildError::NonFinite {
+                    what: "points (flattened, N per point)",
+                    index: index * N + axis,
+                });
+            }
+        }
+        let d = end - start;
+        let length = d.norm();
+        let segment = if length <= MIN_SEGMENT_LENGTH {
+            limits.validate()?;
+            None
+        } else {
+            // Profile::new validates the limits.
+            let profile = Profile::new(length, limits)?;
+            Some(Segment {
+                start,
+                direction: d / length,
+                profile,
+                limits: *limits,
+                t0: 0.0,
+                s0: 0.0,
+            })
+        };
+        self.segments.clear();
+        let (duration, path_length) = match segment {
+            Some(seg) => {
+                let duration = seg.profile.duration();
+                // Cannot fail after `clear` (capacity MAX_SEGMENTS >= 1).
+                self.segments.push(seg).map_err(|_| BuildError::Capacity {
+                    what: "points",
+                    capacity: MAX_POINTS,
+                    got: 2,
+                })?;
+                (duration, length)
+            }
+            None => (0.0, 0.0),
+        };
+        self.start = start;
+        self.end = end;
+        self.limits = *limits;
+        self.duration = duration;
+        self.path_length = path_length;
+        Ok(())
+    }
+
     /// Rest-to-rest moves through `points` (2..=[`MAX_POINTS`]), stopping at each one;
     /// segments of length <= [`MIN_SEGMENT_LENGTH`] are skipped. `limits` bound the path
     /// speed, acceleration and jerk (the Euclidean norm of the vector quantities).
