@@ -22,12 +22,12 @@ macro_rules! extractors {
 extractors!(
     /// Real scalars ([`crate::scalars::real`]).
     real: crate::scalars::real => f64 {
-        arm, base_radius, contact_force, cutoff_hz, dt, edge_angle, extension, forearm,
-        half_width, platform_radius,
+        a_max, arm, base_radius, contact_force, cutoff_hz, dt, edge_angle, extension, forearm,
+        half_width, j_max, platform_radius,
         jam_force, jam_margin, link, lowpass_cutoff_hz, mass, max_condition, max_correction,
         max_rate, max_turn, min_motion_fraction, min_sigma, min_step_fraction, orientation_tolerance,
         position_tolerance, ramp, rate_hz, step, threshold, tolerance, torque_deadband,
-        weight,
+        v_max, weight,
     }
 );
 
@@ -41,7 +41,7 @@ extractors!(
 extractors!(
     /// Counts ([`crate::scalars::count`]).
     count: crate::scalars::count => usize {
-        bias_samples, g_level, iterations, max_approach_steps, max_bisections, max_iterations,
+        bias_samples, dim, g_level, iterations, max_approach_steps, max_bisections, max_iterations,
         max_jam_steps, max_steps, moving_average_window, n_displacement, n_force, window,
     }
 );

@@ -107,6 +107,43 @@ pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
     None
 }
 
+/// Fills `out` from a list or tuple of exactly `out.len()` Python floats or ints without
+/// allocating (the per-call inputs of a re-planning loop); else [`fast_vector`]'s float64 vector of that length. `false` (and `out` unspecified) for anything else, which the caller
+/// then reads through numpy and its checks.
+pub(crate) fn fill_fast(o: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
+    fn number(x: &Bound<'_, PyAny>) -> Option<f64> {
+        if let Ok(f) = x.cast::<PyFloat>() {
+            Some(f.value())
+        } else if x.is_exact_instance_of::<PyInt>() {
+            x.extract::<f64>().ok()
+        } else {
+            None
+        }
+    }
+    fn fill<'py>(items: impl Iterator<Item = Bound<'py, PyAny>>, out: &mut [f64]) -> bool {
+        for (d, x) in out.iter_mut().zip(items) {
+            match number(&x) {
+                Some(v) => *d = v,
+                None => return false,
+            }
+        }
+        true
+    }
+    if let Ok(l) = o.cast::<PyList>() {
+        return l.len() == out.len() && fill(l.iter(), out);
+    }
+    if let Ok(t) = o.cast::<PyTuple>() {
+        return t.len() == out.len() && fill(t.iter(), out);
+    }
+    match fast_vector(o) {
+        Some(v) if v.len() == out.len() => {
+            out.copy_from_slice(&v);
+            true
+        }
+        _ => false,
+    }
+}
+
 /// A buffer of `n` zeros for a result (or a copy) whose size the caller chose, allocated
 /// fallibly: `MemoryError` naming `what`, the count and the bytes when the system refuses it
 /// (numpy's answer to the same request), never an abort of the interpreter. A size past

@@ -282,3 +282,50 @@ def test_pose_motion_is_synchronised_and_its_rates_are_derivatives():
         deflect.plan_pose(start, bad, linear, angular)
     with pytest.raises(deflect.InputError, match="plan-only"):
         deflect.plan_pose(start, end, linear, angular, rate_hz=None).pose
+
+
+def test_line_planner_replans_in_place_bit_for_bit():
+    planner = deflect.LinePlanner(2, 1.2, 25.0, 600.0)
+    assert planner.duration == 0.0 and planner.start == planner.end == [0.0, 0.0]
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        s, e = rng.uniform(-0.5, 0.5, 2), rng.uniform(-0.5, 0.5, 2)
+        for start, end in [(s, e), (list(s), tuple(e)), (s.astype(np.float32), e)]:
+            ref = deflect.plan_line(start, end, 1.2, 25.0, 600.0, rate_hz=None)
+            assert planner.plan(start, end) == ref.duration
+            assert planner.duration == ref.duration
+            t = np.linspace(-0.01, ref.duration + 0.01, 17)
+            got, want = planner.at(t), ref.at(t)
+            for k in ("t", "position", "velocity", "acceleration", "jerk"):
+                np.testing.assert_array_equal(got[k], want[k])
+    copy = planner.trajectory(rate_hz=1000.0)
+    assert copy.duration == planner.duration and copy.rate_hz == 1000.0
+    np.testing.assert_array_equal(copy.position[-1], planner.end)
+    # The path limits are ruckig's in 1-D: the same durations.
+    one = deflect.LinePlanner(1, 1.2, 25.0, 600.0)
+    assert one.plan([0.05], [0.35]) == pytest.approx(
+        deflect.plan_line([0.05], [0.35], 1.2, 25.0, 600.0).duration, rel=0, abs=0
+    )
+
+
+def test_line_planner_refuses_and_keeps_its_plan():
+    planner = deflect.LinePlanner(1, 1.2, 25.0, 600.0)
+    d = planner.plan([0.0], [0.3])
+    for start, end, what in [
+        ([np.nan], [0.3], "points"),
+        ([0.0], [0.1, 0.2], "end"),
+        ([0.0], ["x"], "end"),
+        ([0.0 + 1j], [0.3], "start"),
+    ]:
+        with pytest.raises(deflect.InputError, match=what):
+            planner.plan(start, end)
+        assert planner.duration == d and planner.end == [0.3]
+    for args, what in [
+        ((0, 1.0, 1.0, 1.0), "dim"),
+        ((9, 1.0, 1.0, 1.0), "dim"),
+        ((2, 0.0, 1.0, 1.0), "v_max"),
+        ((2, 1.0, np.inf, 1.0), "a_max"),
+        ((2, 1.0, 1.0, 5e-324), "j_max"),
+    ]:
+        with pytest.raises(deflect.InputError, match=what):
+            deflect.LinePlanner(*args)

@@ -139,6 +139,21 @@ def test_trajectories_round_trip_planned_or_sampled(clone):
 
 
 @pytest.mark.parametrize("clone", CLONES)
+def test_line_planner_round_trips_with_its_current_plan(clone):
+    planner = deflect.LinePlanner(3, 1.0, 20.0, 400.0)
+    planner.plan([0.0, 0.1, 0.2], [0.2, -0.05, 0.3])
+    other = clone(planner)
+    assert repr(other) == repr(planner)
+    assert (other.limits, other.start, other.end) == (planner.limits, planner.start, planner.end)
+    times = np.linspace(-0.1, 1.0, 13)
+    for k, v in planner.at(times).items():
+        np.testing.assert_array_equal(other.at(times)[k], v, k)
+    # The copy re-plans on its own.
+    other.plan([0.0, 0.0, 0.0], [0.1, 0.0, 0.0])
+    assert planner.end == [0.2, -0.05, 0.3]
+
+
+@pytest.mark.parametrize("clone", CLONES)
 def test_pose_trajectory_round_trips(robots, clone):
     ur5 = robots[1]
     q0 = np.array([0.3, -1.2, 1.5, -1.9, -1.57, 0.4])

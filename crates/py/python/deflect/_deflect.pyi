@@ -80,6 +80,7 @@ __all__ = [
     "DeltaCorrector",
     "DisplacementField",
     "Trajectory",
+    "LinePlanner",
     "plan_line",
     "plan_polyline",
     "paper_limits",
@@ -442,6 +443,32 @@ class Trajectory:
     @property
     def is_planned(self) -> bool: ...
     def __len__(self) -> int: ...
+
+@final
+class LinePlanner:
+    """One straight-line plan in ``dim`` coordinates (1..=8) re-planned in place per move
+    (ruckig's ``calculate(input, trajectory)`` habit); path limits validated once."""
+    def __new__(cls, dim: int, v_max: float, a_max: float, j_max: float) -> "LinePlanner": ...
+    def plan(self, start: _ArrayLike, end: _ArrayLike) -> float:
+        """Re-plans from ``start`` to ``end`` in place (bit for bit ``plan_line``) and returns
+        the duration [s]; on error the previous plan is kept."""
+    def at(self, t: Union[float, _ArrayLike]) -> Dict[str, Any]:
+        """State of the current plan at ``t`` [s], as ``Trajectory.at``."""
+    def trajectory(self, rate_hz: Optional[float] = 2000.0) -> Trajectory:
+        """A copy of the current plan, as ``plan_line`` returns it."""
+    def __getnewargs__(self) -> Tuple[int, float, float, float]: ...
+    def __getstate__(self) -> Tuple[List[float], List[float]]: ...
+    def __setstate__(self, state: Tuple[List[float], List[float]]) -> None: ...
+    @property
+    def duration(self) -> float: ...
+    @property
+    def dim(self) -> int: ...
+    @property
+    def limits(self) -> Tuple[float, float, float]: ...
+    @property
+    def start(self) -> List[float]: ...
+    @property
+    def end(self) -> List[float]: ...
 
 def plan_line(
     start: _ArrayLike,

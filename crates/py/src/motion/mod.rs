@@ -23,6 +23,7 @@ use crate::scalars::real;
 pub const MAX_DIM: usize = 8;
 
 mod plan;
+mod planner;
 
 pub(crate) use plan::{LimitSpec, Plan, Samples};
 use plan::{limit_spec, plan_dyn};
@@ -141,6 +142,24 @@ fn samples_to_dict<'py>(
     Ok(d)
 }
 
+/// `Trajectory.at` and `LinePlanner.at`: the states of `plan` at `t` (a number or (m,)).
+fn plan_at<'py>(
+    py: Python<'py>,
+    plan: &Plan,
+    t: &Bound<'py, PyAny>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let a = float_array(t, "t")?;
+    let (times, scalar) = match a.ndim() {
+        0 => (vec![real(t, "t")?], true),
+        1 => (vector_upto(t, "t", MAX_SAMPLES, "MAX_SAMPLES")?, false),
+        _ => {
+            return Err(shape_error("t", "a number or (m,)", a.shape()));
+        }
+    };
+    let s = py.detach(|| plan.eval(&times)).map_err(tick_err)?;
+    samples_to_dict(py, &s, scalar)
+}
+
 fn from_samples_n<const N: usize>(
     rate_hz: f64,
     position: &ArrayView2<'_, f64>,
@@ -248,16 +267,7 @@ impl Trajectory {
                  them: index its arrays instead",
             ));
         };
-        let a = float_array(t, "t")?;
-        let (times, scalar) = match a.ndim() {
-            0 => (vec![real(t, "t")?], true),
-            1 => (vector_upto(t, "t", MAX_SAMPLES, "MAX_SAMPLES")?, false),
-            _ => {
-                return Err(shape_error("t", "a number or (m,)", a.shape()));
-            }
-        };
-        let s = py.detach(|| plan.eval(&times)).map_err(tick_err)?;
-        samples_to_dict(py, &s, scalar)
+        plan_at(py, plan, t)
     }
 
     /// The same plan with its ticks at `rate_hz` [Hz] (at most 2^22 ticks).
@@ -545,6 +555,7 @@ fn trajectory_reduce<'py>(
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Trajectory>()?;
+    m.add_class::<planner::LinePlanner>()?;
     m.add_function(wrap_pyfunction!(plan_line, m)?)?;
     m.add_function(wrap_pyfunction!(plan_polyline, m)?)?;
     m.add_function(wrap_pyfunction!(paper_limits, m)?)?;
