@@ -9,16 +9,17 @@ use deflect_core::compliance_map::{
 use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
 use numpy::ndarray::{Array1, Array2, Array4};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray4, PyReadonlyArray2, ToPyArray};
+use numpy::{IntoPyArray, PyArray1, PyArray4, PyReadonlyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{batch_pair, check_count, indices, matrix, try_rows, vector_upto};
+use crate::arrays::{batch_pair, check_count, indices, matrix, vector_upto};
 use crate::batch;
 use crate::errors::{build_err, load_err, shape_error, tick_err};
 use crate::field::DisplacementField;
+use crate::out::{emit, fill_into};
 
 pub(crate) fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
     match s.to_ascii_lowercase().as_str() {
@@ -346,8 +347,8 @@ impl ComplianceMap {
     /// Displacement (n_displacement,) [m] at `position` (x, y) [m] (a 3rd entry, z, is
     /// ignored: the map is planar) under `force` (n_force,) [N]. Keywords override the map's
     /// default `interpolation` ("bilinear" | "bicubic") and `out_of_grid` ("error" | "clamp"
-    /// | "extrapolate") for this call.
-    #[pyo3(signature = (position, force, *, interpolation=None, out_of_grid=None))]
+    /// | "extrapolate") for this call. Into `out` (n_displacement,) if given.
+    #[pyo3(signature = (position, force, *, interpolation=None, out_of_grid=None, out=None))]
     fn displacement<'py>(
         &self,
         py: Python<'py>,
@@ -355,23 +356,23 @@ impl ComplianceMap {
         force: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let o = self.options(interpolation, out_of_grid)?;
         let p = match vector_upto(position, "position", 3, "3 coordinates")?.as_slice() {
             &[x, y] | &[x, y, _] => [x, y],
             other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
         };
         let f = vector_upto(force, "force", cm::MAX_AXES, "MAX_AXES")?;
+        let nd = self.inner.n_displacement();
         let mut buf = [0.0; MAX_AXES];
-        let out = buf
-            .get_mut(..self.inner.n_displacement())
-            .unwrap_or(&mut []);
+        let d = buf.get_mut(..nd).unwrap_or(&mut []);
         self.inner
-            .displacement_with(p, &f, out, o)
+            .displacement_with(p, &f, d, o)
             .map_err(tick_err)?;
         // A new numpy-owned array with the values copied: cheaper than handing over a Rust
         // buffer for a few entries.
-        Ok(PyArray1::from_slice(py, out))
+        emit(py, d, &[nd], out)
     }
 
     /// Displacements (N, n_displacement) [m] for positions `P` (N, 2) or (N, 3) [m] (z
@@ -379,9 +380,10 @@ impl ComplianceMap {
     /// or one-row 2-D) that broadcasts over the other's rows, as in numpy (a displacement
     /// field under one load, or one point under many loads). float64 C-contiguous arrays are
     /// read in place. Runs without the GIL, on every core for large batches. With
-    /// `out_of_grid="error"` the first row outside the grid raises `InputError`.
+    /// `out_of_grid="error"` the first row outside the grid raises `InputError`. Into `out`
+    /// (N, n_displacement) if given.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
-    #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None))]
+    #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None, out=None))]
     fn displacement_batch<'py>(
         &self,
         py: Python<'py>,
@@ -389,7 +391,8 @@ impl ComplianceMap {
         F: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let opts = self.options(interpolation, out_of_grid)?;
         let (nf, nd) = (self.inner.n_force(), self.inner.n_displacement());
         let (n, pm, fm) = batch_pair((P, "P", &[2, 3]), (F, "F", &[nf]))?;
@@ -399,35 +402,34 @@ impl ComplianceMap {
             return Err(InputError::new_err("P and F: rows do not broadcast"));
         };
         let view = self.inner.view();
-        let mut out = try_rows(n, nd, "the batch's result")?;
-        py.detach(|| {
-            batch::chunks(
-                &mut out,
-                nd,
-                batch::row_cost::MAP_QUERY,
-                || (Vec::new(), Vec::new()),
-                |rows, (pb, fb), o| {
-                    // Block by block: a C-contiguous argument is read in place, a broadcast
-                    // or strided one copied a block at a time.
-                    let first = rows.start;
-                    for b in batch::blocks(rows) {
-                        let (pr, fr) = (
-                            batch::block(&p, b.clone(), pb),
-                            batch::block(&f, b.clone(), fb),
-                        );
-                        let ob = o
-                            .get_mut((b.start - first) * nd..(b.end - first) * nd)
-                            .unwrap_or_default();
-                        view.displacement_batch(pr, pc.max(1), fr, ob, opts)
-                            .map_err(|e| (b.start + e.row, e.error))?;
-                    }
-                    Ok(())
-                },
-            )
-        })?;
-        let arr =
-            Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
-        Ok(arr.into_pyarray(py))
+        fill_into(py, &[n, nd], out, |buf| {
+            py.detach(|| {
+                batch::chunks(
+                    buf,
+                    nd,
+                    batch::row_cost::MAP_QUERY,
+                    || (Vec::new(), Vec::new()),
+                    |rows, (pb, fb), o| {
+                        // Block by block: a C-contiguous argument is read in place, a broadcast
+                        // or strided one copied a block at a time.
+                        let first = rows.start;
+                        for b in batch::blocks(rows) {
+                            let (pr, fr) = (
+                                batch::block(&p, b.clone(), pb),
+                                batch::block(&f, b.clone(), fb),
+                            );
+                            let ob = o
+                                .get_mut((b.start - first) * nd..(b.end - first) * nd)
+                                .unwrap_or_default();
+                            view.displacement_batch(pr, pc.max(1), fr, ob, opts)
+                                .map_err(|e| (b.start + e.row, e.error))?;
+                        }
+                        Ok(())
+                    },
+                )
+            })
+            .map_err(PyErr::from)
+        })
     }
 
     /// Leave-one-node-out cross-validation of bilinear vs bicubic: `forces` (K, n_force) [N];

@@ -7,18 +7,19 @@ use deflect_core::compliance_map::{
     QueryOptions,
 };
 use deflect_core::io::{grid_csv, map_json};
-use numpy::ndarray::{Array2, ArrayD, IxDyn};
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayDyn, PyUntypedArrayMethods, ToPyArray};
+use numpy::ndarray::{ArrayD, IxDyn};
+use numpy::{IntoPyArray, PyArray1, PyArrayDyn, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{array_dyn, check_count, indices, matrix, try_copy, try_rows, vector_upto};
+use crate::arrays::{array_dyn, check_count, indices, matrix, try_copy, vector_upto};
 use crate::compliance_map::{
     ComplianceMap, interpolation_name, out_of_grid_name, parse_interpolation, parse_out_of_grid,
     query_options, units,
 };
 use crate::errors::{build_err, load_err, shape_error, tick_err, tick_err_at};
+use crate::out::{emit, fill_into};
 
 /// A compliance map over a grid of 1 to 4 dimensions: `axes` a list of 1-4 increasing node
 /// coordinate arrays (task space x, y, z [m], or joint angles [rad]), named by `names`
@@ -316,8 +317,9 @@ impl GridMap {
     }
 
     /// Displacement (n_displacement,) [m] at `point` (dims,) under `force` (n_force,) [N];
-    /// keywords override the default options for this call.
-    #[pyo3(signature = (point, force, *, interpolation=None, out_of_grid=None))]
+    /// keywords override the default options for this call. Into `out` (n_displacement,) if
+    /// given.
+    #[pyo3(signature = (point, force, *, interpolation=None, out_of_grid=None, out=None))]
     fn displacement<'py>(
         &self,
         py: Python<'py>,
@@ -325,25 +327,25 @@ impl GridMap {
         force: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let o = self.options(interpolation, out_of_grid)?;
         let p = vector_upto(point, "point", MAX_GRID_DIMS, "MAX_GRID_DIMS")?;
         let f = vector_upto(force, "force", MAX_AXES, "MAX_AXES")?;
+        let nd = self.inner.n_displacement();
         let mut buf = [0.0; MAX_AXES];
-        let out = buf
-            .get_mut(..self.inner.n_displacement())
-            .unwrap_or(&mut []);
+        let d = buf.get_mut(..nd).unwrap_or(&mut []);
         self.inner
-            .displacement_with(&p, &f, out, o)
+            .displacement_with(&p, &f, d, o)
             .map_err(|e| self.query_err(None, e))?;
-        Ok(PyArray1::from_slice(py, out))
+        emit(py, d, &[nd], out)
     }
 
     /// Displacements (N, n_displacement) [m] at points `P` (N, dims) under forces `F`
     /// (N, n_force), or one force row (n_force,) for every point [N]. Runs without the GIL;
-    /// the first refused row raises naming it.
+    /// the first refused row raises naming it. Into `out` (N, n_displacement) if given.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
-    #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None))]
+    #[pyo3(signature = (P, F, *, interpolation=None, out_of_grid=None, out=None))]
     fn displacement_batch<'py>(
         &self,
         py: Python<'py>,
@@ -351,7 +353,8 @@ impl GridMap {
         F: &Bound<'py, PyAny>,
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let o = self.options(interpolation, out_of_grid)?;
         let (dims, nf, nd) = (
             self.inner.dims(),
@@ -389,15 +392,11 @@ impl GridMap {
                 &p_copy[..]
             }
         };
-        let mut out = try_rows(n, nd, "the batch's result")?;
-        py.detach(|| {
-            self.inner
-                .displacement_batch_with(points, forces, &mut out, o)
+        fill_into(py, &[n, nd], out, |buf| {
+            py.detach(|| self.inner.displacement_batch_with(points, forces, buf, o))
+                .map(|_| ())
+                .map_err(|e| self.query_err(Some(e.row), e.error))
         })
-        .map_err(|e| self.query_err(Some(e.row), e.error))?;
-        let arr =
-            Array2::from_shape_vec((n, nd), out).map_err(|e| InputError::new_err(e.to_string()))?;
-        Ok(arr.into_pyarray(py))
     }
 
     /// Grid dimensions.

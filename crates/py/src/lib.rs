@@ -31,6 +31,7 @@ mod machining;
 mod machining_job;
 mod mechanism;
 mod motion;
+mod out;
 mod pickle;
 mod pose_motion;
 mod posture;

@@ -7,15 +7,16 @@ use deflect_core::TickError;
 use deflect_core::io;
 use deflect_core::vjm::{self, Data, Vector6};
 use numpy::ndarray::{Array2, ArrayView2};
-use numpy::{IntoPyArray, PyArray, PyArray1, PyArray2, PyArray3, ToPyArray};
+use numpy::{PyArray1, PyArray2, ToPyArray};
 
 use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{batch_pair, iso_to_py, matrix, matrix_to_py, pose, try_rows, vector, vector6};
+use crate::arrays::{batch_pair, iso_to_py, matrix, pose, vector, vector6};
 use crate::batch;
 use crate::errors::{load_err, tick_err};
+use crate::out::{emit, fill_into};
 
 /// A serial robot with virtual joints (VJM paper, Eq. 1-9). All arrays are SI, base frame.
 #[pyclass(module = "deflect", frozen)]
@@ -117,32 +118,37 @@ impl SerialRobot {
         Ok(Self::new(crate::pickle::robot_of(state)?))
     }
 
-    /// Rigid TCP pose, a (4, 4) homogeneous matrix [m].
+    /// Rigid TCP pose, a (4, 4) homogeneous matrix [m]; into `out` (4, 4) if given.
+    #[pyo3(signature = (q, *, out=None))]
     fn forward<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let t = vjm::forward(model, &mut self.data(), &q).map_err(tick_err)?;
-        Ok(iso_to_py(py, &t))
+        // Row-major: the transpose's column-major storage.
+        emit(py, t.to_homogeneous().transpose().as_slice(), &[4, 4], out)
     }
 
     /// TCP deflection `[dx, dy, dz, rx, ry, rz]` [m, rad] under the TCP wrench
-    /// `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m], both in the base frame.
+    /// `[Fx, Fy, Fz, Mx, My, Mz]` [N, N m], both in the base frame; into `out` (6,) if given.
+    #[pyo3(signature = (q, wrench, *, out=None))]
     fn deflection<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         wrench: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let d =
             vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Exact).map_err(tick_err)?;
-        Ok(d.as_slice().to_pyarray(py))
+        emit(py, d.as_slice(), &[6], out)
     }
 
     /// TCP deflection in static equilibrium, laid out as `deflection`: the spring moments
@@ -199,32 +205,37 @@ impl SerialRobot {
         Ok(a.to_pyarray(py))
     }
 
-    /// Cartesian compliance of the linearized model, (6, 6), `[F; M] -> [dp; dr]`.
+    /// Cartesian compliance of the linearized model, (6, 6), `[F; M] -> [dp; dr]`; into
+    /// `out` (6, 6) if given.
+    #[pyo3(signature = (q, *, out=None))]
     fn compliance<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let c = vjm::compliance(model, &mut self.data(), &q).map_err(tick_err)?;
-        Ok(matrix_to_py(py, &c))
+        emit(py, c.transpose().as_slice(), &[6, 6], out)
     }
 
     /// Linearized deflection `compliance(q) @ wrench`, (6,) [m, rad], in one call (the
-    /// first-order term of `deflection`).
+    /// first-order term of `deflection`); into `out` (6,) if given.
+    #[pyo3(signature = (q, wrench, *, out=None))]
     fn linear_deflection<'py>(
         &self,
         py: Python<'py>,
         q: &Bound<'py, PyAny>,
         wrench: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
         let q = vector(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let d = vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Linearized)
             .map_err(tick_err)?;
-        Ok(d.as_slice().to_pyarray(py))
+        emit(py, d.as_slice(), &[6], out)
     }
 
     /// Actuated-joint Jacobian of the rigid TCP, (6, dof), rows `[v; w]`, base frame.
@@ -282,21 +293,23 @@ impl SerialRobot {
     /// Deflections of many loaded poses at once: `Q` (N, dof), `W` (N, 6) -> (N, 6) [m, rad];
     /// either may be a single row ((dof,) or (6,)) that broadcasts over the other's rows, as
     /// in numpy (one pose under many wrenches, one wrench over many poses). float64
-    /// C-contiguous arrays are read in place. Runs without the GIL.
+    /// C-contiguous arrays are read in place. Runs without the GIL. Into `out` (N, 6) if given.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    #[pyo3(signature = (Q, W, *, out=None))]
     fn deflection_batch<'py>(
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
         W: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let dof = self.inner.model.dof();
         let (n, qm, wm) = batch_pair((Q, "Q", &[dof]), (W, "W", &[6]))?;
         let (q, w) = (qm.as_array(), wm.as_array());
         let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
             return Err(InputError::new_err("Q and W: rows do not broadcast"));
         };
-        self.per_row(py, q, &[n, 6], |model, data, qi, i, o| {
+        self.per_row(py, q, &[n, 6], out, |model, data, qi, i, o| {
             let wi = Vector6::from_iterator(w.row(i).iter().copied());
             let d = vjm::deflection(model, data, qi, &wi, vjm::Load::Exact)?;
             o.copy_from_slice(d.as_slice());
@@ -306,16 +319,18 @@ impl SerialRobot {
 
     /// Rigid TCP poses of many joint vectors: `Q` (N, dof) -> (N, 4, 4). float64
     /// C-contiguous input is read in place; runs without the GIL, on every core for large
-    /// batches.
+    /// batches. Into `out` (N, 4, 4) if given.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    #[pyo3(signature = (Q, *, out=None))]
     fn forward_batch<'py>(
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let qm = matrix(Q, "Q", None, Some(self.inner.model.dof()))?;
         let q = qm.as_array();
-        self.per_row(py, q, &[q.nrows(), 4, 4], |model, data, qi, _, o| {
+        self.per_row(py, q, &[q.nrows(), 4, 4], out, |model, data, qi, _, o| {
             let t = vjm::forward(model, data, qi)?.to_homogeneous();
             // Row-major 4 x 4: the transpose's column-major storage.
             o.copy_from_slice(t.transpose().as_slice());
@@ -325,16 +340,18 @@ impl SerialRobot {
 
     /// Cartesian compliances of many joint vectors: `Q` (N, dof) -> (N, 6, 6), as
     /// `compliance`. float64 C-contiguous input is read in place; runs without the GIL, on
-    /// every core for large batches.
+    /// every core for large batches. Into `out` (N, 6, 6) if given.
     #[allow(non_snake_case)] // reason: matrix names as in the documented Python signature
+    #[pyo3(signature = (Q, *, out=None))]
     fn compliance_batch<'py>(
         &self,
         py: Python<'py>,
         Q: &Bound<'py, PyAny>,
-    ) -> PyResult<Bound<'py, PyArray3<f64>>> {
+        out: Option<&Bound<'py, PyAny>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
         let qm = matrix(Q, "Q", None, Some(self.inner.model.dof()))?;
         let q = qm.as_array();
-        self.per_row(py, q, &[q.nrows(), 6, 6], |model, data, qi, _, o| {
+        self.per_row(py, q, &[q.nrows(), 6, 6], out, |model, data, qi, _, o| {
             let c = vjm::compliance(model, data, qi)?;
             o.copy_from_slice(c.transpose().as_slice());
             Ok(())
@@ -378,51 +395,36 @@ impl SerialRobot {
     /// `shape[1..].product()` numbers of the result of `shape`. Without the GIL, on every core
     /// for large batches ([`batch::row_cost::VJM`]); the first failing row raises as the
     /// single call would, naming the row.
-    fn per_row<'py, D, F>(
+    fn per_row<'py, F>(
         &self,
         py: Python<'py>,
         q: ArrayView2<'_, f64>,
         shape: &[usize],
+        out: Option<&Bound<'py, PyAny>>,
         row: F,
-    ) -> PyResult<Bound<'py, PyArray<f64, D>>>
+    ) -> PyResult<Bound<'py, PyAny>>
     where
-        D: numpy::ndarray::Dimension,
         F: Fn(&vjm::Model, &mut Data, &[f64], usize, &mut [f64]) -> Result<(), TickError> + Sync,
     {
         let model = &self.inner.model;
         let dof = model.dof();
         let width = shape.iter().skip(1).product();
-        let mut out = try_rows(q.nrows(), width, "the batch's result")?;
-        py.detach(|| {
-            batch::rows(
-                &mut out,
-                width,
-                batch::row_cost::VJM,
-                || (Data::new(model), vec![0.0; dof]),
-                |i, (data, qi), o| {
-                    for (d, s) in qi.iter_mut().zip(q.row(i)) {
-                        *d = *s;
-                    }
-                    row(model, data, qi, i, o)
-                },
-            )
-        })?;
-        rows_to_py(py, out, shape)
+        fill_into(py, shape, out, |buf| {
+            py.detach(|| {
+                batch::rows(
+                    buf,
+                    width,
+                    batch::row_cost::VJM,
+                    || (Data::new(model), vec![0.0; dof]),
+                    |i, (data, qi), o| {
+                        for (d, s) in qi.iter_mut().zip(q.row(i)) {
+                            *d = *s;
+                        }
+                        row(model, data, qi, i, o)
+                    },
+                )
+            })
+            .map_err(PyErr::from)
+        })
     }
-}
-
-/// `out` as a numpy array of `shape`, its buffer handed over (no copy).
-fn rows_to_py<'py, D>(
-    py: Python<'py>,
-    out: Vec<f64>,
-    shape: &[usize],
-) -> PyResult<Bound<'py, PyArray<f64, D>>>
-where
-    D: numpy::ndarray::Dimension,
-{
-    let a = numpy::ndarray::ArrayD::from_shape_vec(shape.to_vec(), out)
-        .map_err(|e| InputError::new_err(format!("internal: {e}")))?
-        .into_dimensionality::<D>()
-        .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
-    Ok(a.into_pyarray(py))
 }

@@ -141,16 +141,20 @@ class SerialRobot:
     def base_link(self) -> str: ...
     @property
     def tip_link(self) -> str: ...
-    def forward(self, q: _ArrayLike) -> _FloatArray:
+    def forward(self, q: _ArrayLike, *, out: Optional[_FloatArray] = None) -> _FloatArray:
         """Rigid TCP pose, (4, 4)."""
-    def deflection(self, q: _ArrayLike, wrench: _ArrayLike) -> _FloatArray:
+    def deflection(
+        self, q: _ArrayLike, wrench: _ArrayLike, *, out: Optional[_FloatArray] = None
+    ) -> _FloatArray:
         """[dx, dy, dz, rx, ry, rz] [m, rad] under wrench [Fx, Fy, Fz, Mx, My, Mz] [N, N m].
         ``InputError`` for a load that turns a virtual joint beyond the small-deflection model."""
     def spring_angles(self, q: _ArrayLike, wrench: _ArrayLike) -> _FloatArray:
         """(n_springs, 3) elastic angles [rad] (Eq. 7)."""
-    def compliance(self, q: _ArrayLike) -> _FloatArray:
+    def compliance(self, q: _ArrayLike, *, out: Optional[_FloatArray] = None) -> _FloatArray:
         """(6, 6) Cartesian compliance of the linearized model."""
-    def linear_deflection(self, q: _ArrayLike, wrench: _ArrayLike) -> _FloatArray:
+    def linear_deflection(
+        self, q: _ArrayLike, wrench: _ArrayLike, *, out: Optional[_FloatArray] = None
+    ) -> _FloatArray:
         """(6,) linearized deflection compliance(q) @ wrench [m, rad], one call."""
     def joint_jacobian(self, q: _ArrayLike) -> _FloatArray:
         """(6, dof) actuated-joint Jacobian, rows [v; w]."""
@@ -160,11 +164,13 @@ class SerialRobot:
         """(dof,) axis-specific correction. ``max_iterations`` 0..=256 and ``tolerance`` finite
         and >= 0 (``InputError`` otherwise); ``ConvergenceError`` when the residual stays above
         ``tolerance`` (the message says whether the iteration stalled at its fixed point)."""
-    def forward_batch(self, Q: _ArrayLike) -> _FloatArray:
+    def forward_batch(self, Q: _ArrayLike, *, out: Optional[_FloatArray] = None) -> _FloatArray:
         """(N, dof) -> (N, 4, 4) rigid TCP poses; GIL released, every core for N >= 2048."""
-    def compliance_batch(self, Q: _ArrayLike) -> _FloatArray:
+    def compliance_batch(self, Q: _ArrayLike, *, out: Optional[_FloatArray] = None) -> _FloatArray:
         """(N, dof) -> (N, 6, 6) compliances; GIL released, every core for N >= 2048."""
-    def deflection_batch(self, Q: _ArrayLike, W: _ArrayLike) -> _FloatArray:
+    def deflection_batch(
+        self, Q: _ArrayLike, W: _ArrayLike, *, out: Optional[_FloatArray] = None
+    ) -> _FloatArray:
         """(N, dof), (N, 6) -> (N, 6) [m, rad]; a single row of either broadcasts over the
         other's rows. float64 C-contiguous input is read in place; the GIL is released and
         batches of N >= 2048 rows run on every core."""
@@ -242,6 +248,7 @@ class GridMap:
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
+        out: Optional[_FloatArray] = None,
     ) -> _FloatArray: ...
     def displacement_batch(
         self,
@@ -250,6 +257,7 @@ class GridMap:
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
+        out: Optional[_FloatArray] = None,
     ) -> _FloatArray: ...
     @property
     def dims(self) -> int: ...
@@ -345,6 +353,7 @@ class ComplianceMap:
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
+        out: Optional[_FloatArray] = None,
     ) -> _FloatArray:
         """(n_displacement,) [m] at position (2,) or (3,) [m] (z ignored) under force [N]."""
     def displacement_batch(
@@ -354,6 +363,7 @@ class ComplianceMap:
         *,
         interpolation: Optional[str] = None,
         out_of_grid: Optional[str] = None,
+        out: Optional[_FloatArray] = None,
     ) -> _FloatArray:
         """(N, 2|3) [m], (N, n_force) [N] -> (N, n_displacement) [m]; a single row of either
         broadcasts over the other's rows. float64 C-contiguous input is read in place; the
