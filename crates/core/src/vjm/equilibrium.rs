@@ -86,7 +86,7 @@ fn deflected_frames(
                 t *= pre;
                 let qi = q.get(*index).copied().unwrap_or(0.0);
                 if *revolute {
-                    t.rotation *= UnitQuaternion::from_axis_angle(axis, qi);
+                    t.rotation *= super::trig::axis_angle(axis, qi);
                 } else {
                     t.translation.vector += t.rotation * (axis.into_inner() * qi);
                 }

@@ -20,7 +20,7 @@
 //! linearization ([`super::deflection`] with [`Load::ExactWithArm`] or
 //! [`Load::LinearizedWithArm`]). Allocation-free, bounded by the chain length.
 
-use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Vector3};
 
 use super::data::check_q;
 use super::model::Op;
@@ -150,7 +150,7 @@ fn motion_pass(
                 if *revolute {
                     al += u * qdd + w.cross(&(u * qd));
                     w += u * qd;
-                    frame.rotation *= UnitQuaternion::from_axis_angle(axis, qi);
+                    frame.rotation *= super::trig::axis_angle(axis, qi);
                 } else {
                     acc += u * qdd + w.cross(&(u * qd)) * 2.0;
                     frame.translation.vector += u * qi;

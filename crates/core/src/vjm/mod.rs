@@ -21,6 +21,7 @@ mod deflection;
 mod equilibrium;
 mod loads;
 mod model;
+mod trig;
 
 pub use correction::{
     JointCorrection, MAX_CORRECTION_ITERATIONS, POSE_TOLERANCE, commanded_pose, joint_correction,
