@@ -214,6 +214,43 @@ fn bench(c: &mut Criterion) {
             })
         });
     }
+    // The same batch over uniformly random points (a workspace sweep, what a Python batch
+    // gets): no pattern for the branch predictor to learn.
+    let mut state = 0x9E37_79B9_7F4A_7C15_u64;
+    let mut uniform = move || {
+        // xorshift64*: a fixed, reproducible sequence in [0, 1).
+        state ^= state >> 12;
+        state ^= state << 25;
+        state ^= state >> 27;
+        (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut rpos = Vec::with_capacity(2 * n);
+    for _ in 0..n {
+        rpos.push(0.172132 + 0.1 * uniform());
+        rpos.push(-0.075 + 0.15 * uniform());
+    }
+    let bilinear = QueryOptions {
+        interpolation: Interpolation::Bilinear,
+        out_of_grid: OutOfGrid::Error,
+    };
+    group.bench_function("batch_1e5/Bilinear/even_random", |b| {
+        b.iter(|| {
+            black_box(even.displacement_batch(black_box(&rpos), 2, &force, &mut out, bilinear))
+        })
+    });
+    group.bench_function("batch_1e5/reference_hand/even_random", |b| {
+        b.iter(|| {
+            for ((p, f), o) in rpos
+                .chunks_exact(2)
+                .zip(force.chunks_exact(2))
+                .zip(out.chunks_exact_mut(2))
+            {
+                let r = hand.query([p[0], p[1]], [f[0], f[1]]);
+                o.copy_from_slice(&r);
+            }
+            black_box(&out);
+        })
+    });
     group.bench_function("batch_1e5/reference_hand/even", |b| {
         b.iter(|| {
             for ((p, f), o) in pos
