@@ -52,13 +52,14 @@ fn sampling_has_a_budget_instead_of_an_abort() {
         normal.ticks(1e300),
         Err(TickError::Budget { what: "ticks", .. })
     ));
+    // 0.15 m at 1 um/s: 1.5e5 s, within MAX_DURATION; at 100 MHz past MAX_TICKS.
     assert!(matches!(
-        y_line(1e-300).ticks(2000.0),
+        y_line(1e-6).ticks(1e8),
         Err(TickError::Budget { what: "ticks", .. })
     ));
     // A call that stores every tick names one budget however far past it the request is
     // (not MAX_TICKS for the farthest), with whole numbers.
-    let far = y_line(1e-300).sample_count(2000.0).unwrap_err();
+    let far = y_line(1e-6).sample_count(1e8).unwrap_err();
     assert!(matches!(
         far,
         TickError::Budget {
@@ -477,4 +478,73 @@ fn fit_statistics_are_finite_or_the_fit_is_refused() {
         matches!(r, Err(LoadError::Build(BuildError::NonFinite { .. }))),
         "{r:?}"
     );
+}
+
+/// Issue 28: joint positions past MAX_JOINT_POSITION, a deflection rotation past pi, a NaN
+/// in a batch row's ignored z, a sub-normal rate, an endless motion: typed errors, not
+/// finite nonsense or NaN.
+#[test]
+fn silent_cases_are_typed_errors() {
+    let model = ModelBuilder::new()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([1e4, 1e5, 1e5])
+        .unwrap()
+        .fixed(Isometry3::translation(0.5, 0.0, 0.0))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    for q in [1e300, -2e6] {
+        assert!(matches!(
+            vjm::forward(&model, &mut data, &[q]),
+            Err(TickError::InvalidArgument { value, .. }) if value == q
+        ));
+    }
+    assert!(vjm::forward(&model, &mut data, &[vjm::MAX_JOINT_POSITION]).is_ok());
+    assert!(matches!(
+        vjm::commanded_pose(&Isometry3::identity(), &Vector6::repeat(1e300)),
+        Err(TickError::InvalidArgument { .. })
+    ));
+    assert!(matches!(
+        vjm::commanded_pose(
+            &Isometry3::identity(),
+            &Vector6::new(0.0, f64::NAN, 0.0, 0.0, 0.0, 0.0)
+        ),
+        Err(TickError::NonFinite { index: 1, .. })
+    ));
+    let map = map_csv::from_path(
+        format!(
+            "{}/../../data/paksoy2025_compliance_oc.csv",
+            env!("CARGO_MANIFEST_DIR")
+        ),
+        ForceUnit::Newton,
+        LengthUnit::Millimetre,
+    )
+    .unwrap();
+    let mut out = [0.0; 4];
+    let pos = [0.2, 0.0, 0.0, 0.2, 0.01, f64::NAN];
+    let e = map
+        .displacement_batch(&pos, 3, &[100.0, 0.0, 100.0, 0.0], &mut out, map.options())
+        .unwrap_err();
+    assert_eq!(e.row, 1);
+    assert!(matches!(e.error, TickError::NonFinite { index: 2, .. }));
+    assert!(deflect_core::compliance_map::planar_position(&[0.2, 0.0, f64::NAN]).is_err());
+    assert_eq!(
+        deflect_core::compliance_map::planar_position(&[0.2, 0.1, 9.0]).unwrap(),
+        [0.2, 0.1]
+    );
+    let lim = Limits::new(1e-300, 1.0, 1.0).unwrap();
+    assert!(matches!(
+        Trajectory::line(Vector2::new(0.0, 0.0), Vector2::new(0.1, 0.0), &lim),
+        Err(BuildError::InvalidParameter { .. })
+    ));
+    let ok = y_line(0.42);
+    assert!(matches!(
+        ok.tick_count(5e-324),
+        Err(TickError::InvalidArgument {
+            what: "rate_hz",
+            ..
+        })
+    ));
 }

@@ -93,10 +93,14 @@ fn path_budgets_and_faults_are_typed() {
         ..PathOptions::default()
     };
     assert!(path::sample(&p, &o).is_err());
-    // 900 m at 1 mm/min: far past MAX_PATH_SAMPLES.
-    let long = program("G1 X900000 F1\n");
+    // 10 m at 1 mm/min: 6e5 s (within MAX_DURATION), far past MAX_PATH_SAMPLES.
+    let long = program("G1 X10000 F1\n");
     let e = path::sample(&long, &PathOptions::default()).unwrap_err();
     assert!(e.to_string().contains("MAX_PATH_SAMPLES"), "{e}");
+    // 900 m at 1 mm/min: 5.4e7 s, a move no controller runs.
+    let endless = program("G1 X900000 F1\n");
+    let e = path::sample(&endless, &PathOptions::default()).unwrap_err();
+    assert!(e.to_string().contains("MAX_DURATION"), "{e}");
     let still = program("G0 X0 Y0 Z20\n");
     assert!(path::sample(&still, &PathOptions::default()).is_err());
 }

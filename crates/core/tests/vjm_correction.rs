@@ -120,7 +120,7 @@ fn joint_correction_six_dof_converges_exactly() {
     assert!((t.rotation * target.rotation.inverse()).angle() < 1e-13);
     // The commanded Cartesian pose moves the TCP against the deflection.
     let d = vjm::deflection(&model, &mut data, &q, &wr, vjm::Load::Exact).unwrap();
-    let cmd = vjm::commanded_pose(&target, &d);
+    let cmd = vjm::commanded_pose(&target, &d).unwrap();
     let dp = cmd.translation.vector - target.translation.vector;
     assert_relative_eq!(dp, -d.fixed_rows::<3>(0).into_owned(), epsilon = 1e-15);
     let back = UnitQuaternion::from_scaled_axis(d.fixed_rows::<3>(3).into_owned()) * cmd.rotation;

@@ -34,7 +34,7 @@ extractors!(
 extractors!(
     /// Optional real scalars ([`crate::scalars::opt_real`]).
     opt_real: crate::scalars::opt_real => Option<f64> {
-        approach_step, rate_hz, spacing, stop_radius, target_force,
+        approach_step, rate_hz, spacing, stop_radius, t, target_force,
     }
 );
 

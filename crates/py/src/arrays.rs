@@ -81,11 +81,19 @@ pub fn array_dyn<'py>(o: &Bound<'py, PyAny>, what: &str) -> PyResult<PyReadonlyA
     readonly(&float_array(o, what)?, what)
 }
 
+/// Longest input [`fast_vector`] reads (per-call vectors: joints, wrenches, points).
+const FAST_VECTOR_MAX: usize = 64;
+
 /// The numbers of a float64 1-D numpy array, a list or a tuple of Python floats and ints,
 /// read directly (the common per-call inputs: no numpy round trip). `None` for anything
 /// else, which then goes through numpy's conversion and its checks.
 pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
+    // Only short inputs: a long one goes through the checked path, whose budget comes before
+    // any copy (an infallible copy of 1e8 entries here would abort the interpreter).
     if let Ok(a) = o.cast::<PyArray1<f64>>() {
+        if a.len() > FAST_VECTOR_MAX {
+            return None;
+        }
         // `to_vec` copies under the GIL without registering a borrow: rust-numpy's borrow
         // tracking costs more than the copy of a few entries (measured ~0.2 us per array).
         return a.to_vec().ok();
@@ -99,9 +107,15 @@ pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
         }
     };
     if let Ok(l) = o.cast::<PyList>() {
+        if l.len() > FAST_VECTOR_MAX {
+            return None;
+        }
         return l.iter().map(number).collect();
     }
     if let Ok(t) = o.cast::<PyTuple>() {
+        if t.len() > FAST_VECTOR_MAX {
+            return None;
+        }
         return t.iter().map(number).collect();
     }
     None

@@ -359,10 +359,8 @@ impl ComplianceMap {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let o = self.options(interpolation, out_of_grid)?;
-        let p = match vector_upto(position, "position", 3, "3 coordinates")?.as_slice() {
-            &[x, y] | &[x, y, _] => [x, y],
-            other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
-        };
+        let p = cm::planar_position(&vector_upto(position, "position", 3, "3 coordinates")?)
+            .map_err(tick_err)?;
         let f = vector_upto(force, "force", cm::MAX_AXES, "MAX_AXES")?;
         let nd = self.inner.n_displacement();
         let mut buf = [0.0; MAX_AXES];

@@ -1,6 +1,6 @@
 //! `DisplacementField`: a compliance map evaluated once at a fixed load.
 
-use deflect_core::compliance_map::{DisplacementField as CoreField, MAX_AXES};
+use deflect_core::compliance_map::{self as cm, DisplacementField as CoreField, MAX_AXES};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
@@ -44,10 +44,8 @@ impl DisplacementField {
         py: Python<'py>,
         position: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let p = match vector_upto(position, "position", 3, "3 coordinates")?.as_slice() {
-            &[x, y] | &[x, y, _] => [x, y],
-            other => return Err(shape_error("position", "(2,) or (3,)", &[other.len()])),
-        };
+        let p = cm::planar_position(&vector_upto(position, "position", 3, "3 coordinates")?)
+            .map_err(tick_err)?;
         let mut buf = [0.0; MAX_AXES];
         let out = buf
             .get_mut(..self.inner.n_displacement())

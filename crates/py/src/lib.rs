@@ -48,6 +48,8 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("MAX_SAMPLES", deflect_core::motion::MAX_SAMPLES)?;
     m.add("MAX_TICKS", deflect_core::motion::MAX_TICKS)?;
     m.add("MAX_SPRING_ANGLE", deflect_core::vjm::MAX_SPRING_ANGLE)?;
+    m.add("MAX_JOINT_POSITION", deflect_core::vjm::MAX_JOINT_POSITION)?;
+    m.add("MAX_DURATION", deflect_core::motion::MAX_DURATION)?;
     m.add("MAX_DOF", deflect_core::vjm::MAX_DOF)?;
     m.add("MAX_SPRINGS", deflect_core::vjm::MAX_SPRINGS)?;
     m.add(

@@ -380,7 +380,8 @@ fn commanded_pose<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f64>>> {
     let iso = pose(target, "target")?;
     let d = vector6(deflection, "deflection")?;
-    Ok(iso_to_py(py, &vjm::commanded_pose(&iso, &d)))
+    let cmd = vjm::commanded_pose(&iso, &d).map_err(tick_err)?;
+    Ok(iso_to_py(py, &cmd))
 }
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {

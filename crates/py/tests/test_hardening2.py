@@ -132,14 +132,15 @@ def test_complex_atlas_positions_are_refused_not_truncated():
 # Budgets: one per quantity, named --------------------------------------------------------
 def test_a_call_that_stores_every_tick_names_one_budget_however_far_past_it():
     start, end = np.eye(4), np.eye(4)
-    end[0, 3] = 1e12
+    # 9e5 m at 1 m/s: 9e5 s, within MAX_DURATION; at 2 MHz 1.8e12 ticks, past MAX_TICKS too.
+    end[0, 3] = 9e5
     lim = (1.0, 10.0, 100.0)
     end1 = np.eye(4)
     end1[0, 3] = 1.0
     cases = [
-        lambda: deflect.plan_pose(start, end, lim, lim),  # far past both budgets
+        lambda: deflect.plan_pose(start, end, lim, lim, rate_hz=2e6),  # far past both budgets
         lambda: deflect.plan_pose(start, end1, lim, lim, rate_hz=1e12),  # past the samples only
-        lambda: deflect.plan_line([0.0], [1e12], 1.0, 10.0, 100.0),
+        lambda: deflect.plan_line([0.0], [9e5], 1.0, 10.0, 100.0, rate_hz=2e6),
         lambda: deflect.plan_line([0.0], [1.0], 1.0, 10.0, 100.0, rate_hz=1e12),
     ]
     for f in cases:

@@ -85,7 +85,7 @@ impl DisplacementField {
     }
 
     /// Many positions, allocation-free: row `r` reads `positions[r * stride..]` (x, y \[m\];
-    /// further entries ignored) and writes `out[r * n_displacement..]`. Stops at the first
+    /// further entries ignored, but refused when not finite) and writes `out[r * n_displacement..]`. Stops at the first
     /// refused row.
     pub fn displacement_batch(
         &self,
@@ -115,6 +115,13 @@ impl DisplacementField {
             let (Some(&x), Some(&y)) = (p.first(), p.get(1)) else {
                 continue;
             };
+            if let Some(index) = super::ignored_non_finite(p) {
+                let error = TickError::NonFinite {
+                    what: "position",
+                    index,
+                };
+                return Err(BatchError { row, error });
+            }
             match self.values.displacement_with([x, y], &[1.0], o, options) {
                 Ok(place) => summary.count(place),
                 Err(error) => return Err(BatchError { row, error }),

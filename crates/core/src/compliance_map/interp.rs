@@ -81,6 +81,13 @@ impl ComplianceMapView<'_> {
             let (Some(&x), Some(&y)) = (p.first(), p.get(1)) else {
                 continue;
             };
+            if let Some(index) = super::ignored_non_finite(p) {
+                let error = TickError::NonFinite {
+                    what: "position",
+                    index,
+                };
+                return Err(BatchError { row, error });
+            }
             match self.eval([x, y], f, o, options) {
                 Ok(place) => summary.count(place),
                 Err(error) => return Err(BatchError { row, error }),
@@ -115,6 +122,15 @@ impl ComplianceMapView<'_> {
             ) else {
                 continue;
             };
+            if stride > 2
+                && let Some(index) = super::ignored_non_finite(p)
+            {
+                let error = TickError::NonFinite {
+                    what: "position",
+                    index,
+                };
+                return Err(BatchError { row, error });
+            }
             match self.bilinear_inside::<ND, NF>([px, py], fa) {
                 Some(acc) if acc.iter().fold(0.0, |a, v| a + v * 0.0) == 0.0 => {
                     *oa = acc;

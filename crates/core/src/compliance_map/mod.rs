@@ -167,6 +167,33 @@ impl Data {
 /// queries.
 pub type Model<'a> = ComplianceMapView<'a>;
 
+/// `[x, y]` of a query position given as 2 or 3 entries \[m\]: the maps are planar, so a z
+/// entry is ignored, but it must be finite like the others (a NaN anywhere in a position is
+/// a broken input, not a value to drop).
+pub fn planar_position(p: &[f64]) -> Result<[f64; 2], TickError> {
+    match *p {
+        [x, y] | [x, y, _] => {
+            crate::error::check_finite("position", p)?;
+            Ok([x, y])
+        }
+        _ => Err(TickError::WrongLength {
+            what: "position (x, y or x, y, z)",
+            expected: 2,
+            got: p.len(),
+        }),
+    }
+}
+
+/// The entries of a batch row past x and y (z, ignored) must be finite too: the index of the
+/// first that is not, counted in the row.
+#[inline(always)]
+pub(crate) fn ignored_non_finite(row: &[f64]) -> Option<usize> {
+    row.iter()
+        .skip(2)
+        .position(|v| !v.is_finite())
+        .map(|k| k + 2)
+}
+
 /// One query of the tick shape: the displacement at `position` `[x, y]` \[m\] under `force`
 /// (`n_force` entries \[N | N m\]) with the map's default options, into `data.displacement`.
 /// Allocation-free, never panics; see [`ComplianceMapView::displacement_with`].

@@ -90,6 +90,17 @@ impl Payload {
                 measure: min,
             });
         }
+        // A rigid body's principal moments obey the triangle inequality: each is at most
+        // the sum of the other two (diag(1, 1, 5) is no body's inertia).
+        let (sum, max) = (eig.sum(), eig.max());
+        let excess = max - (sum - max);
+        if excess > 1e-9 * scale {
+            return Err(BuildError::InvalidParameter {
+                what: "payload inertia (a principal moment exceeds the sum of the other two)",
+                value: excess,
+                expected: "principal moments with I1 + I2 >= I3 (a rigid body's)",
+            });
+        }
         Ok(())
     }
 
@@ -468,6 +479,8 @@ pub fn step(
     process: Option<&Vector6>,
 ) -> Result<Tick, TickError> {
     data.vjm.check_model(&model.chain)?;
+    // The time is not used, but a NaN there is a broken caller all the same.
+    check_finite("t", &[desired.t])?;
     let pose = &desired.pose;
     check_finite("desired position", pose.translation.vector.as_slice())?;
     check_finite("desired orientation", pose.rotation.coords.as_slice())?;

@@ -146,7 +146,10 @@ pub fn parse(urdf: &str) -> Result<urdf_rs::Robot, LoadError> {
 }
 
 /// Loads a serial robot from URDF and stiffness TOML texts. The chain runs from `base_link`
-/// (default: the URDF's root) to `tip_link`.
+/// (default: the URDF's root) to `tip_link`. The URDF must be one tree (a second root link
+/// is refused, naming the roots). A joint axis of any non-zero length is normalised (the
+/// specification asks for a unit vector; exporters round): `0 0 2` is the z axis, and a
+/// prismatic joint still moves one metre per unit of `q`.
 pub fn from_str(
     urdf: &str,
     stiffness: &str,
@@ -209,6 +212,27 @@ pub fn assemble(
                 link: j.child.link.clone(),
             });
         }
+    }
+    // The URDF specification asks for one tree: a second root is a link nothing attaches,
+    // left over or misspelt, and which of them is the base would be a guess.
+    let mut roots: Vec<&str> = robot
+        .links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|l| !parent_joint.contains_key(l))
+        .collect();
+    if roots.len() > 1 {
+        roots.truncate(8);
+        return Err(LoadError::InvalidValue {
+            element: "URDF".to_string(),
+            field: "root links",
+            expected: "one root link (every other link the child of a joint)".to_string(),
+            got: format!(
+                "several: '{}'{}",
+                roots.join("', '"),
+                if roots.len() == 8 { ", ..." } else { "" }
+            ),
+        });
     }
     if !links.contains(tip_link) {
         return Err(LoadError::UnknownLink {

@@ -79,6 +79,10 @@ pub const MAX_TICKS: u64 = 1 << 40;
 pub const MAX_SAMPLES: usize = 1 << 22;
 /// Segments at most this long \[m\] are skipped when a polyline is planned.
 pub const MIN_SEGMENT_LENGTH: f64 = 1.0e-12;
+/// Longest planned motion (segment or pose move) \[s\]: 1e6 s, 11.6 days. Limits of 1e-300
+/// plan a finite but absurd 3e299 s; past this the planner refuses them as it refuses
+/// sub-normal limits, rather than return a motion no controller will run.
+pub const MAX_DURATION: f64 = 1.0e6;
 /// Gravity used to turn the paper's "1..5 g" into accelerations \[m/s^2\] (the paper converts
 /// 5 kgf to 49.05 N, i.e. uses 9.81).
 pub const PAPER_G: f64 = 9.81;
@@ -177,7 +181,7 @@ pub fn paper_limits(g_level: u8) -> Result<Limits, BuildError> {
 /// Ticks of a motion of `duration` \[s\] at `rate_hz`: tick `k` at `k / rate_hz`, the last
 /// exactly at the duration, so `ceil(duration * rate) + 1` (rounding of 1e-9 tick tolerated,
 /// so that a duration of exactly `k` ticks gives `k + 1`). [`TickError::InvalidArgument`] for
-/// a rate that is not finite and > 0, [`TickError::Budget`] past [`MAX_TICKS`].
+/// a rate that is not finite, normal and > 0, [`TickError::Budget`] past [`MAX_TICKS`].
 pub(crate) fn tick_count(duration: f64, rate_hz: f64) -> Result<usize, TickError> {
     counted(duration, rate_hz, "ticks", "MAX_TICKS", MAX_TICKS as f64)
 }
@@ -202,7 +206,9 @@ fn counted(
     budget: &'static str,
     limit: f64,
 ) -> Result<usize, TickError> {
-    if !(rate_hz.is_finite() && rate_hz > 0.0) {
+    // Sub-normal rates are refused like sub-normal limits: 5e-324 Hz is one tick per
+    // 6e315 years, a typo, not a rate.
+    if !(rate_hz.is_normal() && rate_hz > 0.0) {
         return Err(TickError::InvalidArgument {
             what: "rate_hz",
             value: rate_hz,

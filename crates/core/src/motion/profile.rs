@@ -95,6 +95,13 @@ impl Profile {
                 expected: "limits that give a finite duration",
             });
         }
+        if duration > super::MAX_DURATION {
+            return Err(BuildError::InvalidParameter {
+                what: "limits (the motion lasts longer than MAX_DURATION)",
+                value: duration,
+                expected: "limits that move the length within MAX_DURATION = 1e6 s",
+            });
+        }
         Ok(Self {
             length,
             jerk: j,

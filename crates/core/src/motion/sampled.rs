@@ -31,7 +31,50 @@ pub struct SampledTrajectory<const N: usize> {
 }
 
 fn check_rate(rate_hz: f64) -> Result<f64, BuildError> {
-    crate::error::param("rate_hz", rate_hz, rate_hz > 0.0, "finite and > 0 (Hz)")
+    // A sub-normal rate makes the step infinite (every difference NaN).
+    crate::error::param(
+        "rate_hz",
+        rate_hz,
+        rate_hz.is_normal() && rate_hz > 0.0,
+        "finite and > 0 (Hz, not sub-normal)",
+    )
+}
+
+/// Refuses differences that overflowed (samples near `f64::MAX`, or a rate so high that
+/// `1 / rate^2` underflows the step) and a duration that did: the caller would get
+/// infinities or NaN for a motion no controller can run.
+fn check_differences<const N: usize>(t: &SampledTrajectory<N>) -> Result<(), BuildError> {
+    for (what, v) in [
+        (
+            "samples and rate_hz (the velocities' finite differences overflow)",
+            &t.velocity,
+        ),
+        (
+            "samples and rate_hz (the accelerations' finite differences overflow)",
+            &t.acceleration,
+        ),
+        (
+            "samples and rate_hz (the jerks' finite differences overflow)",
+            &t.jerk,
+        ),
+    ] {
+        if let Some(bad) = v.iter().flat_map(|p| p.iter()).find(|c| !c.is_finite()) {
+            return Err(BuildError::InvalidParameter {
+                what,
+                value: *bad,
+                expected: "samples and a rate whose finite differences are finite",
+            });
+        }
+    }
+    let duration = t.duration();
+    if !duration.is_finite() {
+        return Err(BuildError::InvalidParameter {
+            what: "rate_hz (the duration of the samples overflows)",
+            value: t.rate_hz,
+            expected: "a rate that gives a finite duration",
+        });
+    }
+    Ok(())
 }
 
 fn check_samples<const N: usize>(
@@ -88,6 +131,7 @@ fn simple_derivative<const N: usize>(p: &[SVector<f64, N>], h: f64) -> Vec<SVect
 
 impl<const N: usize> SampledTrajectory<N> {
     /// From positions at `rate_hz` (at least 4 samples, at most [`MAX_SAMPLES`]).
+    /// [`BuildError::InvalidParameter`] when a finite difference or the duration overflows.
     pub fn from_positions(
         rate_hz: f64,
         position: Vec<SVector<f64, N>>,
@@ -117,13 +161,15 @@ impl<const N: usize> SampledTrajectory<N> {
             .collect();
         let velocity = derivative(&position, h);
         let jerk = simple_derivative(&acceleration, h);
-        Ok(Self {
+        let t = Self {
             rate_hz,
             position,
             velocity,
             acceleration,
             jerk,
-        })
+        };
+        check_differences(&t)?;
+        Ok(t)
     }
 
     /// From positions and their accelerations (the same number of samples, at least 3).
@@ -152,13 +198,15 @@ impl<const N: usize> SampledTrajectory<N> {
         let h = 1.0 / rate_hz;
         let velocity = derivative(&position, h);
         let jerk = simple_derivative(&acceleration, h);
-        Ok(Self {
+        let t = Self {
             rate_hz,
             position,
             velocity,
             acceleration,
             jerk,
-        })
+        };
+        check_differences(&t)?;
+        Ok(t)
     }
 
     /// Sampling rate \[Hz\].

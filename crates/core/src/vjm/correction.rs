@@ -29,15 +29,33 @@ const SVD_MAX_ITERATIONS: usize = 100;
 /// [`crate::vjm::deflection`] at the target) lands on `target`: translation minus `dp`,
 /// rotation turned back by `dr`. First order in the pose dependence of the deflection, exact
 /// for the given deflection.
-/// Inputs are the caller's (finite by construction of the isometry and the deflection of
-/// [`crate::vjm::deflection`]).
-pub fn commanded_pose(target: &Isometry3<f64>, deflection: &Vector6) -> Isometry3<f64> {
+///
+/// [`TickError::NonFinite`] for a non-finite input, [`TickError::InvalidArgument`] for a
+/// rotation part longer than pi (a rotation vector's angle is at most pi; 1e300 rad would turn
+/// into NaN), [`TickError::NonFiniteOutput`] if the pose overflows.
+pub fn commanded_pose(
+    target: &Isometry3<f64>,
+    deflection: &Vector6,
+) -> Result<Isometry3<f64>, TickError> {
+    check_finite("deflection", deflection.as_slice())?;
+    check_finite("target translation", target.translation.vector.as_slice())?;
+    check_finite("target rotation", target.rotation.coords.as_slice())?;
     let dp = Vector3::new(deflection[0], deflection[1], deflection[2]);
     let dr = Vector3::new(deflection[3], deflection[4], deflection[5]);
-    Isometry3::from_parts(
+    let angle = dr.norm();
+    if angle > core::f64::consts::PI {
+        return Err(TickError::InvalidArgument {
+            what: "deflection rotation (|dr| rad; a rotation vector's angle is at most pi)",
+            value: angle,
+        });
+    }
+    let pose = Isometry3::from_parts(
         Translation3::from(target.translation.vector - dp),
         UnitQuaternion::from_scaled_axis(-dr) * target.rotation,
-    )
+    );
+    check_output("commanded translation", pose.translation.vector.as_slice())?;
+    check_output("commanded rotation", pose.rotation.coords.as_slice())?;
+    Ok(pose)
 }
 
 /// Result of [`joint_correction`].

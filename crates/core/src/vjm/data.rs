@@ -96,5 +96,22 @@ pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickE
             got: q.len(),
         });
     }
-    check_finite("q", q)
+    check_finite("q", q)?;
+    check_joint_range(q)
+}
+
+/// Largest |joint position| any per-tick function accepts \[rad or m\]: 1e6 (159,000 turns of
+/// a continuous joint, 1,000 km of travel). Past it a joint value is a units or overflow
+/// mistake (1e300 rad still gives finite sines), refused rather than computed.
+pub const MAX_JOINT_POSITION: f64 = 1.0e6;
+
+/// [`TickError::InvalidArgument`] for a joint past [`MAX_JOINT_POSITION`].
+pub(crate) fn check_joint_range(q: &[f64]) -> Result<(), TickError> {
+    match q.iter().find(|v| v.abs() > MAX_JOINT_POSITION) {
+        Some(&value) => Err(TickError::InvalidArgument {
+            what: "q (a joint position past MAX_JOINT_POSITION = 1e6 rad or m)",
+            value,
+        }),
+        None => Ok(()),
+    }
 }

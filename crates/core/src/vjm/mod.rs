@@ -27,7 +27,8 @@ pub use correction::{
     JointCorrection, MAX_CORRECTION_ITERATIONS, POSE_TOLERANCE, commanded_pose, joint_correction,
     joint_delta, pose_from_matrix, rotation_from_matrix,
 };
-pub use data::Data;
+pub(crate) use data::check_joint_range;
+pub use data::{Data, MAX_JOINT_POSITION};
 pub(crate) use deflection::rotation_vector;
 pub use deflection::{MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian};
 #[cfg(feature = "alloc")]

@@ -15,6 +15,10 @@ MAX_SAMPLES: int
 MAX_TICKS: int
 #: Largest elastic angle of a spring the small-deflection model accepts [rad].
 MAX_SPRING_ANGLE: float
+#: Largest |joint position| any call accepts [rad or m] (1e6).
+MAX_JOINT_POSITION: float
+#: Longest planned motion [s] (1e6, 11.6 days).
+MAX_DURATION: float
 #: Most joints of a serial arm.
 MAX_DOF: int
 #: Most springs (virtual joints) of a serial arm.
@@ -42,6 +46,8 @@ __all__ = [
     "MAX_SAMPLES",
     "MAX_TICKS",
     "MAX_SPRING_ANGLE",
+    "MAX_JOINT_POSITION",
+    "MAX_DURATION",
     "MAX_DOF",
     "MAX_SPRINGS",
     "MAX_MEASUREMENTS",

@@ -326,7 +326,7 @@ impl SerialDalembertCorrector {
     /// One tick: the desired TCP `pose` (4, 4) and its `velocity`, `acceleration` (3,)
     /// [m/s, m/s^2], `angular_velocity`, `angular_acceleration` (3,) [rad/s, rad/s^2] (zeros
     /// if left out), all base frame, and an optional `process_wrench` (6,) [N, N m] at the TCP.
-    /// `t` is ignored, so that `step(**trajectory.at(t))` works. Returns a dict: `desired`,
+    /// `t` [s] is not used (it may be given, finite, so that `step(**trajectory.at(t))` works). Returns a dict: `desired`,
     /// `commanded` (4, 4), `joints` (dof,), `wrench` (6,), `deflection` (6,), `iterations`,
     /// `position_error`, `orientation_error`, `sigma_min`.
     #[pyo3(signature = (pose, velocity=None, acceleration=None, angular_velocity=None, angular_acceleration=None, process_wrench=None, t=None))]
@@ -340,11 +340,11 @@ impl SerialDalembertCorrector {
         angular_velocity: Option<&Bound<'py, PyAny>>,
         angular_acceleration: Option<&Bound<'py, PyAny>>,
         process_wrench: Option<&Bound<'py, PyAny>>,
-        t: Option<&Bound<'py, PyAny>>,
+        #[pyo3(from_py_with = args::opt_real::t)] t: Option<f64>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let _ = t;
         let state = PoseState {
-            t: 0.0,
+            // Not used by the tick; core refuses a non-finite one all the same.
+            t: t.unwrap_or(0.0),
             pose: crate::arrays::pose(pose, "pose")?,
             velocity: vec3(velocity, "velocity")?,
             acceleration: vec3(acceleration, "acceleration")?,

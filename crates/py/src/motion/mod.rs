@@ -107,7 +107,7 @@ impl Trajectory {
                  .at(t) or sample it with .sampled(rate_hz)",
             ));
         };
-        let s = py.detach(|| plan.sample(rate)).map_err(tick_err)?;
+        let s = py.detach(|| plan.sample(rate))?;
         Ok(self.samples.get_or_init(|| s))
     }
 }
@@ -156,7 +156,7 @@ fn plan_at<'py>(
             return Err(shape_error("t", "a number or (m,)", a.shape()));
         }
     };
-    let s = py.detach(|| plan.eval(&times)).map_err(tick_err)?;
+    let s = py.detach(|| plan.eval(&times))?;
     samples_to_dict(py, &s, scalar)
 }
 
@@ -178,7 +178,7 @@ fn from_samples_n<const N: usize>(
         }
     }
     .map_err(build_err)?;
-    let mut out = Samples::zeros(traj.len(), N);
+    let mut out = Samples::try_zeros(traj.len(), N)?;
     for i in 0..traj.len() {
         out.set(i, &traj.state(i).map_err(tick_err)?);
     }

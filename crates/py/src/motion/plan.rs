@@ -10,8 +10,9 @@ use numpy::ndarray::{Array1, Array2, ArrayView2};
 use pyo3::prelude::*;
 
 use super::MAX_DIM;
-use crate::arrays::{float_array, vector};
-use crate::errors::{build_err, shape_error};
+use crate::InputError;
+use crate::arrays::{float_array, try_rows, try_zeros, vector};
+use crate::errors::{build_err, shape_error, tick_err};
 use crate::scalars::real;
 
 /// A plan in `N` coordinates, `N` known at run time. Boxed: a trajectory holds room for its
@@ -56,14 +57,22 @@ pub(crate) struct Samples {
 }
 
 impl Samples {
-    pub(super) fn zeros(n: usize, d: usize) -> Self {
-        Self {
-            t: Array1::zeros(n),
-            position: Array2::zeros((n, d)),
-            velocity: Array2::zeros((n, d)),
-            acceleration: Array2::zeros((n, d)),
-            jerk: Array2::zeros((n, d)),
-        }
+    /// `n` rows of `d` zeros, allocated fallibly: `MemoryError` naming the request when the
+    /// system refuses it (up to `MAX_SAMPLES` rows of 8 coordinates is 1.1 GB), never an
+    /// abort of the interpreter.
+    pub(super) fn try_zeros(n: usize, d: usize) -> PyResult<Self> {
+        let what = "the trajectory's samples";
+        let rows = || -> PyResult<Array2<f64>> {
+            let v = try_rows(n, d, what)?;
+            Array2::from_shape_vec((n, d), v).map_err(|e| InputError::new_err(e.to_string()))
+        };
+        Ok(Self {
+            t: Array1::from_vec(try_zeros(n, what)?),
+            position: rows()?,
+            velocity: rows()?,
+            acceleration: rows()?,
+            jerk: rows()?,
+        })
     }
 
     pub(super) fn set<const N: usize>(&mut self, i: usize, s: &State<N>) {
@@ -87,20 +96,20 @@ impl Samples {
 /// Every tick of `traj` at `rate_hz`. The count comes first from deflect-core's
 /// [`CoreTraj::sample_count`], which refuses more than `deflect_core::motion::MAX_SAMPLES`
 /// ticks before anything is allocated.
-fn sample_plan<const N: usize>(traj: &CoreTraj<N>, rate_hz: f64) -> Result<Samples, TickError> {
-    let n = traj.sample_count(rate_hz)?;
-    let mut out = Samples::zeros(n, N);
-    for (i, s) in traj.ticks(rate_hz)?.enumerate().take(n) {
+fn sample_plan<const N: usize>(traj: &CoreTraj<N>, rate_hz: f64) -> PyResult<Samples> {
+    let n = traj.sample_count(rate_hz).map_err(tick_err)?;
+    let mut out = Samples::try_zeros(n, N)?;
+    for (i, s) in traj.ticks(rate_hz).map_err(tick_err)?.enumerate().take(n) {
         out.set(i, &s);
     }
     Ok(out)
 }
 
 /// The states of `traj` at `times`.
-fn eval_plan<const N: usize>(traj: &CoreTraj<N>, times: &[f64]) -> Result<Samples, TickError> {
-    let mut out = Samples::zeros(times.len(), N);
+fn eval_plan<const N: usize>(traj: &CoreTraj<N>, times: &[f64]) -> PyResult<Samples> {
+    let mut out = Samples::try_zeros(times.len(), N)?;
     for (i, &t) in times.iter().enumerate() {
-        out.set(i, &traj.sample(t)?);
+        out.set(i, &traj.sample(t).map_err(tick_err)?);
     }
     Ok(out)
 }
@@ -115,10 +124,10 @@ impl Plan {
     pub(super) fn sample_count(&self, rate_hz: f64) -> Result<usize, TickError> {
         with_plan!(self, p => p.sample_count(rate_hz))
     }
-    pub(super) fn sample(&self, rate_hz: f64) -> Result<Samples, TickError> {
+    pub(super) fn sample(&self, rate_hz: f64) -> PyResult<Samples> {
         with_plan!(self, p => sample_plan(p, rate_hz))
     }
-    pub(super) fn eval(&self, times: &[f64]) -> Result<Samples, TickError> {
+    pub(super) fn eval(&self, times: &[f64]) -> PyResult<Samples> {
         with_plan!(self, p => eval_plan(p, times))
     }
 }
