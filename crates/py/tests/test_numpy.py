@@ -4,8 +4,14 @@ the argument, the expected and the received shape.
 
 Copies are counted with tracemalloc, which sees every allocation numpy makes (deflect's own
 outputs are Rust buffers handed to numpy, not traced): an input that is converted shows up as
-a peak of its float64 size, one read in place as (almost) nothing."""
+a peak of its float64 size, one read in place as (almost) nothing. tracemalloc cannot see a
+copy made in Rust; the proof that there is none is a child process whose address space is
+capped below the size of one copy (test_no_copy_is_proven_under_an_address_space_limit)."""
 
+import json
+import os
+import subprocess
+import sys
 import tracemalloc
 
 import numpy as np
@@ -172,3 +178,82 @@ def test_linear_deflection_is_compliance_times_wrench(kr300):
     np.testing.assert_array_equal(kr300.linear_deflection(list(q), list(w)), kr300.linear_deflection(q, w))
     with pytest.raises(deflect.InputError, match="wrench"):
         kr300.linear_deflection(q, [0.0, 0.0, np.inf, 0.0, 0.0, 0.0])
+
+
+_NO_COPY_CHILD = r"""
+import json, os, resource, sys
+import numpy as np
+import deflect
+
+repo = sys.argv[1]
+m = deflect.ComplianceMap.from_csv(os.path.join(repo, "data/paksoy2025_compliance_oc.csv"))
+robot = deflect.SerialRobot.from_urdf(
+    os.path.join(repo, "robots/kr300/kr300_r2500.urdf"),
+    os.path.join(repo, "robots/kr300/kr300_r2500_stiffness.toml"),
+    "tcp",
+)
+rng = np.random.default_rng(3)
+# Built in place, without temporaries: nothing freed is left for a copy to reuse.
+n = 4_000_000  # (n, 2) float64: 64 MB, one copy of P
+p = rng.random((n, 2))
+p *= [0.08, 0.14]
+p += [0.18, -0.07]
+f = np.array([150.0, -80.0])
+out = np.zeros((n, 2))
+k = 1_000_000  # (k, 6) float64: 48 MB, one copy of Q
+q = rng.random((k, 6))
+q *= 0.2
+q += [-0.1, -1.0, 1.3, -0.1, 0.9708, -0.1]
+w = np.array([-386.1, 386.1, 120.0, 0.0, 0.0, 0.0])
+dout = np.zeros((k, 6))
+p32, q32 = p.astype(np.float32), q.astype(np.float32)
+# Every code path once, threads and their allocator arenas included, before the cap.
+m.displacement_batch(p[:50_000], f, out=out[:50_000])
+robot.deflection_batch(q[:5_000], w, out=dout[:5_000])
+size = os.sysconf("SC_PAGE_SIZE") * int(open("/proc/self/statm").read().split()[0])
+headroom = 24 << 20  # below one copy of either input
+resource.setrlimit(resource.RLIMIT_AS, (size + headroom, resource.RLIM_INFINITY))
+res = {}
+for name, call in [
+    ("map_in_place", lambda: m.displacement_batch(p, f, out=out)),
+    ("vjm_in_place", lambda: robot.deflection_batch(q, w, out=dout)),
+    ("map_float32", lambda: m.displacement_batch(p32, f, out=out)),
+    ("vjm_float32", lambda: robot.deflection_batch(q32, w, out=dout)),
+]:
+    try:
+        call()
+        res[name] = "ok"
+    except MemoryError:
+        res[name] = "MemoryError"
+print(json.dumps(res))
+"""
+
+
+def test_no_copy_is_proven_under_an_address_space_limit():
+    """float64 C-contiguous batch input is read in place: with the process's address space
+    capped at its size plus 24 MB, a batch over a 64 MB (48 MB) input still runs, while the
+    same data as float32, which must be converted into a float64 copy, raises MemoryError.
+    A copy made anywhere (numpy or Rust) counts against the cap."""
+    # A fixed mmap threshold (every large block mapped on allocation, unmapped on free) and
+    # one malloc arena (worker threads otherwise reserve 64 MB arenas, where a refused
+    # mapping is retried): no memory already counted by the cap is left for a copy to reuse.
+    # A copy in Rust would abort the child (infallible allocation), one in numpy raise.
+    env = dict(
+        os.environ,
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+        MALLOC_MMAP_THRESHOLD_="131072",
+        MALLOC_ARENA_MAX="1",
+    )
+    repo = str(REPO)
+    proc = subprocess.run(
+        [sys.executable, "-c", _NO_COPY_CHILD, repo], capture_output=True, text=True, timeout=120, env=env
+    )
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    res = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert res == {
+        "map_in_place": "ok",
+        "vjm_in_place": "ok",
+        "map_float32": "MemoryError",
+        "vjm_float32": "MemoryError",
+    }, res
