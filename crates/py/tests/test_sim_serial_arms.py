@@ -49,8 +49,8 @@ def test_defaults_run_and_the_correction_reduces_the_path_error(tmp_path, name, 
     assert len(o["q0"]) == robot.dof
     for q, (lo, hi) in zip(o["q0"], robot.joint_limits):
         assert lo + min(0.1, 0.05 * (hi - lo)) - 1e-12 <= q <= hi - min(0.1, 0.05 * (hi - lo)) + 1e-12
-    # The testbed arm's static compliance is the model's J K^-1 J^T.
-    assert s["static_rel_error"] < 0.02, s["static_rel_error"]
+    # The testbed arm's static compliance is the model's J K^-1 J^T (the UR5's to 0.12 %).
+    assert s["static_rel_error"] < (0.005 if name == "ur5" else 0.02), s["static_rel_error"]
     runs = {(r["path"], r["corrected"]): r["metrics"] for r in s["runs"]}
     for path in ("Line", "Circle"):
         before, after = runs[(path, False)], runs[(path, True)]
@@ -59,3 +59,23 @@ def test_defaults_run_and_the_correction_reduces_the_path_error(tmp_path, name, 
         # (measured 57-96 %).
         assert after["path_max_mm"] < 0.5 * before["path_max_mm"], (name, path, before, after)
         assert after["path_rms_mm"] < 0.5 * before["path_rms_mm"], (name, path, before, after)
+
+
+def test_kr300_default_reduces_the_path_error_on_a_shortened_motion(tmp_path):
+    """The default scene (the KR 300 with 150 kg at 1 g, links' inertia corrected), on motions
+    a twentieth of the default size (1.4 s of wall clock): the reductions the notes report for
+    the full motions (88.5 / 96.4 %) hold in kind here (measured 69.1 / 90.8 % on the path
+    maximum, 76.9 / 91.8 % RMS), and the static compliance is the model's."""
+    cmd = ["cargo", "run", "--release", "--quiet", "-p", "deflect-sim", "--", "serial",
+           "--scale", "0.05", "--out", str(tmp_path)]
+    res = subprocess.run(cmd, cwd=REPO, capture_output=True, text=True, timeout=1800)
+    assert res.returncode == 0, res.stderr
+    s = json.loads((tmp_path / "serial_summary.json").read_text())
+    assert s["static_rel_error"] < 0.01, s["static_rel_error"]
+    runs = {(r["path"], r["corrected"]): r["metrics"] for r in s["runs"]}
+    for path, least in (("Line", 0.6), ("Circle", 0.85)):
+        before, after = runs[(path, False)], runs[(path, True)]
+        assert before["path_max_mm"] > 1.0, (path, before)
+        reduction = 1.0 - after["path_max_mm"] / before["path_max_mm"]
+        assert reduction > least, (path, reduction, before, after)
+        assert after["path_rms_mm"] < (1.0 - least) * before["path_rms_mm"], (path, before, after)
