@@ -56,7 +56,11 @@ fn predicted_loaded_pose_equals_the_desired_pose_at_every_tick() {
     for k in 0..n {
         let s = traj.sample(traj.tick_time(rate, k, n)).unwrap();
         let tick = serial::step(&model, &mut data, &s, None).unwrap();
-        // Independent check: deflect the commanded joints under the tick's wrench.
+        // Consistency check, not an independent one: deflect the commanded joints under the
+        // tick's own wrench with the same vjm::deflection the corrector inverts. The
+        // independent check is Python's (crates/py/tests/test_serial.py,
+        // test_corrected_commands_land_the_loaded_arm_on_the_desired_pose: the wrench from
+        // the payload's own Newton-Euler in numpy, the landing from numpy's chain).
         let d = vjm::deflection(
             &robot.model,
             &mut check,
@@ -100,8 +104,9 @@ fn with_the_links_inertia_the_loaded_pose_still_lands_on_the_desired_pose() {
         let s = traj.sample(traj.tick_time(2000.0, k, n)).unwrap();
         let tick = serial::step(&model, &mut data, &s, None).unwrap();
         let q = &tick.joints[..6];
-        // Independent joint rates and accelerations at the command: LU solves of the rigid
-        // Jacobian there (the corrector uses damped least squares at its warm start).
+        // Joint rates and accelerations at the command by another route (LU solves of the
+        // rigid Jacobian there; the corrector uses damped least squares at its warm start),
+        // on deflect's own Jacobian.
         vjm::joint_jacobian(&robot.model, &mut check, q).unwrap();
         let lu = check.jacobian.fixed_columns::<6>(0).into_owned().lu();
         let (v, w) = (s.velocity, s.angular_velocity);

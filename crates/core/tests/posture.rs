@@ -1,6 +1,9 @@
-//! Stiffness-optimal posture on the shipped KR 300: the refined optimum agrees with a brute
-//! scan at 0.1 degree, every reported posture reaches the task, and unreachable angles are
-//! reported as such (NaN, never a zero deflection).
+//! Stiffness-optimal posture on the shipped KR 300: the refined optimum agrees with a fine
+//! scan at 0.1 degree around the coarse best (a check of the refinement, made with the sweep
+//! itself: the coarse optimum and the IK branch are checked independently in Python,
+//! `test_atlas.py::test_sweep_best_agrees_with_an_independent_full_turn_scan`), every reported
+//! posture reaches the task, and unreachable angles are reported as such (NaN, never a zero
+//! deflection).
 
 use deflect_core::SerialRobot;
 use deflect_core::TickError;

@@ -248,3 +248,84 @@ def test_per_tick_state_is_deep_copied_but_not_pickled(robots):
     with pytest.raises(TypeError, match="cannot pickle a ContourTracer"):
         pickle.dumps(tracer)
     assert copy.deepcopy(tracer).state == tracer.state
+
+
+# The property deferred twice: for any valid model a pickled copy computes what the original
+# does, bit for bit, on any input in its domain.
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+PROPERTY = settings(max_examples=40, deadline=None, database=None, suppress_health_check=[HealthCheck.too_slow])
+_finite = st.floats(-1e3, 1e3, allow_nan=False)
+
+
+@st.composite
+def grid_maps(draw):
+    dims = draw(st.integers(1, 3))
+    nf, nd = draw(st.integers(1, 3)), draw(st.integers(1, 3))
+    axes = []
+    for _ in range(dims):
+        n = draw(st.integers(2, 4))
+        steps = draw(st.lists(st.floats(0.01, 1.0), min_size=n - 1, max_size=n - 1))
+        start = draw(st.floats(-1.0, 1.0))
+        axes.append(start + np.concatenate([[0.0], np.cumsum(steps)]))
+    shape = tuple(len(a) for a in axes) + (nd, nf)
+    coeff = st.lists(_finite, min_size=int(np.prod(shape)), max_size=int(np.prod(shape)))
+    slopes = np.array(draw(coeff)).reshape(shape) * 1e-6
+    offsets = np.array(draw(coeff)).reshape(shape) * 1e-6
+    interp = draw(st.sampled_from(["multilinear", "cubic"]))
+    m = deflect.GridMap(axes, nf, nd, slopes, offsets, interpolation=interp, out_of_grid="clamp")
+    u = np.array(draw(st.lists(st.floats(-0.2, 1.2), min_size=5 * dims, max_size=5 * dims))).reshape(5, dims)
+    lo, hi = np.array([a[0] for a in axes]), np.array([a[-1] for a in axes])
+    points = lo + u * (hi - lo)
+    forces = np.array(draw(st.lists(_finite, min_size=5 * nf, max_size=5 * nf))).reshape(5, nf)
+    return m, points, forces
+
+
+@PROPERTY
+@given(grid_maps(), st.sampled_from([pickle.dumps, copy.deepcopy]))
+def test_pickled_maps_compute_what_the_original_does(case, how):
+    m, points, forces = case
+    other = pickle.loads(how(m)) if how is pickle.dumps else how(m)
+    np.testing.assert_array_equal(other.displacement_batch(points, forces), m.displacement_batch(points, forces))
+    np.testing.assert_array_equal(other.slopes, m.slopes)
+    assert other.to_json() == m.to_json()
+
+
+@PROPERTY
+@given(
+    st.lists(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3), min_size=2, max_size=6),
+    st.floats(0.05, 2.0),
+    st.floats(1.0, 50.0),
+    st.floats(10.0, 1e4),
+    st.lists(st.floats(-0.5, 5.0), min_size=7, max_size=7),
+)
+def test_pickled_trajectories_and_planners_compute_what_the_original_does(pts, v, a, j, times):
+    pts = np.array(pts)
+    traj = deflect.plan_polyline(pts, v, a, j, rate_hz=None)
+    other = pickle.loads(pickle.dumps(traj))
+    for k, val in traj.at(np.array(times)).items():
+        np.testing.assert_array_equal(other.at(np.array(times))[k], val, k)
+    planner = deflect.LinePlanner(3, v, a, j)
+    planner.plan(pts[0], pts[-1])
+    copy_ = pickle.loads(pickle.dumps(planner))
+    assert copy_.duration == planner.duration
+    for k, val in planner.at(np.array(times)).items():
+        np.testing.assert_array_equal(copy_.at(np.array(times))[k], val, k)
+
+
+@PROPERTY
+@given(st.lists(st.lists(st.floats(-0.4, 0.4), min_size=6, max_size=6), min_size=1, max_size=4),
+       st.lists(st.lists(_finite, min_size=6, max_size=6), min_size=1, max_size=4))
+def test_pickled_robots_compute_what_the_original_does(dq, wrench):
+    robot = _KR300
+    other = pickle.loads(pickle.dumps(robot))
+    q = np.array([0.0, -0.9, 1.4, 0.0, 1.0708, 0.0]) + np.array(dq)
+    w = np.array(wrench)[: len(q)]
+    q = q[: len(w)]
+    np.testing.assert_array_equal(other.deflection_batch(q, w), robot.deflection_batch(q, w))
+    np.testing.assert_array_equal(other.compliance_batch(q), robot.compliance_batch(q))
+    np.testing.assert_array_equal(other.forward_batch(q), robot.forward_batch(q))
+
+
+_KR300 = deflect.SerialRobot.from_urdf(KR300_URDF, KR300_TOML, "tcp")

@@ -47,6 +47,13 @@ METADATA_KEYS = {
 FOXGLOVE = {"foxglove.PosesInFrame", "foxglove.SceneUpdate"}
 # A unit in a field's name, for numeric fields without a description.
 UNIT_SUFFIX = re.compile(r"_(m|mm|mm2|s|ms|n|rad|mrad|kg|g|deg|m_s|n_m)$", re.IGNORECASE)
+# A description that states a unit: it opens with one (SI, "1" for dimensionless, "px" for
+# the viewer's pixels), then at most a remark in parentheses or after a comma; or, for an
+# integer code, it lists the codes ("0 LINE_STRIP, 1 LINE_LOOP, ...").
+UNIT_DESCRIPTION = re.compile(
+    r"^(m|mm|N|N m|rad|mrad|s|ms|ns|kg|1|px|m/s|m/s\^2|rad/s|rad/s\^2|Hz)(\b|$)( \([^)]*\)|, [^,]+(, [^,]+)*)?( or m)?$"
+)
+CODE_LIST = re.compile(r"^0 \w+(, \d+ \w+)+$")
 
 
 @pytest.fixture(scope="module")
@@ -158,7 +165,13 @@ def test_every_numeric_field_declares_its_unit(logs):
             if not sname.startswith("deflect."):
                 continue
             for path, key, p in numeric_fields(schema):
-                assert p.get("description") or UNIT_SUFFIX.search(key), (name, sname, path)
+                d = p.get("description")
+                if d is None:
+                    assert UNIT_SUFFIX.search(key), (name, sname, path)
+                elif p.get("type") == "integer" and CODE_LIST.match(d):
+                    continue
+                else:
+                    assert UNIT_DESCRIPTION.match(d), (name, sname, path, d)
 
 
 def test_one_time_base_every_run_from_zero(logs):
