@@ -117,18 +117,27 @@ fn every_malformed_input_is_a_named_error() {
             referenced_by: "tip_link".into()
         }
     );
-    // A second tree: the tip exists but hangs off another root.
+    // A second tree: the URDF has two roots (the specification asks for one), refused
+    // naming both, whichever link the chain would use.
     let island = urdf(
         r#"xyz="0.5 0 0" rpy="0 0 0""#,
         "0 0 1",
         r#"<link name="other_root"/><link name="island"/>
   <joint name="k" type="fixed"><parent link="other_root"/><child link="island"/></joint>"#,
     );
+    for tip in ["island", "tip"] {
+        assert!(matches!(
+            SerialRobot::from_str(&island, STIFF, Some("base"), tip).unwrap_err(),
+            LoadError::InvalidValue { field: "root links", ref got, .. }
+                if got.contains("'base', 'other_root'")
+        ));
+    }
+    // One tree, a tip that is not below the base.
     assert_eq!(
-        SerialRobot::from_str(&island, STIFF, Some("base"), "island").unwrap_err(),
+        SerialRobot::from_str(&good_urdf(), STIFF, Some("tip"), "base").unwrap_err(),
         LoadError::TipNotReachable {
-            tip: "island".into(),
-            base: "base".into()
+            tip: "base".into(),
+            base: "tip".into()
         }
     );
     let dup_link = urdf(

@@ -30,21 +30,23 @@ pub(crate) enum Plan {
     D8(Box<CoreTraj<8>>),
 }
 
-/// Runs `$body` with `$t` bound to the plan of whatever dimension `$plan` holds.
+/// Runs `$body` with `$t` bound to the plan of whatever dimension `$plan` holds (`&Plan`
+/// or `&mut Plan`).
 macro_rules! with_plan {
     ($plan:expr, $t:ident => $body:expr) => {
         match $plan {
-            Plan::D1($t) => $body,
-            Plan::D2($t) => $body,
-            Plan::D3($t) => $body,
-            Plan::D4($t) => $body,
-            Plan::D5($t) => $body,
-            Plan::D6($t) => $body,
-            Plan::D7($t) => $body,
-            Plan::D8($t) => $body,
+            $crate::motion::plan::Plan::D1($t) => $body,
+            $crate::motion::plan::Plan::D2($t) => $body,
+            $crate::motion::plan::Plan::D3($t) => $body,
+            $crate::motion::plan::Plan::D4($t) => $body,
+            $crate::motion::plan::Plan::D5($t) => $body,
+            $crate::motion::plan::Plan::D6($t) => $body,
+            $crate::motion::plan::Plan::D7($t) => $body,
+            $crate::motion::plan::Plan::D8($t) => $body,
         }
     };
 }
+pub(super) use with_plan;
 
 /// Every tick of a trajectory, one row each.
 #[derive(Debug, Clone)]

@@ -8,7 +8,7 @@ use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::plan::{LimitSpec, Plan};
+use super::plan::{LimitSpec, Plan, with_plan};
 use super::{MAX_DIM, Recipe, Trajectory, plan_at};
 use crate::InputError;
 use crate::args;
@@ -56,26 +56,10 @@ fn at_rest<const N: usize>(limits: &Limits) -> PyResult<Box<CoreTraj<N>>> {
         .map_err(build_err)
 }
 
-/// Runs `$body` with `$t` bound to the plan of whatever dimension `$plan` holds.
-macro_rules! each_dim {
-    ($plan:expr, $t:ident => $body:expr) => {
-        match $plan {
-            Plan::D1($t) => $body,
-            Plan::D2($t) => $body,
-            Plan::D3($t) => $body,
-            Plan::D4($t) => $body,
-            Plan::D5($t) => $body,
-            Plan::D6($t) => $body,
-            Plan::D7($t) => $body,
-            Plan::D8($t) => $body,
-        }
-    };
-}
-
 impl LinePlanner {
     /// Start and end points of the current plan.
     fn points(&self) -> (Vec<f64>, Vec<f64>) {
-        each_dim!(&self.plan, t => (t.start().as_slice().to_vec(), t.end().as_slice().to_vec()))
+        with_plan!(&self.plan, t => (t.start().as_slice().to_vec(), t.end().as_slice().to_vec()))
     }
 }
 
@@ -112,7 +96,7 @@ impl LinePlanner {
     /// each) in place and returns its duration [s]. On error the previous plan is kept.
     fn plan(&mut self, start: &Bound<'_, PyAny>, end: &Bound<'_, PyAny>) -> PyResult<f64> {
         let l = self.limits;
-        each_dim!(&mut self.plan, t => replan(t, start, end, &l))
+        with_plan!(&mut self.plan, t => replan(t, start, end, &l))
     }
 
     /// The exact state of the current plan at `t` [s], as `Trajectory.at`.
