@@ -98,14 +98,7 @@ pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
         // tracking costs more than the copy of a few entries (measured ~0.2 us per array).
         return a.to_vec().ok();
     }
-    let number = |x: Bound<'_, PyAny>| -> Option<f64> {
-        // Floats and their subclasses (numpy.float64 is one); ints exactly (not bool).
-        if x.is_instance_of::<PyFloat>() || x.is_exact_instance_of::<PyInt>() {
-            x.extract::<f64>().ok()
-        } else {
-            None
-        }
-    };
+    let number = |x: Bound<'_, PyAny>| py_number(&x);
     if let Ok(l) = o.cast::<PyList>() {
         if l.len() > FAST_VECTOR_MAX {
             return None;
@@ -121,22 +114,26 @@ pub(crate) fn fast_vector(o: &Bound<'_, PyAny>) -> Option<Vec<f64>> {
     None
 }
 
+/// A Python float (or subclass: numpy.float64 is one) or an exact int (not bool) as f64; `None`
+/// for anything else, which then goes through numpy and its checks.
+fn py_number(x: &Bound<'_, PyAny>) -> Option<f64> {
+    if let Ok(f) = x.cast::<PyFloat>() {
+        Some(f.value())
+    } else if x.is_exact_instance_of::<PyInt>() {
+        x.extract::<f64>().ok()
+    } else {
+        None
+    }
+}
+
 /// Fills `out` from a list or tuple of exactly `out.len()` Python floats or ints without
-/// allocating (the per-call inputs of a re-planning loop); else [`fast_vector`]'s float64 vector of that length. `false` (and `out` unspecified) for anything else, which the caller
+/// allocating (the per-call inputs of a re-planning loop); else [`fast_vector`]'s float64
+/// vector of that length. `false` (and `out` unspecified) for anything else, which the caller
 /// then reads through numpy and its checks.
 pub(crate) fn fill_fast(o: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
-    fn number(x: &Bound<'_, PyAny>) -> Option<f64> {
-        if let Ok(f) = x.cast::<PyFloat>() {
-            Some(f.value())
-        } else if x.is_exact_instance_of::<PyInt>() {
-            x.extract::<f64>().ok()
-        } else {
-            None
-        }
-    }
     fn fill<'py>(items: impl Iterator<Item = Bound<'py, PyAny>>, out: &mut [f64]) -> bool {
         for (d, x) in out.iter_mut().zip(items) {
-            match number(&x) {
+            match py_number(&x) {
                 Some(v) => *d = v,
                 None => return false,
             }

@@ -333,6 +333,5 @@ fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickError> {
             got: q.len(),
         });
     }
-    crate::error::check_finite("q", q)?;
     crate::vjm::check_joint_range(q)
 }

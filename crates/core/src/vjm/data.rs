@@ -4,7 +4,7 @@
 use nalgebra::{Isometry3, Matrix6, SMatrix, Vector3};
 
 use super::model::{MAX_DOF, MAX_MASSES, MAX_SPRINGS, Model};
-use crate::error::{TickError, check_finite};
+use crate::error::TickError;
 
 /// Per-call workspace and the last call's by-products, sized once for any model
 /// (fixed capacities, so creating one allocates nothing). Records the dimensions of the model
@@ -96,7 +96,6 @@ pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickE
             got: q.len(),
         });
     }
-    check_finite("q", q)?;
     check_joint_range(q)
 }
 
@@ -105,10 +104,16 @@ pub(crate) fn check_q(model: &Model, data: &Data, q: &[f64]) -> Result<(), TickE
 /// mistake (1e300 rad still gives finite sines), refused rather than computed.
 pub const MAX_JOINT_POSITION: f64 = 1.0e6;
 
+/// One pass over the joints: [`TickError::NonFinite`] for NaN or an infinity,
 /// [`TickError::InvalidArgument`] for a joint past [`MAX_JOINT_POSITION`].
 pub(crate) fn check_joint_range(q: &[f64]) -> Result<(), TickError> {
-    match q.iter().find(|v| v.abs() > MAX_JOINT_POSITION) {
-        Some(&value) => Err(TickError::InvalidArgument {
+    match q
+        .iter()
+        .enumerate()
+        .find(|(_, v)| v.is_nan() || v.abs() > MAX_JOINT_POSITION)
+    {
+        Some((index, v)) if !v.is_finite() => Err(TickError::NonFinite { what: "q", index }),
+        Some((_, &value)) => Err(TickError::InvalidArgument {
             what: "q (a joint position past MAX_JOINT_POSITION = 1e6 rad or m)",
             value,
         }),
