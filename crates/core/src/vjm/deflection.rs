@@ -4,6 +4,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
 
+use super::chain::{compose, rotate_axis, turn};
 use super::data::check_q;
 use super::loads::arm_pass;
 use super::model::{Op, Pass};
@@ -100,8 +101,8 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
                     continue; // unreachable: built together
                 };
                 let i = step.index;
-                frame *= step.pre;
-                let u = frame.rotation * step.axis.into_inner();
+                frame = compose(&frame, &step.pre, step.pre_turns);
+                let u = rotate_axis(&frame.rotation, step.kind, &step.axis);
                 if let (Some(a), Some(o)) =
                     (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
                 {
@@ -110,14 +111,19 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
                 }
                 let qi = q.get(i).copied().unwrap_or(0.0);
                 if step.revolute {
-                    frame.rotation *= super::trig::axis_angle(&step.axis, qi);
+                    let (s, c) = super::trig::sin_cos(qi * 0.5);
+                    frame.rotation = turn(&frame.rotation, step.kind, &step.axis, s, c);
                 } else {
                     frame.translation.vector += u * qi;
                 }
             }
-            Pass::Spring { local, index } => {
+            Pass::Spring {
+                local,
+                turns,
+                index,
+            } => {
                 if let Some(slot) = data.spring_frames.get_mut(*index) {
-                    *slot = frame * local;
+                    *slot = compose(&frame, local, *turns);
                 }
             }
         }
@@ -130,10 +136,11 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
 fn tcp_pass(model: &Model, q: &[f64]) -> Isometry3<f64> {
     let mut frame = Isometry3::identity();
     for step in model.tcp_chain.iter() {
-        frame *= step.pre;
+        frame = compose(&frame, &step.pre, step.pre_turns);
         let qi = q.get(step.index).copied().unwrap_or(0.0);
         if step.revolute {
-            frame.rotation *= super::trig::axis_angle(&step.axis, qi);
+            let (s, c) = super::trig::sin_cos(qi * 0.5);
+            frame.rotation = turn(&frame.rotation, step.kind, &step.axis, s, c);
         } else {
             frame.translation.vector += frame.rotation * (step.axis.into_inner() * qi);
         }
@@ -176,8 +183,10 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
 /// angles \[rad\] of the spring with compliances `compliance` and rigid world frame `frame`
 /// under the moment `m` \[N m\] (world axes, about its origin). The one guard of the
 /// small-deflection model: an angle past [`MAX_SPRING_ANGLE`] (or NaN from overflowing
-/// moments) is refused.
-#[inline]
+/// moments) is refused. Always inlined: called out of line, the moment stored by the caller
+/// and reloaded across its element boundary stalled store forwarding (a quarter of
+/// `deflection`'s time in perf, KR 300).
+#[inline(always)]
 fn spring_angles(
     compliance: &Vector3<f64>,
     frame: &Isometry3<f64>,

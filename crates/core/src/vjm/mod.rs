@@ -14,6 +14,7 @@
 //! [`compliance`] (the 6x6 Cartesian compliance), [`joint_jacobian`], and the solvers built on
 //! them ([`joint_correction`], [`equilibrium`]).
 
+mod chain;
 mod correction;
 mod data;
 mod deflection;

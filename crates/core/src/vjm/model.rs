@@ -2,6 +2,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Unit, Vector3};
 
+use super::chain::{AxisKind, rotation_is_identity};
 use crate::error::BuildError;
 
 /// Most actuated joints a model may have: a 6-axis arm plus a linear track and a turntable,
@@ -97,7 +98,11 @@ pub(crate) enum Op {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct TcpStep {
     pub pre: Isometry3<f64>,
+    /// Whether `pre` rotates (else it is a translation: [`super::chain::compose`]).
+    pub pre_turns: bool,
     pub axis: Unit<Vector3<f64>>,
+    /// `axis` as the specialised compositions take it.
+    pub kind: AxisKind,
     pub revolute: bool,
     pub index: usize,
 }
@@ -111,6 +116,8 @@ pub(crate) enum Pass {
     Joint(usize),
     Spring {
         local: Isometry3<f64>,
+        /// Whether `local` rotates.
+        turns: bool,
         index: usize,
     },
 }
@@ -487,9 +494,12 @@ impl ModelBuilder {
             match *e {
                 Element::Fixed(t) => tail *= t,
                 Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
+                    let pre = core::mem::replace(&mut tail, Isometry3::identity());
                     let step = TcpStep {
-                        pre: core::mem::replace(&mut tail, Isometry3::identity()),
+                        pre_turns: !rotation_is_identity(&pre),
+                        pre,
                         axis,
+                        kind: AxisKind::of(&axis),
                         revolute: matches!(e, Element::Revolute { .. }),
                         index,
                     };
@@ -502,8 +512,10 @@ impl ModelBuilder {
                     })?;
                 }
                 Element::Spring { offset, index, .. } => {
+                    let local = tail * offset;
                     pass.push(Pass::Spring {
-                        local: tail * offset,
+                        turns: !rotation_is_identity(&local),
+                        local,
                         index,
                     })
                     .map_err(|_| capacity)?;
