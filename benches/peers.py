@@ -271,6 +271,8 @@ def bench_motion(args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
+    ap.add_argument("--only", choices=("vjm", "map", "motion"), action="append",
+                    help="run only these groups (repeatable); all by default")
     args = ap.parse_args()
     args.repeats = 5 if args.quick else 41
     args.inner = 20 if args.quick else 200
@@ -280,6 +282,8 @@ def main():
     print(f"{'pair':<44} {'deflect':>10} {'peer':>10} {'unit':<8} {'ratio':>7}  {'speedup':>8}  "
           "max rel diff")
     for bench in (bench_vjm, bench_map, bench_motion):
+        if args.only and bench.__name__.removeprefix("bench_") not in args.only:
+            continue
         try:
             bench(args)
         except ImportError as e:

@@ -151,6 +151,92 @@ fn batch_equals_single_bit_for_bit() {
     }
 }
 
+/// The blocked batch of evenly spaced maps (64 rows a block): rows at every node coordinate
+/// and one ulp either side (where the cell estimate `(x - x0) / step` rounds to the wrong
+/// cell and the single query corrects it), rows outside and non-finite rows scattered across
+/// block edges: every row the single query's bits, and a refused row reported by its index.
+#[test]
+fn blocked_batch_equals_single_at_rounding_edges() {
+    // Nodes 0.1 apart from 0.1: x0 + k step is not exactly the stored node for every k.
+    let x: Vec<f64> = (0..7).map(|k| 0.1 + 0.1 * k as f64).collect();
+    let y: Vec<f64> = (0..5).map(|k| -0.3 + 0.15 * k as f64).collect();
+    let nodes = x.len() * y.len();
+    let coef = |k: usize| ((k as f64) * 0.7548776662466927).fract() * 1e-5 - 4e-6;
+    let slopes: Vec<f64> = (0..4 * nodes).map(coef).collect();
+    let offsets: Vec<f64> = (0..4 * nodes).map(|k| coef(k + 1000)).collect();
+    let map = ComplianceMap::new(x.clone(), y.clone(), 2, 2, slopes, offsets).unwrap();
+    let mut pos = Vec::new();
+    for (a, b) in x.iter().zip(y.iter().cycle()) {
+        for v in [a.next_down(), *a, a.next_up()] {
+            for w in [b.next_down(), *b, b.next_up()] {
+                pos.push([v, w]);
+            }
+        }
+    }
+    let n_edges = pos.len();
+    for k in 0..300 {
+        let t = k as f64 * 0.618_033_988_749_895;
+        pos.push([0.05 + 0.75 * t.fract(), -0.35 + 0.7 * (t * 1.7).fract()]);
+    }
+    let n = pos.len();
+    let force: Vec<f64> = (0..2 * n)
+        .map(|k| 200.0 * ((k as f64) * 0.37).sin())
+        .collect();
+    let flat: Vec<f64> = pos.iter().flatten().copied().collect();
+    for policy in [OutOfGrid::Clamp, OutOfGrid::Extrapolate] {
+        let o = opts(Interpolation::Bilinear, policy);
+        let mut out = vec![0.0; 2 * n];
+        let summary = map
+            .displacement_batch(&flat, 2, &force, &mut out, o)
+            .unwrap();
+        assert!(
+            summary.inside > n_edges / 2 && summary.inside < n,
+            "{summary:?}"
+        );
+        for (k, p) in pos.iter().enumerate() {
+            let single = query(&map, *p, [force[2 * k], force[2 * k + 1]], o);
+            assert_eq!(single[0].to_bits(), out[2 * k].to_bits(), "row {k} {p:?}");
+            assert_eq!(
+                single[1].to_bits(),
+                out[2 * k + 1].to_bits(),
+                "row {k} {p:?}"
+            );
+        }
+    }
+    // A NaN force in the second block, after rows inside and outside the grid: that row.
+    let mut bad = force.clone();
+    bad[2 * 100 + 1] = f64::NAN;
+    let mut out = vec![0.0; 2 * n];
+    let o = opts(Interpolation::Bilinear, OutOfGrid::Clamp);
+    let err = map
+        .displacement_batch(&flat, 2, &bad, &mut out, o)
+        .unwrap_err();
+    assert_eq!(
+        (err.row, err.error),
+        (
+            100,
+            TickError::NonFinite {
+                what: "force",
+                index: 1
+            }
+        )
+    );
+    // An infinite position in the third block.
+    let mut bad = flat.clone();
+    bad[2 * 150] = f64::INFINITY;
+    let err = map
+        .displacement_batch(&bad, 2, &force, &mut out, o)
+        .unwrap_err();
+    assert_eq!(err.row, 150);
+    assert!(matches!(
+        err.error,
+        TickError::NonFinite {
+            what: "position",
+            index: 0
+        }
+    ));
+}
+
 /// The owning map's packed coefficient layout (slopes, then offset sums, node by node) and a
 /// borrowed view over the plain tables give the same bits, for the fixed-size kernels (2 x 2,
 /// 3 x 3, 6 x 6) and the generic one (3 x 2), every interpolation and out-of-grid policy,

@@ -107,6 +107,11 @@ impl ComplianceMapView<'_> {
         out: &mut [f64],
         options: QueryOptions,
     ) -> Result<BatchSummary, BatchError> {
+        if let Some(result) =
+            self.batch_bilinear_even::<ND, NF>(positions, stride, forces, out, options)
+        {
+            return result;
+        }
         let mut summary = BatchSummary::default();
         for (row, ((p, f), o)) in positions
             .chunks_exact(stride)
@@ -146,7 +151,7 @@ impl ComplianceMapView<'_> {
     }
 
     #[inline(always)]
-    fn eval(
+    pub(super) fn eval(
         &self,
         position: [f64; 2],
         force: &[f64],

@@ -133,6 +133,33 @@ impl ComplianceMapView<'_> {
         acc
     }
 
+    /// [`Self::blend_fixed`] over a bilinear cell's nodes `n00, n00 + 1, n00 + ny,
+    /// n00 + ny + 1` from the packed layout (the view must have it), reading the two runs of
+    /// adjacent nodes as two slices (two bounds checks instead of four). Same bits.
+    #[inline(always)]
+    pub(super) fn blend_cell_packed<const ND: usize, const NF: usize>(
+        &self,
+        n00: usize,
+        ny: usize,
+        weights: &[f64; 4],
+        f: &[f64; NF],
+    ) -> Option<[f64; ND]> {
+        let b = packed_block(ND, NF);
+        let near = self.packed.get(n00 * b..n00 * b + 2 * b)?;
+        let far = self.packed.get((n00 + ny) * b..(n00 + ny) * b + 2 * b)?;
+        let (n0, n1) = near.split_at(b);
+        let (n2, n3) = far.split_at(b);
+        let mut acc = [0.0; ND];
+        for (blk, w) in [n0, n1, n2, n3].into_iter().zip(weights) {
+            let (s, o) = blk.split_at(ND * NF);
+            for ((a, s_row), o_d) in acc.iter_mut().zip(s.chunks_exact(NF)).zip(o) {
+                let line = s_row.iter().zip(f).fold(0.0, |a, (s, fk)| a + s * fk);
+                *a += w * (line + o_d);
+            }
+        }
+        Some(acc)
+    }
+
     /// The blend for any sizes into `out` (`nd` entries), dispatching to the fixed kernels
     /// for the common shapes (the paper's 2 x 2, 3-D, 6-D).
     #[inline(always)]

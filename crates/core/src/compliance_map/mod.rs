@@ -41,6 +41,7 @@
 //! # Ok::<(), deflect_core::BuildError>(())
 //! ```
 
+mod batch;
 mod grid;
 mod interp;
 mod kernel;
