@@ -146,13 +146,47 @@ pub(crate) fn fill_fast(o: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
     if let Ok(t) = o.cast::<PyTuple>() {
         return t.len() == out.len() && fill(t.iter(), out);
     }
-    match fast_vector(o) {
-        Some(v) if v.len() == out.len() => {
-            out.copy_from_slice(&v);
-            true
-        }
-        _ => false,
+    if let Ok(a) = o.cast::<PyArray1<f64>>() {
+        // Element by element (any stride): no copy into a Vec and no borrow registration,
+        // both of which cost more than reading a few numbers.
+        return a.len() == out.len()
+            && out
+                .iter_mut()
+                .enumerate()
+                .all(|(i, d)| a.get_owned([i]).map(|v| *d = v).is_some());
     }
+    false
+}
+
+/// A joint vector (at most [`vjm::MAX_DOF`] entries) on the stack: the per-call inputs of the
+/// single-call methods, read without a heap allocation by [`fill_fast`] when they are a
+/// float64 vector, a list or a tuple, else through [`vector`]'s checks.
+#[derive(Debug, Clone, Copy)]
+pub struct Joints {
+    buf: [f64; vjm::MAX_DOF],
+    len: usize,
+}
+
+impl core::ops::Deref for Joints {
+    type Target = [f64];
+    fn deref(&self) -> &[f64] {
+        self.buf.get(..self.len).unwrap_or(&[])
+    }
+}
+
+/// `o` as a joint vector of exactly `n` entries ([`Joints`]); errors as [`vector`].
+pub fn joints(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Joints> {
+    let mut j = Joints {
+        buf: [0.0; vjm::MAX_DOF],
+        len: n,
+    };
+    let Some(slot) = j.buf.get_mut(..n) else {
+        return vector(o, what, n).and(Err(shape_error(what, "(MAX_DOF,)", &[n])));
+    };
+    if !fill_fast(o, slot) {
+        slot.copy_from_slice(&vector(o, what, n)?);
+    }
+    Ok(j)
 }
 
 /// A buffer of `n` zeros for a result (or a copy) whose size the caller chose, allocated
@@ -250,7 +284,11 @@ pub fn vector(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Vec<f64>> 
 
 /// A 6-vector (wrench or pose change).
 pub fn vector6(o: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector6> {
-    Ok(Vector6::from_column_slice(&vector(o, what, 6)?))
+    let mut v = [0.0; 6];
+    if !fill_fast(o, &mut v) {
+        v.copy_from_slice(&vector(o, what, 6)?);
+    }
+    Ok(Vector6::from(v))
 }
 
 /// `o` as a 2-D float array; `rows`/`cols` fix a dimension (`None`: any). The message shows

@@ -13,7 +13,7 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{batch_pair, iso_to_py, matrix, pose, vector, vector6};
+use crate::arrays::{batch_pair, iso_to_py, joints, matrix, pose, vector6};
 use crate::batch;
 use crate::errors::{load_err, tick_err};
 use crate::out::{emit, fill_into};
@@ -127,7 +127,7 @@ impl SerialRobot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let t = vjm::forward(model, &mut self.data(), &q).map_err(tick_err)?;
         // Row-major: the transpose's column-major storage.
         emit(py, t.to_homogeneous().transpose().as_slice(), &[4, 4], out)
@@ -144,7 +144,7 @@ impl SerialRobot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let d =
             vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Exact).map_err(tick_err)?;
@@ -169,7 +169,7 @@ impl SerialRobot {
         #[pyo3(from_py_with = args::real::tolerance)] tolerance: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let options = vjm::EquilibriumOptions {
             max_iterations,
@@ -188,7 +188,7 @@ impl SerialRobot {
         wrench: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let mut data = self.data();
         vjm::deflection(model, &mut data, &q, &w, vjm::Load::Exact).map_err(tick_err)?;
@@ -215,7 +215,7 @@ impl SerialRobot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let c = vjm::compliance(model, &mut self.data(), &q).map_err(tick_err)?;
         emit(py, c.transpose().as_slice(), &[6, 6], out)
     }
@@ -231,7 +231,7 @@ impl SerialRobot {
         out: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyAny>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let d = vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Linearized)
             .map_err(tick_err)?;
@@ -245,7 +245,7 @@ impl SerialRobot {
         q: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let mut data = self.data();
         vjm::joint_jacobian(model, &mut data, &q).map_err(tick_err)?;
         let j = &data.jacobian;
@@ -271,7 +271,7 @@ impl SerialRobot {
         #[pyo3(from_py_with = args::real::tolerance)] tolerance: f64,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
         let model = &self.inner.model;
-        let q = vector(q, "q", model.dof())?;
+        let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
         let c = vjm::joint_correction(model, &mut self.data(), &q, &w, max_iterations, tolerance)
             .map_err(tick_err)?;
