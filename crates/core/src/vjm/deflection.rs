@@ -2,7 +2,7 @@
 //! Cartesian compliance. Every function here is allocation-free, bounded by the chain length
 //! and panic-free.
 
-use nalgebra::{Isometry3, Matrix3, Matrix6, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Matrix6, UnitQuaternion, Vector3};
 
 use super::chain::{compose, rotate_axis, turn};
 use super::data::check_q;
@@ -146,27 +146,6 @@ fn tcp_pass(model: &Model, q: &[f64]) -> Isometry3<f64> {
         }
     }
     frame * model.tcp_tail
-}
-
-/// The six distinct entries `[a00, a01, a02, a11, a12, a22]` of the symmetric
-/// `A = R diag(c) R^T`: a spring's compliance to moments in world axes.
-#[inline(always)]
-fn spread(rot: &Matrix3<f64>, c: &Vector3<f64>) -> [f64; 6] {
-    let (u, v, w) = (
-        rot.column(0).into_owned(),
-        rot.column(1).into_owned(),
-        rot.column(2).into_owned(),
-    );
-    let g =
-        |i: f64, j: f64, k: f64, l: f64, m: f64, n: f64| c.x * i * j + c.y * k * l + c.z * m * n;
-    [
-        g(u.x, u.x, v.x, v.x, w.x, w.x),
-        g(u.x, u.y, v.x, v.y, w.x, w.y),
-        g(u.x, u.z, v.x, v.z, w.x, w.z),
-        g(u.y, u.y, v.y, v.y, w.y, w.y),
-        g(u.y, u.z, v.y, v.z, w.y, w.z),
-        g(u.z, u.z, v.z, v.z, w.z, w.z),
-    ]
 }
 
 /// Rigid TCP pose in the base frame (Eq. 2 with i = 0). `q` \[rad or m\], length
@@ -432,54 +411,10 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
     let tcp = rigid_pass(model, data, q);
     // Per spring with world axes R and compliances c, lever r from its origin to the TCP and
     // S = [r]x: the columns [u_a x r; u_a] of J_s give the blocks A = R diag(c) R^T
-    // (rotation), -S A (translation-rotation) and S A S^T (translation), summed over springs.
-    // A and S A S^T are symmetric: their six distinct entries are computed once each, and
-    // S is applied as cross products, not as a full 3 x 3 product (a third of the flops of
-    // the 6 x 6 outer products, half of the plain 3 x 3 products).
-    let (mut c_vv, mut c_vw, mut c_ww) = ([0.0; 6], Matrix3::zeros(), [0.0; 6]);
-    for op in model.ops.iter() {
-        let Op::Spring {
-            compliance, index, ..
-        } = op
-        else {
-            continue;
-        };
-        let Some(f) = data.spring_frames.get(*index) else {
-            continue;
-        };
-        let r = tcp.translation.vector - f.translation.vector;
-        let rot = f.rotation.to_rotation_matrix().into_inner();
-        let a = spread(&rot, compliance);
-        // B = S A, column j = r x A_j.
-        let b0 = r.cross(&Vector3::new(a[0], a[1], a[2]));
-        let b1 = r.cross(&Vector3::new(a[1], a[3], a[4]));
-        let b2 = r.cross(&Vector3::new(a[2], a[4], a[5]));
-        // S A S^T = -(S A) S: row i of B against the columns of -S, six entries.
-        let (rx, ry, rz) = (r.x, r.y, r.z);
-        let dv = [
-            b2.x * ry - b1.x * rz,
-            b0.x * rz - b2.x * rx,
-            b1.x * rx - b0.x * ry,
-            b0.y * rz - b2.y * rx,
-            b1.y * rx - b0.y * ry,
-            b1.z * rx - b0.z * ry,
-        ];
-        let b = Matrix3::from_columns(&[b0, b1, b2]);
-        for (acc, v) in c_vv.iter_mut().zip(dv) {
-            *acc += v;
-        }
-        for (acc, v) in c_ww.iter_mut().zip(a) {
-            *acc += v;
-        }
-        c_vw -= b;
-    }
-    let sym = |e: [f64; 6]| Matrix3::new(e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5]);
-    let (c_vv, c_ww) = (sym(c_vv), sym(c_ww));
-    let mut c = Matrix6::zeros();
-    c.fixed_view_mut::<3, 3>(0, 0).copy_from(&c_vv);
-    c.fixed_view_mut::<3, 3>(0, 3).copy_from(&c_vw);
-    c.fixed_view_mut::<3, 3>(3, 0).copy_from(&c_vw.transpose());
-    c.fixed_view_mut::<3, 3>(3, 3).copy_from(&c_ww);
+    // (rotation), -S A (translation-rotation) and S A S^T (translation), summed over springs
+    // four at a time (`lanes`). A and S A S^T are symmetric: their six distinct entries are
+    // computed once each, and S is applied as cross products.
+    let c = super::lanes::compliance_sums(model, data, &tcp.translation.vector);
     data.tcp = tcp;
     data.compliance = c;
     check_output("compliance", c.as_slice())?;

@@ -20,6 +20,7 @@ mod data;
 mod deflection;
 #[cfg(feature = "alloc")]
 mod equilibrium;
+mod lanes;
 mod loads;
 mod model;
 mod trig;

@@ -134,6 +134,9 @@ pub struct Model {
     pub(crate) pass: heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }>,
     /// The fixed transform after the last joint.
     pub(crate) tcp_tail: Isometry3<f64>,
+    /// Each spring's compliances by spring index (zero past the spring count), for the
+    /// lane-parallel kernels.
+    pub(crate) spring_compliance: [Vector3<f64>; MAX_SPRINGS],
     pub(crate) dof: usize,
     pub(crate) springs: usize,
     pub(crate) masses: usize,
@@ -523,7 +526,18 @@ impl ModelBuilder {
                 Element::Mass { .. } => {}
             }
         }
+        let mut spring_compliance = [Vector3::zeros(); MAX_SPRINGS];
+        for e in &self.elements {
+            if let Element::Spring {
+                compliance, index, ..
+            } = e
+                && let Some(slot) = spring_compliance.get_mut(*index)
+            {
+                *slot = *compliance;
+            }
+        }
         Ok(Model {
+            spring_compliance,
             elements: self.elements,
             ops,
             tcp_chain,
