@@ -120,10 +120,19 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
             Pass::Spring {
                 local,
                 turns,
+                shifts,
                 index,
             } => {
                 if let Some(slot) = data.spring_frames.get_mut(*index) {
-                    *slot = compose(&frame, local, *turns);
+                    // `frame * local`, without the products by zeros and ones.
+                    *slot = match (*turns, *shifts) {
+                        (_, true) => compose(&frame, local, *turns),
+                        (true, false) => Isometry3::from_parts(
+                            frame.translation,
+                            frame.rotation * local.rotation,
+                        ),
+                        (false, false) => frame,
+                    };
                 }
             }
         }

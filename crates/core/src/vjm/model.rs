@@ -118,6 +118,8 @@ pub(crate) enum Pass {
         local: Isometry3<f64>,
         /// Whether `local` rotates.
         turns: bool,
+        /// Whether `local` translates (a spring placed at a joint's frame does not).
+        shifts: bool,
         index: usize,
     },
 }
@@ -518,6 +520,7 @@ impl ModelBuilder {
                     let local = tail * offset;
                     pass.push(Pass::Spring {
                         turns: !rotation_is_identity(&local),
+                        shifts: local.translation.vector != Vector3::zeros(),
                         local,
                         index,
                     })
