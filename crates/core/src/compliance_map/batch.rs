@@ -9,9 +9,8 @@
 //! `bilinear_stencil`), and a row it cannot vouch for (outside the grid, not finite, at a
 //! node coordinate's rounding edge, a non-finite result) takes the single query's path.
 
-use super::interp::{BatchError, BatchSummary};
+use super::interp::{BatchError, BatchSummary, ignored_entries};
 use super::{ComplianceMapView, QueryOptions};
-use crate::error::TickError;
 
 /// Rows per block: the first phase's results (6 values a row) stay in L1 (3 KB).
 const BLOCK: usize = 64;
@@ -130,15 +129,7 @@ fn even_blocks<const ND: usize, const NF: usize>(
             .zip(ob.chunks_exact_mut(ND));
         for (k, (((n, w), ok), ((p, f), o))) in cells.zip(rows).enumerate() {
             let row = first_row + k;
-            if stride > 2
-                && let Some(index) = super::ignored_non_finite(p)
-            {
-                let error = TickError::NonFinite {
-                    what: "position",
-                    index,
-                };
-                return Err(BatchError { row, error });
-            }
+            ignored_entries(row, p, stride)?;
             if *ok
                 && let (Ok(fa), Ok(oa)) = (
                     <&[f64; NF]>::try_from(f),

@@ -4,6 +4,24 @@
 use super::{ComplianceMapView, Interpolation, QueryOptions};
 use crate::error::{Placement, TickError};
 
+/// Row `row`'s entries past x and y (z, ignored) must be finite: the batch's error otherwise.
+#[inline(always)]
+pub(super) fn ignored_entries(row: usize, p: &[f64], stride: usize) -> Result<(), BatchError> {
+    if stride <= 2 {
+        return Ok(());
+    }
+    match super::ignored_non_finite(p) {
+        Some(index) => Err(BatchError {
+            row,
+            error: TickError::NonFinite {
+                what: "position",
+                index,
+            },
+        }),
+        None => Ok(()),
+    }
+}
+
 impl ComplianceMapView<'_> {
     /// Displacement at `position` `[x, y]` \[m\] under `force` (`n_force` entries, \[N\] or
     /// \[N m\]) written into `out` (`n_displacement` entries, \[m\] or \[rad\]), with explicit
@@ -81,13 +99,7 @@ impl ComplianceMapView<'_> {
             let (Some(&x), Some(&y)) = (p.first(), p.get(1)) else {
                 continue;
             };
-            if let Some(index) = super::ignored_non_finite(p) {
-                let error = TickError::NonFinite {
-                    what: "position",
-                    index,
-                };
-                return Err(BatchError { row, error });
-            }
+            ignored_entries(row, p, stride)?;
             match self.eval([x, y], f, o, options) {
                 Ok(place) => summary.count(place),
                 Err(error) => return Err(BatchError { row, error }),
@@ -127,15 +139,7 @@ impl ComplianceMapView<'_> {
             ) else {
                 continue;
             };
-            if stride > 2
-                && let Some(index) = super::ignored_non_finite(p)
-            {
-                let error = TickError::NonFinite {
-                    what: "position",
-                    index,
-                };
-                return Err(BatchError { row, error });
-            }
+            ignored_entries(row, p, stride)?;
             match self.bilinear_inside::<ND, NF>([px, py], fa) {
                 Some(acc) if acc.iter().fold(0.0, |a, v| a + v * 0.0) == 0.0 => {
                     *oa = acc;
