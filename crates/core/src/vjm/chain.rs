@@ -33,19 +33,41 @@ impl AxisKind {
     }
 }
 
-/// Whether `t`'s rotation is exactly the identity (its composition is then a translation).
-pub(crate) fn rotation_is_identity(t: &Isometry3<f64>) -> bool {
-    t.rotation.coords == UnitQuaternion::identity().coords
+/// What a fixed transform does, decided once at build: whether it rotates and whether it
+/// translates (a spring placed at a joint's own frame only rotates; `rpy="0 0 0"` only
+/// translates).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Shape {
+    Identity,
+    Translation,
+    Rotation,
+    General,
 }
 
-/// `frame * t` where `t`'s rotation is the identity when `turns` is false.
+impl Shape {
+    pub(crate) fn of(t: &Isometry3<f64>) -> Self {
+        let turns = t.rotation.coords != UnitQuaternion::identity().coords;
+        let shifts = t.translation.vector != Vector3::zeros();
+        match (turns, shifts) {
+            (false, false) => Self::Identity,
+            (false, true) => Self::Translation,
+            (true, false) => Self::Rotation,
+            (true, true) => Self::General,
+        }
+    }
+}
+
+/// `frame * t` for `t` of the given shape, without the products by zeros and ones.
 #[inline(always)]
-pub(crate) fn compose(frame: &Isometry3<f64>, t: &Isometry3<f64>, turns: bool) -> Isometry3<f64> {
-    if turns {
-        frame * t
-    } else {
-        let shift = frame.rotation * t.translation.vector;
-        Isometry3::from_parts((frame.translation.vector + shift).into(), frame.rotation)
+pub(crate) fn compose(frame: &Isometry3<f64>, t: &Isometry3<f64>, shape: Shape) -> Isometry3<f64> {
+    match shape {
+        Shape::General => frame * t,
+        Shape::Translation => {
+            let shift = frame.rotation * t.translation.vector;
+            Isometry3::from_parts((frame.translation.vector + shift).into(), frame.rotation)
+        }
+        Shape::Rotation => Isometry3::from_parts(frame.translation, frame.rotation * t.rotation),
+        Shape::Identity => *frame,
     }
 }
 
@@ -109,10 +131,13 @@ mod tests {
         let r = UnitQuaternion::from_euler_angles(0.3, -1.1, 2.4);
         let t = Isometry3::translation(0.3, -0.2, 1.7);
         let f = Isometry3::from_parts(Vector3::new(1.0, 2.0, -0.5).into(), r);
-        let general = f * t;
-        let fast = compose(&f, &t, false);
-        assert_eq!(general.translation.vector, fast.translation.vector);
-        assert_eq!(general.rotation.coords, fast.rotation.coords);
+        let turn_only = Isometry3::from_parts(Vector3::zeros().into(), r);
+        for t in [t, turn_only, Isometry3::identity(), f] {
+            let general = f * t;
+            let fast = compose(&f, &t, Shape::of(&t));
+            assert_eq!(general.translation.vector, fast.translation.vector);
+            assert_eq!(general.rotation.coords, fast.rotation.coords);
+        }
         for (axis, kind) in [
             (Vector3::x_axis(), AxisKind::X),
             (Vector3::y_axis(), AxisKind::Y),
@@ -139,7 +164,7 @@ mod tests {
         }
         let other = Unit::new_normalize(Vector3::new(0.0, 0.0, -1.0));
         assert_eq!(AxisKind::of(&other), AxisKind::Other);
-        assert!(rotation_is_identity(&t));
-        assert!(!rotation_is_identity(&f));
+        assert_eq!(Shape::of(&t), Shape::Translation);
+        assert_eq!(Shape::of(&f), Shape::General);
     }
 }

@@ -101,7 +101,7 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
                     continue; // unreachable: built together
                 };
                 let i = step.index;
-                frame = compose(&frame, &step.pre, step.pre_turns);
+                frame = compose(&frame, &step.pre, step.pre_shape);
                 let u = rotate_axis(&frame.rotation, step.kind, &step.axis);
                 if let (Some(a), Some(o)) =
                     (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
@@ -119,20 +119,11 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
             }
             Pass::Spring {
                 local,
-                turns,
-                shifts,
+                shape,
                 index,
             } => {
                 if let Some(slot) = data.spring_frames.get_mut(*index) {
-                    // `frame * local`, without the products by zeros and ones.
-                    *slot = match (*turns, *shifts) {
-                        (_, true) => compose(&frame, local, *turns),
-                        (true, false) => Isometry3::from_parts(
-                            frame.translation,
-                            frame.rotation * local.rotation,
-                        ),
-                        (false, false) => frame,
-                    };
+                    *slot = compose(&frame, local, *shape);
                 }
             }
         }
@@ -145,7 +136,7 @@ fn rigid_pass(model: &Model, data: &mut Data, q: &[f64]) -> Isometry3<f64> {
 fn tcp_pass(model: &Model, q: &[f64]) -> Isometry3<f64> {
     let mut frame = Isometry3::identity();
     for step in model.tcp_chain.iter() {
-        frame = compose(&frame, &step.pre, step.pre_turns);
+        frame = compose(&frame, &step.pre, step.pre_shape);
         let qi = q.get(step.index).copied().unwrap_or(0.0);
         if step.revolute {
             let (s, c) = super::trig::sin_cos(qi * 0.5);

@@ -2,7 +2,7 @@
 
 use nalgebra::{Isometry3, Matrix3, Unit, Vector3};
 
-use super::chain::{AxisKind, rotation_is_identity};
+use super::chain::{AxisKind, Shape};
 use crate::error::BuildError;
 
 /// Most actuated joints a model may have: a 6-axis arm plus a linear track and a turntable,
@@ -98,8 +98,8 @@ pub(crate) enum Op {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct TcpStep {
     pub pre: Isometry3<f64>,
-    /// Whether `pre` rotates (else it is a translation: [`super::chain::compose`]).
-    pub pre_turns: bool,
+    /// What `pre` does ([`super::chain::compose`]).
+    pub pre_shape: Shape,
     pub axis: Unit<Vector3<f64>>,
     /// `axis` as the specialised compositions take it.
     pub kind: AxisKind,
@@ -116,10 +116,8 @@ pub(crate) enum Pass {
     Joint(usize),
     Spring {
         local: Isometry3<f64>,
-        /// Whether `local` rotates.
-        turns: bool,
-        /// Whether `local` translates (a spring placed at a joint's frame does not).
-        shifts: bool,
+        /// What `local` does ([`super::chain::compose`]).
+        shape: Shape,
         index: usize,
     },
 }
@@ -501,7 +499,7 @@ impl ModelBuilder {
                 Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
                     let pre = core::mem::replace(&mut tail, Isometry3::identity());
                     let step = TcpStep {
-                        pre_turns: !rotation_is_identity(&pre),
+                        pre_shape: Shape::of(&pre),
                         pre,
                         axis,
                         kind: AxisKind::of(&axis),
@@ -519,8 +517,7 @@ impl ModelBuilder {
                 Element::Spring { offset, index, .. } => {
                     let local = tail * offset;
                     pass.push(Pass::Spring {
-                        turns: !rotation_is_identity(&local),
-                        shifts: local.translation.vector != Vector3::zeros(),
+                        shape: Shape::of(&local),
                         local,
                         index,
                     })
