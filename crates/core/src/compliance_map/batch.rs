@@ -9,51 +9,12 @@
 //! `bilinear_stencil`), and a row it cannot vouch for (outside the grid, not finite, at a
 //! node coordinate's rounding edge, a non-finite result) takes the single query's path.
 
+use super::grid::EvenAxis;
 use super::interp::{BatchError, BatchSummary, ignored_entries};
 use super::{ComplianceMapView, QueryOptions};
 
 /// Rows per block: the first phase's results (6 values a row) stay in L1 (3 KB).
 const BLOCK: usize = 64;
-
-/// An evenly spaced axis as the first phase reads it.
-#[derive(Clone, Copy)]
-struct Even<'a> {
-    nodes: &'a [f64],
-    first: f64,
-    last: f64,
-    inv_step: f64,
-    last_cell: usize,
-}
-
-impl<'a> Even<'a> {
-    fn of(axis: &super::grid::Axis<'a>) -> Option<Self> {
-        (axis.inv_step > 0.0).then(|| Self {
-            nodes: axis.nodes,
-            first: axis.first(),
-            last: axis.last(),
-            inv_step: axis.inv_step,
-            last_cell: axis.nodes.len().saturating_sub(2),
-        })
-    }
-
-    /// The cell of `v` and its local coordinate, as `Axis::cell_t_inside`, and whether `v`
-    /// is inside the axis and needs no rounding correction (else the row takes the single
-    /// query's path, which applies it).
-    #[inline(always)]
-    fn cell_t(&self, v: f64) -> (usize, f64, bool) {
-        // Saturating float->int cast; negative and NaN become 0 (the row is refused below).
-        let i = (((v - self.first) * self.inv_step) as usize).min(self.last_cell);
-        let lo = self.nodes.get(i).copied().unwrap_or(f64::NAN);
-        let hi = self.nodes.get(i + 1).copied().unwrap_or(f64::NAN);
-        let t = if v == hi {
-            1.0
-        } else {
-            (v - lo) * self.inv_step
-        };
-        let ok = (v >= self.first) & (v <= self.last) & (v >= lo) & (v <= hi);
-        (i, t, ok)
-    }
-}
 
 impl ComplianceMapView<'_> {
     /// The blocked bilinear batch, fixed sizes; `None` when an axis is uneven or the view
@@ -66,7 +27,7 @@ impl ComplianceMapView<'_> {
         out: &mut [f64],
         options: QueryOptions,
     ) -> Option<Result<BatchSummary, BatchError>> {
-        let (ex, ey) = (Even::of(&self.x)?, Even::of(&self.y)?);
+        let (ex, ey) = (self.x.even()?, self.y.even()?);
         if self.packed.is_empty() {
             return None;
         }
@@ -88,8 +49,8 @@ impl ComplianceMapView<'_> {
 )]
 fn even_blocks<const ND: usize, const NF: usize>(
     view: &ComplianceMapView<'_>,
-    ex: Even<'_>,
-    ey: Even<'_>,
+    ex: EvenAxis<'_>,
+    ey: EvenAxis<'_>,
     positions: &[f64],
     stride: usize,
     forces: &[f64],

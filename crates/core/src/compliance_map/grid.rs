@@ -69,7 +69,7 @@ fn uniform_inv_step(nodes: &[f64]) -> f64 {
     if even && step > 0.0 { 1.0 / step } else { 0.0 }
 }
 
-impl Axis<'_> {
+impl<'a> Axis<'a> {
     #[inline(always)]
     fn node(&self, k: usize) -> f64 {
         self.nodes.get(k).copied().unwrap_or(0.0)
@@ -88,8 +88,7 @@ impl Axis<'_> {
         let n = self.nodes.len();
         let last_cell = n.saturating_sub(2);
         if self.inv_step > 0.0 {
-            // Saturating float->int cast; negative and NaN become 0.
-            let mut i = (((v - self.node(0)) * self.inv_step) as usize).min(last_cell);
+            let mut i = even_estimate(v, self.node(0), self.inv_step, last_cell);
             // One step of correction against rounding at the node coordinates. The test
             // that decides it is rarely true whatever the cell; the cell's own tests
             // (`i > 0`, `i < last_cell`) only run then: on scattered queries (a batch over
@@ -187,10 +186,10 @@ impl Axis<'_> {
     ) -> Result<(usize, f64, Placement), TickError> {
         let (i, v, place) = self.locate(axis, v, policy)?;
         let (x0, x1) = (self.node(i), self.node(i + 1));
-        let t = if v == x1 {
+        let t = if self.inv_step > 0.0 {
+            even_t(v, x0, x1, self.inv_step)
+        } else if v == x1 {
             1.0
-        } else if self.inv_step > 0.0 {
-            (v - x0) * self.inv_step
         } else {
             (v - x0) / (x1 - x0)
         };
@@ -201,14 +200,25 @@ impl Axis<'_> {
     #[inline(always)]
     pub(crate) fn cell_t_inside(&self, v: f64) -> (usize, f64) {
         let (i, x0, x1) = self.cell_nodes(v);
-        let t = if v == x1 {
+        let t = if self.inv_step > 0.0 {
+            even_t(v, x0, x1, self.inv_step)
+        } else if v == x1 {
             1.0
-        } else if self.inv_step > 0.0 {
-            (v - x0) * self.inv_step
         } else {
             (v - x0) / (x1 - x0)
         };
         (i, t)
+    }
+
+    /// This axis for the blocked batch, when it is evenly spaced.
+    pub(crate) fn even(&self) -> Option<EvenAxis<'a>> {
+        (self.inv_step > 0.0).then(|| EvenAxis {
+            nodes: self.nodes,
+            first: self.first(),
+            last: self.last(),
+            inv_step: self.inv_step,
+            last_cell: self.nodes.len().saturating_sub(2),
+        })
     }
 
     /// First node coordinate.
@@ -275,6 +285,45 @@ impl Axis<'_> {
             }
         }
         Ok((s, place))
+    }
+}
+
+/// The cell estimate on an evenly spaced axis, `(v - first) / step`, within the cells (a
+/// saturating float->int cast: negative and NaN become 0).
+#[inline(always)]
+fn even_estimate(v: f64, first: f64, inv_step: f64, last_cell: usize) -> usize {
+    (((v - first) * inv_step) as usize).min(last_cell)
+}
+
+/// The local coordinate of `v` in the cell `[lo, hi]` of an evenly spaced axis (exactly 1 at
+/// its upper node).
+#[inline(always)]
+fn even_t(v: f64, lo: f64, hi: f64, inv_step: f64) -> f64 {
+    if v == hi { 1.0 } else { (v - lo) * inv_step }
+}
+
+/// An evenly spaced axis as the blocked batch reads it (`super::batch`): its ends and cell
+/// count loaded once.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct EvenAxis<'a> {
+    nodes: &'a [f64],
+    first: f64,
+    last: f64,
+    inv_step: f64,
+    last_cell: usize,
+}
+
+impl EvenAxis<'_> {
+    /// The cell of `v` and its local coordinate, as [`Axis::cell_t_inside`], and whether `v`
+    /// is inside the axis and needs no rounding correction: computed without a branch on
+    /// the data, the correction left to the single query's path for the rows it refuses.
+    #[inline(always)]
+    pub(crate) fn cell_t(&self, v: f64) -> (usize, f64, bool) {
+        let i = even_estimate(v, self.first, self.inv_step, self.last_cell);
+        let lo = self.nodes.get(i).copied().unwrap_or(f64::NAN);
+        let hi = self.nodes.get(i + 1).copied().unwrap_or(f64::NAN);
+        let ok = (v >= self.first) & (v <= self.last) & (v >= lo) & (v <= hi);
+        (i, even_t(v, lo, hi, self.inv_step), ok)
     }
 }
 
