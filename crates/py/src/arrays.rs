@@ -181,7 +181,12 @@ pub fn joints(o: &Bound<'_, PyAny>, what: &str, n: usize) -> PyResult<Joints> {
         len: n,
     };
     let Some(slot) = j.buf.get_mut(..n) else {
-        return vector(o, what, n).and(Err(shape_error(what, "(MAX_DOF,)", &[n])));
+        // Unreachable: a model has at most MAX_DOF joints.
+        return Err(shape_error(
+            what,
+            &format!("at most ({},)", vjm::MAX_DOF),
+            &[n],
+        ));
     };
     if !fill_fast(o, slot) {
         slot.copy_from_slice(&vector(o, what, n)?);
