@@ -5,6 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 VENV="${DEFLECT_VENV:-.venv}"
 PY="${PYTHON:-python3}"
+# A clean CI checkout builds everything once: incremental caches would only take disk.
+if [ "${CI:-}" = true ]; then export CARGO_INCREMENTAL=0; fi
 
 echo "== Rust: format, lints, tests =="
 cargo fmt --all -- --check
