@@ -25,8 +25,9 @@ difference between the two results:
   `ComplianceMap.displacement` and `displacement_batch`;
 - jerk-limited motion: ruckig's `calculate` (plan only) and `calculate` + `at_time` per tick at
   2 kHz, against `plan_line(..., rate_hz=None)` and `plan_line(...)` + `position`; ruckig's
-  habit on both sides (one planner object re-planned in place: `LinePlanner.plan`), with the
-  input set once and with new points set per plan; on a 1-D move
+  habit on both sides (one planner object re-planned in place), with the input points set once
+  (`LinePlanner.start` / `end`, then `plan()`) and with new points set per plan
+  (`plan(start, end)`); both sides called through a lambda; on a 1-D move
   and on the paper's 2-D y-line (deflect limits the path, ruckig each axis: with one axis
   moving both solve the same problem).
 """
@@ -236,11 +237,14 @@ def bench_motion(args):
                           args.repeats, args.inner)
         t_p = median_time(lambda: otg.calculate(inp, traj), args.repeats, args.inner)
         row(f"{label} jerk-limited plan only (duration)", t_d, t_p, 1e6, "us", agree)
-        # Both habits matched: one planner object re-planned in place per move.
+        # Both habits matched: one planner object re-planned in place per move, its input
+        # points set once (ruckig's `InputParameter`; deflect's `LinePlanner.start / end`).
         planner = deflect.LinePlanner(len(start), v, a, j)
-        agree = abs(planner.plan(start, end) - traj.duration) / traj.duration
-        t_d = median_time(lambda: planner.plan(start, end), args.repeats, args.inner)
-        row(f"{label} re-planned in place (LinePlanner)", t_d, t_p, 1e6, "us", agree)
+        planner.start, planner.end = start, end
+        agree = abs(planner.plan() - traj.duration) / traj.duration
+        t_d = median_time(lambda: planner.plan(), args.repeats, args.inner)
+        t_p = median_time(lambda: otg.calculate(inp, traj), args.repeats, args.inner)
+        row(f"{label} re-planned in place (LinePlanner.plan())", t_d, t_p, 1e6, "us", agree)
 
         # A new move per plan: both sides take the points from Python each time.
         def ruckig_new_move():
@@ -249,7 +253,8 @@ def bench_motion(args):
 
         t_d = median_time(lambda: planner.plan(start, end), args.repeats, args.inner)
         t_p = median_time(ruckig_new_move, args.repeats, args.inner)
-        row(f"{label} new points per plan (LinePlanner)", t_d, t_p, 1e6, "us", agree)
+        row(f"{label} new points per plan (LinePlanner.plan(start, end))", t_d, t_p, 1e6, "us",
+            agree)
 
         dt = 1.0 / 2000.0
 

@@ -2,14 +2,15 @@
 //! of this bench only), each called as its own documentation calls it: ruckig's `Ruckig`,
 //! `InputParameter` and `Trajectory` built and the input filled once, `calculate` per plan;
 //! deflect's `Limits` built once, `Trajectory::line` per plan, and one trajectory re-planned
-//! in place per plan (`replan_line`, ruckig's habit); the profile solve alone too.
+//! in place per plan (`replan_line`, ruckig's habit; `replan_line_with` under limits
+//! prepared once, as Python's `LinePlanner` plans); the profile solve alone too.
 //! A 1-D move, and the paper's 150 mm y-line (x held: per-axis and path limits coincide).
 //! `cargo bench --bench planner`.
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use deflect_core::motion::{Limits, Profile, Trajectory};
+use deflect_core::motion::{Limits, PreparedLimits, Profile, Trajectory};
 use nalgebra::{Vector1, Vector2};
 use rsruckig::prelude::*;
 
@@ -73,6 +74,18 @@ fn bench(c: &mut Criterion) {
             mine.duration()
         })
     });
+    let prepared = PreparedLimits::new(&limits).unwrap();
+    group.bench_function("1d/deflect_replan_line_with", |b| {
+        b.iter(|| {
+            mine.replan_line_with(
+                black_box(Vector1::new(0.05)),
+                black_box(Vector1::new(0.35)),
+                &prepared,
+            )
+            .unwrap();
+            mine.duration()
+        })
+    });
     group.bench_function("1d/deflect_profile_solve", |b| {
         b.iter(|| Profile::new(black_box(0.3), &limits).unwrap().duration())
     });
@@ -109,6 +122,18 @@ fn bench(c: &mut Criterion) {
                     black_box(Vector2::new(0.22, -0.075)),
                     black_box(Vector2::new(0.22, 0.075)),
                     &limits,
+                )
+                .unwrap();
+            mine2.duration()
+        })
+    });
+    group.bench_function("2d_y_line/deflect_replan_line_with", |b| {
+        b.iter(|| {
+            mine2
+                .replan_line_with(
+                    black_box(Vector2::new(0.22, -0.075)),
+                    black_box(Vector2::new(0.22, 0.075)),
+                    &prepared,
                 )
                 .unwrap();
             mine2.duration()

@@ -10,7 +10,7 @@
 use approx::assert_relative_eq;
 use deflect_core::motion::{
     self, Limits, MAX_POINTS, PAPER_ACCEL_TIMES, PAPER_G, PAPER_X_DURATIONS, PAPER_Y_DURATIONS,
-    Profile, Trajectory,
+    PreparedLimits, Profile, Trajectory,
 };
 use deflect_core::{BuildError, TickError};
 use nalgebra::{SVector, Vector2, Vector3};
@@ -417,8 +417,66 @@ fn zero_length_segments_are_skipped() {
     assert_eq!(still.ticks(2000.0).unwrap().count(), 1);
 }
 
+/// The closed form solved from scratch for one length, written out as the module docs give
+/// it: `(t_j, t_a, t_v)`.
+fn closed_form(length: f64, v: f64, a: f64, j: f64) -> (f64, f64, f64) {
+    let (mut t_j, mut t_a) = if a * a / j <= v {
+        (a / j, v / a - a / j)
+    } else {
+        ((v / j).sqrt(), 0.0)
+    };
+    if length < j * t_j * (t_j + t_a) * (2.0 * t_j + t_a) {
+        if length >= 2.0 * a * a * a / (j * j) {
+            t_j = a / j;
+            t_a = 0.5 * ((t_j * t_j + 4.0 * length / a).sqrt() - 3.0 * t_j);
+        } else {
+            t_j = (length / (2.0 * j)).cbrt();
+            t_a = 0.0;
+        }
+    }
+    let t_a = t_a.max(0.0);
+    let ap = j * t_j;
+    let s1 = j * t_j * t_j * t_j / 6.0;
+    let v1 = 0.5 * j * t_j * t_j;
+    let s2 = s1 + v1 * t_a + 0.5 * ap * t_a * t_a;
+    let v2 = v1 + ap * t_a;
+    let s3 = s2 + v2 * t_j + 0.5 * ap * t_j * t_j - j * t_j * t_j * t_j / 6.0;
+    let v3 = v2 + ap * t_j - 0.5 * j * t_j * t_j;
+    let t_v = if v3 > 0.0 {
+        ((length - 2.0 * s3) / v3).max(0.0)
+    } else {
+        0.0
+    };
+    (t_j, t_a, t_v)
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
+
+    /// Limits prepared once give, for every length (all four cases of the closed form), the
+    /// profile solved from scratch, bit for bit.
+    #[test]
+    fn prepared_limits_profile_is_the_closed_form_bit_for_bit(
+        lengths in prop::collection::vec(0.0f64..2.0, 1..16),
+        v in 0.01f64..5.0,
+        a in 0.1f64..100.0,
+        j in 1.0f64..1e5,
+    ) {
+        let l = lim(v, a, j);
+        let prepared = PreparedLimits::new(&l).unwrap();
+        prop_assert_eq!(prepared.limits(), &l);
+        // Short lengths too: cases 3 and 4 need a length below the cruise distance.
+        for length in lengths.iter().flat_map(|x| [*x, x * 1e-3, x * 1e-6]) {
+            let p = prepared.profile(length).unwrap();
+            let (t_j, t_a, t_v) = closed_form(length, v, a, j);
+            prop_assert_eq!(
+                [p.t_j(), p.t_a(), p.t_v()].map(f64::to_bits),
+                [t_j, t_a, t_v].map(f64::to_bits),
+                "length {}", length
+            );
+            prop_assert_eq!(p, Profile::new(length, &l).unwrap());
+        }
+    }
 
     #[test]
     fn random_profiles_respect_limits(
@@ -454,6 +512,9 @@ proptest! {
         let (s, e) = (Vector3::from(start), if same { Vector3::from(start) } else { Vector3::from(end) });
         tr.replan_line(s, e, &l).unwrap();
         prop_assert_eq!(&tr, &Trajectory::line(s, e, &l).unwrap());
+        let mut again = Trajectory::polyline(&before, &lim(1.0, 10.0, 100.0)).unwrap();
+        again.replan_line_with(s, e, &PreparedLimits::new(&l).unwrap()).unwrap();
+        prop_assert_eq!(&again, &tr);
     }
 
     #[test]

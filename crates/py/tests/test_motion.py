@@ -308,6 +308,44 @@ def test_line_planner_replans_in_place_bit_for_bit():
     )
 
 
+def test_line_planner_plans_from_its_input_points():
+    # ruckig's habit: the input points are set (or kept), `plan()` plans from them.
+    planner = deflect.LinePlanner(2, 1.2, 25.0, 600.0)
+    planner.start, planner.end = [0.1, -0.2], np.array([0.3, 0.25])
+    assert (planner.start, planner.end) == ([0.1, -0.2], [0.3, 0.25])
+    assert planner.duration == 0.0  # setting points plans nothing
+    ref = deflect.plan_line([0.1, -0.2], [0.3, 0.25], 1.2, 25.0, 600.0, rate_hz=None)
+    assert planner.plan() == ref.duration
+    # Planned again from the same input: the same plan, computed again.
+    assert planner.plan() == ref.duration
+    np.testing.assert_array_equal(planner.at(0.1)["position"], ref.at(0.1)["position"])
+    # One point given: the other is the input's.
+    other = deflect.plan_line([0.1, -0.2], [0.0, 0.0], 1.2, 25.0, 600.0, rate_hz=None)
+    assert planner.plan(end=(0.0, 0.0)) == other.duration
+    assert planner.end == [0.0, 0.0]
+    back = deflect.plan_line([0.3, 0.3], [0.0, 0.0], 1.2, 25.0, 600.0, rate_hz=None)
+    assert planner.plan(start=[0.3, 0.3]) == back.duration
+    # plan(start, end) makes its points the input.
+    planner.plan([0.0, 0.0], [0.2, 0.1])
+    assert (planner.start, planner.end) == ([0.0, 0.0], [0.2, 0.1])
+    assert planner.plan() == planner.duration
+    # A bad point set is refused by the setter (shape) or by the next plan (value); on a
+    # refused plan the previous plan and input stay.
+    with pytest.raises(deflect.InputError, match="start"):
+        planner.start = [0.0, 0.0, 0.0]
+    planner.end = [np.nan, 0.0]
+    d = planner.duration
+    with pytest.raises(deflect.InputError, match="points"):
+        planner.plan()
+    assert planner.duration == d
+    with pytest.raises(deflect.InputError, match="points"):
+        planner.plan(start=[np.inf, 0.0], end=[0.0, 0.0])
+    assert planner.start == [0.0, 0.0]
+    with pytest.raises(deflect.InputError, match="points"):
+        planner.plan(start=[1.0, 0.0])
+    assert planner.start == [0.0, 0.0]
+
+
 def test_line_planner_refuses_and_keeps_its_plan():
     planner = deflect.LinePlanner(1, 1.2, 25.0, 600.0)
     d = planner.plan([0.0], [0.3])

@@ -142,15 +142,17 @@ def test_trajectories_round_trip_planned_or_sampled(clone):
 def test_line_planner_round_trips_with_its_current_plan(clone):
     planner = deflect.LinePlanner(3, 1.0, 20.0, 400.0)
     planner.plan([0.0, 0.1, 0.2], [0.2, -0.05, 0.3])
+    planner.end = [0.4, 0.0, 0.0]  # an input not planned yet travels too
     other = clone(planner)
     assert repr(other) == repr(planner)
     assert (other.limits, other.start, other.end) == (planner.limits, planner.start, planner.end)
+    assert other.end == [0.4, 0.0, 0.0] and other.duration == planner.duration
     times = np.linspace(-0.1, 1.0, 13)
     for k, v in planner.at(times).items():
         np.testing.assert_array_equal(other.at(times)[k], v, k)
     # The copy re-plans on its own.
     other.plan([0.0, 0.0, 0.0], [0.1, 0.0, 0.0])
-    assert planner.end == [0.2, -0.05, 0.3]
+    assert planner.end == [0.4, 0.0, 0.0] and planner.start == [0.0, 0.1, 0.2]
 
 
 @pytest.mark.parametrize("clone", CLONES)

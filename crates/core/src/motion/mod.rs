@@ -48,7 +48,7 @@ mod sampled;
 mod trajectory;
 
 pub use pose::{PoseLimits, PoseState, PoseTrajectory};
-pub use profile::{PathState, Profile};
+pub use profile::{PathState, PreparedLimits, Profile};
 #[cfg(feature = "alloc")]
 pub use sampled::SampledTrajectory;
 pub use trajectory::{AxisLimits, Cursor, Data, State, Trajectory, step};

@@ -36,38 +36,40 @@ pub struct Profile {
     v3: f64,
 }
 
-impl Profile {
-    /// The profile over `length` \[m\] (finite, >= 0; 0 gives a zero-duration profile).
-    pub fn new(length: f64, limits: &Limits) -> Result<Self, BuildError> {
-        limits.validate()?;
-        param(
-            "profile length",
-            length,
-            length >= 0.0,
-            "finite and >= 0 (m)",
-        )?;
-        let (v, a, j) = (limits.v_max, limits.a_max, limits.j_max);
-        // Acceleration half that reaches v_max (cases 1 and 2).
-        let (mut t_j, mut t_a) = if a * a / j <= v {
-            (a / j, v / a - a / j)
-        } else {
-            (ComplexField::sqrt(v / j), 0.0)
-        };
-        let a_peak = j * t_j;
-        // Distance of the acceleration and deceleration halves together.
-        let d_v = a_peak * (t_j + t_a) * (2.0 * t_j + t_a);
-        if length < d_v {
-            if length >= 2.0 * a * a * a / (j * j) {
-                // Case 3.
-                t_j = a / j;
-                t_a = 0.5 * (ComplexField::sqrt(t_j * t_j + 4.0 * length / a) - 3.0 * t_j);
-            } else {
-                // Case 4.
-                t_j = ComplexField::cbrt(length / (2.0 * j));
-                t_a = 0.0;
-            }
-        }
-        t_a = t_a.max(0.0);
+/// Path limits validated once, with the part of the profile that does not depend on the
+/// length solved once: the acceleration half that reaches `v_max` (cases 1 and 2 of the
+/// closed form). A planner that plans move after move under the same limits (Python's
+/// `LinePlanner`, [`super::Trajectory::replan_line_with`]) builds this once and solves only
+/// the length's part per move. [`Self::profile`] is bit for bit [`Profile::new`]: both are
+/// the same arithmetic on the same numbers, only kept from the first call.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PreparedLimits {
+    limits: Limits,
+    // The acceleration half that reaches v_max: its jerk and acceleration phase durations
+    // (t_a as solved, before clamping at 0), and the distance of both halves.
+    t_j: f64,
+    t_a: f64,
+    d_v: f64,
+    // Its phase-end states, from t_a clamped at 0: what every move of length >= d_v uses.
+    cruise: Phases,
+}
+
+/// `t_j`, `t_a` (clamped at 0) and the states at the end of phases 1, 2, 3.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Phases {
+    t_j: f64,
+    t_a: f64,
+    s1: f64,
+    v1: f64,
+    s2: f64,
+    v2: f64,
+    s3: f64,
+    v3: f64,
+}
+
+impl Phases {
+    fn new(j: f64, t_j: f64, t_a: f64) -> Self {
+        let t_a = t_a.max(0.0);
         let ap = j * t_j;
         let s1 = j * t_j * t_j * t_j / 6.0;
         let v1 = 0.5 * j * t_j * t_j;
@@ -75,18 +77,84 @@ impl Profile {
         let v2 = v1 + ap * t_a;
         let s3 = s2 + v2 * t_j + 0.5 * ap * t_j * t_j - j * t_j * t_j * t_j / 6.0;
         let v3 = v2 + ap * t_j - 0.5 * j * t_j * t_j;
-        let t_v = if v3 > 0.0 {
-            ((length - 2.0 * s3) / v3).max(0.0)
+        Self {
+            t_j,
+            t_a,
+            s1,
+            v1,
+            s2,
+            v2,
+            s3,
+            v3,
+        }
+    }
+}
+
+impl PreparedLimits {
+    /// `limits` validated ([`Limits::validate`]) and the length-independent part solved.
+    pub fn new(limits: &Limits) -> Result<Self, BuildError> {
+        limits.validate()?;
+        let (v, a, j) = (limits.v_max, limits.a_max, limits.j_max);
+        // Acceleration half that reaches v_max (cases 1 and 2).
+        let (t_j, t_a) = if a * a / j <= v {
+            (a / j, v / a - a / j)
+        } else {
+            (ComplexField::sqrt(v / j), 0.0)
+        };
+        let a_peak = j * t_j;
+        // Distance of the acceleration and deceleration halves together.
+        let d_v = a_peak * (t_j + t_a) * (2.0 * t_j + t_a);
+        Ok(Self {
+            limits: *limits,
+            t_j,
+            t_a,
+            d_v,
+            cruise: Phases::new(j, t_j, t_a),
+        })
+    }
+
+    /// The validated limits.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The profile over `length` \[m\] (finite, >= 0; 0 gives a zero-duration profile).
+    pub fn profile(&self, length: f64) -> Result<Profile, BuildError> {
+        param(
+            "profile length",
+            length,
+            length >= 0.0,
+            "finite and >= 0 (m)",
+        )?;
+        let (a, j) = (self.limits.a_max, self.limits.j_max);
+        let p = if length < self.d_v {
+            let (t_j, t_a) = if length >= 2.0 * a * a * a / (j * j) {
+                // Case 3.
+                let t_j = a / j;
+                (
+                    t_j,
+                    0.5 * (ComplexField::sqrt(t_j * t_j + 4.0 * length / a) - 3.0 * t_j),
+                )
+            } else {
+                // Case 4.
+                (ComplexField::cbrt(length / (2.0 * j)), 0.0)
+            };
+            Phases::new(j, t_j, t_a)
+        } else {
+            self.cruise
+        };
+        let t_v = if p.v3 > 0.0 {
+            ((length - 2.0 * p.s3) / p.v3).max(0.0)
         } else {
             0.0
         };
         // Limits far outside any machine (a sub-normal v_max, a jerk of 1e-300) overflow the
         // closed form; refuse them rather than plan a motion of infinite duration.
-        let duration = 2.0 * (2.0 * t_j + t_a) + t_v;
-        let reached = 2.0 * s3 + v3 * t_v;
+        let duration = 2.0 * (2.0 * p.t_j + p.t_a) + t_v;
+        let reached = 2.0 * p.s3 + p.v3 * t_v;
         if !(duration.is_finite()
-            && s3.is_finite()
-            && v3.is_finite()
+            && p.s3.is_finite()
+            && p.v3.is_finite()
             && (reached - length).abs() <= 1.0e-9 * length.max(f64::MIN_POSITIVE))
         {
             return Err(BuildError::InvalidParameter {
@@ -102,19 +170,27 @@ impl Profile {
                 expected: "limits that move the length within MAX_DURATION = 1e6 s",
             });
         }
-        Ok(Self {
+        Ok(Profile {
             length,
             jerk: j,
-            t_j,
-            t_a,
+            t_j: p.t_j,
+            t_a: p.t_a,
             t_v,
-            s1,
-            v1,
-            s2,
-            v2,
-            s3,
-            v3,
+            s1: p.s1,
+            v1: p.v1,
+            s2: p.s2,
+            v2: p.v2,
+            s3: p.s3,
+            v3: p.v3,
         })
+    }
+}
+
+impl Profile {
+    /// The profile over `length` \[m\] (finite, >= 0; 0 gives a zero-duration profile).
+    /// Planning many lengths under the same limits: [`PreparedLimits`].
+    pub fn new(length: f64, limits: &Limits) -> Result<Self, BuildError> {
+        PreparedLimits::new(limits)?.profile(length)
     }
 
     /// Path length \[m\].

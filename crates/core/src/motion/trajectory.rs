@@ -2,7 +2,9 @@
 
 use nalgebra::{ComplexField, SVector};
 
-use super::{Limits, MAX_POINTS, MAX_SEGMENTS, MIN_SEGMENT_LENGTH, PathState, Profile};
+use super::{
+    Limits, MAX_POINTS, MAX_SEGMENTS, MIN_SEGMENT_LENGTH, PathState, PreparedLimits, Profile,
+};
 use crate::error::{BuildError, TickError};
 
 /// The state of an N-D trajectory at one time.
@@ -137,6 +139,18 @@ impl<const N: usize> Trajectory<N> {
         end: SVector<f64, N>,
         limits: &Limits,
     ) -> Result<(), BuildError> {
+        self.replan_line_with(start, end, &PreparedLimits::new(limits)?)
+    }
+
+    /// [`Self::replan_line`] under limits validated and prepared once ([`PreparedLimits`]):
+    /// per move only the length's part of the profile is solved. Bit for bit the same
+    /// trajectory; on error `self` is unchanged.
+    pub fn replan_line_with(
+        &mut self,
+        start: SVector<f64, N>,
+        end: SVector<f64, N>,
+        limits: &PreparedLimits,
+    ) -> Result<(), BuildError> {
         for (index, p) in [&start, &end].into_iter().enumerate() {
             if let Some(axis) = p.iter().position(|c| !c.is_finite()) {
                 return Err(BuildError::NonFinite {
@@ -148,16 +162,13 @@ impl<const N: usize> Trajectory<N> {
         let d = end - start;
         let length = d.norm();
         let segment = if length <= MIN_SEGMENT_LENGTH {
-            limits.validate()?;
             None
         } else {
-            // Profile::new validates the limits.
-            let profile = Profile::new(length, limits)?;
             Some(Segment {
                 start,
                 direction: d / length,
-                profile,
-                limits: *limits,
+                profile: limits.profile(length)?,
+                limits: *limits.limits(),
                 t0: 0.0,
                 s0: 0.0,
             })
@@ -178,7 +189,7 @@ impl<const N: usize> Trajectory<N> {
         };
         self.start = start;
         self.end = end;
-        self.limits = *limits;
+        self.limits = *limits.limits();
         self.duration = duration;
         self.path_length = path_length;
         Ok(())

@@ -465,16 +465,19 @@ class LinePlanner:
     """One straight-line plan in ``dim`` coordinates (1..=8) re-planned in place per move
     (ruckig's ``calculate(input, trajectory)`` habit); path limits validated once."""
     def __new__(cls, dim: int, v_max: float, a_max: float, j_max: float) -> "LinePlanner": ...
-    def plan(self, start: _ArrayLike, end: _ArrayLike) -> float:
+    def plan(self, start: Optional[_ArrayLike] = None, end: Optional[_ArrayLike] = None) -> float:
         """Re-plans from ``start`` to ``end`` in place (bit for bit ``plan_line``) and returns
-        the duration [s]; on error the previous plan is kept."""
+        the duration [s]; a point not given is the input's (``start`` / ``end``, ruckig's
+        ``InputParameter``). On error the previous plan and input are kept."""
     def at(self, t: Union[float, _ArrayLike]) -> Dict[str, Any]:
         """State of the current plan at ``t`` [s], as ``Trajectory.at``."""
     def trajectory(self, rate_hz: Optional[float] = 2000.0) -> Trajectory:
         """A copy of the current plan, as ``plan_line`` returns it."""
     def __getnewargs__(self) -> Tuple[int, float, float, float]: ...
-    def __getstate__(self) -> Tuple[List[float], List[float]]: ...
-    def __setstate__(self, state: Tuple[List[float], List[float]]) -> None: ...
+    def __getstate__(self) -> Tuple[List[float], List[float], List[float], List[float]]: ...
+    def __setstate__(
+        self, state: Tuple[List[float], List[float], List[float], List[float]]
+    ) -> None: ...
     @property
     def duration(self) -> float: ...
     @property
@@ -482,9 +485,15 @@ class LinePlanner:
     @property
     def limits(self) -> Tuple[float, float, float]: ...
     @property
-    def start(self) -> List[float]: ...
+    def start(self) -> List[float]:
+        """Input start point: what ``plan()`` plans from."""
+    @start.setter
+    def start(self, value: _ArrayLike) -> None: ...
     @property
-    def end(self) -> List[float]: ...
+    def end(self) -> List[float]:
+        """Input end point: what ``plan()`` plans to."""
+    @end.setter
+    def end(self, value: _ArrayLike) -> None: ...
 
 def plan_line(
     start: _ArrayLike,

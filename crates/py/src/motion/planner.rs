@@ -1,8 +1,10 @@
 //! `deflect.LinePlanner`: one line plan re-planned in place move after move (ruckig's
 //! `Ruckig.calculate(input, trajectory)` habit), for callers that plan many moves: no
 //! trajectory object per move, the limits validated once, the points read without numpy.
+//! The planner holds its input points as ruckig's `InputParameter` does: set them (or pass
+//! them to `plan`), and `plan()` plans from them.
 
-use deflect_core::motion::{Limits, Trajectory as CoreTraj};
+use deflect_core::motion::{Limits, PreparedLimits, Trajectory as CoreTraj};
 use nalgebra::SVector;
 use numpy::ndarray::Array2;
 use pyo3::prelude::*;
@@ -25,7 +27,33 @@ use crate::errors::build_err;
 #[derive(Debug)]
 pub struct LinePlanner {
     plan: Plan,
-    limits: Limits,
+    /// The limits validated once, with the length-independent part of the profile solved.
+    limits: PreparedLimits,
+    /// The points `plan()` plans from (the first `dim` entries): ruckig's `InputParameter`.
+    /// Set by the `start` / `end` setters and by every `plan(start, end)`.
+    input: [[f64; MAX_DIM]; 2],
+}
+
+/// The first `N` entries of an input point.
+fn input_point<const N: usize>(p: &[f64; MAX_DIM]) -> SVector<f64, N> {
+    SVector::from_fn(|i, _| p.get(i).copied().unwrap_or(0.0))
+}
+
+/// `o` (`dim` numbers) into an input point: the checks of `plan`'s points (the values
+/// themselves are validated by the plan).
+fn read_input(
+    o: &Bound<'_, PyAny>,
+    what: &str,
+    dim: usize,
+    into: &mut [f64; MAX_DIM],
+) -> PyResult<()> {
+    let mut p = [0.0; MAX_DIM];
+    let slot = p.get_mut(..dim).unwrap_or_default();
+    if !fill_fast(o, slot) {
+        slot.copy_from_slice(&vector(o, what, dim)?);
+    }
+    *into = p;
+    Ok(())
 }
 
 /// `o` as a point of `N` coordinates: lists, tuples and float64 vectors read directly, the
@@ -38,14 +66,32 @@ fn point<const N: usize>(o: &Bound<'_, PyAny>, what: &str) -> PyResult<SVector<f
     Ok(p)
 }
 
+/// Plans from `start` to `end` and, once planned, makes them the input.
 fn replan<const N: usize>(
     traj: &mut CoreTraj<N>,
     start: &Bound<'_, PyAny>,
     end: &Bound<'_, PyAny>,
-    limits: &Limits,
+    limits: &PreparedLimits,
+    input: &mut [[f64; MAX_DIM]; 2],
 ) -> PyResult<f64> {
     let (s, e) = (point::<N>(start, "start")?, point::<N>(end, "end")?);
-    traj.replan_line(s, e, limits).map_err(build_err)?;
+    traj.replan_line_with(s, e, limits).map_err(build_err)?;
+    for (slot, p) in input.iter_mut().zip([s, e]) {
+        for (x, v) in slot.iter_mut().zip(p.iter()) {
+            *x = *v;
+        }
+    }
+    Ok(traj.duration())
+}
+
+fn replan_input<const N: usize>(
+    traj: &mut CoreTraj<N>,
+    input: &[[f64; MAX_DIM]; 2],
+    limits: &PreparedLimits,
+) -> PyResult<f64> {
+    let [s, e] = input;
+    traj.replan_line_with(input_point::<N>(s), input_point::<N>(e), limits)
+        .map_err(build_err)?;
     Ok(traj.duration())
 }
 
@@ -61,6 +107,15 @@ impl LinePlanner {
     fn points(&self) -> (Vec<f64>, Vec<f64>) {
         with_plan!(&self.plan, t => (t.start().as_slice().to_vec(), t.end().as_slice().to_vec()))
     }
+
+    /// An input point as a list of `dim` numbers.
+    fn input_list(&self, which: usize) -> Vec<f64> {
+        let dim = self.plan.dim();
+        self.input
+            .get(which)
+            .map(|p| p.iter().take(dim).copied().collect())
+            .unwrap_or_default()
+    }
 }
 
 #[pymethods]
@@ -73,30 +128,64 @@ impl LinePlanner {
         #[pyo3(from_py_with = args::real::a_max)] a_max: f64,
         #[pyo3(from_py_with = args::real::j_max)] j_max: f64,
     ) -> PyResult<Self> {
-        let limits = Limits::new(v_max, a_max, j_max).map_err(build_err)?;
+        let limits = Limits::new(v_max, a_max, j_max)
+            .and_then(|l| PreparedLimits::new(&l))
+            .map_err(build_err)?;
         let plan = match dim {
-            1 => Plan::D1(at_rest(&limits)?),
-            2 => Plan::D2(at_rest(&limits)?),
-            3 => Plan::D3(at_rest(&limits)?),
-            4 => Plan::D4(at_rest(&limits)?),
-            5 => Plan::D5(at_rest(&limits)?),
-            6 => Plan::D6(at_rest(&limits)?),
-            7 => Plan::D7(at_rest(&limits)?),
-            8 => Plan::D8(at_rest(&limits)?),
+            1 => Plan::D1(at_rest(limits.limits())?),
+            2 => Plan::D2(at_rest(limits.limits())?),
+            3 => Plan::D3(at_rest(limits.limits())?),
+            4 => Plan::D4(at_rest(limits.limits())?),
+            5 => Plan::D5(at_rest(limits.limits())?),
+            6 => Plan::D6(at_rest(limits.limits())?),
+            7 => Plan::D7(at_rest(limits.limits())?),
+            8 => Plan::D8(at_rest(limits.limits())?),
             _ => {
                 return Err(InputError::new_err(format!(
                     "dim = {dim}: expected 1 <= dim <= {MAX_DIM}"
                 )));
             }
         };
-        Ok(Self { plan, limits })
+        Ok(Self {
+            plan,
+            limits,
+            input: [[0.0; MAX_DIM]; 2],
+        })
     }
 
     /// Re-plans the time-optimal rest-to-rest line from `start` to `end` (`dim` numbers
-    /// each) in place and returns its duration [s]. On error the previous plan is kept.
-    fn plan(&mut self, start: &Bound<'_, PyAny>, end: &Bound<'_, PyAny>) -> PyResult<f64> {
+    /// each) in place and returns its duration [s]. A point not given is the planner's input
+    /// (`start` / `end`, ruckig's `InputParameter`): `plan()` plans from the points set
+    /// before. Given points become the input once the plan succeeds; on error the previous
+    /// plan and input are kept.
+    #[pyo3(signature = (start=None, end=None))]
+    fn plan(
+        &mut self,
+        start: Option<&Bound<'_, PyAny>>,
+        end: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<f64> {
         let l = self.limits;
-        with_plan!(&mut self.plan, t => replan(t, start, end, &l))
+        match (start, end) {
+            (None, None) => with_plan!(&mut self.plan, t => replan_input(t, &self.input, &l)),
+            (Some(s), Some(e)) => {
+                let input = &mut self.input;
+                with_plan!(&mut self.plan, t => replan(t, s, e, &l, input))
+            }
+            (s, e) => {
+                let dim = self.plan.dim();
+                let mut input = self.input;
+                let [si, ei] = &mut input;
+                if let Some(s) = s {
+                    read_input(s, "start", dim, si)?;
+                }
+                if let Some(e) = e {
+                    read_input(e, "end", dim, ei)?;
+                }
+                let d = with_plan!(&mut self.plan, t => replan_input(t, &input, &l))?;
+                self.input = input;
+                Ok(d)
+            }
+        }
     }
 
     /// The exact state of the current plan at `t` [s], as `Trajectory.at`.
@@ -118,7 +207,7 @@ impl LinePlanner {
             .map_err(|e| InputError::new_err(e.to_string()))?;
         let recipe = Recipe::Planned {
             points,
-            spec: LimitSpec::Path(self.limits),
+            spec: LimitSpec::Path(*self.limits.limits()),
         };
         Trajectory::planned(self.plan.clone(), recipe, rate_hz)
     }
@@ -136,36 +225,65 @@ impl LinePlanner {
     /// Path limits `(v_max, a_max, j_max)`.
     #[getter]
     fn limits(&self) -> (f64, f64, f64) {
-        (self.limits.v_max, self.limits.a_max, self.limits.j_max)
+        let l = self.limits.limits();
+        (l.v_max, l.a_max, l.j_max)
     }
-    /// Start point of the current plan.
+    /// Start point of the input: what `plan()` plans from (after a plan, the plan's start).
     #[getter]
     fn start(&self) -> Vec<f64> {
-        self.points().0
+        self.input_list(0)
     }
-    /// End point of the current plan.
+    /// Sets the start point of the next `plan()` (`dim` numbers; their values are checked
+    /// when planning).
+    #[setter]
+    fn set_start(&mut self, start: &Bound<'_, PyAny>) -> PyResult<()> {
+        let dim = self.plan.dim();
+        let [s, _] = &mut self.input;
+        read_input(start, "start", dim, s)
+    }
+    /// End point of the input: what `plan()` plans to (after a plan, the plan's end).
     #[getter]
     fn end(&self) -> Vec<f64> {
-        self.points().1
+        self.input_list(1)
+    }
+    /// Sets the end point of the next `plan()`.
+    #[setter]
+    fn set_end(&mut self, end: &Bound<'_, PyAny>) -> PyResult<()> {
+        let dim = self.plan.dim();
+        let [_, e] = &mut self.input;
+        read_input(end, "end", dim, e)
     }
 
-    /// Pickling: the limits, then the current line planned again (bit for bit).
+    /// Pickling: the limits, then the current line planned again (bit for bit) and the
+    /// input restored.
     fn __getnewargs__(&self) -> (usize, f64, f64, f64) {
-        let l = self.limits;
+        let l = self.limits.limits();
         (self.plan.dim(), l.v_max, l.a_max, l.j_max)
     }
-    fn __getstate__(&self) -> (Vec<f64>, Vec<f64>) {
-        self.points()
+    #[allow(clippy::type_complexity)] // reason: the pickled tuple, spelled out for pyo3
+    fn __getstate__(&self) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+        let (s, e) = self.points();
+        (s, e, self.input_list(0), self.input_list(1))
     }
-    fn __setstate__(&mut self, py: Python<'_>, state: (Vec<f64>, Vec<f64>)) -> PyResult<()> {
+    fn __setstate__(
+        &mut self,
+        py: Python<'_>,
+        state: (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>),
+    ) -> PyResult<()> {
         let (s, e) = (
             state.0.into_pyobject(py)?.into_any(),
             state.1.into_pyobject(py)?.into_any(),
         );
-        self.plan(&s, &e).map(|_| ())
+        self.plan(Some(&s), Some(&e))?;
+        let (si, ei) = (
+            state.2.into_pyobject(py)?.into_any(),
+            state.3.into_pyobject(py)?.into_any(),
+        );
+        self.set_start(&si)?;
+        self.set_end(&ei)
     }
     fn __repr__(&self) -> String {
-        let l = self.limits;
+        let l = self.limits.limits();
         format!(
             "LinePlanner(dim={}, v_max={}, a_max={}, j_max={}, duration={:.6} s)",
             self.plan.dim(),
