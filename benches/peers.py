@@ -278,7 +278,12 @@ def main():
     ap.add_argument("--quick", action="store_true", help="fewer repeats (a smoke run)")
     ap.add_argument("--only", choices=("vjm", "map", "motion"), action="append",
                     help="run only these groups (repeatable); all by default")
+    ap.add_argument("--ur5-path", action="store_true",
+                    help="print the UR5 URDF's path and exit (for DEFLECT_UR5_URDF, benches/vjm.rs)")
     args = ap.parse_args()
+    if args.ur5_path:
+        print(ur5_urdf())
+        return
     args.repeats = 5 if args.quick else 41
     args.inner = 20 if args.quick else 200
     args.rows = 2_000 if args.quick else 20_000

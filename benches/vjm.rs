@@ -1,5 +1,7 @@
 //! Criterion benchmarks of the virtual-joint model on the shipped KR 300 (6 joints,
-//! 11 virtual joints). `cargo bench --bench vjm`.
+//! 11 virtual joints), and on the UR5 of example-robot-data (6 joints, one spring each: the
+//! chain `benches/peers.py` times from Python) when `DEFLECT_UR5_URDF` names its URDF
+//! (`benches/peers.py --ur5-path` prints it). `cargo bench --bench vjm`.
 
 use std::hint::black_box;
 
@@ -36,6 +38,39 @@ fn bench(c: &mut Criterion) {
     });
     g.bench_function("joint_correction_1_step", |b| {
         b.iter(|| vjm::joint_correction(model, &mut data, black_box(&q), black_box(&w), 1, 0.0))
+    });
+    g.finish();
+    ur5(c);
+}
+
+/// The UR5 calls of `benches/peers.py`, natively: what the Python binding adds is the
+/// difference.
+fn ur5(c: &mut Criterion) {
+    let Ok(urdf) = std::env::var("DEFLECT_UR5_URDF") else {
+        eprintln!("vjm_ur5: skipped (set DEFLECT_UR5_URDF to the UR5 URDF of example-robot-data)");
+        return;
+    };
+    let stiffness = deflect_tests::repo_path("robots/ur5/ur5_stiffness.toml");
+    let robot = match deflect_core::SerialRobot::from_path(&urdf, &stiffness, "tool0") {
+        Ok(r) => r,
+        Err(e) => panic!("DEFLECT_UR5_URDF={urdf}: {e}"),
+    };
+    let model = &robot.model;
+    let mut data = Data::new(model);
+    // The joints and wrench of benches/peers.py.
+    let q = [0.0, -1.2, 1.4, -0.7, 1.1, 0.3];
+    let w = Vector6::new(30.0, -20.0, 50.0, 2.0, -1.0, 0.5);
+    let mut g = c.benchmark_group("vjm_ur5");
+    for (name, load) in [
+        ("linear_deflection", vjm::Load::Linearized),
+        ("deflection", vjm::Load::Exact),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| vjm::deflection(model, &mut data, black_box(&q), black_box(&w), load))
+        });
+    }
+    g.bench_function("compliance", |b| {
+        b.iter(|| vjm::compliance(model, &mut data, black_box(&q)))
     });
     g.finish();
 }

@@ -33,28 +33,59 @@ impl AxisKind {
     }
 }
 
-/// What a fixed transform does, decided once at build: whether it rotates and whether it
-/// translates (a spring placed at a joint's own frame only rotates; `rpy="0 0 0"` only
+/// What a fixed transform does, decided once at build: whether it rotates (and whether
+/// about a coordinate axis: `rpy` with one non-zero angle, the usual URDF case) and whether
+/// it translates (a spring placed at a joint's own frame only rotates; `rpy="0 0 0"` only
 /// translates).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Shape {
     Identity,
     Translation,
+    /// A rotation about a coordinate axis (the axis as [`AxisKind`], never `Other`).
+    AxisRotation(AxisKind),
+    /// A translation, then a rotation about a coordinate axis.
+    AxisGeneral(AxisKind),
     Rotation,
     General,
 }
 
 impl Shape {
     pub(crate) fn of(t: &Isometry3<f64>) -> Self {
-        let turns = t.rotation.coords != UnitQuaternion::identity().coords;
+        let q = &t.rotation;
+        let turns = q.coords != UnitQuaternion::identity().coords;
         let shifts = t.translation.vector != Vector3::zeros();
-        match (turns, shifts) {
-            (false, false) => Self::Identity,
-            (false, true) => Self::Translation,
-            (true, false) => Self::Rotation,
-            (true, true) => Self::General,
+        let axis = match (q.i != 0.0, q.j != 0.0, q.k != 0.0) {
+            (true, false, false) => Some(AxisKind::X),
+            (false, true, false) => Some(AxisKind::Y),
+            (false, false, true) => Some(AxisKind::Z),
+            _ => None,
+        };
+        match (turns, shifts, axis) {
+            (false, false, _) => Self::Identity,
+            (false, true, _) => Self::Translation,
+            (true, false, Some(k)) => Self::AxisRotation(k),
+            (true, true, Some(k)) => Self::AxisGeneral(k),
+            (true, false, None) => Self::Rotation,
+            (true, true, None) => Self::General,
         }
     }
+}
+
+/// `r * q` for `q` a rotation about the coordinate axis `kind`: nalgebra's product with the
+/// zero terms left out ([`turn`]).
+#[inline(always)]
+fn axis_product(
+    r: &UnitQuaternion<f64>,
+    kind: AxisKind,
+    q: &UnitQuaternion<f64>,
+) -> UnitQuaternion<f64> {
+    let s = match kind {
+        AxisKind::X => q.i,
+        AxisKind::Y => q.j,
+        AxisKind::Z => q.k,
+        AxisKind::Other => return r * q, // not built: `Shape::of` names X, Y or Z only
+    };
+    UnitQuaternion::new_unchecked(coordinate_turn(r, kind, s, q.w).unwrap_or(*r.quaternion()))
 }
 
 /// `frame * t` for `t` of the given shape, without the products by zeros and ones.
@@ -66,7 +97,18 @@ pub(crate) fn compose(frame: &Isometry3<f64>, t: &Isometry3<f64>, shape: Shape) 
             let shift = frame.rotation * t.translation.vector;
             Isometry3::from_parts((frame.translation.vector + shift).into(), frame.rotation)
         }
+        Shape::AxisGeneral(kind) => {
+            let shift = frame.rotation * t.translation.vector;
+            Isometry3::from_parts(
+                (frame.translation.vector + shift).into(),
+                axis_product(&frame.rotation, kind, &t.rotation),
+            )
+        }
         Shape::Rotation => Isometry3::from_parts(frame.translation, frame.rotation * t.rotation),
+        Shape::AxisRotation(kind) => Isometry3::from_parts(
+            frame.translation,
+            axis_product(&frame.rotation, kind, &t.rotation),
+        ),
         Shape::Identity => *frame,
     }
 }
@@ -81,16 +123,27 @@ pub(crate) fn turn(
     s: f64,
     c: f64,
 ) -> UnitQuaternion<f64> {
+    match coordinate_turn(r, kind, s, c) {
+        Some(q) => UnitQuaternion::new_unchecked(q),
+        None => r * UnitQuaternion::new_unchecked(Quaternion::from_parts(c, axis.as_ref() * s)),
+    }
+}
+
+/// [`turn`] about a coordinate axis; `None` for [`AxisKind::Other`].
+#[inline(always)]
+fn coordinate_turn(
+    r: &UnitQuaternion<f64>,
+    kind: AxisKind,
+    s: f64,
+    c: f64,
+) -> Option<Quaternion<f64>> {
     let (w, x, y, z) = (r.w, r.i, r.j, r.k);
-    let q = match kind {
+    Some(match kind {
         AxisKind::X => Quaternion::new(w * c - x * s, w * s + x * c, y * c + z * s, z * c - y * s),
         AxisKind::Y => Quaternion::new(w * c - y * s, x * c - z * s, w * s + y * c, x * s + z * c),
         AxisKind::Z => Quaternion::new(w * c - z * s, x * c + y * s, y * c - x * s, w * s + z * c),
-        AxisKind::Other => {
-            return r * UnitQuaternion::new_unchecked(Quaternion::from_parts(c, axis.as_ref() * s));
-        }
-    };
-    UnitQuaternion::new_unchecked(q)
+        AxisKind::Other => return None,
+    })
 }
 
 /// `r * axis` (the joint's axis in world axes): nalgebra's vector rotation
@@ -132,12 +185,44 @@ mod tests {
         let t = Isometry3::translation(0.3, -0.2, 1.7);
         let f = Isometry3::from_parts(Vector3::new(1.0, 2.0, -0.5).into(), r);
         let turn_only = Isometry3::from_parts(Vector3::zeros().into(), r);
-        for t in [t, turn_only, Isometry3::identity(), f] {
+        let check = |t: Isometry3<f64>| {
             let general = f * t;
             let fast = compose(&f, &t, Shape::of(&t));
             assert_eq!(general.translation.vector, fast.translation.vector);
-            assert_eq!(general.rotation.coords, fast.rotation.coords);
+            assert_eq!(
+                general.rotation.coords,
+                fast.rotation.coords,
+                "{:?}",
+                Shape::of(&t)
+            );
+        };
+        for t in [t, turn_only, Isometry3::identity(), f] {
+            check(t);
         }
+        // URDF's usual rotations: one non-zero rpy angle, with and without a translation.
+        for angle in [
+            core::f64::consts::FRAC_PI_2,
+            -core::f64::consts::FRAC_PI_2,
+            0.3,
+            3.0,
+        ] {
+            for axis in [Vector3::x_axis(), Vector3::y_axis(), Vector3::z_axis()] {
+                let q = UnitQuaternion::from_axis_angle(&axis, angle);
+                check(Isometry3::from_parts(Vector3::zeros().into(), q));
+                check(Isometry3::from_parts(
+                    Vector3::new(0.1, -0.4, 0.25).into(),
+                    q,
+                ));
+            }
+        }
+        let about_x = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -1.0);
+        let shifted = Isometry3::from_parts(Vector3::new(0.0, 0.0, 0.2).into(), about_x);
+        assert_eq!(Shape::of(&shifted), Shape::AxisGeneral(AxisKind::X));
+        let about_z = Isometry3::from_parts(
+            Vector3::zeros().into(),
+            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.5),
+        );
+        assert_eq!(Shape::of(&about_z), Shape::AxisRotation(AxisKind::Z));
         for (axis, kind) in [
             (Vector3::x_axis(), AxisKind::X),
             (Vector3::y_axis(), AxisKind::Y),
