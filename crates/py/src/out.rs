@@ -4,9 +4,7 @@
 //! before any work, `InputError` naming `out` otherwise (numpy would cast other dtypes; here
 //! a cast would be the allocation `out=` exists to avoid, so it is refused instead).
 
-use numpy::{
-    PyArray1, PyArrayDyn, PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArrayMethods, ToPyArray,
-};
+use numpy::{PyArrayDyn, PyArrayMethods, PyReadwriteArrayDyn, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 
 use crate::InputError;
@@ -66,12 +64,21 @@ pub(crate) fn emit<'py>(
     out: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let Some(o) = out else {
-        let a: Bound<'py, PyArray1<f64>> = values.to_pyarray(py);
-        return if shape.len() == 1 {
-            Ok(a.into_any())
-        } else {
-            Ok(a.reshape(shape.to_vec())?.into_any())
-        };
+        // Made in its shape (one copy), not as a vector reshaped through numpy's `reshape`,
+        // and with a fixed number of dimensions where it can (ndarray's dynamic dimensions
+        // cost more than the copy).
+        let bad = |e: numpy::ndarray::ShapeError| InputError::new_err(format!("the result: {e}"));
+        return Ok(match *shape {
+            [_] => values.to_pyarray(py).into_any(),
+            [r, c] => numpy::ndarray::ArrayView2::from_shape((r, c), values)
+                .map_err(bad)?
+                .to_pyarray(py)
+                .into_any(),
+            _ => numpy::ndarray::ArrayViewD::from_shape(shape, values)
+                .map_err(bad)?
+                .to_pyarray(py)
+                .into_any(),
+        });
     };
     let mut w = out_buffer(o, shape)?;
     match w.as_slice_mut() {
