@@ -309,8 +309,14 @@ impl SerialRobot {
         let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
             return Err(InputError::new_err("Q and W: rows do not broadcast"));
         };
+        // A C-contiguous W is read as rows of its slice; a broadcast or strided one through
+        // ndarray's row views (several times the cost of the copy).
+        let w_rows = w.as_slice();
         self.per_row(py, q, &[n, 6], out, |model, data, qi, i, o| {
-            let wi = Vector6::from_iterator(w.row(i).iter().copied());
+            let wi = match w_rows.and_then(|s| s.get(6 * i..6 * i + 6)) {
+                Some(r) => Vector6::from_column_slice(r),
+                None => Vector6::from_iterator(w.row(i).iter().copied()),
+            };
             let d = vjm::deflection(model, data, qi, &wi, vjm::Load::Exact)?;
             o.copy_from_slice(d.as_slice());
             Ok(())
@@ -410,6 +416,7 @@ impl SerialRobot {
         let model = &self.inner.model;
         let dof = model.dof();
         let width = shape.iter().skip(1).product();
+        let q_rows = q.as_slice();
         fill_into(py, shape, out, |buf| {
             py.detach(|| {
                 batch::rows(
@@ -418,6 +425,11 @@ impl SerialRobot {
                     batch::row_cost::VJM,
                     || (Data::new(model), vec![0.0; dof]),
                     |i, (data, qi), o| {
+                        // A C-contiguous Q is read in place, row by row of its slice;
+                        // a broadcast or strided one is copied through its row views.
+                        if let Some(r) = q_rows.and_then(|s| s.get(dof * i..dof * (i + 1))) {
+                            return row(model, data, r, i, o);
+                        }
                         for (d, s) in qi.iter_mut().zip(q.row(i)) {
                             *d = *s;
                         }
