@@ -250,7 +250,7 @@ pub fn joint_correction(
         deflection(model, data, qs, wrench, Load::Exact)?;
         let d = data.tcp_deflected;
         let ep = d.translation.vector - target.translation.vector;
-        let er = (d.rotation * target.rotation.inverse()).scaled_axis();
+        let er = super::rotation_vector(&(d.rotation * target.rotation.inverse()));
         let e = Vector6::new(ep.x, ep.y, ep.z, er.x, er.y, er.z);
         let residual = e.norm();
         out.iterations = it;

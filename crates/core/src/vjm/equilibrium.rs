@@ -258,7 +258,7 @@ pub fn equilibrium(
         *slot = *a;
     }
     let dp = tcp.translation.vector - rigid.translation.vector;
-    let dr = (tcp.rotation * rigid.rotation.inverse()).scaled_axis();
+    let dr = super::rotation_vector(&(tcp.rotation * rigid.rotation.inverse()));
     let d = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z);
     check_output("deflection", d.as_slice())?;
     data.tcp_deflected = tcp;
