@@ -24,16 +24,9 @@ pub struct PathState {
 pub struct Profile {
     length: f64,
     jerk: f64,
-    t_j: f64,
-    t_a: f64,
     t_v: f64,
-    // State at the end of phases 1, 2, 3 (end of the acceleration half).
-    s1: f64,
-    v1: f64,
-    s2: f64,
-    v2: f64,
-    s3: f64,
-    v3: f64,
+    // t_j, t_a and the state at the end of phases 1, 2, 3 (end of the acceleration half).
+    phases: Phases,
 }
 
 /// Path limits validated once, with the part of the profile that does not depend on the
@@ -173,15 +166,8 @@ impl PreparedLimits {
         Ok(Profile {
             length,
             jerk: j,
-            t_j: p.t_j,
-            t_a: p.t_a,
             t_v,
-            s1: p.s1,
-            v1: p.v1,
-            s2: p.s2,
-            v2: p.v2,
-            s3: p.s3,
-            v3: p.v3,
+            phases: p,
         })
     }
 }
@@ -199,11 +185,11 @@ impl Profile {
     }
     /// Duration of each of the four constant-jerk phases \[s\].
     pub fn t_j(&self) -> f64 {
-        self.t_j
+        self.phases.t_j
     }
     /// Duration of each of the two constant-acceleration phases \[s\].
     pub fn t_a(&self) -> f64 {
-        self.t_a
+        self.phases.t_a
     }
     /// Duration of the constant-velocity phase \[s\].
     pub fn t_v(&self) -> f64 {
@@ -211,7 +197,7 @@ impl Profile {
     }
     /// Acceleration (= deceleration) time `2 t_j + t_a` \[s\].
     pub fn accel_time(&self) -> f64 {
-        2.0 * self.t_j + self.t_a
+        2.0 * self.phases.t_j + self.phases.t_a
     }
     /// Total duration `2 (2 t_j + t_a) + t_v` \[s\].
     pub fn duration(&self) -> f64 {
@@ -219,15 +205,15 @@ impl Profile {
     }
     /// Peak speed \[m/s\] (`v_max` unless the path is too short).
     pub fn v_peak(&self) -> f64 {
-        self.v3
+        self.phases.v3
     }
     /// Peak acceleration \[m/s^2\] (`a_max` unless the path or `v_max` is too small).
     pub fn a_peak(&self) -> f64 {
-        self.jerk * self.t_j
+        self.jerk * self.phases.t_j
     }
     /// Phase durations `[t_j, t_a, t_j, t_v, t_j, t_a, t_j]` \[s\].
     pub fn phase_durations(&self) -> [f64; 7] {
-        let (tj, ta) = (self.t_j, self.t_a);
+        let (tj, ta) = (self.phases.t_j, self.phases.t_a);
         [tj, ta, tj, self.t_v, tj, ta, tj]
     }
 
@@ -260,7 +246,7 @@ impl Profile {
 
     /// Acceleration half and cruise, integrated forward from rest.
     fn first_half(&self, t: f64) -> PathState {
-        let (j, tj, ta) = (self.jerk, self.t_j, self.t_a);
+        let (j, tj, ta) = (self.jerk, self.phases.t_j, self.phases.t_a);
         let ap = j * tj;
         if t < tj {
             PathState {
@@ -272,24 +258,24 @@ impl Profile {
         } else if t < tj + ta {
             let d = t - tj;
             PathState {
-                s: self.s1 + self.v1 * d + 0.5 * ap * d * d,
-                v: self.v1 + ap * d,
+                s: self.phases.s1 + self.phases.v1 * d + 0.5 * ap * d * d,
+                v: self.phases.v1 + ap * d,
                 a: ap,
                 j: 0.0,
             }
         } else if t < 2.0 * tj + ta {
             let d = t - tj - ta;
             PathState {
-                s: self.s2 + self.v2 * d + 0.5 * ap * d * d - j * d * d * d / 6.0,
-                v: self.v2 + ap * d - 0.5 * j * d * d,
+                s: self.phases.s2 + self.phases.v2 * d + 0.5 * ap * d * d - j * d * d * d / 6.0,
+                v: self.phases.v2 + ap * d - 0.5 * j * d * d,
                 a: ap - j * d,
                 j: -j,
             }
         } else {
             let d = t - (2.0 * tj + ta);
             PathState {
-                s: self.s3 + self.v3 * d,
-                v: self.v3,
+                s: self.phases.s3 + self.phases.v3 * d,
+                v: self.phases.v3,
                 a: 0.0,
                 j: 0.0,
             }
