@@ -463,7 +463,8 @@ class Trajectory:
 @final
 class LinePlanner:
     """One straight-line plan in ``dim`` coordinates (1..=8) re-planned in place per move
-    (ruckig's ``calculate(input, trajectory)`` habit); path limits validated once."""
+    (ruckig's ``calculate(input, trajectory)`` habit); path limits validated once. Set
+    ``start`` / ``end`` and call ``plan()``, or pass the points to ``plan(start, end)``."""
     def __new__(cls, dim: int, v_max: float, a_max: float, j_max: float) -> "LinePlanner": ...
     def plan(self, start: Optional[_ArrayLike] = None, end: Optional[_ArrayLike] = None) -> float:
         """Re-plans from ``start`` to ``end`` in place (bit for bit ``plan_line``) and returns

@@ -21,8 +21,9 @@ use crate::errors::build_err;
 /// `v_max` [m/s], `a_max` [m/s^2], `j_max` [m/s^3] (Euclidean norms; finite and > 0),
 /// validated once here. `plan(start, end)` re-plans the planner's one trajectory in place,
 /// bit for bit `plan_line(start, end, v_max, a_max, j_max, rate_hz=None)`, and returns the
-/// duration [s]; `at(t)` evaluates it and `trajectory()` copies it out as a `Trajectory`.
-/// Until the first `plan` it rests at the origin. Per-coordinate limits: `plan_line`.
+/// duration [s]; or set `start` / `end` (ruckig's `InputParameter`) and call `plan()`.
+/// `at(t)` evaluates the plan and `trajectory()` copies it out as a `Trajectory`. Until the
+/// first `plan` it rests at the origin. Per-coordinate limits: `plan_line`.
 #[pyclass(module = "deflect")]
 #[derive(Debug)]
 pub struct LinePlanner {
