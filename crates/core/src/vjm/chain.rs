@@ -33,84 +33,74 @@ impl AxisKind {
     }
 }
 
-/// What a fixed transform does, decided once at build: whether it rotates (and whether
-/// about a coordinate axis: `rpy` with one non-zero angle, the usual URDF case) and whether
-/// it translates (a spring placed at a joint's own frame only rotates; `rpy="0 0 0"` only
+/// What a fixed transform does, decided once at build: how it rotates and whether it
+/// translates (a spring placed at a joint's own frame only rotates; `rpy="0 0 0"` only
 /// translates).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Shape {
-    Identity,
-    Translation,
-    /// A rotation about a coordinate axis (the axis as [`AxisKind`], never `Other`).
-    AxisRotation(AxisKind),
-    /// A translation, then a rotation about a coordinate axis.
-    AxisGeneral(AxisKind),
-    Rotation,
+pub(crate) struct Shape {
+    pub turn: Turn,
+    pub shifts: bool,
+}
+
+/// How a fixed transform rotates.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Turn {
+    /// Not at all.
+    None,
+    /// About a coordinate axis (`rpy` with one non-zero angle, the usual URDF case; the axis
+    /// as [`AxisKind`], never `Other`).
+    Axis(AxisKind),
+    /// Any other rotation.
     General,
 }
 
 impl Shape {
     pub(crate) fn of(t: &Isometry3<f64>) -> Self {
         let q = &t.rotation;
-        let turns = q.coords != UnitQuaternion::identity().coords;
-        let shifts = t.translation.vector != Vector3::zeros();
-        let axis = match (q.i != 0.0, q.j != 0.0, q.k != 0.0) {
-            (true, false, false) => Some(AxisKind::X),
-            (false, true, false) => Some(AxisKind::Y),
-            (false, false, true) => Some(AxisKind::Z),
-            _ => None,
+        let turn = if q.coords == UnitQuaternion::identity().coords {
+            Turn::None
+        } else {
+            match (q.i != 0.0, q.j != 0.0, q.k != 0.0) {
+                (true, false, false) => Turn::Axis(AxisKind::X),
+                (false, true, false) => Turn::Axis(AxisKind::Y),
+                (false, false, true) => Turn::Axis(AxisKind::Z),
+                _ => Turn::General,
+            }
         };
-        match (turns, shifts, axis) {
-            (false, false, _) => Self::Identity,
-            (false, true, _) => Self::Translation,
-            (true, false, Some(k)) => Self::AxisRotation(k),
-            (true, true, Some(k)) => Self::AxisGeneral(k),
-            (true, false, None) => Self::Rotation,
-            (true, true, None) => Self::General,
+        Self {
+            turn,
+            shifts: t.translation.vector != Vector3::zeros(),
         }
     }
 }
 
-/// `r * q` for `q` a rotation about the coordinate axis `kind`: nalgebra's product with the
-/// zero terms left out ([`turn`]).
-#[inline(always)]
-fn axis_product(
-    r: &UnitQuaternion<f64>,
-    kind: AxisKind,
-    q: &UnitQuaternion<f64>,
-) -> UnitQuaternion<f64> {
-    let s = match kind {
-        AxisKind::X => q.i,
-        AxisKind::Y => q.j,
-        AxisKind::Z => q.k,
-        AxisKind::Other => return r * q, // not built: `Shape::of` names X, Y or Z only
-    };
-    UnitQuaternion::new_unchecked(coordinate_turn(r, kind, s, q.w).unwrap_or(*r.quaternion()))
-}
-
-/// `frame * t` for `t` of the given shape, without the products by zeros and ones.
+/// `frame * t` for `t` of the given shape, without the products by zeros and ones: bit for
+/// bit nalgebra's product (the rotation, and the translation `frame.rotation * t.translation`
+/// added to the frame's).
 #[inline(always)]
 pub(crate) fn compose(frame: &Isometry3<f64>, t: &Isometry3<f64>, shape: Shape) -> Isometry3<f64> {
-    match shape {
-        Shape::General => frame * t,
-        Shape::Translation => {
-            let shift = frame.rotation * t.translation.vector;
-            Isometry3::from_parts((frame.translation.vector + shift).into(), frame.rotation)
+    let rotation = match shape.turn {
+        Turn::None => frame.rotation,
+        Turn::Axis(kind) => {
+            let s = match kind {
+                AxisKind::X => t.rotation.i,
+                AxisKind::Y => t.rotation.j,
+                AxisKind::Z => t.rotation.k,
+                AxisKind::Other => 0.0, // not built: `Shape::of` names X, Y or Z only
+            };
+            match coordinate_turn(&frame.rotation, kind, s, t.rotation.w) {
+                Some(q) => UnitQuaternion::new_unchecked(q),
+                None => frame.rotation * t.rotation,
+            }
         }
-        Shape::AxisGeneral(kind) => {
-            let shift = frame.rotation * t.translation.vector;
-            Isometry3::from_parts(
-                (frame.translation.vector + shift).into(),
-                axis_product(&frame.rotation, kind, &t.rotation),
-            )
-        }
-        Shape::Rotation => Isometry3::from_parts(frame.translation, frame.rotation * t.rotation),
-        Shape::AxisRotation(kind) => Isometry3::from_parts(
-            frame.translation,
-            axis_product(&frame.rotation, kind, &t.rotation),
-        ),
-        Shape::Identity => *frame,
-    }
+        Turn::General => frame.rotation * t.rotation,
+    };
+    let translation = if shape.shifts {
+        frame.translation.vector + frame.rotation * t.translation.vector
+    } else {
+        frame.translation.vector
+    };
+    Isometry3::from_parts(translation.into(), rotation)
 }
 
 /// `r * e`, `e = [c, s axis]` the joint's rotation by an angle with half-angle sine `s` and
@@ -217,12 +207,24 @@ mod tests {
         }
         let about_x = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), -1.0);
         let shifted = Isometry3::from_parts(Vector3::new(0.0, 0.0, 0.2).into(), about_x);
-        assert_eq!(Shape::of(&shifted), Shape::AxisGeneral(AxisKind::X));
+        assert_eq!(
+            Shape::of(&shifted),
+            Shape {
+                turn: Turn::Axis(AxisKind::X),
+                shifts: true
+            }
+        );
         let about_z = Isometry3::from_parts(
             Vector3::zeros().into(),
             UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 0.5),
         );
-        assert_eq!(Shape::of(&about_z), Shape::AxisRotation(AxisKind::Z));
+        assert_eq!(
+            Shape::of(&about_z),
+            Shape {
+                turn: Turn::Axis(AxisKind::Z),
+                shifts: false
+            }
+        );
         for (axis, kind) in [
             (Vector3::x_axis(), AxisKind::X),
             (Vector3::y_axis(), AxisKind::Y),
@@ -249,7 +251,19 @@ mod tests {
         }
         let other = Unit::new_normalize(Vector3::new(0.0, 0.0, -1.0));
         assert_eq!(AxisKind::of(&other), AxisKind::Other);
-        assert_eq!(Shape::of(&t), Shape::Translation);
-        assert_eq!(Shape::of(&f), Shape::General);
+        assert_eq!(
+            Shape::of(&t),
+            Shape {
+                turn: Turn::None,
+                shifts: true
+            }
+        );
+        assert_eq!(
+            Shape::of(&f),
+            Shape {
+                turn: Turn::General,
+                shifts: true
+            }
+        );
     }
 }
