@@ -430,11 +430,10 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
     // (rotation), -S A (translation-rotation) and S A S^T (translation), summed over springs
     // four at a time (`lanes`). A and S A S^T are symmetric: their six distinct entries are
     // computed once each, and S is applied as cross products.
-    let c = super::lanes::compliance_sums(model, data, &tcp.translation.vector);
+    super::lanes::compliance_sums(model, data, &tcp.translation.vector);
     data.tcp = tcp;
-    data.compliance = c;
-    check_output("compliance", c.as_slice())?;
-    Ok(c)
+    check_output("compliance", data.compliance.as_slice())?;
+    Ok(data.compliance)
 }
 
 /// The actuated-joint Jacobian of the rigid TCP, rows `[v; w]` in the base frame, into

@@ -1,7 +1,11 @@
 //! Four springs at a time: the per-spring sums of the Cartesian compliance computed lane by
-//! lane over springs (structure of arrays), so that the compiler emits one vector operation
-//! for four springs. The plain arithmetic on `[f64; 4]` becomes SSE2 pairs in the baseline
-//! build and AVX2 / AVX-512 vectors in the versions chosen at run time (with `std`).
+//! lane over springs (structure of arrays). The kernel is written once over [`Lanes`]: plain
+//! `[f64; 4]` arithmetic on every target, and explicit AVX2 registers (through `pulp`, chosen
+//! at run time with `std` on x86-64). Left to the compiler's straight-line vectoriser, the
+//! plain form became a mix of 128-, 256- and 512-bit operations with shuffles and spills
+//! (KR 300: half of `compliance`'s 350 ns); the explicit registers keep one vector operation
+//! per lane operation. The two forms are the same operations in the same order (no fused
+//! multiply-add), so they agree bit for bit.
 //!
 //! Each lane sums its springs in chain order and the four lanes are added at the end: a
 //! different order of the same sums than one running total, equal to rounding (the VJM tests
@@ -9,25 +13,41 @@
 
 use core::ops::{Add, Mul, Sub};
 
-use nalgebra::{Isometry3, Matrix3, Matrix6, Vector3};
+use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::{Data, Model};
+
+/// A way to hold four `f64` lanes: its vector type, and the conversions from and to arrays.
+pub(crate) trait Lanes: Copy {
+    /// Four lanes, with lane-wise arithmetic.
+    type V: Copy + Add<Output = Self::V> + Sub<Output = Self::V> + Mul<Output = Self::V>;
+    /// The lanes of `a`.
+    fn load(self, a: [f64; 4]) -> Self::V;
+    /// The lanes of `v` as an array.
+    fn store(self, v: Self::V) -> [f64; 4];
+    /// `x` in every lane.
+    #[inline(always)]
+    fn splat(self, x: f64) -> Self::V {
+        self.load([x; 4])
+    }
+    /// `((l0 + l1) + l2) + l3`.
+    #[inline(always)]
+    fn total(self, v: Self::V) -> f64 {
+        let [a, b, c, d] = self.store(v);
+        ((a + b) + c) + d
+    }
+}
+
+/// Plain arrays: every target, and the fallback without AVX2.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Plain;
 
 /// Four lanes of `f64`.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct F4(pub [f64; 4]);
 
-impl F4 {
-    /// `((l0 + l1) + l2) + l3`.
-    #[inline(always)]
-    fn total(self) -> f64 {
-        let [a, b, c, d] = self.0;
-        ((a + b) + c) + d
-    }
-}
-
 // Written out lane by lane (not through an iterator): the form the compiler's straight-line
-// vectoriser turns into one vector instruction.
+// vectoriser turns into vector instructions where it can.
 macro_rules! lanewise {
     ($trait:ident, $f:ident, $op:tt) => {
         impl $trait for F4 {
@@ -44,15 +64,76 @@ lanewise!(Add, add, +);
 lanewise!(Sub, sub, -);
 lanewise!(Mul, mul, *);
 
-/// Three lanes-vectors: x, y, z of four springs.
-#[derive(Debug, Clone, Copy, Default)]
-struct V4 {
-    x: F4,
-    y: F4,
-    z: F4,
+impl Lanes for Plain {
+    type V = F4;
+    #[inline(always)]
+    fn load(self, a: [f64; 4]) -> F4 {
+        F4(a)
+    }
+    #[inline(always)]
+    fn store(self, v: F4) -> [f64; 4] {
+        v.0
+    }
 }
 
-impl V4 {
+/// AVX2 registers, with the token proving the CPU has them.
+#[cfg(all(feature = "std", target_arch = "x86_64"))]
+mod avx {
+    use core::ops::{Add, Mul, Sub};
+
+    use pulp::f64x4;
+    use pulp::x86::V3;
+
+    /// One AVX2 register of four `f64`.
+    #[derive(Debug, Clone, Copy)]
+    pub(crate) struct Avx4 {
+        simd: V3,
+        v: f64x4,
+    }
+
+    macro_rules! avxwise {
+        ($trait:ident, $f:ident, $op:ident) => {
+            impl $trait for Avx4 {
+                type Output = Self;
+                #[inline(always)]
+                fn $f(self, o: Self) -> Self {
+                    Self {
+                        simd: self.simd,
+                        v: self.simd.$op(self.v, o.v),
+                    }
+                }
+            }
+        };
+    }
+    avxwise!(Add, add, add_f64x4);
+    avxwise!(Sub, sub, sub_f64x4);
+    avxwise!(Mul, mul, mul_f64x4);
+
+    impl super::Lanes for V3 {
+        type V = Avx4;
+        #[inline(always)]
+        fn load(self, a: [f64; 4]) -> Avx4 {
+            Avx4 {
+                simd: self,
+                v: pulp::cast(a),
+            }
+        }
+        #[inline(always)]
+        fn store(self, v: Avx4) -> [f64; 4] {
+            pulp::cast(v.v)
+        }
+    }
+}
+
+/// Three lanes-vectors: x, y, z of four springs.
+#[derive(Debug, Clone, Copy)]
+struct V4<T> {
+    x: T,
+    y: T,
+    z: T,
+}
+
+impl<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>> V4<T> {
     #[inline(always)]
     fn cross(self, o: Self) -> Self {
         Self {
@@ -65,30 +146,63 @@ impl V4 {
 
 /// The summed blocks of `C = sum_s J_s K_s^-1 J_s^T` for the springs of the last rigid pass
 /// and the TCP at `p` (see [`super::compliance`] for the algebra): the six distinct entries
-/// of the symmetric translation and rotation blocks and the translation-rotation block.
-pub(super) fn compliance_sums(model: &Model, data: &Data, p: &Vector3<f64>) -> Matrix6<f64> {
+/// of the symmetric translation and rotation blocks and the translation-rotation block, into
+/// `data.compliance`. Written in place: a matrix built on the stack and copied into `data`
+/// cost a `memcpy` whose wide loads stalled on the element stores just made (a sixth of
+/// `compliance`'s time, KR 300).
+pub(super) fn compliance_sums(model: &Model, data: &mut Data, p: &Vector3<f64>) {
     let (vv, vw, ww) = blocks(model, data, p);
     let sym = |e: [f64; 6]| Matrix3::new(e[0], e[1], e[2], e[1], e[3], e[4], e[2], e[4], e[5]);
     let (c_vv, c_ww) = (sym(vv), sym(ww));
     let c_vw = Matrix3::from_row_slice(&vw);
-    let mut c = Matrix6::zeros();
+    let c = &mut data.compliance;
     c.fixed_view_mut::<3, 3>(0, 0).copy_from(&c_vv);
     c.fixed_view_mut::<3, 3>(0, 3).copy_from(&c_vw);
     c.fixed_view_mut::<3, 3>(3, 0).copy_from(&c_vw.transpose());
     c.fixed_view_mut::<3, 3>(3, 3).copy_from(&c_ww);
-    c
 }
 
-/// The lane loop, compiled once per instruction set (with `std`).
-#[cfg_attr(
-    feature = "std",
-    multiversion::multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))
-)]
+/// The lane sums, in AVX2 registers where the CPU has them.
 fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], [f64; 6]) {
+    #[cfg(all(feature = "std", target_arch = "x86_64"))]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        /// The kernel as pulp's inlined closure.
+        struct Kernel<'a> {
+            simd: pulp::x86::V3,
+            model: &'a Model,
+            data: &'a Data,
+            p: &'a Vector3<f64>,
+        }
+        impl pulp::NullaryFnOnce for Kernel<'_> {
+            type Output = ([f64; 6], [f64; 9], [f64; 6]);
+            #[inline(always)]
+            fn call(self) -> Self::Output {
+                blocks_in(self.simd, self.model, self.data, self.p)
+            }
+        }
+        return simd.vectorize(Kernel {
+            simd,
+            model,
+            data,
+            p,
+        });
+    }
+    blocks_in(Plain, model, data, p)
+}
+
+/// The lane loop over the springs, in the lanes `l`.
+#[inline(always)]
+fn blocks_in<L: Lanes>(
+    l: L,
+    model: &Model,
+    data: &Data,
+    p: &Vector3<f64>,
+) -> ([f64; 6], [f64; 9], [f64; 6]) {
     let n = model.springs;
-    let mut vv = [F4::default(); 6];
-    let mut vw = [F4::default(); 9];
-    let mut ww = [F4::default(); 6];
+    let zero = l.splat(0.0);
+    let mut vv = [zero; 6];
+    let mut vw = [zero; 9];
+    let mut ww = [zero; 6];
     // Whole chunks of four: past the spring count the workspace holds identity frames and
     // the model zero compliances, which add exactly zero.
     let frames = data.spring_frames.chunks_exact(4);
@@ -112,10 +226,10 @@ fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], 
         let c0 = cs.each_ref().map(|c| c.x);
         let c1 = cs.each_ref().map(|c| c.y);
         let c2 = cs.each_ref().map(|c| c.z);
-        let (w, x, y, z) = (F4(qw), F4(qx), F4(qy), F4(qz));
-        let (c0, c1, c2) = (F4(c0), F4(c1), F4(c2));
+        let (w, x, y, z) = (l.load(qw), l.load(qx), l.load(qy), l.load(qz));
+        let (c0, c1, c2) = (l.load(c0), l.load(c1), l.load(c2));
         // Rotation matrix of the unit quaternion (columns: the spring's axes in world axes).
-        let two = F4([2.0; 4]);
+        let two = l.splat(2.0);
         let (ww_, xx, yy, zz) = (w * w, x * x, y * y, z * z);
         let (xy, xz, yz) = (x * y, x * z, y * z);
         let (wx, wy, wz) = (w * x, w * y, w * z);
@@ -135,7 +249,7 @@ fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], 
             z: ww_ - xx - yy + zz,
         };
         // A = R diag(c) R^T, six distinct entries.
-        let g = |i: F4, j: F4, k: F4, l: F4, m: F4, n: F4| c0 * i * j + c1 * k * l + c2 * m * n;
+        let g = |i, j, k, l, m, n| c0 * i * j + c1 * k * l + c2 * m * n;
         let a = [
             g(u.x, u.x, v.x, v.x, t.x, t.x),
             g(u.x, u.y, v.x, v.y, t.x, t.y),
@@ -145,9 +259,9 @@ fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], 
             g(u.z, u.z, v.z, v.z, t.z, t.z),
         ];
         let r = V4 {
-            x: F4([p.x; 4]) - F4(ox),
-            y: F4([p.y; 4]) - F4(oy),
-            z: F4([p.z; 4]) - F4(oz),
+            x: l.splat(p.x) - l.load(ox),
+            y: l.splat(p.y) - l.load(oy),
+            z: l.splat(p.z) - l.load(oz),
         };
         let [a0, a1, a2, a3, a4, a5] = a;
         // B = S A (S = [r]x), column j = r x A_j.
@@ -187,5 +301,65 @@ fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], 
             *acc = *acc - d;
         }
     }
-    (vv.map(F4::total), vw.map(F4::total), ww.map(F4::total))
+    let total = |v| l.total(v);
+    (vv.map(total), vw.map(total), ww.map(total))
+}
+
+#[cfg(test)]
+mod tests {
+    use nalgebra::{Isometry3, UnitQuaternion, Vector3};
+
+    use super::*;
+    use crate::vjm::{Data, ModelBuilder, deflection};
+
+    /// Six springs (a whole chunk of four and a partial one) on an oblique three-joint arm.
+    pub(super) fn arm() -> (Model, [f64; 3]) {
+        let model = ModelBuilder::new()
+            .fixed(Isometry3::translation(0.0, 0.0, 0.4))
+            .unwrap()
+            .revolute(Vector3::z())
+            .unwrap()
+            .spring([2.0e5, 3.0e5, 4.0e4])
+            .unwrap()
+            .fixed(Isometry3::from_parts(
+                Vector3::new(0.1, 0.0, 0.2).into(),
+                UnitQuaternion::from_euler_angles(-0.3, 0.1, 0.2),
+            ))
+            .unwrap()
+            .spring([5.0e4, f64::INFINITY, 7.0e4])
+            .unwrap()
+            .revolute(Vector3::new(0.3, -0.5, 0.81).normalize())
+            .unwrap()
+            .spring([3.0e4, 6.0e4, 1.0e4])
+            .unwrap()
+            .fixed(Isometry3::translation(0.6, 0.05, 0.0))
+            .unwrap()
+            .spring([8.0e4, 2.0e4, 9.0e4])
+            .unwrap()
+            .revolute(Vector3::y())
+            .unwrap()
+            .spring([4.0e4, 4.5e4, 5.0e4])
+            .unwrap()
+            .fixed(Isometry3::translation(0.3, 0.0, -0.1))
+            .unwrap()
+            .spring([1.0e5, 1.0e5, 2.0e5])
+            .unwrap()
+            .build()
+            .unwrap();
+        (model, [0.7, -1.2, 0.15])
+    }
+
+    #[test]
+    fn avx2_lanes_equal_the_plain_lanes_bit_for_bit() {
+        let (model, q) = arm();
+        let mut data = Data::new(&model);
+        deflection::joint_jacobian(&model, &mut data, &q).unwrap();
+        let p = data.tcp.translation.vector;
+        let plain = blocks_in(Plain, &model, &data, &p);
+        assert!(plain.0.iter().all(|v| *v != 0.0), "{plain:?}");
+        #[cfg(all(feature = "std", target_arch = "x86_64"))]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            assert_eq!(blocks_in(simd, &model, &data, &p), plain);
+        }
+    }
 }
