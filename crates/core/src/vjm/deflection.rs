@@ -18,34 +18,21 @@ use crate::error::{TickError, check_finite, check_output};
 pub const MAX_SPRING_ANGLE: f64 = 0.5;
 
 /// `(sin x, cos x)`. Elastic angles are tiny (1e-6..1e-3 rad): below 0.01 rad a Taylor series
-/// is exact to rounding and several times cheaper than the library call. Below 1e-3 the
-/// terms past x^5 (sine) and x^4 (cosine) are below 1e-21 relative and are left out; up to
-/// 0.01 the series runs to x^9 / x^10 (next terms below 1e-22 relative). Multiplications by
-/// the reciprocal factorial ratios, not divisions: a chain of divisions would dominate the
-/// deflection's latency. Zero (a rigid axis) costs nothing.
+/// to x^7 / x^6 is exact to rounding (the next terms, x^9 / 9! and x^8 / 8!, are below 3e-21
+/// relative) and several times cheaper than the library call; the lanes of
+/// [`super::turns`] evaluate the same series. Multiplications by the reciprocal factorial
+/// ratios, not divisions: a chain of divisions would dominate the deflection's latency.
 #[inline]
 fn sin_cos_small(x: f64) -> (f64, f64) {
     const R6: f64 = 1.0 / 6.0;
     const R20: f64 = 1.0 / 20.0;
     const R42: f64 = 1.0 / 42.0;
-    const R72: f64 = 1.0 / 72.0;
     const R12: f64 = 1.0 / 12.0;
     const R30: f64 = 1.0 / 30.0;
-    const R56: f64 = 1.0 / 56.0;
-    const R90: f64 = 1.0 / 90.0;
-    let ax = x.abs();
-    if ax == 0.0 {
-        (x, 1.0)
-    } else if ax < 1.0e-3 {
+    if x.abs() < 1.0e-2 {
         let x2 = x * x;
-        let s = x * (1.0 - x2 * R6 * (1.0 - x2 * R20));
-        let c = 1.0 - x2 * 0.5 * (1.0 - x2 * R12);
-        (s, c)
-    } else if ax < 1.0e-2 {
-        let x2 = x * x;
-        let s = x * (1.0 - x2 * R6 * (1.0 - x2 * R20 * (1.0 - x2 * R42 * (1.0 - x2 * R72))));
-        let c = 1.0
-            - x2 * 0.5 * (1.0 - x2 * R12 * (1.0 - x2 * R30 * (1.0 - x2 * R56 * (1.0 - x2 * R90))));
+        let s = x * (1.0 - x2 * R6 * (1.0 - x2 * R20 * (1.0 - x2 * R42)));
+        let c = 1.0 - x2 * 0.5 * (1.0 - x2 * R12 * (1.0 - x2 * R30));
         (s, c)
     } else {
         (
@@ -85,7 +72,7 @@ pub(crate) fn rotation_vector(q: &UnitQuaternion<f64>) -> Vector3<f64> {
 /// `Rz(gamma) Ry(beta) Rx(alpha)` as a unit quaternion (Eq. 4; nalgebra's
 /// `from_euler_angles(alpha, beta, gamma)`), from half-angle sines and cosines.
 #[inline]
-fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64> {
+pub(super) fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64> {
     let (sr, cr) = sin_cos_small(alpha * 0.5);
     let (sp, cp) = sin_cos_small(beta * 0.5);
     let (sy, cy) = sin_cos_small(gamma * 0.5);
@@ -174,72 +161,13 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
     Ok(tcp)
 }
 
-/// Eq. 7 for one spring, `alpha = M_C / k_C`, `beta = M_B / k_B`, `gamma = M_A / k_A`: the
-/// angles \[rad\] of the spring with compliances `compliance` and rigid world frame `frame`
-/// under the moment `m` \[N m\] (world axes, about its origin). The one guard of the
-/// small-deflection model: an angle past [`MAX_SPRING_ANGLE`] (or NaN from overflowing
-/// moments) is refused. Always inlined: called out of line, the moment stored by the caller
-/// and reloaded across its element boundary stalled store forwarding (a quarter of
-/// `deflection`'s time in perf, KR 300).
-#[inline(always)]
-fn spring_angles(
-    compliance: &Vector3<f64>,
-    frame: &Isometry3<f64>,
-    m: &Vector3<f64>,
-) -> Result<Vector3<f64>, TickError> {
-    let angles = compliance.component_mul(&frame.rotation.inverse_transform_vector(m));
-    let largest = angles.amax();
-    if largest.is_nan() || largest > MAX_SPRING_ANGLE {
-        return Err(TickError::InvalidArgument {
-            what: "load (an elastic angle exceeds MAX_SPRING_ANGLE, outside the \
-                   small-deflection model)",
-            value: largest,
-        });
-    }
-    Ok(angles)
-}
-
 // The loops over the springs below are written out (`let Op::Spring { .. } = op else
 // continue`): a shared `filter_map` iterator over the ops measured 25-55 % slower in
 // `vjm::deflection` and `vjm::compliance` (benches/latency.rs, KR 300).
 
-/// The moment on every spring of the TCP `wrench` at `tcp` (Eq. 5-6: the load moved to the
-/// spring's origin, world axes) and its angles (Eq. 7), from the rigid frames of the last
-/// pass, into `data.spring_moments` and `data.spring_angles`.
-fn tcp_loads(
-    model: &Model,
-    data: &mut Data,
-    tcp: &Isometry3<f64>,
-    wrench: &Vector6,
-) -> Result<(), TickError> {
-    let force = Vector3::new(wrench[0], wrench[1], wrench[2]);
-    let moment = Vector3::new(wrench[3], wrench[4], wrench[5]);
-    let p_tcp = tcp.translation.vector;
-    for op in model.ops.iter() {
-        let Op::Spring {
-            compliance, index, ..
-        } = op
-        else {
-            continue;
-        };
-        let Some(f) = data.spring_frames.get(*index).copied() else {
-            continue;
-        };
-        let m = moment + (p_tcp - f.translation.vector).cross(&force);
-        let angles = spring_angles(compliance, &f, &m)?;
-        if let (Some(ms), Some(a)) = (
-            data.spring_moments.get_mut(*index),
-            data.spring_angles.get_mut(*index),
-        ) {
-            *ms = m;
-            *a = angles;
-        }
-    }
-    Ok(())
-}
-
 /// The angles (Eq. 7) of every spring from `data.spring_moments`, into `data.spring_angles`.
-fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> {
+/// Then [`super::turns::check_angles`]: the largest angle, or the model's guard.
+fn angles_from_moments(model: &Model, data: &mut Data) -> Result<f64, TickError> {
     for op in model.ops.iter() {
         let Op::Spring {
             compliance, index, ..
@@ -253,35 +181,12 @@ fn angles_from_moments(model: &Model, data: &mut Data) -> Result<(), TickError> 
         ) else {
             continue;
         };
-        let angles = spring_angles(compliance, f, m)?;
+        let angles = compliance.component_mul(&f.rotation.inverse_transform_vector(m));
         if let Some(slot) = data.spring_angles.get_mut(*index) {
             *slot = angles;
         }
     }
-    Ok(())
-}
-
-/// The deflected TCP (Eq. 8) from the spring angles: with `F_k` the rigid world frame of
-/// spring `k` and `R*_k` its rotation (Eq. 4), the deflected chain is
-/// `T = (F_1 R*_1 F_1^-1) ... (F_n R*_n F_n^-1) T_tcp` (each factor turns the rest of the
-/// chain about the spring's origin), applied from the last spring back: one rotation per
-/// spring instead of a second walk along the chain.
-pub(super) fn deflected_tcp(model: &Model, data: &Data, tcp: &Isometry3<f64>) -> Isometry3<f64> {
-    let (mut r, mut p) = (tcp.rotation, tcp.translation.vector);
-    for k in (0..model.springs).rev() {
-        let (Some(f), Some(a)) = (data.spring_frames.get(k), data.spring_angles.get(k)) else {
-            continue;
-        };
-        let e = euler_zyx(a.x, a.y, a.z);
-        // F e F^-1: conjugating a quaternion by a rotation turns its vector part (one
-        // vector rotation instead of two quaternion products).
-        let v = f.rotation * e.imag();
-        let q = UnitQuaternion::new_unchecked(nalgebra::Quaternion::from_parts(e.scalar(), v));
-        let origin = f.translation.vector;
-        r = q * r;
-        p = q * (p - origin) + origin;
-    }
-    Isometry3::from_parts(p.into(), r)
+    super::turns::check_angles(model, data)
 }
 
 /// The first-order deflection `sum_s [theta_s x (p_tcp - o_s); theta_s]` of the spring
@@ -309,22 +214,6 @@ fn displaced(t: &Isometry3<f64>, d: &Vector6) -> Isometry3<f64> {
         (t.translation.vector + dp).into(),
         UnitQuaternion::from_scaled_axis(dr) * t.rotation,
     )
-}
-
-/// `[dp; dr]` of the deflected TCP against the rigid one, and both poses into `data`.
-fn finish_deflection(
-    data: &mut Data,
-    tcp: &Isometry3<f64>,
-    deflected: &Isometry3<f64>,
-) -> Result<Vector6, TickError> {
-    let dp = deflected.translation.vector - tcp.translation.vector;
-    let dr = rotation_vector(&(deflected.rotation * tcp.rotation.inverse()));
-    let d = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z);
-    // A wrench of 1e308 N overflows the spring moments: refuse rather than return NaN.
-    check_output("deflection", d.as_slice())?;
-    data.tcp = *tcp;
-    data.tcp_deflected = *deflected;
-    Ok(d)
 }
 
 /// TCP deflection `[dx, dy, dz, rx, ry, rz]` \[m, rad\] in the base frame at joints `q`
@@ -357,11 +246,11 @@ pub fn deflection(
 ) -> Result<Vector6, TickError> {
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
-    let tcp = match load.arm() {
+    // The rigid TCP and the largest elastic angle.
+    let (tcp, largest) = match load.arm() {
         Some(motion) => {
             let tcp = arm_pass(model, data, q, wrench, motion)?;
-            angles_from_moments(model, data)?;
-            tcp
+            (tcp, angles_from_moments(model, data)?)
         }
         None => {
             let tcp = rigid_pass(model, data, q);
@@ -373,18 +262,26 @@ pub fn deflection(
                 for slot in data.spring_moments.iter_mut().take(n) {
                     *slot = Vector3::zeros();
                 }
+                (tcp, 0.0)
             } else {
-                tcp_loads(model, data, &tcp, wrench)?;
+                (tcp, super::turns::tcp_loads(model, data, &tcp, wrench)?)
             }
-            tcp
         }
     };
     fill_jacobian(model, data, &tcp);
     match load {
-        Load::Rigid => finish_deflection(data, &tcp, &tcp),
+        Load::Rigid => {
+            data.tcp = tcp;
+            data.tcp_deflected = tcp;
+            Ok(Vector6::zeros())
+        }
         Load::Exact | Load::ExactWithArm(_) => {
-            let deflected = deflected_tcp(model, data, &tcp);
-            finish_deflection(data, &tcp, &deflected)
+            let (d, deflected) = super::turns::deflected_tcp(model, data, &tcp, largest);
+            // A wrench of 1e308 N overflows the spring moments: refuse rather than return NaN.
+            check_output("deflection", d.as_slice())?;
+            data.tcp = tcp;
+            data.tcp_deflected = deflected;
+            Ok(d)
         }
         Load::Linearized | Load::LinearizedWithArm(_) => {
             let d = linear_sum(model, data, &tcp);

@@ -125,17 +125,47 @@ mod avx {
     }
 }
 
+/// A computation over lanes, written once for every [`Lanes`].
+pub(crate) trait LaneKernel {
+    /// What it returns.
+    type Output;
+    /// Runs it in the lanes `l`. Implementations are `#[inline(always)]`, so that the
+    /// arithmetic is compiled inside [`dispatch`]'s AVX2 function.
+    fn run<L: Lanes>(self, l: L) -> Self::Output;
+}
+
+/// Runs `kernel` in AVX2 registers where the CPU has them (with `std` on x86-64: one cached
+/// feature check), in plain arrays otherwise.
+#[inline(always)]
+pub(crate) fn dispatch<K: LaneKernel>(kernel: K) -> K::Output {
+    #[cfg(all(feature = "std", target_arch = "x86_64"))]
+    if let Some(simd) = pulp::x86::V3::try_new() {
+        /// The kernel as pulp's closure, compiled with AVX2 enabled.
+        struct Avx<K>(pulp::x86::V3, K);
+        impl<K: LaneKernel> pulp::NullaryFnOnce for Avx<K> {
+            type Output = K::Output;
+            #[inline(always)]
+            fn call(self) -> K::Output {
+                self.1.run(self.0)
+            }
+        }
+        return simd.vectorize(Avx(simd, kernel));
+    }
+    kernel.run(Plain)
+}
+
 /// Three lanes-vectors: x, y, z of four springs.
 #[derive(Debug, Clone, Copy)]
-struct V4<T> {
-    x: T,
-    y: T,
-    z: T,
+pub(crate) struct V4<T> {
+    pub(crate) x: T,
+    pub(crate) y: T,
+    pub(crate) z: T,
 }
 
 impl<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>> V4<T> {
+    /// The cross product, lane by lane, in nalgebra's order of operations.
     #[inline(always)]
-    fn cross(self, o: Self) -> Self {
+    pub(crate) fn cross(self, o: Self) -> Self {
         Self {
             x: self.y * o.z - self.z * o.y,
             y: self.z * o.x - self.x * o.z,
@@ -164,30 +194,16 @@ pub(super) fn compliance_sums(model: &Model, data: &mut Data, p: &Vector3<f64>) 
 
 /// The lane sums, in AVX2 registers where the CPU has them.
 fn blocks(model: &Model, data: &Data, p: &Vector3<f64>) -> ([f64; 6], [f64; 9], [f64; 6]) {
-    #[cfg(all(feature = "std", target_arch = "x86_64"))]
-    if let Some(simd) = pulp::x86::V3::try_new() {
-        /// The kernel as pulp's inlined closure.
-        struct Kernel<'a> {
-            simd: pulp::x86::V3,
-            model: &'a Model,
-            data: &'a Data,
-            p: &'a Vector3<f64>,
+    /// [`blocks_in`] as a lane kernel.
+    struct Blocks<'a>(&'a Model, &'a Data, &'a Vector3<f64>);
+    impl LaneKernel for Blocks<'_> {
+        type Output = ([f64; 6], [f64; 9], [f64; 6]);
+        #[inline(always)]
+        fn run<L: Lanes>(self, l: L) -> Self::Output {
+            blocks_in(l, self.0, self.1, self.2)
         }
-        impl pulp::NullaryFnOnce for Kernel<'_> {
-            type Output = ([f64; 6], [f64; 9], [f64; 6]);
-            #[inline(always)]
-            fn call(self) -> Self::Output {
-                blocks_in(self.simd, self.model, self.data, self.p)
-            }
-        }
-        return simd.vectorize(Kernel {
-            simd,
-            model,
-            data,
-            p,
-        });
     }
-    blocks_in(Plain, model, data, p)
+    dispatch(Blocks(model, data, p))
 }
 
 /// The lane loop over the springs, in the lanes `l`.
@@ -306,14 +322,14 @@ fn blocks_in<L: Lanes>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
     use super::*;
     use crate::vjm::{Data, ModelBuilder, deflection};
 
     /// Six springs (a whole chunk of four and a partial one) on an oblique three-joint arm.
-    pub(super) fn arm() -> (Model, [f64; 3]) {
+    pub(crate) fn arm() -> (Model, [f64; 3]) {
         let model = ModelBuilder::new()
             .fixed(Isometry3::translation(0.0, 0.0, 0.4))
             .unwrap()

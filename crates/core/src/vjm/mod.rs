@@ -24,6 +24,7 @@ mod lanes;
 mod loads;
 mod model;
 mod trig;
+mod turns;
 
 pub use correction::{
     JointCorrection, MAX_CORRECTION_ITERATIONS, POSE_TOLERANCE, commanded_pose, joint_correction,
