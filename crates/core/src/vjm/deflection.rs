@@ -166,8 +166,8 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
 // `vjm::deflection` and `vjm::compliance` (benches/latency.rs, KR 300).
 
 /// The angles (Eq. 7) of every spring from `data.spring_moments`, into `data.spring_angles`.
-/// Then [`super::turns::check_angles`]: the largest angle, or the model's guard.
-fn angles_from_moments(model: &Model, data: &mut Data) -> Result<f64, TickError> {
+/// (Checked by the kernels of [`super::turns`].)
+fn angles_from_moments(model: &Model, data: &mut Data) {
     for op in model.ops.iter() {
         let Op::Spring {
             compliance, index, ..
@@ -186,23 +186,6 @@ fn angles_from_moments(model: &Model, data: &mut Data) -> Result<f64, TickError>
             *slot = angles;
         }
     }
-    super::turns::check_angles(model, data)
-}
-
-/// The first-order deflection `sum_s [theta_s x (p_tcp - o_s); theta_s]` of the spring
-/// angles, `theta_s = R_s a_s` the world rotation vector of spring `s` about its origin
-/// `o_s`: `C(q) w` when the moments come from the TCP wrench alone.
-fn linear_sum(model: &Model, data: &Data, tcp: &Isometry3<f64>) -> Vector6 {
-    let mut d = Vector6::zeros();
-    for k in 0..model.springs {
-        let (Some(f), Some(a)) = (data.spring_frames.get(k), data.spring_angles.get(k)) else {
-            continue;
-        };
-        let theta = f.rotation * a;
-        let lin = theta.cross(&(tcp.translation.vector - f.translation.vector));
-        d += Vector6::new(lin.x, lin.y, lin.z, theta.x, theta.y, theta.z);
-    }
-    d
 }
 
 /// `t` moved by the small pose change `d = [dp; dr]` (translation, then the rotation vector
@@ -246,51 +229,41 @@ pub fn deflection(
 ) -> Result<Vector6, TickError> {
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
-    // The rigid TCP and the largest elastic angle.
-    let (tcp, largest) = match load.arm() {
+    // The rigid TCP, and the TCP wrench whose loads the springs' pass computes (with an arm
+    // motion, the moments of every load are in `data` already).
+    let (tcp, tcp_wrench) = match load.arm() {
         Some(motion) => {
             let tcp = arm_pass(model, data, q, wrench, motion)?;
-            (tcp, angles_from_moments(model, data)?)
+            angles_from_moments(model, data);
+            (tcp, None)
         }
-        None => {
-            let tcp = rigid_pass(model, data, q);
-            if load == Load::Rigid {
-                let n = model.springs;
-                for slot in data.spring_angles.iter_mut().take(n) {
-                    *slot = Vector3::zeros();
-                }
-                for slot in data.spring_moments.iter_mut().take(n) {
-                    *slot = Vector3::zeros();
-                }
-                (tcp, 0.0)
-            } else {
-                (tcp, super::turns::tcp_loads(model, data, &tcp, wrench)?)
-            }
-        }
+        None => (rigid_pass(model, data, q), Some(wrench)),
     };
     fill_jacobian(model, data, &tcp);
-    match load {
+    let (d, deflected) = match load {
         Load::Rigid => {
-            data.tcp = tcp;
-            data.tcp_deflected = tcp;
-            Ok(Vector6::zeros())
+            let n = model.springs;
+            for slot in data.spring_angles.iter_mut().take(n) {
+                *slot = Vector3::zeros();
+            }
+            for slot in data.spring_moments.iter_mut().take(n) {
+                *slot = Vector3::zeros();
+            }
+            (Vector6::zeros(), None)
         }
         Load::Exact | Load::ExactWithArm(_) => {
-            let (d, deflected) = super::turns::deflected_tcp(model, data, &tcp, largest);
-            // A wrench of 1e308 N overflows the spring moments: refuse rather than return NaN.
-            check_output("deflection", d.as_slice())?;
-            data.tcp = tcp;
-            data.tcp_deflected = deflected;
-            Ok(d)
+            let (d, deflected) = super::turns::exact(model, data, &tcp, tcp_wrench)?;
+            (d, Some(deflected))
         }
         Load::Linearized | Load::LinearizedWithArm(_) => {
-            let d = linear_sum(model, data, &tcp);
-            check_output("deflection", d.as_slice())?;
-            data.tcp = tcp;
-            data.tcp_deflected = displaced(&tcp, &d);
-            Ok(d)
+            (super::turns::linear(model, data, &tcp, tcp_wrench)?, None)
         }
-    }
+    };
+    // A wrench of 1e308 N overflows the spring moments: refuse rather than return NaN.
+    check_output("deflection", d.as_slice())?;
+    data.tcp = tcp;
+    data.tcp_deflected = deflected.unwrap_or_else(|| displaced(&tcp, &d));
+    Ok(d)
 }
 
 /// Fills `data.jacobian` from the joint axes and origins of the last pass: one column per

@@ -1,5 +1,5 @@
-//! The springs' loads (Eq. 5-7) and turns (Eq. 3-4, 8) four springs at a time, in the lanes of
-//! [`super::lanes`], and the deflected TCP as a product of the turns.
+//! The springs' loads (Eq. 5-7), turns (Eq. 3-4, 8) and first-order sums, four springs at a
+//! time in the lanes of [`super::lanes`], in one pass over the springs.
 //!
 //! The deflected chain of Eq. 8 is `T = Q_1 ... Q_n T_tcp`, `Q_k` the turn of spring `k` about
 //! its origin `o_k` (`x -> q_k (x - o_k) + o_k`, `q_k` the rotation of Eq. 4 in world axes).
@@ -7,51 +7,28 @@
 //! `(q_k, q_k L_k - L_k)` with the lever `L_k = p_tcp - o_k`, and `q_k L_k - L_k` is computed
 //! without forming `q_k L_k` (no cancellation of metre-sized terms). The TCP's deflection is
 //! then the translation of the product `Q'_1 ... Q'_n` and the rotation vector of its rotation,
-//! each accurate relative to the deflection itself rather than to the arm's size. The product is
-//! formed as four interleaved runs of consecutive springs, then combined: four independent
-//! dependency chains instead of one through all springs.
+//! each accurate relative to the deflection itself rather than to the arm's size.
+//!
+//! Lane `g` takes the `g`-th run of `ceil(n / 4)` consecutive springs, and step `c` of the pass
+//! spring `g ceil(n / 4) + c` of each run: the loads and turns of four springs at once, and the
+//! product as four independent runs (combined at the end) instead of one dependency chain
+//! through all springs.
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use super::deflection::{MAX_SPRING_ANGLE, euler_zyx};
+use super::deflection::{MAX_SPRING_ANGLE, euler_zyx, rotation_vector};
 use super::lanes::{LaneKernel, Lanes, V4, dispatch};
 use super::{Data, Model, Vector6};
 use crate::error::TickError;
 
 /// Below this elastic angle \[rad\] (half-angle 1e-2) the turns' sines and cosines are the
-/// series of [`super::deflection`]'s `sin_cos_small`; a spring turned further is recomputed
-/// with the library's.
+/// series of [`super::deflection`]'s `sin_cos_small`; with a spring turned further the turns are
+/// formed one by one with the library's.
 const SERIES_ANGLE: f64 = 2.0e-2;
 
-/// The four entries of a per-spring table from `base` (past the spring count the tables hold
-/// identity frames, zero compliances and zero angles, which add nothing).
+/// Lane-wise `a * s` for a vector of lanes and one lane value.
 #[inline(always)]
-fn four<T>(table: &[T], base: usize) -> Option<&[T; 4]> {
-    table.get(base..base + 4)?.try_into().ok()
-}
-
-/// Rotation (`w`, vector part `u`) and origin `o` of four frames, as lanes.
-#[inline(always)]
-fn frame_lanes<L: Lanes>(l: L, fs: &[Isometry3<f64>; 4]) -> (L::V, V4<L::V>, V4<L::V>) {
-    let q = fs.each_ref().map(|f| f.rotation.coords);
-    let o = fs.each_ref().map(|f| f.translation.vector);
-    let w = l.load(q.map(|v| v.w));
-    let u = V4 {
-        x: l.load(q.map(|v| v.x)),
-        y: l.load(q.map(|v| v.y)),
-        z: l.load(q.map(|v| v.z)),
-    };
-    let o = V4 {
-        x: l.load(o.map(|v| v.x)),
-        y: l.load(o.map(|v| v.y)),
-        z: l.load(o.map(|v| v.z)),
-    };
-    (w, u, o)
-}
-
-/// `a * s` lane by lane, for a vector of lanes and one lane value.
-#[inline(always)]
-fn scale<L: Lanes>(a: V4<L::V>, s: L::V) -> V4<L::V> {
+fn scale<V: Copy + core::ops::Mul<Output = V>>(a: V4<V>, s: V) -> V4<V> {
     V4 {
         x: a.x * s,
         y: a.y * s,
@@ -60,7 +37,7 @@ fn scale<L: Lanes>(a: V4<L::V>, s: L::V) -> V4<L::V> {
 }
 
 #[inline(always)]
-fn add<L: Lanes>(a: V4<L::V>, b: V4<L::V>) -> V4<L::V> {
+fn add<V: Copy + core::ops::Add<Output = V>>(a: V4<V>, b: V4<V>) -> V4<V> {
     V4 {
         x: a.x + b.x,
         y: a.y + b.y,
@@ -69,7 +46,7 @@ fn add<L: Lanes>(a: V4<L::V>, b: V4<L::V>) -> V4<L::V> {
 }
 
 #[inline(always)]
-fn sub<L: Lanes>(a: V4<L::V>, b: V4<L::V>) -> V4<L::V> {
+fn sub<V: Copy + core::ops::Sub<Output = V>>(a: V4<V>, b: V4<V>) -> V4<V> {
     V4 {
         x: a.x - b.x,
         y: a.y - b.y,
@@ -77,96 +54,38 @@ fn sub<L: Lanes>(a: V4<L::V>, b: V4<L::V>) -> V4<L::V> {
     }
 }
 
-/// Writes lane `j < n - base` of `v` into `out[base + j]`.
+/// Four vectors as lanes.
 #[inline(always)]
-fn scatter<L: Lanes>(l: L, v: V4<L::V>, out: &mut [Vector3<f64>], base: usize, n: usize) {
+fn load3<L: Lanes>(l: L, v: [Vector3<f64>; 4]) -> V4<L::V> {
+    V4 {
+        x: l.load(v.map(|v| v.x)),
+        y: l.load(v.map(|v| v.y)),
+        z: l.load(v.map(|v| v.z)),
+    }
+}
+
+/// One vector in every lane.
+#[inline(always)]
+fn splat3<L: Lanes>(l: L, v: &Vector3<f64>) -> V4<L::V> {
+    V4 {
+        x: l.splat(v.x),
+        y: l.splat(v.y),
+        z: l.splat(v.z),
+    }
+}
+
+/// Writes lane `g` of `v` into `out[k_g]` for the springs `k_g` in `at`.
+#[inline(always)]
+fn scatter<L: Lanes>(l: L, v: V4<L::V>, out: &mut [Vector3<f64>], at: [Option<usize>; 4]) {
     let (x, y, z) = (l.store(v.x), l.store(v.y), l.store(v.z));
-    for j in 0..4 {
-        if base + j < n
+    for (g, k) in at.into_iter().enumerate() {
+        if let Some(k) = k
             && let (Some(slot), Some(x), Some(y), Some(z)) =
-                (out.get_mut(base + j), x.get(j), y.get(j), z.get(j))
+                (out.get_mut(k), x.get(g), y.get(g), z.get(g))
         {
             *slot = Vector3::new(*x, *y, *z);
         }
     }
-}
-
-/// The moment on every spring of the TCP `wrench` at `tcp` (Eq. 5-6: the load moved to the
-/// spring's origin, world axes) and its angles (Eq. 7), from the rigid frames of the last
-/// pass, into `data.spring_moments` and `data.spring_angles`; then [`check_angles`] (the
-/// largest angle).
-pub(super) fn tcp_loads(
-    model: &Model,
-    data: &mut Data,
-    tcp: &Isometry3<f64>,
-    wrench: &Vector6,
-) -> Result<f64, TickError> {
-    /// The lane kernel.
-    struct Loads<'a> {
-        model: &'a Model,
-        data: &'a mut Data,
-        p: Vector3<f64>,
-        force: Vector3<f64>,
-        moment: Vector3<f64>,
-    }
-    impl LaneKernel for Loads<'_> {
-        type Output = ();
-        #[inline(always)]
-        fn run<L: Lanes>(self, l: L) {
-            let Self {
-                model,
-                data,
-                p,
-                force,
-                moment,
-            } = self;
-            let n = model.springs;
-            let splat = |v: Vector3<f64>| V4 {
-                x: l.splat(v.x),
-                y: l.splat(v.y),
-                z: l.splat(v.z),
-            };
-            let (p, force, moment) = (splat(p), splat(force), splat(moment));
-            let two = l.splat(2.0);
-            for base in (0..n).step_by(4) {
-                let (Some(fs), Some(cs)) = (
-                    four(&data.spring_frames, base),
-                    four(&model.spring_compliance, base),
-                ) else {
-                    continue; // unreachable: the tables hold whole chunks
-                };
-                let (w, u, o) = frame_lanes(l, fs);
-                // Eq. 5-6: m = M + (p_tcp - o) x F.
-                let m = add::<L>(moment, sub::<L>(p, o).cross(force));
-                // The moment in the spring's axes, R^T m: nalgebra's rotation by the
-                // conjugate (w, -u), `(t' w + (-u) x t') + m` with `t' = 2 (-u) x m`,
-                // written with `t = 2 u x m` as `(u x t - t w) + m` (the same bits).
-                let t = scale::<L>(u.cross(m), two);
-                let local = add::<L>(sub::<L>(u.cross(t), scale::<L>(t, w)), m);
-                // Eq. 7: the angles M / k.
-                let c = V4 {
-                    x: l.load(cs.map(|c| c.x)),
-                    y: l.load(cs.map(|c| c.y)),
-                    z: l.load(cs.map(|c| c.z)),
-                };
-                let angles = V4 {
-                    x: c.x * local.x,
-                    y: c.y * local.y,
-                    z: c.z * local.z,
-                };
-                scatter(l, m, &mut data.spring_moments, base, n);
-                scatter(l, angles, &mut data.spring_angles, base, n);
-            }
-        }
-    }
-    dispatch(Loads {
-        model,
-        data: &mut *data,
-        p: tcp.translation.vector,
-        force: Vector3::new(wrench[0], wrench[1], wrench[2]),
-        moment: Vector3::new(wrench[3], wrench[4], wrench[5]),
-    });
-    check_angles(model, data)
 }
 
 /// The largest elastic angle of any spring \[rad\]; [`TickError::InvalidArgument`] for the first
@@ -202,8 +121,8 @@ fn sin_cos_series<L: Lanes>(l: L, x: L::V) -> (L::V, L::V) {
 
 /// The turn of one spring relative to the rigid TCP at `p` (see the module): `q = F e F^-1`
 /// with `e` the rotation of Eq. 4 from the spring's angles `a` and `F` its world frame, and the
-/// translation `q L - L`, `L = p - o`. The scalar twin of [`lane_turns`], for springs turned
-/// past the series' range.
+/// translation `q L - L`, `L = p - o`. The scalar twin of [`Frames4::turn`], for springs
+/// turned past the series' range.
 fn turn_of(f: &Isometry3<f64>, a: &Vector3<f64>, p: &Vector3<f64>) -> Isometry3<f64> {
     let e = euler_zyx(a.x, a.y, a.z);
     let v = f.rotation * e.imag();
@@ -238,173 +157,252 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
             y: a.w * b.u.y - a.u.x * b.u.z + a.u.y * b.w + a.u.z * b.u.x,
             z: a.w * b.u.z + a.u.x * b.u.y - a.u.y * b.u.x + a.u.z * b.w,
         };
-        let c = a.u.cross(b.t);
-        let r = V4 {
-            x: c.x * two,
-            y: c.y * two,
-            z: c.z * two,
-        };
+        let r = scale(a.u.cross(b.t), two);
         let rc = a.u.cross(r);
-        let t = V4 {
-            x: a.t.x + ((r.x * a.w + rc.x) + b.t.x),
-            y: a.t.y + ((r.y * a.w + rc.y) + b.t.y),
-            z: a.t.z + ((r.z * a.w + rc.z) + b.t.z),
-        };
+        let t = add(a.t, add(add(scale(r, a.w), rc), b.t));
         Self { w, u, t }
     }
 }
 
-/// The lane kernel of [`turn_product`]: the four runs' products, as arrays of lanes.
+/// The rigid world frames of four springs as lanes: rotation `w`, `u` and origin `o`.
 #[derive(Clone, Copy)]
-struct Runs<'a> {
-    model: &'a Model,
-    data: &'a Data,
-    p: Vector3<f64>,
+struct Frames4<V> {
+    w: V,
+    u: V4<V>,
+    o: V4<V>,
 }
-impl LaneKernel for Runs<'_> {
+
+impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::ops::Mul<Output = V>>
+    Frames4<V>
+{
+    /// The vector `v` (world axes) in the frames' axes, `R^T v`: nalgebra's rotation by the
+    /// conjugate `(w, -u)`, `(t' w + (-u) x t') + v` with `t' = 2 (-u) x v`, written with
+    /// `t = 2 u x v` as `(u x t - t w) + v` (the same bits).
+    #[inline(always)]
+    fn to_local(&self, v: V4<V>, two: V) -> V4<V> {
+        let t = scale(self.u.cross(v), two);
+        add(sub(self.u.cross(t), scale(t, self.w)), v)
+    }
+
+    /// The vector `v` (the frames' axes) in world axes, `R v`: nalgebra's
+    /// `(t w + u x t) + v`, `t = 2 u x v`.
+    #[inline(always)]
+    fn to_world(&self, v: V4<V>, two: V) -> V4<V> {
+        let t = scale(self.u.cross(v), two);
+        add(add(scale(t, self.w), self.u.cross(t)), v)
+    }
+
+    /// The turns of the four springs by the angles `a` relative to the rigid TCP at `p`, with
+    /// the series' sines (all angles below [`SERIES_ANGLE`]): the lanes of [`turn_of`].
+    #[inline(always)]
+    fn turn<L: Lanes<V = V>>(&self, l: L, a: V4<V>, p: V4<V>, two: V) -> Motion4<V> {
+        let half = l.splat(0.5);
+        // Eq. 4, `Rz(gamma) Ry(beta) Rx(alpha)` from the half-angles (as `euler_zyx`, the
+        // same operations).
+        let (sr, cr) = sin_cos_series(l, a.x * half);
+        let (sp, cp) = sin_cos_series(l, a.y * half);
+        let (sy, cy) = sin_cos_series(l, a.z * half);
+        let ew = cr * cp * cy + sr * sp * sy;
+        let e = V4 {
+            x: sr * cp * cy - cr * sp * sy,
+            y: cr * sp * cy + sr * cp * sy,
+            z: cr * cp * sy - sr * sp * cy,
+        };
+        // F e F^-1: the vector part turned by F.
+        let v = self.to_world(e, two);
+        // q L - L without q L: `t2 ew + v x t2`, `t2 = 2 v x L`.
+        let t2 = scale(v.cross(sub(p, self.o)), two);
+        Motion4 {
+            w: ew,
+            u: v,
+            t: add(scale(t2, ew), v.cross(t2)),
+        }
+    }
+}
+
+/// One pass over the springs in lanes: with `LOADS`, the moments and angles of the TCP wrench
+/// (into `data`), else the angles already in `data`; with `EXACT`, the four runs' products of
+/// the turns (lanes of `w, u.x, u.y, u.z, t.x, t.y, t.z`), else the first-order sums
+/// `sum_s [theta_s x L_s; theta_s]` (lanes of the six components; the seventh is zero).
+struct Springs<'a, const LOADS: bool, const EXACT: bool> {
+    model: &'a Model,
+    data: &'a mut Data,
+    p: Vector3<f64>,
+    force: Vector3<f64>,
+    moment: Vector3<f64>,
+}
+
+impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXACT> {
     type Output = [[f64; 4]; 7];
     #[inline(always)]
     fn run<L: Lanes>(self, l: L) -> [[f64; 4]; 7] {
-        let Self { model, data, p } = self;
+        let Self {
+            model,
+            data,
+            p,
+            force,
+            moment,
+        } = self;
         let n = model.springs;
         let run = n.div_ceil(4);
-        let p = V4 {
-            x: l.splat(p.x),
-            y: l.splat(p.y),
-            z: l.splat(p.z),
-        };
-        let (zero, one, two, half) = (l.splat(0.0), l.splat(1.0), l.splat(2.0), l.splat(0.5));
+        let (p, force, moment) = (splat3(l, &p), splat3(l, &force), splat3(l, &moment));
+        let (zero, one, two) = (l.splat(0.0), l.splat(1.0), l.splat(2.0));
         let none = V4 {
             x: zero,
             y: zero,
             z: zero,
         };
-        let mut acc = Motion4 {
+        let mut product = Motion4 {
             w: one,
             u: none,
             t: none,
         };
+        let (mut lin, mut rot) = (none, none);
         let identity = Isometry3::identity();
         let still = Vector3::zeros();
         for c in 0..run {
-            // Spring g run + c of each run; past the count, an identity frame and no
-            // turn (the identity motion, exactly).
-            let pick = |g: usize| {
-                let k = g * run + c;
-                match (data.spring_frames.get(k), data.spring_angles.get(k)) {
-                    (Some(f), Some(a)) if k < n => (f, a),
-                    _ => (&identity, &still),
-                }
+            // Spring g run + c of each run; past the count, an identity frame, no
+            // compliance and no angle (no moment, no turn: the identity motion, exactly).
+            let at = [0, 1, 2, 3].map(|g| Some(g * run + c).filter(|k| *k < n));
+            let pick = |table: &[Vector3<f64>]| {
+                at.map(|k| k.and_then(|k| table.get(k)).copied().unwrap_or(still))
             };
-            let springs = [pick(0), pick(1), pick(2), pick(3)];
-            let fs = springs.map(|(f, _)| f);
-            let a = springs.map(|(_, a)| a);
-            let turn = lane_turns(l, fs, a, p, two, half);
-            acc = acc.then(turn, two);
+            let fs = at.map(|k| {
+                k.and_then(|k| data.spring_frames.get(k))
+                    .unwrap_or(&identity)
+            });
+            let q = fs.map(|f| f.rotation.coords);
+            let frames = Frames4 {
+                w: l.load(q.map(|v| v.w)),
+                u: load3(l, q.map(|v| v.xyz())),
+                o: load3(l, fs.map(|f| f.translation.vector)),
+            };
+            let lever = sub(p, frames.o);
+            let a = if LOADS {
+                // Eq. 5-6: m = M + (p_tcp - o) x F; Eq. 7: the angles M / k in the
+                // spring's axes.
+                let m = add(moment, lever.cross(force));
+                let c = load3(l, pick(&model.spring_compliance));
+                let local = frames.to_local(m, two);
+                let a = V4 {
+                    x: c.x * local.x,
+                    y: c.y * local.y,
+                    z: c.z * local.z,
+                };
+                scatter(l, m, &mut data.spring_moments, at);
+                scatter(l, a, &mut data.spring_angles, at);
+                a
+            } else {
+                load3(l, pick(&data.spring_angles))
+            };
+            if EXACT {
+                product = product.then(frames.turn(l, a, p, two), two);
+            } else {
+                // theta = R a, the world rotation vector; its translation theta x L.
+                let theta = frames.to_world(a, two);
+                lin = add(lin, theta.cross(lever));
+                rot = add(rot, theta);
+            }
         }
-        [
-            l.store(acc.w),
-            l.store(acc.u.x),
-            l.store(acc.u.y),
-            l.store(acc.u.z),
-            l.store(acc.t.x),
-            l.store(acc.t.y),
-            l.store(acc.t.z),
-        ]
-    }
-}
-/// The product `Q'_1 ... Q'_n` of every spring's turn relative to the rigid TCP at `p` (see the
-/// module), from `data.spring_angles` and the rigid frames of the last pass. Lane `g` forms the
-/// product of the `g`-th run of consecutive springs (`ceil(n / 4)` springs each), step `c`
-/// turning spring `g ceil(n / 4) + c` of each run at once; the four runs are combined at the end.
-/// With a spring past the series' range (`largest`, the largest angle, from [`check_angles`];
-/// rare: 0.02 rad is a large elastic angle), the turns one by one with the library's sines.
-fn turn_product(model: &Model, data: &Data, p: &Vector3<f64>, largest: f64) -> Isometry3<f64> {
-    if largest >= SERIES_ANGLE {
-        let springs = data.spring_frames.iter().zip(data.spring_angles.iter());
-        return springs
-            .take(model.springs)
-            .fold(Isometry3::identity(), |t, (f, a)| t * turn_of(f, a, p));
-    }
-    let [w, x, y, z, tx, ty, tz] = dispatch(Runs { model, data, p: *p });
-    let motion = |g: usize| {
-        let at = |v: [f64; 4]| v.get(g).copied().unwrap_or(0.0);
-        Isometry3::from_parts(
-            Translation3::new(at(tx), at(ty), at(tz)),
-            UnitQuaternion::new_unchecked(Quaternion::new(at(w), at(x), at(y), at(z))),
-        )
-    };
-    (motion(0) * motion(1)) * (motion(2) * motion(3))
-}
-
-/// The turns of four springs relative to the rigid TCP at `p`, with the series' sines (all
-/// angles below [`SERIES_ANGLE`]): the lanes of [`turn_of`].
-#[inline(always)]
-fn lane_turns<L: Lanes>(
-    l: L,
-    fs: [&Isometry3<f64>; 4],
-    a: [&Vector3<f64>; 4],
-    p: V4<L::V>,
-    two: L::V,
-    half: L::V,
-) -> Motion4<L::V> {
-    let q = fs.map(|f| f.rotation.coords);
-    let o = fs.map(|f| f.translation.vector);
-    let w = l.load(q.map(|v| v.w));
-    let u = V4 {
-        x: l.load(q.map(|v| v.x)),
-        y: l.load(q.map(|v| v.y)),
-        z: l.load(q.map(|v| v.z)),
-    };
-    let o = V4 {
-        x: l.load(o.map(|v| v.x)),
-        y: l.load(o.map(|v| v.y)),
-        z: l.load(o.map(|v| v.z)),
-    };
-    // Eq. 4, `Rz(gamma) Ry(beta) Rx(alpha)` from the half-angles (as `euler_zyx`, the same
-    // operations).
-    let (sr, cr) = sin_cos_series(l, l.load(a.map(|a| a.x)) * half);
-    let (sp, cp) = sin_cos_series(l, l.load(a.map(|a| a.y)) * half);
-    let (sy, cy) = sin_cos_series(l, l.load(a.map(|a| a.z)) * half);
-    let ew = cr * cp * cy + sr * sp * sy;
-    let e = V4 {
-        x: sr * cp * cy - cr * sp * sy,
-        y: cr * sp * cy + sr * cp * sy,
-        z: cr * cp * sy - sr * sp * cy,
-    };
-    // F e F^-1: the vector part turned by F (nalgebra's `(t w + u x t) + v`, `t = 2 u x v`).
-    let t = scale::<L>(u.cross(e), two);
-    let v = add::<L>(add::<L>(scale::<L>(t, w), u.cross(t)), e);
-    // q L - L without q L: `t2 ew + v x t2`, `t2 = 2 v x L`.
-    let lever = sub::<L>(p, o);
-    let t2 = scale::<L>(v.cross(lever), two);
-    let shift = add::<L>(scale::<L>(t2, ew), v.cross(t2));
-    Motion4 {
-        w: ew,
-        u: v,
-        t: shift,
+        let s = |v: L::V| l.store(v);
+        if EXACT {
+            let (w, u, t) = (product.w, product.u, product.t);
+            [s(w), s(u.x), s(u.y), s(u.z), s(t.x), s(t.y), s(t.z)]
+        } else {
+            [
+                s(lin.x),
+                s(lin.y),
+                s(lin.z),
+                s(rot.x),
+                s(rot.y),
+                s(rot.z),
+                [0.0; 4],
+            ]
+        }
     }
 }
 
-/// The deflected TCP (Eq. 8) from `data.spring_angles` (the largest `largest`, from
-/// [`check_angles`]) and the rigid frames of the last pass: the deflection `[dp; dr]` of the
-/// TCP at `tcp` and the deflected pose (see the module).
-pub(super) fn deflected_tcp(
+/// Runs [`Springs`] for the TCP at `tcp`, with the TCP `wrench`'s loads or (`None`) the angles
+/// in `data`.
+fn springs<const EXACT: bool>(
     model: &Model,
-    data: &Data,
+    data: &mut Data,
     tcp: &Isometry3<f64>,
-    largest: f64,
-) -> (Vector6, Isometry3<f64>) {
-    let total = turn_product(model, data, &tcp.translation.vector, largest);
-    let dp = total.translation.vector;
-    let dr = super::deflection::rotation_vector(&total.rotation);
-    let deflected = Isometry3::from_parts(
-        (tcp.translation.vector + dp).into(),
-        total.rotation * tcp.rotation,
-    );
-    (Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z), deflected)
+    wrench: Option<&Vector6>,
+) -> [[f64; 4]; 7] {
+    let p = tcp.translation.vector;
+    match wrench {
+        Some(w) => dispatch(Springs::<true, EXACT> {
+            model,
+            data,
+            p,
+            force: Vector3::new(w[0], w[1], w[2]),
+            moment: Vector3::new(w[3], w[4], w[5]),
+        }),
+        None => dispatch(Springs::<false, EXACT> {
+            model,
+            data,
+            p,
+            force: Vector3::zeros(),
+            moment: Vector3::zeros(),
+        }),
+    }
 }
 
+/// The exact deflection (Eq. 8-9) of the TCP at `tcp` from the rigid frames of the last pass:
+/// under the TCP `wrench` (its moments and angles into `data`), or (`None`) from the angles in
+/// `data`. The deflection `[dp; dr]` and the deflected pose; [`check_angles`]' error.
+pub(super) fn exact(
+    model: &Model,
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    wrench: Option<&Vector6>,
+) -> Result<(Vector6, Isometry3<f64>), TickError> {
+    let [w, x, y, z, tx, ty, tz] = springs::<true>(model, data, tcp, wrench);
+    let largest = check_angles(model, data)?;
+    let p = tcp.translation.vector;
+    let total = if largest < SERIES_ANGLE {
+        let run = |g: usize| {
+            let at = |v: [f64; 4]| v.get(g).copied().unwrap_or(0.0);
+            Isometry3::from_parts(
+                Translation3::new(at(tx), at(ty), at(tz)),
+                UnitQuaternion::new_unchecked(Quaternion::new(at(w), at(x), at(y), at(z))),
+            )
+        };
+        (run(0) * run(1)) * (run(2) * run(3))
+    } else {
+        // A spring past the series' range (rare: 0.02 rad is a large elastic angle): the
+        // turns one by one, with the library's sines.
+        let springs = data.spring_frames.iter().zip(data.spring_angles.iter());
+        springs
+            .take(model.springs)
+            .fold(Isometry3::identity(), |t, (f, a)| t * turn_of(f, a, &p))
+    };
+    let dp = total.translation.vector;
+    let dr = rotation_vector(&total.rotation);
+    let deflected = Isometry3::from_parts((p + dp).into(), total.rotation * tcp.rotation);
+    Ok((Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z), deflected))
+}
+
+/// The first-order deflection `sum_s [theta_s x (p_tcp - o_s); theta_s]` of the TCP at `tcp`,
+/// `theta_s = R_s a_s` the world rotation vector of spring `s` about its origin `o_s`, under
+/// the TCP `wrench` (its moments and angles into `data`; then the deflection is `C(q) w`) or
+/// (`None`) from the angles in `data`; [`check_angles`]' error.
+pub(super) fn linear(
+    model: &Model,
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    wrench: Option<&Vector6>,
+) -> Result<Vector6, TickError> {
+    let sums = springs::<false>(model, data, tcp, wrench);
+    check_angles(model, data)?;
+    let total = |v: [f64; 4]| {
+        let [a, b, c, d] = v;
+        ((a + b) + c) + d
+    };
+    let [x, y, z, rx, ry, rz, _] = sums.map(total);
+    Ok(Vector6::new(x, y, z, rx, ry, rz))
+}
 #[cfg(test)]
 mod tests {
     use nalgebra::{Isometry3, UnitQuaternion, Vector3};
@@ -455,19 +453,34 @@ mod tests {
         }
     }
 
+    /// The kernel in AVX2 registers (where the CPU has them) and in plain arrays: the same
+    /// results and the same moments and angles in `data`, bit for bit.
+    fn lanes_agree<const LOADS: bool, const EXACT: bool>(model: &Model, data: &Data) {
+        let (mut a, mut b) = (data.clone(), data.clone());
+        let p = data.tcp.translation.vector;
+        let kernel = |data| Springs::<LOADS, EXACT> {
+            model,
+            data,
+            p,
+            force: Vector3::new(120.0, -80.0, 45.0),
+            moment: Vector3::new(30.0, -20.0, 15.0),
+        };
+        let plain = kernel(&mut a).run(Plain);
+        assert!(plain.iter().flatten().any(|v| *v != 0.0));
+        assert_eq!(dispatch(kernel(&mut b)), plain);
+        assert_eq!(a.spring_angles, b.spring_angles);
+        assert_eq!(a.spring_moments, b.spring_moments);
+    }
+
     #[test]
-    fn avx2_runs_equal_the_plain_runs_bit_for_bit() {
+    fn avx2_lanes_equal_the_plain_lanes_bit_for_bit() {
         let (model, q) = crate::vjm::lanes::tests::arm();
         let mut data = Data::new(&model);
         let w = Vector6::new(120.0, -80.0, 45.0, 30.0, -20.0, 15.0);
         deflection(&model, &mut data, &q, &w, Load::Exact).unwrap();
-        let runs = Runs {
-            model: &model,
-            data: &data,
-            p: data.tcp.translation.vector,
-        };
-        let plain = runs.run(Plain);
-        assert!(plain.iter().flatten().all(|v| v.is_finite()));
-        assert_eq!(dispatch(runs), plain);
+        lanes_agree::<true, true>(&model, &data);
+        lanes_agree::<true, false>(&model, &data);
+        lanes_agree::<false, true>(&model, &data);
+        lanes_agree::<false, false>(&model, &data);
     }
 }
