@@ -179,7 +179,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// conjugate `(w, -u)`, `(t' w + (-u) x t') + v` with `t' = 2 (-u) x v`, written with
     /// `t = 2 u x v` as `(u x t - t w) + v` (the same bits).
     #[inline(always)]
-    fn to_local(&self, v: V4<V>, two: V) -> V4<V> {
+    fn local(&self, v: V4<V>, two: V) -> V4<V> {
         let t = scale(self.u.cross(v), two);
         add(sub(self.u.cross(t), scale(t, self.w)), v)
     }
@@ -187,7 +187,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// The vector `v` (the frames' axes) in world axes, `R v`: nalgebra's
     /// `(t w + u x t) + v`, `t = 2 u x v`.
     #[inline(always)]
-    fn to_world(&self, v: V4<V>, two: V) -> V4<V> {
+    fn world(&self, v: V4<V>, two: V) -> V4<V> {
         let t = scale(self.u.cross(v), two);
         add(add(scale(t, self.w), self.u.cross(t)), v)
     }
@@ -209,7 +209,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
             z: cr * cp * sy - sr * sp * cy,
         };
         // F e F^-1: the vector part turned by F.
-        let v = self.to_world(e, two);
+        let v = self.world(e, two);
         // q L - L without q L: `t2 ew + v x t2`, `t2 = 2 v x L`.
         let t2 = scale(v.cross(sub(p, self.o)), two);
         Motion4 {
@@ -283,7 +283,7 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
                 // spring's axes.
                 let m = add(moment, lever.cross(force));
                 let c = load3(l, pick(&model.spring_compliance));
-                let local = frames.to_local(m, two);
+                let local = frames.local(m, two);
                 let a = V4 {
                     x: c.x * local.x,
                     y: c.y * local.y,
@@ -299,7 +299,7 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
                 product = product.then(frames.turn(l, a, p, two), two);
             } else {
                 // theta = R a, the world rotation vector; its translation theta x L.
-                let theta = frames.to_world(a, two);
+                let theta = frames.world(a, two);
                 lin = add(lin, theta.cross(lever));
                 rot = add(rot, theta);
             }
