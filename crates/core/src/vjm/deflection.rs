@@ -89,8 +89,8 @@ pub(super) fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64
 /// (before their own motion), which every kernel below reads. Compiled for AVX2 too and chosen
 /// at run time (with `std`): the VEX encoding's three-operand form drops the register copies
 /// of the baseline SSE2 code (UR5 linearized deflection -7 %, KR 300 compliance -3 %; an
-/// AVX-512 version measured the same, and the same for the load and deflected-pose loops
-/// measured 8-13 % slower, so they stay baseline).
+/// AVX-512 version measured the same). The springs' loads and turns that follow run in the
+/// explicit lanes of [`super::turns`] and [`super::lanes`].
 #[cfg_attr(
     feature = "std",
     multiversion::multiversion(targets("x86_64+avx2+fma"))
@@ -161,12 +161,8 @@ pub fn forward(model: &Model, data: &mut Data, q: &[f64]) -> Result<Isometry3<f6
     Ok(tcp)
 }
 
-// The loops over the springs below are written out (`let Op::Spring { .. } = op else
-// continue`): a shared `filter_map` iterator over the ops measured 25-55 % slower in
-// `vjm::deflection` and `vjm::compliance` (benches/latency.rs, KR 300).
-
-/// The angles (Eq. 7) of every spring from `data.spring_moments`, into `data.spring_angles`.
-/// (Checked by the kernels of [`super::turns`].)
+/// The angles (Eq. 7) of every spring from `data.spring_moments` (the arm's own loads with
+/// the TCP wrench), into `data.spring_angles`; [`super::turns`] checks them.
 fn angles_from_moments(model: &Model, data: &mut Data) {
     for op in model.ops.iter() {
         let Op::Spring {
@@ -189,8 +185,8 @@ fn angles_from_moments(model: &Model, data: &mut Data) {
 }
 
 /// `t` moved by the small pose change `d = [dp; dr]` (translation, then the rotation vector
-/// applied in the base frame): the loaded pose of the linearized model.
-/// The rotation is nalgebra's `from_scaled_axis` with the inline sine and cosine of
+/// applied in the base frame): the loaded pose of the linearized model. The rotation is
+/// nalgebra's `from_scaled_axis` with the inline sine and cosine of
 /// [`super::trig`] (the library's `sincos` was 5 % of the UR5's linearized deflection).
 fn displaced(t: &Isometry3<f64>, d: &Vector6) -> Isometry3<f64> {
     let dp = Vector3::new(d[0], d[1], d[2]);

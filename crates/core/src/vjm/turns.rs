@@ -22,7 +22,7 @@ use super::{Data, Model, Vector6};
 use crate::error::TickError;
 
 /// Below this elastic angle \[rad\] (half-angle 1e-2) the turns' sines and cosines are the
-/// series of [`super::deflection`]'s `sin_cos_small`; with a spring turned further the turns are
+/// series of the deflection's `sin_cos_small`; with a spring turned further the turns are
 /// formed one by one with the library's.
 const SERIES_ANGLE: f64 = 2.0e-2;
 
