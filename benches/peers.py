@@ -162,10 +162,10 @@ def bench_vjm(args):
     d_batch = robot.compliance_batch(qs) @ ws[:, :, None]
     ref = np.array([peer.compliance(qs[i]) @ ws[i] for i in range(min(n, 200))])
     agree_b = np.abs(d_batch[: len(ref), :, 0] - ref).max() / np.abs(ref).max()
-    t_d = median_time(lambda: robot.compliance_batch(qs), max(3, args.repeats // 10)) / n
+    t_d = median_time(lambda: robot.compliance_batch(qs), max(5, args.repeats // 2)) / n
     t_p = median_time(lambda: [peer.compliance(x) for x in qs[:2000]], 3) / 2000
     row(f"UR5 compliance, batch of {n} (per row)", t_d, t_p, 1e6, "us", agree_b)
-    t_d = median_time(lambda: robot.deflection_batch(qs, ws), max(3, args.repeats // 10)) / n
+    t_d = median_time(lambda: robot.deflection_batch(qs, ws), max(5, args.repeats // 2)) / n
     row(f"UR5 deflection_batch of {n} (per row) vs C w", t_d, t_p, 1e6, "us", None)
 
 

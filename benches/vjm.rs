@@ -95,6 +95,16 @@ fn ur5(c: &mut Criterion) {
             }
         })
     });
+    // The same rows four at a time (`deflection_batch`'s path), each row's bits the same.
+    g.bench_function("exact_deflection_x4_1024_random_rows", |b| {
+        b.iter(|| {
+            for four in rows.chunks_exact(4) {
+                let q = [0, 1, 2, 3].map(|r| four[r].0.as_slice());
+                let w = [0, 1, 2, 3].map(|r| &four[r].1);
+                let _ = black_box(vjm::exact_deflection_x4(model, &data, q, w));
+            }
+        })
+    });
     g.finish();
 }
 

@@ -79,3 +79,48 @@ fn kr300_validation_loads() {
     assert_relative_eq!(mm[1], 2.232, max_relative = 2e-3);
     assert_relative_eq!(mm[2], 0.967, max_relative = 2e-3);
 }
+
+/// `deflection_batch`'s four-row path on the KR 300 (spring offsets, 11 virtual joints) over
+/// random poses and wrenches: each row bit for bit the one-row deflection; groups with a
+/// spring past 0.02 rad are declined (the one-row path then takes them).
+#[test]
+fn kr300_four_rows_are_the_one_row_path_bit_for_bit() {
+    let r = kr300();
+    let model = &r.model;
+    let mut data = vjm::Data::new(model);
+    let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut uniform = |lo: f64, hi: f64| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let (mut taken, mut declined) = (0, 0);
+    for _ in 0..300 {
+        let q: [[f64; 6]; 4] = [0; 4].map(|_| [0; 6].map(|_| uniform(-2.5, 2.5)));
+        let w: [Vector6; 4] = [0; 4].map(|_| {
+            let scale = 10f64.powf(uniform(1.0, 4.7)); // 10 N to 50 kN
+            Vector6::from_fn(|i, _| uniform(-1.0, 1.0) * if i < 3 { scale } else { scale / 10.0 })
+        });
+        let rows = vjm::exact_deflection_x4(
+            model,
+            &data,
+            q.each_ref().map(|q| q.as_slice()),
+            w.each_ref(),
+        );
+        match rows {
+            Some(rows) => {
+                taken += 1;
+                for ((q, w), d) in q.iter().zip(&w).zip(rows) {
+                    let one = vjm::deflection(model, &mut data, q, w, vjm::Load::Exact).unwrap();
+                    assert_eq!(d, one, "{q:?} {w:?}");
+                }
+            }
+            None => declined += 1,
+        }
+    }
+    assert!(
+        taken > 100 && declined > 0,
+        "taken {taken}, declined {declined}"
+    );
+}

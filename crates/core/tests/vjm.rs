@@ -339,3 +339,55 @@ fn compiled_passes_equal_the_definitions() {
         })
     );
 }
+
+/// The four-row path of `deflection_batch` on a chain with a prismatic joint, an oblique axis
+/// and springs between fixed transforms: each row bit for bit the one-row deflection.
+#[test]
+fn four_rows_with_a_prismatic_joint_are_the_one_row_path() {
+    let model = ModelBuilder::new()
+        .fixed(Isometry3::translation(0.0, 0.0, 0.4))
+        .unwrap()
+        .revolute(Vector3::z())
+        .unwrap()
+        .spring([2.0e5, 3.0e5, 4.0e4])
+        .unwrap()
+        .prismatic(Vector3::new(0.3, -0.5, 0.81).normalize())
+        .unwrap()
+        .fixed(Isometry3::from_parts(
+            Vector3::new(0.1, 0.0, 0.2).into(),
+            UnitQuaternion::from_euler_angles(-0.3, 0.1, 0.2),
+        ))
+        .unwrap()
+        .spring([5.0e4, INF, 7.0e4])
+        .unwrap()
+        .revolute(Vector3::x())
+        .unwrap()
+        .fixed(Isometry3::translation(0.3, 0.0, -0.1))
+        .unwrap()
+        .build()
+        .unwrap();
+    let mut data = Data::new(&model);
+    let q = [
+        [0.7, 0.2, -1.2],
+        [-2.0, -0.4, 0.3],
+        [0.0, 0.0, 0.0],
+        [3.1, 1.5, -3.0],
+    ];
+    let wrenches = [
+        w([120.0, -80.0, 45.0, 3.0, -2.0, 1.5]),
+        w([0.0, 0.0, -500.0, 0.0, 0.0, 0.0]),
+        w([10.0, 20.0, 30.0, 40.0, 50.0, 60.0]),
+        w([-300.0, 100.0, 0.0, 0.0, 12.0, 0.0]),
+    ];
+    let rows = vjm::exact_deflection_x4(
+        &model,
+        &data,
+        q.each_ref().map(|q| q.as_slice()),
+        wrenches.each_ref(),
+    )
+    .unwrap();
+    for ((q, wr), d) in q.iter().zip(&wrenches).zip(rows) {
+        let one = vjm::deflection(&model, &mut data, q, wr, vjm::Load::Exact).unwrap();
+        assert_eq!(d, one, "{q:?}");
+    }
+}

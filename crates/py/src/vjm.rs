@@ -309,17 +309,77 @@ impl SerialRobot {
         let (Some(q), Some(w)) = (q.broadcast((n, dof)), w.broadcast((n, 6))) else {
             return Err(InputError::new_err("Q and W: rows do not broadcast"));
         };
-        // A C-contiguous W is read as rows of its slice; a broadcast or strided one through
-        // ndarray's row views (several times the cost of the copy).
-        let w_rows = w.as_slice();
-        self.per_row(py, q, &[n, 6], out, |model, data, qi, i, o| {
-            let wi = match w_rows.and_then(|s| s.get(6 * i..6 * i + 6)) {
-                Some(r) => Vector6::from_column_slice(r),
-                None => Vector6::from_iterator(w.row(i).iter().copied()),
-            };
-            let d = vjm::deflection(model, data, qi, &wi, vjm::Load::Exact)?;
-            o.copy_from_slice(d.as_slice());
-            Ok(())
+        // C-contiguous Q and W are read as rows of their slices; broadcast or strided ones
+        // through ndarray's row views (several times the cost of the copy).
+        let (q_rows, w_rows) = (q.as_slice(), w.as_slice());
+        let model = &self.inner.model;
+        let w_row = |i: usize| match w_rows.and_then(|s| s.get(6 * i..6 * i + 6)) {
+            Some(r) => Vector6::from_column_slice(r),
+            None => Vector6::from_iterator(w.row(i).iter().copied()),
+        };
+        // Row `i` of Q: in place, or copied into `buf`.
+        let q_row = |i: usize, buf: &mut Vec<f64>| {
+            if q_rows.and_then(|s| s.get(dof * i..dof * (i + 1))).is_none() {
+                buf.clear();
+                buf.extend(q.row(i).iter().copied());
+            }
+        };
+        fn q_at<'a>(rows: Option<&'a [f64]>, dof: usize, i: usize, buf: &'a [f64]) -> &'a [f64] {
+            rows.and_then(|s| s.get(dof * i..dof * (i + 1)))
+                .unwrap_or(buf)
+        }
+        let workspace = || (Data::new(model), [0; 4].map(|_| Vec::with_capacity(dof)));
+        fill_into(py, &[n, 6], out, |buf| {
+            py.detach(|| {
+                batch::chunks(buf, 6, batch::row_cost::VJM, workspace, |rows, ws, o| {
+                    let (data, qb) = ws;
+                    // Four rows at a time in the lanes (each row's bits are the one-row
+                    // path's); a group the four-row path declines, and the last rows, one
+                    // at a time.
+                    for (g, og) in o.chunks_mut(4 * 6).enumerate() {
+                        let base = rows.start + 4 * g;
+                        if og.len() == 4 * 6 {
+                            let ws4 = [0, 1, 2, 3].map(|r| w_row(base + r));
+                            for (r, b) in qb.iter_mut().enumerate() {
+                                q_row(base + r, b);
+                            }
+                            let [b0, b1, b2, b3] = &*qb;
+                            let q4 = [
+                                q_at(q_rows, dof, base, b0),
+                                q_at(q_rows, dof, base + 1, b1),
+                                q_at(q_rows, dof, base + 2, b2),
+                                q_at(q_rows, dof, base + 3, b3),
+                            ];
+                            if let Some(d4) =
+                                vjm::exact_deflection_x4(model, data, q4, ws4.each_ref())
+                            {
+                                for (d, orow) in d4.iter().zip(og.chunks_mut(6)) {
+                                    orow.copy_from_slice(d.as_slice());
+                                }
+                                continue;
+                            }
+                        }
+                        for (r, orow) in og.chunks_mut(6).enumerate() {
+                            let i = base + r;
+                            let Some(b) = qb.first_mut() else {
+                                continue; // unreachable: four buffers
+                            };
+                            q_row(i, b);
+                            let d = vjm::deflection(
+                                model,
+                                data,
+                                q_at(q_rows, dof, i, b),
+                                &w_row(i),
+                                vjm::Load::Exact,
+                            )
+                            .map_err(|e| (i, e))?;
+                            orow.copy_from_slice(d.as_slice());
+                        }
+                    }
+                    Ok(())
+                })
+            })
+            .map_err(PyErr::from)
         })
     }
 

@@ -30,6 +30,11 @@ pub(crate) trait Lanes: Copy {
     fn splat(self, x: f64) -> Self::V {
         self.load([x; 4])
     }
+    /// `|v|` lane by lane.
+    fn abs(self, v: Self::V) -> Self::V;
+    /// The larger of `a` and `b` lane by lane (for finite lanes; which of the two a NaN lane
+    /// gives is the instruction's).
+    fn max(self, a: Self::V, b: Self::V) -> Self::V;
     /// `((l0 + l1) + l2) + l3`.
     #[inline(always)]
     fn total(self, v: Self::V) -> f64 {
@@ -73,6 +78,15 @@ impl Lanes for Plain {
     #[inline(always)]
     fn store(self, v: F4) -> [f64; 4] {
         v.0
+    }
+    #[inline(always)]
+    fn abs(self, v: F4) -> F4 {
+        F4(v.0.map(f64::abs))
+    }
+    #[inline(always)]
+    fn max(self, a: F4, b: F4) -> F4 {
+        let ([a0, a1, a2, a3], [b0, b1, b2, b3]) = (a.0, b.0);
+        F4([a0.max(b0), a1.max(b1), a2.max(b2), a3.max(b3)])
     }
 }
 
@@ -121,6 +135,20 @@ mod avx {
         #[inline(always)]
         fn store(self, v: Avx4) -> [f64; 4] {
             pulp::cast(v.v)
+        }
+        #[inline(always)]
+        fn abs(self, v: Avx4) -> Avx4 {
+            Avx4 {
+                simd: self,
+                v: self.abs_f64x4(v.v),
+            }
+        }
+        #[inline(always)]
+        fn max(self, a: Avx4, b: Avx4) -> Avx4 {
+            Avx4 {
+                simd: self,
+                v: pulp::Simd::max_f64s(self, a.v, b.v),
+            }
         }
     }
 }

@@ -23,6 +23,7 @@ mod equilibrium;
 mod lanes;
 mod loads;
 mod model;
+mod rows;
 mod trig;
 mod turns;
 
@@ -40,6 +41,7 @@ pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};
 pub use model::{
     Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder, valid_stiffness,
 };
+pub use rows::exact_deflection_x4;
 
 /// A 6-vector `[x, y, z, rx, ry, rz]`: a wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] or a small
 /// pose change `[dx, dy, dz, rx, ry, rz]` \[m, rad\] (rotation vector), always in the base frame.

@@ -7,7 +7,11 @@
 
 #![allow(clippy::excessive_precision)] // reason: fdlibm's constants, digit for digit as published
 
+use core::ops::{Add, Mul, Sub};
+
 use nalgebra::{Quaternion, Unit, UnitQuaternion, Vector3};
+
+use super::lanes::Lanes;
 
 const S1: f64 = -1.666_666_666_666_663_243_48e-1;
 const S2: f64 = 8.333_333_333_322_489_461_24e-3;
@@ -31,29 +35,47 @@ const SHIFT: f64 = 6_755_399_441_055_744.0;
 /// Largest |x| reduced here.
 const REDUCE_MAX: f64 = 823_550.0; // 2^19 * pi/2
 
+/// fdlibm's `__kernel_sin`, written once for plain numbers and lanes.
 #[inline(always)]
-fn kernel_sin(x: f64) -> f64 {
+fn kernel_sin<T: Copy + Add<Output = T> + Mul<Output = T>>(x: T, k: impl Fn(f64) -> T) -> T {
     let z = x * x;
     let v = z * x;
-    let r = S2 + z * (S3 + z * (S4 + z * (S5 + z * S6)));
-    x + v * (S1 + z * r)
+    let r = k(S2) + z * (k(S3) + z * (k(S4) + z * (k(S5) + z * k(S6))));
+    x + v * (k(S1) + z * r)
 }
 
+/// fdlibm's `__kernel_cos`, written once for plain numbers and lanes.
 #[inline(always)]
-fn kernel_cos(x: f64) -> f64 {
+fn kernel_cos<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>>(
+    x: T,
+    k: impl Fn(f64) -> T,
+) -> T {
     let z = x * x;
     let w = z * z;
-    let r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
-    let hz = 0.5 * z;
-    let one_minus = 1.0 - hz;
-    one_minus + (((1.0 - one_minus) - hz) + z * r)
+    let r = z * (k(C1) + z * (k(C2) + z * k(C3))) + w * w * (k(C4) + z * (k(C5) + z * k(C6)));
+    let hz = k(0.5) * z;
+    let one_minus = k(1.0) - hz;
+    one_minus + (((k(1.0) - one_minus) - hz) + z * r)
+}
+
+/// The quadrant's `(sin x, cos x)` from the kernels' `s`, `c` of the reduced argument and the
+/// shifted quotient `t`.
+#[inline(always)]
+fn quadrant(t: f64, s: f64, c: f64) -> (f64, f64) {
+    match t.to_bits() & 3 {
+        0 => (s, c),
+        1 => (c, -s),
+        2 => (-s, -c),
+        _ => (-c, s),
+    }
 }
 
 /// `(sin x, cos x)`.
 #[inline(always)]
 pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
+    let k = |v: f64| v;
     if x.abs() <= core::f64::consts::FRAC_PI_4 {
-        return (kernel_sin(x), kernel_cos(x));
+        return (kernel_sin(x, k), kernel_cos(x, k));
     }
     if x.is_nan() || x.abs() > REDUCE_MAX {
         return nalgebra::ComplexField::sin_cos(x);
@@ -63,13 +85,37 @@ pub(crate) fn sin_cos(x: f64) -> (f64, f64) {
     let t = x * INV_PIO2 + SHIFT;
     let k = t - SHIFT;
     let r = (x - k * PIO2_1) - k * PIO2_1T;
-    let (s, c) = (kernel_sin(r), kernel_cos(r));
-    match t.to_bits() & 3 {
-        0 => (s, c),
-        1 => (c, -s),
-        2 => (-s, -c),
-        _ => (-c, s),
+    let one = |v: f64| v;
+    quadrant(t, kernel_sin(r, one), kernel_cos(r, one))
+}
+
+/// [`sin_cos`] of four values as lanes, each lane the value of [`sin_cos`] (only the sign of
+/// a zero may differ): the reduction for every lane (for |x| < pi/4 it gives k = 0 and r = x
+/// exactly, the direct path's argument), the kernels in the lanes, and the quadrant's signs
+/// and swap as exact products with 0 and +-1 (`d = k mod 4` in [-2, 2], `sin = s (1 - |d|) +
+/// c d (2 - |d|)`). Values the reduction does not cover as [`sin_cos`] does (past
+/// `REDUCE_MAX`, non-finite, within 1e-12 of pi/4 where the direct path's bound falls) take
+/// [`sin_cos`] lane by lane.
+#[inline(always)]
+pub(crate) fn sin_cos_lanes<L: Lanes>(l: L, x: [f64; 4]) -> (L::V, L::V) {
+    let edge = |x: &f64| {
+        x.is_nan() || x.abs() > REDUCE_MAX || (x.abs() - core::f64::consts::FRAC_PI_4).abs() < 1e-12
+    };
+    if x.iter().any(edge) {
+        let v = x.map(sin_cos);
+        return (l.load(v.map(|v| v.0)), l.load(v.map(|v| v.1)));
     }
+    let k = |v: f64| l.splat(v);
+    let (shift, one, two) = (k(SHIFT), k(1.0), k(2.0));
+    let x = l.load(x);
+    let q = (x * k(INV_PIO2) + shift) - shift;
+    let r = (x - q * k(PIO2_1)) - q * k(PIO2_1T);
+    let (s, c) = (kernel_sin(r, k), kernel_cos(r, k));
+    // The quadrant: d = q - 4 round(q / 4), exact for |q| < 2^20.
+    let d = q - k(4.0) * ((q * k(0.25) + shift) - shift);
+    let ad = l.abs(d);
+    let (a, b) = (one - ad, d * (two - ad));
+    (s * a + c * b, c * a - s * b)
 }
 
 /// A rotation by `angle` \[rad\] about the unit `axis`, as nalgebra's
@@ -118,6 +164,39 @@ mod tests {
             );
         }
         assert!(worst > 0.0);
+    }
+
+    #[test]
+    fn lanes_are_sin_cos() {
+        let mut xs: [f64; 4] = [0.0; 4];
+        let check = |x: [f64; 4]| {
+            let plain = sin_cos_lanes(crate::vjm::lanes::Plain, x);
+            for (i, x) in x.iter().enumerate() {
+                let (s, c) = sin_cos(*x);
+                // The same values (a zero's sign aside: 0.0 == -0.0; NaN for NaN).
+                let same = |a: f64, b: f64| a == b || (a.is_nan() && b.is_nan());
+                assert!(same(plain.0.0[i], s) && same(plain.1.0[i], c), "{x}");
+            }
+        };
+        for i in -20_000..=20_000 {
+            let x = i as f64 * 1.0e-3;
+            xs = [x, -x * 0.7, x * 13.0, x.abs()];
+            check(xs);
+        }
+        let edge = core::f64::consts::FRAC_PI_4;
+        for x in [
+            edge,
+            -edge,
+            edge.next_up(),
+            edge.next_down(),
+            -0.0,
+            8.2e5,
+            1e6,
+            f64::NAN,
+        ] {
+            xs[0] = x;
+            check(xs);
+        }
     }
 
     #[test]

@@ -24,7 +24,7 @@ use crate::error::TickError;
 /// Below this elastic angle \[rad\] (half-angle 1e-2) the turns' sines and cosines are the
 /// series of the deflection's `sin_cos_small`; with a spring turned further the turns are
 /// formed one by one with the library's.
-const SERIES_ANGLE: f64 = 2.0e-2;
+pub(super) const SERIES_ANGLE: f64 = 2.0e-2;
 
 /// Lane-wise `a * s` for a vector of lanes and one lane value.
 #[inline(always)]
@@ -137,10 +137,10 @@ fn turn_of(f: &Isometry3<f64>, a: &Vector3<f64>, p: &Vector3<f64>) -> Isometry3<
 
 /// A rigid motion in four lanes: rotation `w`, `u` (vector part) and translation `t`.
 #[derive(Clone, Copy)]
-struct Motion4<V> {
-    w: V,
-    u: V4<V>,
-    t: V4<V>,
+pub(super) struct Motion4<V> {
+    pub(super) w: V,
+    pub(super) u: V4<V>,
+    pub(super) t: V4<V>,
 }
 
 impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::ops::Mul<Output = V>>
@@ -149,7 +149,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// `self * o`, lane by lane: `(q_a q_b, t_a + q_a t_b)`, the quaternion product and the
     /// rotation in nalgebra's order of operations.
     #[inline(always)]
-    fn then(self, o: Self, two: V) -> Self {
+    pub(super) fn then(self, o: Self, two: V) -> Self {
         let (a, b) = (self, o);
         let w = a.w * b.w - a.u.x * b.u.x - a.u.y * b.u.y - a.u.z * b.u.z;
         let u = V4 {
@@ -166,10 +166,10 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
 
 /// The rigid world frames of four springs as lanes: rotation `w`, `u` and origin `o`.
 #[derive(Clone, Copy)]
-struct Frames4<V> {
-    w: V,
-    u: V4<V>,
-    o: V4<V>,
+pub(super) struct Frames4<V> {
+    pub(super) w: V,
+    pub(super) u: V4<V>,
+    pub(super) o: V4<V>,
 }
 
 impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::ops::Mul<Output = V>>
@@ -179,7 +179,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// conjugate `(w, -u)`, `(t' w + (-u) x t') + v` with `t' = 2 (-u) x v`, written with
     /// `t = 2 u x v` as `(u x t - t w) + v` (the same bits).
     #[inline(always)]
-    fn local(&self, v: V4<V>, two: V) -> V4<V> {
+    pub(super) fn local(&self, v: V4<V>, two: V) -> V4<V> {
         let t = scale(self.u.cross(v), two);
         add(sub(self.u.cross(t), scale(t, self.w)), v)
     }
@@ -187,7 +187,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// The vector `v` (the frames' axes) in world axes, `R v`: nalgebra's
     /// `(t w + u x t) + v`, `t = 2 u x v`.
     #[inline(always)]
-    fn world(&self, v: V4<V>, two: V) -> V4<V> {
+    pub(super) fn world(&self, v: V4<V>, two: V) -> V4<V> {
         let t = scale(self.u.cross(v), two);
         add(add(scale(t, self.w), self.u.cross(t)), v)
     }
@@ -195,7 +195,7 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     /// The turns of the four springs by the angles `a` relative to the rigid TCP at `p`, with
     /// the series' sines (all angles below [`SERIES_ANGLE`]): the lanes of [`turn_of`].
     #[inline(always)]
-    fn turn<L: Lanes<V = V>>(&self, l: L, a: V4<V>, p: V4<V>, two: V) -> Motion4<V> {
+    pub(super) fn turn<L: Lanes<V = V>>(&self, l: L, a: V4<V>, p: V4<V>, two: V) -> Motion4<V> {
         let half = l.splat(0.5);
         // Eq. 4, `Rz(gamma) Ry(beta) Rx(alpha)` from the half-angles (as `euler_zyx`, the
         // same operations).

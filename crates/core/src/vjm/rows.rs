@@ -1,0 +1,286 @@
+//! Four loaded poses at a time: the exact deflection of four rows of a batch in the lanes of
+//! [`super::lanes`], one row per lane, every operation that of the one-row path
+//! ([`super::deflection`] with [`super::Load::Exact`]) so that each row's result has the same
+//! bits.
+//!
+//! The one-row path spends a third of its time in the rigid pass, a chain of dependent
+//! quaternion products that no lane layout over springs can share; over rows the whole chain
+//! runs four times at the cost of one. The compositions are the general products where the
+//! one-row pass skips the terms with exact zeros and ones of coordinate axes: the same sums in
+//! the same order, so the same results (only the sign of a zero may differ, which no later
+//! sum keeps).
+
+use nalgebra::{Isometry3, Quaternion, UnitQuaternion};
+
+use super::data::check_q;
+use super::deflection::rotation_vector;
+use super::lanes::{LaneKernel, Lanes, V4, dispatch};
+use super::model::{MAX_SPRINGS, Pass};
+use super::turns::{Frames4, Motion4, SERIES_ANGLE};
+use super::{Data, MAX_SPRING_ANGLE, Model, Vector6};
+use crate::error::check_finite;
+
+/// Rows per call of [`exact_deflection_x4`]: the lanes.
+const ROWS: usize = 4;
+
+/// The exact deflections `[dx, dy, dz, rx, ry, rz]` \[m, rad\] of four loaded poses at once:
+/// row `r` is joints `q[r]` \[rad or m\] under the TCP wrench `wrench[r]` \[N, N m\], each
+/// bit for bit what [`super::deflection`] with [`super::Load::Exact`] returns for it, at
+/// about a third of the cost per row (batches of poses: `deflection_batch`).
+///
+/// `None` when a row is not for the four-row path: a row [`super::deflection`] would refuse
+/// (wrong length, non-finite, past the joint range, a spring past [`MAX_SPRING_ANGLE`], an
+/// overflowing result), or a spring turned past 0.02 rad (which the one-row path takes one
+/// spring at a time). Call [`super::deflection`] on each row then: it returns that row's error
+/// or its value. `data` is checked against the model and otherwise left as it was.
+pub fn exact_deflection_x4(
+    model: &Model,
+    data: &Data,
+    q: [&[f64]; ROWS],
+    wrench: [&Vector6; ROWS],
+) -> Option<[Vector6; ROWS]> {
+    for (q, w) in q.iter().zip(wrench) {
+        check_q(model, data, q).ok()?;
+        check_finite("wrench", w.as_slice()).ok()?;
+    }
+    let [w, x, y, z, tx, ty, tz, largest] = dispatch(Rows { model, q, wrench });
+    let mut out = [Vector6::zeros(); ROWS];
+    for (r, out) in out.iter_mut().enumerate() {
+        let at = |v: [f64; 4]| v.get(r).copied().unwrap_or(f64::NAN);
+        // The one-row path's guard and its series' range (a NaN angle, from an overflow,
+        // makes the result NaN, refused below).
+        let a = at(largest);
+        if a.is_nan() || a > MAX_SPRING_ANGLE || a >= SERIES_ANGLE {
+            return None;
+        }
+        let turn = UnitQuaternion::new_unchecked(Quaternion::new(at(w), at(x), at(y), at(z)));
+        let dr = rotation_vector(&turn);
+        let d = Vector6::new(at(tx), at(ty), at(tz), dr.x, dr.y, dr.z);
+        if !d.iter().all(|v| v.is_finite()) {
+            return None;
+        }
+        *out = d;
+    }
+    Some(out)
+}
+
+/// The lane kernel: the product of the springs' turns relative to each row's rigid TCP (lanes
+/// of `w, u.x, u.y, u.z, t.x, t.y, t.z`) and each row's largest elastic angle.
+struct Rows<'a> {
+    model: &'a Model,
+    q: [&'a [f64]; ROWS],
+    wrench: [&'a Vector6; ROWS],
+}
+
+/// A fixed transform in every lane.
+#[inline(always)]
+fn splat_iso<L: Lanes>(l: L, t: &Isometry3<f64>) -> Motion4<L::V> {
+    let (r, p) = (&t.rotation, &t.translation.vector);
+    Motion4 {
+        w: l.splat(r.w),
+        u: V4 {
+            x: l.splat(r.i),
+            y: l.splat(r.j),
+            z: l.splat(r.k),
+        },
+        t: V4 {
+            x: l.splat(p.x),
+            y: l.splat(p.y),
+            z: l.splat(p.z),
+        },
+    }
+}
+
+/// A lane value per row.
+#[inline(always)]
+fn per_row<L: Lanes>(l: L, f: impl Fn(usize) -> f64) -> L::V {
+    l.load([f(0), f(1), f(2), f(3)])
+}
+
+impl LaneKernel for Rows<'_> {
+    type Output = [[f64; 4]; 8];
+    #[inline(always)]
+    fn run<L: Lanes>(self, l: L) -> [[f64; 4]; 8] {
+        let Self { model, q, wrench } = self;
+        let (zero, one, two) = (l.splat(0.0), l.splat(1.0), l.splat(2.0));
+        let none = V4 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
+        let identity = Motion4 {
+            w: one,
+            u: none,
+            t: none,
+        };
+        // The rigid pass (`deflection::rigid_pass`), the springs' world frames kept as lanes.
+        let mut springs = [identity; MAX_SPRINGS];
+        let mut frame = identity;
+        for p in model.pass.iter() {
+            match p {
+                Pass::Joint(k) => {
+                    let Some(step) = model.tcp_chain.get(*k) else {
+                        continue; // unreachable: built together
+                    };
+                    frame = frame.then(splat_iso(l, &step.pre), two);
+                    let qi = |r: usize| {
+                        q.get(r)
+                            .and_then(|q| q.get(step.index))
+                            .copied()
+                            .unwrap_or(0.0)
+                    };
+                    let axis = step.axis.into_inner();
+                    if step.revolute {
+                        let half = [0, 1, 2, 3].map(|r| qi(r) * 0.5);
+                        let (s, c) = super::trig::sin_cos_lanes(l, half);
+                        let turn = Motion4 {
+                            w: c,
+                            u: V4 {
+                                x: l.splat(axis.x) * s,
+                                y: l.splat(axis.y) * s,
+                                z: l.splat(axis.z) * s,
+                            },
+                            t: none,
+                        };
+                        // The rotation only: `frame.rotation * turn`.
+                        let t = frame.t;
+                        frame = frame.then(turn, two);
+                        frame.t = t;
+                    } else {
+                        let rot = Frames4 {
+                            w: frame.w,
+                            u: frame.u,
+                            o: none,
+                        };
+                        let axis = V4 {
+                            x: l.splat(axis.x),
+                            y: l.splat(axis.y),
+                            z: l.splat(axis.z),
+                        };
+                        let u = rot.world(axis, two);
+                        let qi = per_row(l, qi);
+                        frame.t = V4 {
+                            x: frame.t.x + u.x * qi,
+                            y: frame.t.y + u.y * qi,
+                            z: frame.t.z + u.z * qi,
+                        };
+                    }
+                }
+                Pass::Spring { local, index, .. } => {
+                    if let Some(slot) = springs.get_mut(*index) {
+                        *slot = frame.then(splat_iso(l, local), two);
+                    }
+                }
+            }
+        }
+        let tcp = frame.then(splat_iso(l, &model.tcp_tail), two);
+        // The springs (`turns::Springs` with the loads and the exact product), each row's
+        // spring k in lane r, the four runs of springs one after the other.
+        let p = tcp.t;
+        let column = |i: usize| per_row(l, |r| wrench.get(r).map_or(0.0, |w| w[i]));
+        let force = V4 {
+            x: column(0),
+            y: column(1),
+            z: column(2),
+        };
+        let moment = V4 {
+            x: column(3),
+            y: column(4),
+            z: column(5),
+        };
+        let n = model.springs;
+        let run = n.div_ceil(4);
+        let mut largest = zero;
+        let mut runs = [identity; 4];
+        // Step c turns spring g run + c of every run g: four independent products at once.
+        for c in 0..run {
+            for (g, acc) in runs.iter_mut().enumerate() {
+                let k = g * run + c;
+                let (Some(f), Some(cs)) = (springs.get(k), model.spring_compliance.get(k)) else {
+                    continue;
+                };
+                if k >= n {
+                    continue;
+                }
+                let frames = Frames4 {
+                    w: f.w,
+                    u: f.u,
+                    o: f.t,
+                };
+                let lever = V4 {
+                    x: p.x - frames.o.x,
+                    y: p.y - frames.o.y,
+                    z: p.z - frames.o.z,
+                };
+                let cross = lever.cross(force);
+                let m = V4 {
+                    x: moment.x + cross.x,
+                    y: moment.y + cross.y,
+                    z: moment.z + cross.z,
+                };
+                let local = frames.local(m, two);
+                let a = V4 {
+                    x: l.splat(cs.x) * local.x,
+                    y: l.splat(cs.y) * local.y,
+                    z: l.splat(cs.z) * local.z,
+                };
+                let big = l.max(l.max(l.abs(a.x), l.abs(a.y)), l.abs(a.z));
+                largest = l.max(largest, big);
+                *acc = acc.then(frames.turn(l, a, p, two), two);
+            }
+        }
+        let [r0, r1, r2, r3] = runs;
+        let total = r0.then(r1, two).then(r2.then(r3, two), two);
+        let s = |v: L::V| l.store(v);
+        let (w, u, t) = (total.w, total.u, total.t);
+        [
+            s(w),
+            s(u.x),
+            s(u.y),
+            s(u.z),
+            s(t.x),
+            s(t.y),
+            s(t.z),
+            s(largest),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vjm::{Load, deflection};
+
+    #[test]
+    fn four_rows_are_the_one_row_path_bit_for_bit() {
+        let (model, q0) = crate::vjm::lanes::tests::arm();
+        let mut data = Data::new(&model);
+        let qs: [[f64; 3]; 4] = [q0, [0.1, 2.0, -0.3], [-2.5, 0.4, 0.02], [3.0, -1.0, 0.5]];
+        let ws = [
+            Vector6::new(120.0, -80.0, 45.0, 30.0, -20.0, 15.0),
+            Vector6::new(-60.0, 10.0, 90.0, -5.0, 2.0, 8.0),
+            Vector6::new(0.0, 0.0, -150.0, 0.0, 0.0, 0.0),
+            Vector6::new(20.0, 20.0, 20.0, 1.0, 1.0, 1.0),
+        ];
+        let rows = exact_deflection_x4(
+            &model,
+            &data,
+            qs.each_ref().map(|q| q.as_slice()),
+            ws.each_ref(),
+        )
+        .unwrap();
+        for ((q, w), d) in qs.iter().zip(&ws).zip(rows) {
+            let one = deflection(&model, &mut data, q, w, Load::Exact).unwrap();
+            assert_eq!(d, one, "{q:?}");
+        }
+        // A row past the series' range, or one the one-row path refuses: not for this path.
+        let big = ws[0] * 5.0;
+        let q = qs.each_ref().map(|q| q.as_slice());
+        assert!(exact_deflection_x4(&model, &data, q, [&ws[0], &ws[1], &big, &ws[3]]).is_none());
+        let nan = Vector6::repeat(f64::NAN);
+        assert!(exact_deflection_x4(&model, &data, q, [&ws[0], &nan, &ws[2], &ws[3]]).is_none());
+        let short = [0.0; 2];
+        let q = [q[0], q[1], q[2], short.as_slice()];
+        assert!(exact_deflection_x4(&model, &data, q, ws.each_ref()).is_none());
+    }
+}
