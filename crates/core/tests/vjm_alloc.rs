@@ -28,6 +28,8 @@ fn vjm_calls_do_not_allocate() {
         sink += vjm::deflection(&model, &mut data, &q, &wrench, vjm::Load::Exact).unwrap()[0];
         sink += vjm::compliance(&model, &mut data, &q).unwrap()[(0, 0)];
         vjm::joint_jacobian(&model, &mut data, &q).unwrap();
+        let rows = [&q[..]; 4];
+        sink += vjm::exact_deflection_x4(&model, &data, rows, [&wrench; 4]).unwrap()[3][0];
         if i % 100 == 0 {
             sink += vjm::joint_correction(&model, &mut data, &q, &wrench, 3, 1e-12)
                 .unwrap()
