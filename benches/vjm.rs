@@ -74,13 +74,7 @@ fn ur5(c: &mut Criterion) {
     });
     // The rows of `deflection_batch` in benches/peers.py: joints uniform in [-2, 2] rad,
     // wrenches in [-50, 50] N and N m (a deterministic generator), 1024 rows per iteration.
-    let mut state = 0x2545_f491_4f6c_dd1d_u64;
-    let mut uniform = |lo: f64, hi: f64| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
-    };
+    let mut uniform = deflect_tests::uniform(0x2545_f491_4f6c_dd1d);
     let rows: Vec<([f64; 6], Vector6)> = (0..1024)
         .map(|_| {
             let q = [0; 6].map(|_| uniform(-2.0, 2.0));

@@ -8,6 +8,18 @@ pub fn repo_path(relative: &str) -> String {
     format!("{}/{relative}", env!("CARGO_MANIFEST_DIR"))
 }
 
+/// Uniform numbers in `[lo, hi)` from a xorshift generator seeded with `seed` (non-zero): the
+/// same sequence on every machine, for the random rows of tests and benchmarks.
+pub fn uniform(seed: u64) -> impl FnMut(f64, f64) -> f64 {
+    let mut state = seed;
+    move |lo, hi| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
 /// The shipped KR 300 R2500 model (URDF + Table 1 stiffnesses), chain base_link -> tcp.
 pub fn kr300() -> deflect_core::SerialRobot {
     match deflect_core::SerialRobot::from_path(

@@ -341,7 +341,7 @@ fn compiled_passes_equal_the_definitions() {
 }
 
 /// The four-row path of `deflection_batch` on a chain with a prismatic joint, an oblique axis
-/// and springs between fixed transforms: each row bit for bit the one-row deflection.
+/// and springs between fixed transforms: each row the one-row deflection exactly (`==`).
 #[test]
 fn four_rows_with_a_prismatic_joint_are_the_one_row_path() {
     let model = ModelBuilder::new()

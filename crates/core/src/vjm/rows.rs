@@ -1,14 +1,15 @@
 //! Four loaded poses at a time: the exact deflection of four rows of a batch in the lanes of
 //! [`super::lanes`], one row per lane, every operation that of the one-row path
-//! ([`super::deflection`] with [`super::Load::Exact`]) so that each row's result has the same
-//! bits.
+//! ([`super::deflection`] with [`super::Load::Exact`]) so that each row's result is the same
+//! number (only the sign of a zero may differ: `0.0 == -0.0`).
 //!
 //! The one-row path spends a third of its time in the rigid pass, a chain of dependent
 //! quaternion products that no lane layout over springs can share; over rows the whole chain
-//! runs four times at the cost of one. The compositions are the general products where the
-//! one-row pass skips the terms with exact zeros and ones of coordinate axes: the same sums in
-//! the same order, so the same results (only the sign of a zero may differ, which no later
-//! sum keeps).
+//! runs four times at once. The compositions are the general products where the one-row pass
+//! skips the terms with exact zeros and ones of coordinate axes: the same sums in the same
+//! order, so the same results. The joints' sines and cosines are [`super::trig`]'s, in the
+//! lanes (the quadrant applied as exact products with 0 and +-1). UR5 over random rows: 308
+//! ns per row one at a time, 213 ns four at a time (`cargo bench --bench vjm`).
 
 use nalgebra::{Isometry3, Quaternion, UnitQuaternion};
 
@@ -25,8 +26,9 @@ const ROWS: usize = 4;
 
 /// The exact deflections `[dx, dy, dz, rx, ry, rz]` \[m, rad\] of four loaded poses at once:
 /// row `r` is joints `q[r]` \[rad or m\] under the TCP wrench `wrench[r]` \[N, N m\], each
-/// bit for bit what [`super::deflection`] with [`super::Load::Exact`] returns for it, at
-/// about a third of the cost per row (batches of poses: `deflection_batch`).
+/// what [`super::deflection`] with [`super::Load::Exact`] returns for it (the same number; a
+/// zero's sign aside), at about two thirds of the cost per row (batches of poses:
+/// `deflection_batch`).
 ///
 /// `None` when a row is not for the four-row path: a row [`super::deflection`] would refuse
 /// (wrong length, non-finite, past the joint range, a spring past [`MAX_SPRING_ANGLE`], an
@@ -252,7 +254,7 @@ mod tests {
     use crate::vjm::{Load, deflection};
 
     #[test]
-    fn four_rows_are_the_one_row_path_bit_for_bit() {
+    fn four_rows_are_the_one_row_path_exactly() {
         let (model, q0) = crate::vjm::lanes::tests::arm();
         let mut data = Data::new(&model);
         let qs: [[f64; 3]; 4] = [q0, [0.1, 2.0, -0.3], [-2.5, 0.4, 0.02], [3.0, -1.0, 0.5]];
