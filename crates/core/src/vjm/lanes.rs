@@ -17,10 +17,17 @@ use nalgebra::{Isometry3, Matrix3, Vector3};
 
 use super::{Data, Model};
 
+/// Lane-wise arithmetic: what the kernels' vectors of lanes need.
+pub(crate) trait Arith:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self>
+{
+}
+impl<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>> Arith for T {}
+
 /// A way to hold four `f64` lanes: its vector type, and the conversions from and to arrays.
 pub(crate) trait Lanes: Copy {
     /// Four lanes, with lane-wise arithmetic.
-    type V: Copy + Add<Output = Self::V> + Sub<Output = Self::V> + Mul<Output = Self::V>;
+    type V: Arith;
     /// The lanes of `a`.
     fn load(self, a: [f64; 4]) -> Self::V;
     /// The lanes of `v` as an array.
@@ -190,7 +197,7 @@ pub(crate) struct V4<T> {
     pub(crate) z: T,
 }
 
-impl<T: Copy + Add<Output = T> + Sub<Output = T> + Mul<Output = T>> V4<T> {
+impl<T: Arith> V4<T> {
     /// The cross product, lane by lane, in nalgebra's order of operations.
     #[inline(always)]
     pub(crate) fn cross(self, o: Self) -> Self {

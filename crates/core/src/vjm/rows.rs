@@ -17,7 +17,7 @@ use super::data::check_q;
 use super::deflection::rotation_vector;
 use super::lanes::{LaneKernel, Lanes, V4, dispatch};
 use super::model::{MAX_SPRINGS, Pass};
-use super::turns::{Frames4, Motion4, SERIES_ANGLE};
+use super::turns::{Frames4, Motion4, SERIES_ANGLE, splat3};
 use super::{Data, MAX_SPRING_ANGLE, Model, Vector6};
 use crate::error::check_finite;
 
@@ -77,19 +77,10 @@ struct Rows<'a> {
 /// A fixed transform in every lane.
 #[inline(always)]
 fn splat_iso<L: Lanes>(l: L, t: &Isometry3<f64>) -> Motion4<L::V> {
-    let (r, p) = (&t.rotation, &t.translation.vector);
     Motion4 {
-        w: l.splat(r.w),
-        u: V4 {
-            x: l.splat(r.i),
-            y: l.splat(r.j),
-            z: l.splat(r.k),
-        },
-        t: V4 {
-            x: l.splat(p.x),
-            y: l.splat(p.y),
-            z: l.splat(p.z),
-        },
+        w: l.splat(t.rotation.w),
+        u: splat3(l, &t.rotation.imag()),
+        t: splat3(l, &t.translation.vector),
     }
 }
 
@@ -154,12 +145,7 @@ impl LaneKernel for Rows<'_> {
                             u: frame.u,
                             o: none,
                         };
-                        let axis = V4 {
-                            x: l.splat(axis.x),
-                            y: l.splat(axis.y),
-                            z: l.splat(axis.z),
-                        };
-                        let u = rot.world(axis, two);
+                        let u = rot.world(splat3(l, &axis), two);
                         let qi = per_row(l, qi);
                         frame.t = V4 {
                             x: frame.t.x + u.x * qi,
@@ -214,18 +200,7 @@ impl LaneKernel for Rows<'_> {
                     y: p.y - frames.o.y,
                     z: p.z - frames.o.z,
                 };
-                let cross = lever.cross(force);
-                let m = V4 {
-                    x: moment.x + cross.x,
-                    y: moment.y + cross.y,
-                    z: moment.z + cross.z,
-                };
-                let local = frames.local(m, two);
-                let a = V4 {
-                    x: l.splat(cs.x) * local.x,
-                    y: l.splat(cs.y) * local.y,
-                    z: l.splat(cs.z) * local.z,
-                };
+                let (_, a) = frames.loads(lever, force, moment, splat3(l, cs), two);
                 let big = l.max(l.max(l.abs(a.x), l.abs(a.y)), l.abs(a.z));
                 largest = l.max(largest, big);
                 *acc = acc.then(frames.turn(l, a, p, two), two);

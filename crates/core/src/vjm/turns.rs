@@ -17,7 +17,7 @@
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
 use super::deflection::{MAX_SPRING_ANGLE, euler_zyx, rotation_vector};
-use super::lanes::{LaneKernel, Lanes, V4, dispatch};
+use super::lanes::{Arith, LaneKernel, Lanes, V4, dispatch};
 use super::{Data, Model, Vector6};
 use crate::error::TickError;
 
@@ -66,7 +66,7 @@ fn load3<L: Lanes>(l: L, v: [Vector3<f64>; 4]) -> V4<L::V> {
 
 /// One vector in every lane.
 #[inline(always)]
-fn splat3<L: Lanes>(l: L, v: &Vector3<f64>) -> V4<L::V> {
+pub(super) fn splat3<L: Lanes>(l: L, v: &Vector3<f64>) -> V4<L::V> {
     V4 {
         x: l.splat(v.x),
         y: l.splat(v.y),
@@ -143,9 +143,7 @@ pub(super) struct Motion4<V> {
     pub(super) t: V4<V>,
 }
 
-impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::ops::Mul<Output = V>>
-    Motion4<V>
-{
+impl<V: Arith> Motion4<V> {
     /// `self * o`, lane by lane: `(q_a q_b, t_a + q_a t_b)`, the quaternion product and the
     /// rotation in nalgebra's order of operations.
     #[inline(always)]
@@ -172,9 +170,7 @@ pub(super) struct Frames4<V> {
     pub(super) o: V4<V>,
 }
 
-impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::ops::Mul<Output = V>>
-    Frames4<V>
-{
+impl<V: Arith> Frames4<V> {
     /// The vector `v` (world axes) in the frames' axes, `R^T v`: nalgebra's rotation by the
     /// conjugate `(w, -u)`, `(t' w + (-u) x t') + v` with `t' = 2 (-u) x v`, written with
     /// `t = 2 u x v` as `(u x t - t w) + v` (the same bits).
@@ -182,6 +178,28 @@ impl<V: Copy + core::ops::Add<Output = V> + core::ops::Sub<Output = V> + core::o
     pub(super) fn local(&self, v: V4<V>, two: V) -> V4<V> {
         let t = scale(self.u.cross(v), two);
         add(sub(self.u.cross(t), scale(t, self.w)), v)
+    }
+
+    /// Eq. 5-7 for the four springs: the moment `m = M + L x F` of the TCP's force `F` and
+    /// moment `M` on a spring with lever `L` (TCP minus the spring's origin, world axes), and
+    /// its angles `c * (R^T m)` for the compliances `c`.
+    #[inline(always)]
+    pub(super) fn loads(
+        &self,
+        lever: V4<V>,
+        force: V4<V>,
+        moment: V4<V>,
+        c: V4<V>,
+        two: V,
+    ) -> (V4<V>, V4<V>) {
+        let m = add(moment, lever.cross(force));
+        let local = self.local(m, two);
+        let a = V4 {
+            x: c.x * local.x,
+            y: c.y * local.y,
+            z: c.z * local.z,
+        };
+        (m, a)
     }
 
     /// The vector `v` (the frames' axes) in world axes, `R v`: nalgebra's
@@ -279,16 +297,8 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
             };
             let lever = sub(p, frames.o);
             let a = if LOADS {
-                // Eq. 5-6: m = M + (p_tcp - o) x F; Eq. 7: the angles M / k in the
-                // spring's axes.
-                let m = add(moment, lever.cross(force));
                 let c = load3(l, pick(&model.spring_compliance));
-                let local = frames.local(m, two);
-                let a = V4 {
-                    x: c.x * local.x,
-                    y: c.y * local.y,
-                    z: c.z * local.z,
-                };
+                let (m, a) = frames.loads(lever, force, moment, c, two);
                 scatter(l, m, &mut data.spring_moments, at);
                 scatter(l, a, &mut data.spring_angles, at);
                 a
