@@ -385,3 +385,76 @@ fn displacement_field_equals_the_map_at_its_load() {
         Err(TickError::OutOfGrid { axis: 0, .. })
     ));
 }
+
+/// The batch of evenly spaced maps for positions of stride 2 (four rows at a time in AVX2
+/// lanes where the CPU has them), for each fixed shape (2 x 2, 3 x 3, 6 x 6): every row the
+/// single query's bits, with axes held in registers (3 and 9 nodes) and read from memory
+/// (40 nodes), rows outside the grid, non-finite rows and a last group of three rows.
+#[test]
+fn lane_batch_equals_single_for_every_shape() {
+    for (nd, nf) in [(2, 2), (3, 3), (6, 6)] {
+        for nx in [3, 9, 40] {
+            let x: Vec<f64> = (0..nx)
+                .map(|k| 0.15 + 0.1 / (nx - 1) as f64 * k as f64)
+                .collect();
+            let y: Vec<f64> = (0..5).map(|k| -0.075 + 0.0375 * k as f64).collect();
+            let values = nx * y.len() * nd * nf;
+            let coef = |k: usize| ((k as f64) * 0.754_877_666_246_692_7).fract() * 1e-5 - 4e-6;
+            let slopes: Vec<f64> = (0..values).map(coef).collect();
+            let offsets: Vec<f64> = (0..values).map(|k| coef(k + 7777)).collect();
+            let map = ComplianceMap::new(x.clone(), y.clone(), nf, nd, slopes, offsets).unwrap();
+            let n = 403;
+            let mut pos = Vec::new();
+            for k in 0..n {
+                let t = k as f64 * 0.618_033_988_749_895;
+                let (mut px, py) = (0.14 + 0.12 * t.fract(), -0.08 + 0.16 * (t * 1.7).fract());
+                if k % 97 == 5 {
+                    px = f64::NAN;
+                }
+                if k % 41 == 3 {
+                    px = x[k % nx]; // on a node
+                }
+                pos.extend_from_slice(&[px, py]);
+            }
+            let force: Vec<f64> = (0..nf * n)
+                .map(|k| 200.0 * ((k as f64) * 0.37).sin())
+                .collect();
+            let o = opts(Interpolation::Bilinear, OutOfGrid::Extrapolate);
+            let mut out = vec![0.0; nd * n];
+            let err = map
+                .displacement_batch(&pos, 2, &force, &mut out, o)
+                .unwrap_err();
+            assert_eq!(
+                (err.row, err.error),
+                (
+                    5,
+                    TickError::NonFinite {
+                        what: "position",
+                        index: 0
+                    }
+                ),
+                "{nd}x{nf}, {nx} nodes"
+            );
+            for k in (5..n).step_by(97) {
+                pos[2 * k] = 0.2;
+            }
+            let summary = map
+                .displacement_batch(&pos, 2, &force, &mut out, o)
+                .unwrap();
+            assert!(summary.inside > n / 2 && summary.inside < n, "{summary:?}");
+            assert_eq!(summary.inside + summary.extrapolated, n);
+            let mut single = vec![0.0; nd];
+            for k in 0..n {
+                let (p, f) = ([pos[2 * k], pos[2 * k + 1]], &force[nf * k..nf * (k + 1)]);
+                map.displacement_with(p, f, &mut single, o).unwrap();
+                for d in 0..nd {
+                    assert_eq!(
+                        single[d].to_bits(),
+                        out[nd * k + d].to_bits(),
+                        "{nd}x{nf}, {nx} nodes, row {k} axis {d}"
+                    );
+                }
+            }
+        }
+    }
+}

@@ -8,17 +8,23 @@
 //! the first phase repeats the single query's arithmetic (`cell_nodes`, `cell_t_inside`,
 //! `bilinear_stencil`), and a row it cannot vouch for (outside the grid, not finite, at a
 //! node coordinate's rounding edge, a non-finite result) takes the single query's path.
+//!
+//! On x86-64 with AVX2 (and `std`), positions of stride 2 (the Python binding's layout) go
+//! four rows at a time through `super::batch_avx2` instead; these blocks serve the other
+//! CPUs, the no_std build and positions with a z column.
 
 use super::grid::EvenAxis;
 use super::interp::{BatchError, BatchSummary, ignored_entries};
 use super::{ComplianceMapView, QueryOptions};
+use crate::error::{Placement, TickError};
 
 /// Rows per block: the first phase's results (6 values a row) stay in L1 (3 KB).
 const BLOCK: usize = 64;
 
 impl ComplianceMapView<'_> {
-    /// The blocked bilinear batch, fixed sizes; `None` when an axis is uneven or the view
-    /// has no packed coefficients (the caller then goes row by row).
+    /// The bilinear batch on evenly spaced axes, fixed sizes: AVX2 lanes where they apply,
+    /// else blocks; `None` when an axis is uneven or the view has no packed coefficients
+    /// (the caller then goes row by row).
     pub(super) fn batch_bilinear_even<const ND: usize, const NF: usize>(
         &self,
         positions: &[f64],
@@ -30,6 +36,36 @@ impl ComplianceMapView<'_> {
         let (ex, ey) = (self.x.even()?, self.y.even()?);
         if self.packed.is_empty() {
             return None;
+        }
+        // The lanes compute node offsets in 32 bits.
+        #[cfg(all(feature = "std", target_arch = "x86_64"))]
+        if stride == 2
+            && i32::try_from(self.packed.len()).is_ok()
+            && let Some(simd) = pulp::x86::V3::try_new()
+        {
+            macro_rules! lanes {
+                ($b:literal) => {
+                    super::batch_avx2::batch::<ND, NF, $b>(
+                        simd,
+                        self,
+                        (ex, ey),
+                        positions,
+                        forces,
+                        out,
+                        options,
+                    )
+                };
+            }
+            // The packed block of the batch's fixed shapes: 2 x 2, 3 x 3, 6 x 6.
+            let lanes = match super::kernel::packed_block(ND, NF) {
+                6 => lanes!(6),
+                12 => lanes!(12),
+                42 => lanes!(42),
+                _ => None,
+            };
+            if lanes.is_some() {
+                return lanes;
+            }
         }
         Some(even_blocks::<ND, NF>(
             self, ex, ey, positions, stride, forces, out, options,
@@ -70,16 +106,7 @@ fn even_blocks<const ND: usize, const NF: usize>(
         // Phase 1: cells, weights and the mask, for every row of the block.
         let cells = node.iter_mut().zip(weights.iter_mut()).zip(fast.iter_mut());
         for (((n, w), ok), (p, f)) in cells.zip(pb.chunks_exact(stride).zip(fb.chunks_exact(NF))) {
-            let px = p.first().copied().unwrap_or(f64::NAN);
-            let py = p.get(1).copied().unwrap_or(f64::NAN);
-            // NaN and infinities make this NaN; finite values make it exactly 0.
-            let probe = f.iter().fold(px * 0.0 + py * 0.0, |a, v| a + v * 0.0);
-            let (i, tx, ok_x) = ex.cell_t(px);
-            let (j, ty, ok_y) = ey.cell_t(py);
-            let (ux, uy) = (1.0 - tx, 1.0 - ty);
-            *n = i * ny + j;
-            *w = [ux * uy, ux * ty, tx * uy, tx * ty];
-            *ok = (probe == 0.0) & ok_x & ok_y;
+            (*n, *w, *ok) = cell(&ex, &ey, ny, p, f);
         }
         // Phase 2: the blend, rows in order (the first refused row stops the batch).
         let first_row = b * BLOCK;
@@ -90,27 +117,86 @@ fn even_blocks<const ND: usize, const NF: usize>(
             .zip(ob.chunks_exact_mut(ND));
         for (k, (((n, w), ok), ((p, f), o))) in cells.zip(rows).enumerate() {
             let row = first_row + k;
-            ignored_entries(row, p, stride)?;
-            if *ok
-                && let (Ok(fa), Ok(oa)) = (
-                    <&[f64; NF]>::try_from(f),
-                    <&mut [f64; ND]>::try_from(&mut *o),
-                )
-                && let Some(acc) = view.blend_cell_packed::<ND, NF>(*n, ny, w, fa)
-                && acc.iter().fold(0.0, |a, v| a + v * 0.0) == 0.0
-            {
-                *oa = acc;
-                summary.inside += 1;
-                continue;
-            }
-            let (Some(&px), Some(&py)) = (p.first(), p.get(1)) else {
-                continue; // unreachable: stride >= 2
-            };
-            match view.eval([px, py], f, o, options) {
-                Ok(place) => summary.count(place),
-                Err(error) => return Err(BatchError { row, error }),
+            let place = finish_row::<ND, NF>(view, (*n, w, *ok), p, stride, f, o, options)
+                .map_err(|error| BatchError { row, error })?;
+            if let Some(place) = place {
+                summary.count(place);
             }
         }
     }
     Ok(summary)
+}
+
+/// One row whose cell, weights and mask (`cell`: first node, Eq. 14 weights, inside and
+/// finite) are known: the packed blend when the mask allows and the result is finite, the
+/// single query's path otherwise. `Ok(None)` only for a row too short to hold x and y
+/// (unreachable: stride >= 2).
+#[inline(always)]
+pub(super) fn finish_row<const ND: usize, const NF: usize>(
+    view: &ComplianceMapView<'_>,
+    (n, w, ok): (usize, &[f64; 4], bool),
+    p: &[f64],
+    stride: usize,
+    f: &[f64],
+    o: &mut [f64],
+    options: QueryOptions,
+) -> Result<Option<Placement>, TickError> {
+    ignored_entries(0, p, stride).map_err(|e| e.error)?;
+    if ok
+        && let (Ok(fa), Ok(oa)) = (
+            <&[f64; NF]>::try_from(f),
+            <&mut [f64; ND]>::try_from(&mut *o),
+        )
+        && let Some(acc) = view.blend_cell_packed::<ND, NF>(n, view.y.nodes.len(), w, fa)
+        && acc.iter().fold(0.0, |a, v| a + v * 0.0) == 0.0
+    {
+        *oa = acc;
+        return Ok(Some(Placement::Inside));
+    }
+    let (Some(&px), Some(&py)) = (p.first(), p.get(1)) else {
+        return Ok(None);
+    };
+    view.eval([px, py], f, o, options).map(Some)
+}
+
+/// [`finish_row`] for a row whose cell is not known yet (a batch's last rows, or a group of
+/// the lane kernel it declined): the first phase's arithmetic for this one row.
+#[cfg(all(feature = "std", target_arch = "x86_64"))]
+#[inline(always)]
+pub(super) fn one_row<const ND: usize, const NF: usize>(
+    view: &ComplianceMapView<'_>,
+    (ex, ey): (&EvenAxis<'_>, &EvenAxis<'_>),
+    p: &[f64],
+    stride: usize,
+    f: &[f64],
+    o: &mut [f64],
+    options: QueryOptions,
+) -> Result<Option<Placement>, TickError> {
+    let (n, w, ok) = cell(ex, ey, view.y.nodes.len(), p, f);
+    finish_row::<ND, NF>(view, (n, &w, ok), p, stride, f, o, options)
+}
+
+/// Row `p`'s first node, bilinear weights (Eq. 14) and whether it is inside the grid with
+/// finite input and no rounding correction needed: branch-free, the single query's
+/// arithmetic (`cell_nodes`, `cell_t_inside`, `bilinear_stencil`).
+#[inline(always)]
+fn cell(
+    ex: &EvenAxis<'_>,
+    ey: &EvenAxis<'_>,
+    ny: usize,
+    p: &[f64],
+    f: &[f64],
+) -> (usize, [f64; 4], bool) {
+    let px = p.first().copied().unwrap_or(f64::NAN);
+    let py = p.get(1).copied().unwrap_or(f64::NAN);
+    // NaN and infinities make this NaN; finite values make it exactly 0.
+    let probe = f.iter().fold(px * 0.0 + py * 0.0, |a, v| a + v * 0.0);
+    let (i, tx, ok_x) = ex.cell_t(px);
+    let (j, ty, ok_y) = ey.cell_t(py);
+    let (ux, uy) = (1.0 - tx, 1.0 - ty);
+    (
+        i * ny + j,
+        [ux * uy, ux * ty, tx * uy, tx * ty],
+        (probe == 0.0) & ok_x & ok_y,
+    )
 }

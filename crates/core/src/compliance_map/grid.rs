@@ -306,11 +306,11 @@ fn even_t(v: f64, lo: f64, hi: f64, inv_step: f64) -> f64 {
 /// count loaded once.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct EvenAxis<'a> {
-    nodes: &'a [f64],
-    first: f64,
-    last: f64,
-    inv_step: f64,
-    last_cell: usize,
+    pub(super) nodes: &'a [f64],
+    pub(super) first: f64,
+    pub(super) last: f64,
+    pub(super) inv_step: f64,
+    pub(super) last_cell: usize,
 }
 
 impl EvenAxis<'_> {

@@ -42,6 +42,8 @@
 //! ```
 
 mod batch;
+#[cfg(all(feature = "std", target_arch = "x86_64"))]
+mod batch_avx2;
 mod grid;
 mod interp;
 mod kernel;
