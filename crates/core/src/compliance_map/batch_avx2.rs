@@ -110,7 +110,7 @@ pub(super) fn batch<const ND: usize, const NF: usize, const B: usize>(
 fn group<const ND: usize, const NF: usize, const B: usize>(
     simd: V3,
     view: &ComplianceMapView<'_>,
-    (tx_, ty_): (&Tables<'_>, &Tables<'_>),
+    (along_x, along_y): (&Tables<'_>, &Tables<'_>),
     p: &[f64],
     f: &[f64],
     o: &mut [f64],
@@ -137,8 +137,8 @@ fn group<const ND: usize, const NF: usize, const B: usize>(
     let probe = fl.iter().fold(add(mul(px, zero), mul(py, zero)), |a, &v| {
         add(a, mul(v, zero))
     });
-    let (i, tx, ok_x) = tx_.cells(simd, px);
-    let (j, ty, ok_y) = ty_.cells(simd, py);
+    let (i, tx, ok_x) = along_x.cells(simd, px);
+    let (j, ty, ok_y) = along_y.cells(simd, py);
     let finite = avx._mm256_cmp_pd::<_CMP_EQ_OQ>(probe, zero);
     let ok = avx._mm256_and_pd(avx._mm256_and_pd(ok_x, ok_y), finite);
     if avx._mm256_movemask_pd(ok) != 0b1111 {
