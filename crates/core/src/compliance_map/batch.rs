@@ -117,7 +117,8 @@ fn even_blocks<const ND: usize, const NF: usize>(
             .zip(ob.chunks_exact_mut(ND));
         for (k, (((n, w), ok), ((p, f), o))) in cells.zip(rows).enumerate() {
             let row = first_row + k;
-            let place = finish_row::<ND, NF>(view, (*n, w, *ok), p, stride, f, o, options)
+            let cell = (*n, w, *ok);
+            let place = finish_row::<ND, NF>(view, cell, Row { p, stride, f, o }, options)
                 .map_err(|error| BatchError { row, error })?;
             if let Some(place) = place {
                 summary.count(place);
@@ -125,6 +126,14 @@ fn even_blocks<const ND: usize, const NF: usize>(
         }
     }
     Ok(summary)
+}
+
+/// One row of a batch: its position (`stride` values, x and y first), force and output.
+pub(super) struct Row<'r> {
+    pub p: &'r [f64],
+    pub stride: usize,
+    pub f: &'r [f64],
+    pub o: &'r mut [f64],
 }
 
 /// One row whose cell, weights and mask (`cell`: first node, Eq. 14 weights, inside and
@@ -135,10 +144,7 @@ fn even_blocks<const ND: usize, const NF: usize>(
 pub(super) fn finish_row<const ND: usize, const NF: usize>(
     view: &ComplianceMapView<'_>,
     (n, w, ok): (usize, &[f64; 4], bool),
-    p: &[f64],
-    stride: usize,
-    f: &[f64],
-    o: &mut [f64],
+    Row { p, stride, f, o }: Row<'_>,
     options: QueryOptions,
 ) -> Result<Option<Placement>, TickError> {
     ignored_entries(0, p, stride).map_err(|e| e.error)?;
@@ -166,14 +172,11 @@ pub(super) fn finish_row<const ND: usize, const NF: usize>(
 pub(super) fn one_row<const ND: usize, const NF: usize>(
     view: &ComplianceMapView<'_>,
     (ex, ey): (&EvenAxis<'_>, &EvenAxis<'_>),
-    p: &[f64],
-    stride: usize,
-    f: &[f64],
-    o: &mut [f64],
+    row: Row<'_>,
     options: QueryOptions,
 ) -> Result<Option<Placement>, TickError> {
-    let (n, w, ok) = cell(ex, ey, view.y.nodes.len(), p, f);
-    finish_row::<ND, NF>(view, (n, &w, ok), p, stride, f, o, options)
+    let (n, w, ok) = cell(ex, ey, view.y.nodes.len(), row.p, row.f);
+    finish_row::<ND, NF>(view, (n, &w, ok), row, options)
 }
 
 /// Row `p`'s first node, bilinear weights (Eq. 14) and whether it is inside the grid with

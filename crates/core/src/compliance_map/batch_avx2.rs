@@ -15,7 +15,7 @@ use core::arch::x86_64::{__m128d, __m128i, __m256d, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP
 use pulp::cast;
 use pulp::x86::V3;
 
-use super::batch::one_row;
+use super::batch::{Row, one_row};
 use super::grid::EvenAxis;
 use super::interp::{BatchError, BatchSummary};
 use super::kernel::packed_block;
@@ -57,21 +57,15 @@ pub(super) fn batch<const ND: usize, const NF: usize, const B: usize>(
         type Output = Result<BatchSummary, BatchError>;
         #[inline(always)]
         fn call(self) -> Self::Output {
-            let Self {
-                simd,
-                view,
-                axes,
-                positions,
-                forces,
-                out,
-                options,
-            } = self;
+            let simd = self.simd;
+            let (view, axes, options) = (self.view, &self.axes, self.options);
             let tables = (Tables::new(simd, &axes.0), Tables::new(simd, &axes.1));
             let mut summary = BatchSummary::default();
-            let groups = positions
+            let groups = self
+                .positions
                 .chunks(8)
-                .zip(forces.chunks(4 * NF))
-                .zip(out.chunks_mut(4 * ND));
+                .zip(self.forces.chunks(4 * NF))
+                .zip(self.out.chunks_mut(4 * ND));
             for (g, ((p, f), o)) in groups.enumerate() {
                 if group::<ND, NF, B>(simd, view, (&tables.0, &tables.1), p, f, o) {
                     summary.inside += 4;
@@ -79,11 +73,13 @@ pub(super) fn batch<const ND: usize, const NF: usize, const B: usize>(
                 }
                 let rows = p.chunks_exact(2).zip(f.chunks_exact(NF));
                 for (k, ((p, f), o)) in rows.zip(o.chunks_exact_mut(ND)).enumerate() {
-                    let place = one_row::<ND, NF>(view, (&axes.0, &axes.1), p, 2, f, o, options)
-                        .map_err(|error| BatchError {
+                    let row = Row { p, stride: 2, f, o };
+                    let place = one_row::<ND, NF>(view, (&axes.0, &axes.1), row, options).map_err(
+                        |error| BatchError {
                             row: 4 * g + k,
                             error,
-                        })?;
+                        },
+                    )?;
                     if let Some(place) = place {
                         summary.count(place);
                     }
