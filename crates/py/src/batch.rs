@@ -1,6 +1,7 @@
-//! The one batch runner of the bindings: the rows of a batch are split into one contiguous
-//! chunk per thread (scoped threads, at most [`MAX_THREADS`]), each thread with its own
-//! workspace, and the first failing row in row order is reported. The per-tick core stays
+//! The one batch runner of the bindings: the rows of a batch are split into contiguous
+//! pieces that the threads (scoped, at most [`MAX_THREADS`], the calling thread one of them)
+//! take in row order as they become free, each thread with its own workspace, and the first
+//! failing row in row order is reported. The per-tick core stays
 //! single-threaded and allocation-free; only this wrapper spreads it over threads.
 //!
 //! When to split is one threshold on the work, not on the row count: a batch goes on several
@@ -8,6 +9,8 @@
 //! ([`row_cost`]), reaches [`PARALLEL_MIN_NS`].
 
 use core::ops::Range;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Mutex, PoisonError};
 
 use numpy::ndarray::{ArrayView2, s};
 
@@ -70,10 +73,21 @@ pub fn threads_for(n: usize, row_ns: f64) -> usize {
     std::thread::available_parallelism().map_or(1, |t| t.get().min(MAX_THREADS).min(n))
 }
 
-/// Fills `out` (rows of `width` numbers) chunk by chunk: `chunk(rows, workspace, out_rows)`
+/// Pieces per thread of a threaded batch: each thread takes the next piece in row order
+/// when it is free, so a core busy with something else does less of the batch instead of
+/// holding it up (on a shared machine the second core comes and goes; with one chunk per
+/// thread the batch waited for the slower one).
+pub const PIECES_PER_THREAD: usize = 8;
+
+/// Least estimated work of one piece \[ns\]: a piece's start (a lock, the chunk function's
+/// own setup) stays small beside it.
+pub const PIECE_MIN_NS: f64 = 5.0e4;
+
+/// Fills `out` (rows of `width` numbers) piece by piece: `chunk(rows, workspace, out_rows)`
 /// gets a contiguous range of rows and their slice of `out`, each thread its own
-/// `workspace()`; a failure names the absolute row. On several threads from
-/// [`PARALLEL_MIN_NS`] of estimated work (`row_ns` per row).
+/// `workspace()` (made once per thread); a failure names the absolute row, the first in row
+/// order. On several threads from [`PARALLEL_MIN_NS`] of estimated work (`row_ns` per row),
+/// the calling thread one of them, the rows in pieces that free threads take in order.
 pub fn chunks<W, M, F>(
     out: &mut [f64],
     width: usize,
@@ -88,37 +102,54 @@ where
     let width = width.max(1);
     let n = out.len() / width;
     let threads = threads_for(n, row_ns);
-    let chunk_rows = n.div_ceil(threads).max(1);
-    let run = |first: usize, o: &mut [f64]| -> Result<(), BatchFailure> {
+    let run = |first: usize, w: &mut W, o: &mut [f64]| -> Result<(), BatchFailure> {
         let rows = first..first + o.len() / width;
-        chunk(rows, &mut workspace(), o).map_err(|(row, e)| BatchFailure::Row(row, e))
+        chunk(rows, w, o).map_err(|(row, e)| BatchFailure::Row(row, e))
     };
     if threads == 1 {
-        return run(0, out);
+        return run(0, &mut workspace(), out);
     }
-    // The first chunk runs on the calling thread (already awake, its caches warm): one
-    // thread fewer to start per batch.
-    let (head, tail) = out.split_at_mut(chunk_rows.saturating_mul(width).min(out.len()));
-    let results: Vec<Result<(), BatchFailure>> = std::thread::scope(|scope| {
-        let handles: Vec<_> = tail
-            .chunks_mut(chunk_rows * width)
-            .enumerate()
-            .map(|(c, o)| {
-                let run = &run;
-                scope.spawn(move || run((c + 1) * chunk_rows, o))
-            })
-            .collect();
-        let first = run(0, head);
-        core::iter::once(first)
-            .chain(
-                handles
-                    .into_iter()
-                    .map(|h| h.join().unwrap_or(Err(BatchFailure::Panicked))),
-            )
+    // Whole groups of 8 rows per piece (the four-row kernels' groups stay whole).
+    let by_work = ((n as f64) * row_ns / PIECE_MIN_NS) as usize;
+    let pieces = (threads * PIECES_PER_THREAD).min(by_work).max(threads);
+    let piece_rows = n.div_ceil(pieces).next_multiple_of(8);
+    let queue = Mutex::new(out.chunks_mut(piece_rows * width).enumerate());
+    // The lowest piece that failed: the pieces after it are skipped, the ones before it
+    // (all handed out already) finish, so its first failing row is the batch's.
+    let failed = AtomicUsize::new(usize::MAX);
+    let worker = || -> Option<(usize, BatchFailure)> {
+        let mut w = workspace();
+        let mut first: Option<(usize, BatchFailure)> = None;
+        loop {
+            let next = queue.lock().unwrap_or_else(PoisonError::into_inner).next();
+            let Some((k, o)) = next else {
+                return first;
+            };
+            if k > failed.load(Ordering::Acquire) {
+                continue;
+            }
+            if let Err(e) = run(k * piece_rows, &mut w, o) {
+                failed.fetch_min(k, Ordering::AcqRel);
+                if first.as_ref().is_none_or(|(j, _)| k < *j) {
+                    first = Some((k, e));
+                }
+            }
+        }
+    };
+    let outcomes: Vec<Option<(usize, BatchFailure)>> = std::thread::scope(|scope| {
+        let handles: Vec<_> = (1..threads).map(|_| scope.spawn(worker)).collect();
+        let mine = worker();
+        core::iter::once(mine)
+            .chain(handles.into_iter().map(|h| {
+                h.join()
+                    .unwrap_or(Some((usize::MAX, BatchFailure::Panicked)))
+            }))
             .collect()
     });
-    // Chunks are in row order: the first error is the first failing row.
-    results.into_iter().collect()
+    match outcomes.into_iter().flatten().min_by_key(|(k, _)| *k) {
+        Some((_, e)) => Err(e),
+        None => Ok(()),
+    }
 }
 
 /// [`chunks`] one row at a time: `row(i, workspace, out_row)` for every row `i`.

@@ -138,6 +138,13 @@ def test_batches_on_every_core_match_the_single_calls(kr300):
                  lambda: kr300.compliance_batch(q)]:
         with pytest.raises(deflect.InputError, match="row 3000"):
             call()
+    # The threads take pieces of the rows in order: a failure in the first piece wins over
+    # later ones, and a batch without failures still fills every row.
+    q[10, 0] = np.nan
+    for call in [lambda: kr300.deflection_batch(q, w), lambda: kr300.forward_batch(q),
+                 lambda: kr300.compliance_batch(q)]:
+        with pytest.raises(deflect.InputError, match="row 10[^0-9]"):
+            call()
 
 
 def test_displacement_field_is_the_map_at_a_fixed_load(cmap):
