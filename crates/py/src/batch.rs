@@ -195,6 +195,23 @@ pub fn block<'a, 'd: 'a>(
     buf
 }
 
+/// Row `i` of `a`: in place when `a` is C-contiguous (`rows` its slice, `a.as_slice()`),
+/// else copied into `buf` through the row view (a broadcast or strided argument).
+pub fn row_of<'a>(
+    a: &ArrayView2<'_, f64>,
+    rows: Option<&'a [f64]>,
+    i: usize,
+    buf: &'a mut Vec<f64>,
+) -> &'a [f64] {
+    let width = a.ncols();
+    if let Some(r) = rows.and_then(|s| s.get(width * i..width * (i + 1))) {
+        return r;
+    }
+    buf.clear();
+    buf.extend(a.row(i).iter().copied());
+    buf
+}
+
 /// The blocks of at most [`BLOCK_ROWS`] rows of `rows`, in order.
 pub fn blocks(rows: Range<usize>) -> impl Iterator<Item = Range<usize>> {
     let end = rows.end;

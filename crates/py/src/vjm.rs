@@ -317,17 +317,6 @@ impl SerialRobot {
             Some(r) => Vector6::from_column_slice(r),
             None => Vector6::from_iterator(w.row(i).iter().copied()),
         };
-        // Row `i` of Q: in place, or copied into `buf`.
-        let q_row = |i: usize, buf: &mut Vec<f64>| {
-            if q_rows.and_then(|s| s.get(dof * i..dof * (i + 1))).is_none() {
-                buf.clear();
-                buf.extend(q.row(i).iter().copied());
-            }
-        };
-        fn q_at<'a>(rows: Option<&'a [f64]>, dof: usize, i: usize, buf: &'a [f64]) -> &'a [f64] {
-            rows.and_then(|s| s.get(dof * i..dof * (i + 1)))
-                .unwrap_or(buf)
-        }
         let workspace = || (Data::new(model), [0; 4].map(|_| Vec::with_capacity(dof)));
         fill_into(py, &[n, 6], out, |buf| {
             py.detach(|| {
@@ -340,15 +329,12 @@ impl SerialRobot {
                         let base = rows.start + 4 * g;
                         if og.len() == 4 * 6 {
                             let ws4 = [0, 1, 2, 3].map(|r| w_row(base + r));
-                            for (r, b) in qb.iter_mut().enumerate() {
-                                q_row(base + r, b);
-                            }
-                            let [b0, b1, b2, b3] = &*qb;
+                            let [b0, b1, b2, b3] = qb;
                             let q4 = [
-                                q_at(q_rows, dof, base, b0),
-                                q_at(q_rows, dof, base + 1, b1),
-                                q_at(q_rows, dof, base + 2, b2),
-                                q_at(q_rows, dof, base + 3, b3),
+                                batch::row_of(&q, q_rows, base, b0),
+                                batch::row_of(&q, q_rows, base + 1, b1),
+                                batch::row_of(&q, q_rows, base + 2, b2),
+                                batch::row_of(&q, q_rows, base + 3, b3),
                             ];
                             if let Some(d4) =
                                 vjm::exact_deflection_x4(model, data, q4, ws4.each_ref())
@@ -361,14 +347,11 @@ impl SerialRobot {
                         }
                         for (r, orow) in og.chunks_mut(6).enumerate() {
                             let i = base + r;
-                            let Some(b) = qb.first_mut() else {
-                                continue; // unreachable: four buffers
-                            };
-                            q_row(i, b);
+                            let [b, ..] = qb;
                             let d = vjm::deflection(
                                 model,
                                 data,
-                                q_at(q_rows, dof, i, b),
+                                batch::row_of(&q, q_rows, i, b),
                                 &w_row(i),
                                 vjm::Load::Exact,
                             )
@@ -483,18 +466,8 @@ impl SerialRobot {
                     buf,
                     width,
                     batch::row_cost::VJM,
-                    || (Data::new(model), vec![0.0; dof]),
-                    |i, (data, qi), o| {
-                        // A C-contiguous Q is read in place, row by row of its slice;
-                        // a broadcast or strided one is copied through its row views.
-                        if let Some(r) = q_rows.and_then(|s| s.get(dof * i..dof * (i + 1))) {
-                            return row(model, data, r, i, o);
-                        }
-                        for (d, s) in qi.iter_mut().zip(q.row(i)) {
-                            *d = *s;
-                        }
-                        row(model, data, qi, i, o)
-                    },
+                    || (Data::new(model), Vec::with_capacity(dof)),
+                    |i, (data, qi), o| row(model, data, batch::row_of(&q, q_rows, i, qi), i, o),
                 )
             })
             .map_err(PyErr::from)
