@@ -6,7 +6,7 @@
 
 use deflect_core::vjm::{self, Vector6};
 use nalgebra::{Isometry3, Matrix3, Matrix4, UnitQuaternion};
-use numpy::ndarray::Array2;
+use numpy::ndarray::{Array, Array2, Dimension};
 use numpy::{
     PyArray1, PyArray2, PyArrayDescrMethods, PyArrayDyn, PyArrayMethods, PyReadonlyArray2,
     PyReadonlyArrayDyn, PyUntypedArray, PyUntypedArrayMethods, ToPyArray,
@@ -215,12 +215,43 @@ pub fn try_with_capacity(n: usize, what: &str) -> PyResult<Vec<f64>> {
     Ok(v)
 }
 
+/// An empty vector with room for `n` values of any type (a result's rows of states or
+/// poses), allocated fallibly as [`try_zeros`].
+pub fn try_vec<T>(n: usize, what: &str) -> PyResult<Vec<T>> {
+    let size = core::mem::size_of::<T>().max(1);
+    let refused = || no_memory_bytes(what, n, (n as u128).saturating_mul(size as u128));
+    if n.checked_mul(size).is_none_or(|b| b > isize::MAX as usize) {
+        return Err(refused());
+    }
+    let mut v = Vec::new();
+    v.try_reserve_exact(n).map_err(|_| refused())?;
+    Ok(v)
+}
+
+/// An array of `dim` zeros (`T::default()`), allocated fallibly as [`try_zeros`]: a result
+/// whose size grows with an argument (a trajectory's ticks, a batch's rows).
+pub fn try_array<T: Clone + Default, D: Dimension>(dim: D, what: &str) -> PyResult<Array<T, D>> {
+    let Some(n) = dim.size_checked() else {
+        return Err(no_memory_bytes(what, usize::MAX, u128::MAX));
+    };
+    let mut v = try_vec::<T>(n, what)?;
+    v.resize(n, T::default());
+    Array::from_shape_vec(dim, v).map_err(|e| InputError::new_err(format!("internal: {e}")))
+}
+
 /// [`try_zeros`] for `rows` rows of `width` numbers (a batch's result).
 pub fn try_rows(rows: usize, width: usize, what: &str) -> PyResult<Vec<f64>> {
     let n = rows
         .checked_mul(width)
         .ok_or_else(|| no_memory(what, rows as u128 * width as u128))?;
     try_zeros(n, what)
+}
+
+/// The `MemoryError` of a refused allocation of `n` values, `bytes` in all.
+fn no_memory_bytes(what: &str, n: usize, bytes: u128) -> PyErr {
+    PyMemoryError::new_err(format!(
+        "{what}: cannot allocate {n} values ({bytes} bytes)"
+    ))
 }
 
 /// The `MemoryError` of a refused allocation of `n` float64 numbers.

@@ -12,12 +12,12 @@ use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::stock::ZMap;
 use deflect_core::mechanism::PoseIkOptions;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector2, Vector3};
-use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::ndarray::{Array1, Array2, Ix3};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3};
 use pyo3::prelude::*;
 
 use crate::InputError;
-use crate::arrays::{pose, put_pose, rotation, try_rows, vector};
+use crate::arrays::{pose, put_pose, rotation, try_array, try_rows, vector};
 use crate::errors::{build_err, job_err};
 use crate::machining::{GcodeProgram, coefficients};
 use crate::scalars::{count, pair, real};
@@ -382,13 +382,13 @@ impl MachiningResult {
 
     /// Commanded poses (n, 4, 4), workpiece frame: the Cartesian command.
     #[getter]
-    fn commanded<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray3<f64>> {
+    fn commanded<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray3<f64>>> {
         let n = self.report.samples.len();
-        let mut a = Array3::zeros((n, 4, 4));
+        let mut a = try_array(Ix3(n, 4, 4), "the samples")?;
         for (i, s) in self.report.samples.iter().enumerate() {
             put_pose(&mut a, i, &s.commanded);
         }
-        a.into_pyarray(py)
+        Ok(a.into_pyarray(py))
     }
 
     /// Predicted tool tip without compensation (n, 3) [m].

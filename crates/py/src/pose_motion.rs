@@ -8,7 +8,7 @@ use deflect_core::TickError;
 use deflect_core::motion::{
     DEFAULT_RATE_HZ, Limits, MAX_SAMPLES, PoseLimits, PoseState, PoseTrajectory as Core,
 };
-use numpy::ndarray::{Array1, Array2, Array3};
+use numpy::ndarray::{Array1, Array2, Array3, Ix1, Ix2, Ix3};
 use numpy::{PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -16,7 +16,8 @@ use pyo3::types::PyDict;
 use crate::InputError;
 use crate::args;
 use crate::arrays::{
-    fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, vector_upto,
+    fixed_matrix, float_array, iso_to_py, matrix_to_py, pose_of, put_pose, try_array, try_vec,
+    vector_upto,
 };
 use crate::errors::{build_err, shape_error, tick_err};
 use crate::scalars::real;
@@ -34,15 +35,17 @@ struct PoseSamples {
 }
 
 impl PoseSamples {
-    fn of(states: &[PoseState]) -> Self {
+    /// The rows of `states`, in arrays allocated fallibly (`MemoryError`, never an abort).
+    fn try_of(states: &[PoseState]) -> PyResult<Self> {
         let n = states.len();
+        let what = "the pose samples";
         let mut out = Self {
-            t: Array1::zeros(n),
-            pose: Array3::zeros((n, 4, 4)),
-            velocity: Array2::zeros((n, 3)),
-            acceleration: Array2::zeros((n, 3)),
-            angular_velocity: Array2::zeros((n, 3)),
-            angular_acceleration: Array2::zeros((n, 3)),
+            t: try_array(Ix1(n), what)?,
+            pose: try_array(Ix3(n, 4, 4), what)?,
+            velocity: try_array(Ix2(n, 3), what)?,
+            acceleration: try_array(Ix2(n, 3), what)?,
+            angular_velocity: try_array(Ix2(n, 3), what)?,
+            angular_acceleration: try_array(Ix2(n, 3), what)?,
         };
         for (i, s) in states.iter().enumerate() {
             if let Some(t) = out.t.get_mut(i) {
@@ -61,16 +64,25 @@ impl PoseSamples {
                     .for_each(|(d, x)| *d = *x);
             }
         }
-        out
+        Ok(out)
     }
 }
 
-/// The states of every tick of `traj` at `rate_hz` (at most `MAX_SAMPLES`).
-pub(crate) fn pose_ticks(traj: &Core, rate_hz: f64) -> Result<Vec<PoseState>, TickError> {
-    let n = traj.sample_count(rate_hz)?;
-    (0..n)
-        .map(|k| traj.sample(traj.tick_time(rate_hz, k, n)))
-        .collect()
+/// The states of every tick of `traj` at `rate_hz` (at most `MAX_SAMPLES`), in a vector
+/// allocated fallibly: the outer error a `MemoryError`, the inner one a tick's.
+pub(crate) fn pose_ticks(traj: &Core, rate_hz: f64) -> PyResult<Result<Vec<PoseState>, TickError>> {
+    let n = match traj.sample_count(rate_hz) {
+        Ok(n) => n,
+        Err(e) => return Ok(Err(e)),
+    };
+    let mut states = try_vec(n, "the pose samples")?;
+    for k in 0..n {
+        match traj.sample(traj.tick_time(rate_hz, k, n)) {
+            Ok(s) => states.push(s),
+            Err(e) => return Ok(Err(e)),
+        }
+    }
+    Ok(Ok(states))
 }
 
 /// A 6-D rest-to-rest pose motion (from `plan_pose`), base frame, SI units: the TCP moves on
@@ -122,9 +134,10 @@ impl PoseTrajectory {
                  .at(t) or sample it with .sampled(rate_hz)",
             ));
         };
-        let s = py
-            .detach(|| pose_ticks(&self.plan, rate).map(|v| PoseSamples::of(&v)))
-            .map_err(tick_err)?;
+        let s = py.detach(|| {
+            let states = pose_ticks(&self.plan, rate)?.map_err(tick_err)?;
+            PoseSamples::try_of(&states)
+        })?;
         Ok(self.samples.get_or_init(|| s))
     }
 }
@@ -143,11 +156,10 @@ impl PoseTrajectory {
             1 => (vector_upto(t, "t", MAX_SAMPLES, "MAX_SAMPLES")?, false),
             _ => return Err(shape_error("t", "a number or (m,)", a.shape())),
         };
-        let states = times
-            .iter()
-            .map(|&t| self.plan.sample(t))
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(tick_err)?;
+        let mut states = try_vec(times.len(), "the states")?;
+        for &t in &times {
+            states.push(self.plan.sample(t).map_err(tick_err)?);
+        }
         let d = PyDict::new(py);
         match (scalar, states.first()) {
             (true, Some(s)) => {
@@ -165,7 +177,7 @@ impl PoseTrajectory {
                 )?;
             }
             _ => {
-                let s = PoseSamples::of(&states);
+                let s = PoseSamples::try_of(&states)?;
                 d.set_item("t", s.t.to_pyarray(py))?;
                 d.set_item("pose", s.pose.to_pyarray(py))?;
                 d.set_item("velocity", s.velocity.to_pyarray(py))?;

@@ -7,7 +7,11 @@ the session. The atlas tells "out of reach" from "beyond the model's validity"; 
 is named, once per quantity, in its messages.
 """
 
+import json
+import os
 import pickle
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -207,3 +211,58 @@ def test_at_outside_the_motion_holds_the_end_states_as_documented():
     np.testing.assert_array_equal(pt.at(-1.0)["pose"], np.eye(4))
     np.testing.assert_array_equal(pt.at(1e9)["pose"], pose_end)
     np.testing.assert_array_equal(pt.at(1e9)["velocity"], np.zeros(3))
+
+
+# Results that grow with a trajectory's ticks are allocated fallibly ----------------------
+_TICKS_CHILD = r"""
+import json, os, resource, sys
+import numpy as np
+import deflect
+urdf, toml, q0 = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
+start, end = np.eye(4), np.eye(4)
+end[0, 3] = 1.0
+lim = (1.0, 10.0, 100.0)
+d = deflect.plan_pose(start, end, lim, lim, rate_hz=None).duration
+rate = 4.0e6 / d  # about 4e6 ticks, inside MAX_SAMPLES: 0.64 GB of states, 1 GB of arrays
+times = np.linspace(0.0, d, 4_000_000)
+robot = deflect.SerialRobot.from_urdf(urdf, toml, "tcp")
+corrector = deflect.SerialDalembertCorrector(robot, 5.0, seed=np.array(q0))
+small = deflect.plan_pose(start, end, lim, lim, rate_hz=100.0)
+small.pose, small.at(times[:10])  # every code path once, before the cap
+plan = deflect.plan_pose(start, end, lim, lim, rate_hz=rate)
+size = os.sysconf("SC_PAGE_SIZE") * int(open("/proc/self/statm").read().split()[0])
+resource.setrlimit(resource.RLIMIT_AS, (size + (256 << 20), resource.RLIM_INFINITY))
+res = {}
+for name, call in [
+    ("samples", lambda: plan.pose),
+    ("at", lambda: plan.at(times)),
+    ("correct", lambda: corrector.correct(plan)),
+    ("small_after", lambda: small.at(times[:10])["pose"].shape),
+]:
+    try:
+        out = call()
+        res[name] = "ok" if name != "small_after" else list(out)
+    except MemoryError as e:
+        res[name] = "MemoryError: " + str(e)
+print(json.dumps(res))
+"""
+
+
+def test_results_as_long_as_a_trajectory_raise_memory_error_not_abort():
+    """A pose trajectory's samples, `at` over many times and the serial D'Alembert
+    correction of every tick allocate their results fallibly: with the address space capped
+    256 MB above the process's size, each raises MemoryError naming what it could not
+    allocate (an infallible allocation would abort the child), and the interpreter goes on."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1",
+               MALLOC_MMAP_THRESHOLD_="131072", MALLOC_ARENA_MAX="1")
+    proc = subprocess.run(
+        [sys.executable, "-c", _TICKS_CHILD, str(KR300_URDF), str(KR300_TOML),
+         json.dumps(KR300_POSE.tolist())],
+        capture_output=True, text=True, timeout=120, env=env,
+    )
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    res = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert res["samples"].startswith("MemoryError: the pose samples: cannot allocate"), res
+    assert res["at"].startswith("MemoryError: the states: cannot allocate"), res
+    assert res["correct"].startswith("MemoryError: the corrected trajectory: cannot allocate"), res
+    assert res["small_after"] == [10, 4, 4], res

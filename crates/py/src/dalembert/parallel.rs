@@ -8,14 +8,14 @@ use deflect_core::dalembert::parallel::{self, Tick};
 use deflect_core::mechanism::ParallelRobot2 as CoreRobot2;
 use deflect_core::{Placement, TickError};
 use nalgebra::Vector2;
-use numpy::ndarray::{Array1, Array2};
-use numpy::{PyArray1, PyArray2, ToPyArray};
+use numpy::ndarray::{Array1, Array2, Ix2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::vector;
+use crate::arrays::{try_array, try_copy, vector};
 use crate::compliance_map::ComplianceMap;
 use crate::errors::{build_err, tick_err, tick_err_at};
 use crate::mechanism::ParallelRobot2;
@@ -191,9 +191,19 @@ impl DalembertCorrector {
             )));
         }
         let n = pos.nrows();
+        // Five results of the trajectory's length: allocated fallibly (MemoryError, never an
+        // abort), before the GIL is released.
+        let what = "the corrected path";
+        let mut out: [Array2<f64>; 5] = [
+            try_array(Ix2(n, 2), what)?,
+            try_array(Ix2(n, 2), what)?,
+            try_array(Ix2(n, 2), what)?,
+            try_array(Ix2(n, 2), what)?,
+            try_array(Ix2(n, 2), what)?,
+        ];
+        let t = Array1::from_vec(try_copy(&samples.t.view(), what)?);
         let result = py.detach(|| -> Result<_, (usize, TickError)> {
             let mut data = self.data();
-            let mut out: [Array2<f64>; 5] = core::array::from_fn(|_| Array2::zeros((n, 2)));
             let mut flagged = Vec::new();
             let inputs = pos.rows().into_iter().zip(acc.rows());
             for (i, (prow, arow)) in inputs.enumerate() {
@@ -213,18 +223,17 @@ impl DalembertCorrector {
                     flagged.push(i);
                 }
             }
-            Ok((out, flagged))
+            Ok(flagged)
         });
-        let (out, flagged) = result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
+        let flagged = result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
         let [desired, position, joints, force, displacement] = out;
-        let t: Array1<f64> = samples.t.clone();
         Ok(CorrectedPath {
-            t: t.to_pyarray(py).unbind(),
-            desired: desired.to_pyarray(py).unbind(),
-            commanded: position.to_pyarray(py).unbind(),
-            joints: joints.to_pyarray(py).unbind(),
-            force: force.to_pyarray(py).unbind(),
-            displacement: displacement.to_pyarray(py).unbind(),
+            t: t.into_pyarray(py).unbind(),
+            desired: desired.into_pyarray(py).unbind(),
+            commanded: position.into_pyarray(py).unbind(),
+            joints: joints.into_pyarray(py).unbind(),
+            force: force.into_pyarray(py).unbind(),
+            displacement: displacement.into_pyarray(py).unbind(),
             flagged_ticks: flagged,
         })
     }

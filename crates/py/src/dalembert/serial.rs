@@ -9,14 +9,16 @@ use deflect_core::motion::PoseState;
 use deflect_core::vjm::Deflection;
 use deflect_core::vjm::Vector6;
 use nalgebra::{Matrix3, Vector3};
-use numpy::ndarray::{Array1, Array2, Array3};
-use numpy::{PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods, ToPyArray};
+use numpy::ndarray::{Array2, Ix1, Ix2, Ix3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArray3, PyUntypedArrayMethods, ToPyArray};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{fixed_matrix, float_array, iso_to_py, matrix, put_pose, vector, vector6};
+use crate::arrays::{
+    fixed_matrix, float_array, iso_to_py, matrix, put_pose, try_array, try_copy, vector, vector6,
+};
 use crate::errors::{build_err, tick_err, tick_err_at};
 use crate::pose_motion::{PoseTrajectory, pose_ticks};
 use crate::vjm::SerialRobot;
@@ -376,6 +378,9 @@ impl SerialDalembertCorrector {
             ));
         };
         let n = trajectory.plan.sample_count(rate).map_err(tick_err)?;
+        // Every result (and the broadcast process wrench) grows with the trajectory's ticks
+        // (at most MAX_SAMPLES): allocated fallibly, a MemoryError rather than an abort.
+        let what = "the corrected trajectory";
         let process: Option<Array2<f64>> = match process_wrench {
             None => None,
             Some(w) => {
@@ -383,32 +388,39 @@ impl SerialDalembertCorrector {
                 match a.ndim() {
                     1 => {
                         let v = vector6(w, "process_wrench")?;
-                        Some(Array2::from_shape_fn((n, 6), |(_, j)| {
-                            v.get(j).copied().unwrap_or(0.0)
-                        }))
+                        let mut all = try_array::<f64, _>(Ix2(n, 6), "process_wrench")?;
+                        for mut row in all.rows_mut() {
+                            row.iter_mut().zip(v.iter()).for_each(|(d, x)| *d = *x);
+                        }
+                        Some(all)
                     }
-                    _ => Some(
-                        matrix(w, "process_wrench", Some(n), Some(6))?
-                            .as_array()
-                            .to_owned(),
-                    ),
+                    _ => {
+                        let m = matrix(w, "process_wrench", Some(n), Some(6))?;
+                        let copy = try_copy(&m.as_array(), "process_wrench")?;
+                        Some(
+                            Array2::from_shape_vec((n, 6), copy)
+                                .map_err(|e| InputError::new_err(format!("internal: {e}")))?,
+                        )
+                    }
                 }
             }
         };
         let dof = self.dof();
-        let result = py.detach(|| -> Result<_, (usize, deflect_core::TickError)> {
-            let states = pose_ticks(&trajectory.plan, rate).map_err(|e| (0, e))?;
+        let mut t = try_array::<f64, _>(Ix1(n), what)?;
+        let mut desired = try_array::<f64, _>(Ix3(n, 4, 4), what)?;
+        let mut commanded = try_array::<f64, _>(Ix3(n, 4, 4), what)?;
+        let mut joints = try_array::<f64, _>(Ix2(n, dof), what)?;
+        let mut wrench = try_array::<f64, _>(Ix2(n, 6), what)?;
+        let mut deflection = try_array::<f64, _>(Ix2(n, 6), what)?;
+        let mut iterations = try_array::<u32, _>(Ix1(n), what)?;
+        let mut pos_err = try_array::<f64, _>(Ix1(n), what)?;
+        let mut ori_err = try_array::<f64, _>(Ix1(n), what)?;
+        let mut free = try_array::<f64, _>(Ix1(n), what)?;
+        let states = py
+            .detach(|| pose_ticks(&trajectory.plan, rate))?
+            .map_err(tick_err)?;
+        py.detach(|| -> Result<(), (usize, deflect_core::TickError)> {
             let mut data = self.data();
-            let mut t = Array1::zeros(n);
-            let mut desired = Array3::zeros((n, 4, 4));
-            let mut commanded = Array3::zeros((n, 4, 4));
-            let mut joints = Array2::zeros((n, dof));
-            let mut wrench = Array2::zeros((n, 6));
-            let mut deflection = Array2::zeros((n, 6));
-            let mut iterations = Array1::<u32>::zeros(n);
-            let mut pos_err = Array1::zeros(n);
-            let mut ori_err = Array1::zeros(n);
-            let mut free = Array1::zeros(n);
             for (i, s) in states.iter().enumerate() {
                 let p = process
                     .as_ref()
@@ -440,31 +452,20 @@ impl SerialDalembertCorrector {
                     *x = tick.diagnostics.free_rotation;
                 }
             }
-            Ok((
-                t,
-                desired,
-                commanded,
-                joints,
-                wrench,
-                deflection,
-                iterations,
-                [pos_err, ori_err, free],
-            ))
-        });
-        let (t, desired, commanded, joints, wrench, deflection, iterations, errors) =
-            result.map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
-        let [pos_err, ori_err, free] = errors;
+            Ok(())
+        })
+        .map_err(|(i, e)| tick_err_at(format_args!("tick {i}"), e))?;
         Ok(CorrectedPoses {
-            t: t.to_pyarray(py).unbind(),
-            desired: desired.to_pyarray(py).unbind(),
-            commanded: commanded.to_pyarray(py).unbind(),
-            joints: joints.to_pyarray(py).unbind(),
-            wrench: wrench.to_pyarray(py).unbind(),
-            deflection: deflection.to_pyarray(py).unbind(),
-            iterations: iterations.to_pyarray(py).unbind(),
-            position_error: pos_err.to_pyarray(py).unbind(),
-            orientation_error: ori_err.to_pyarray(py).unbind(),
-            free_rotation: free.to_pyarray(py).unbind(),
+            t: t.into_pyarray(py).unbind(),
+            desired: desired.into_pyarray(py).unbind(),
+            commanded: commanded.into_pyarray(py).unbind(),
+            joints: joints.into_pyarray(py).unbind(),
+            wrench: wrench.into_pyarray(py).unbind(),
+            deflection: deflection.into_pyarray(py).unbind(),
+            iterations: iterations.into_pyarray(py).unbind(),
+            position_error: pos_err.into_pyarray(py).unbind(),
+            orientation_error: ori_err.into_pyarray(py).unbind(),
+            free_rotation: free.into_pyarray(py).unbind(),
         })
     }
 
