@@ -4,7 +4,6 @@
 
 use std::sync::OnceLock;
 
-use deflect_core::TickError;
 use deflect_core::motion::{
     DEFAULT_RATE_HZ, Limits, MAX_SAMPLES, PoseLimits, PoseState, PoseTrajectory as Core,
 };
@@ -69,20 +68,17 @@ impl PoseSamples {
 }
 
 /// The states of every tick of `traj` at `rate_hz` (at most `MAX_SAMPLES`), in a vector
-/// allocated fallibly: the outer error a `MemoryError`, the inner one a tick's.
-pub(crate) fn pose_ticks(traj: &Core, rate_hz: f64) -> PyResult<Result<Vec<PoseState>, TickError>> {
-    let n = match traj.sample_count(rate_hz) {
-        Ok(n) => n,
-        Err(e) => return Ok(Err(e)),
-    };
+/// allocated fallibly: `MemoryError` rather than an abort, a tick's error as its exception.
+pub(crate) fn pose_ticks(traj: &Core, rate_hz: f64) -> PyResult<Vec<PoseState>> {
+    let n = traj.sample_count(rate_hz).map_err(tick_err)?;
     let mut states = try_vec(n, "the pose samples")?;
     for k in 0..n {
-        match traj.sample(traj.tick_time(rate_hz, k, n)) {
-            Ok(s) => states.push(s),
-            Err(e) => return Ok(Err(e)),
-        }
+        states.push(
+            traj.sample(traj.tick_time(rate_hz, k, n))
+                .map_err(tick_err)?,
+        );
     }
-    Ok(Ok(states))
+    Ok(states)
 }
 
 /// A 6-D rest-to-rest pose motion (from `plan_pose`), base frame, SI units: the TCP moves on
@@ -135,7 +131,7 @@ impl PoseTrajectory {
             ));
         };
         let s = py.detach(|| {
-            let states = pose_ticks(&self.plan, rate)?.map_err(tick_err)?;
+            let states = pose_ticks(&self.plan, rate)?;
             PoseSamples::try_of(&states)
         })?;
         Ok(self.samples.get_or_init(|| s))

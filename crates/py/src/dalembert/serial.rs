@@ -416,9 +416,7 @@ impl SerialDalembertCorrector {
         let mut pos_err = try_array::<f64, _>(Ix1(n), what)?;
         let mut ori_err = try_array::<f64, _>(Ix1(n), what)?;
         let mut free = try_array::<f64, _>(Ix1(n), what)?;
-        let states = py
-            .detach(|| pose_ticks(&trajectory.plan, rate))?
-            .map_err(tick_err)?;
+        let states = py.detach(|| pose_ticks(&trajectory.plan, rate))?;
         py.detach(|| -> Result<(), (usize, deflect_core::TickError)> {
             let mut data = self.data();
             for (i, s) in states.iter().enumerate() {
