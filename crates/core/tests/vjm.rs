@@ -234,19 +234,15 @@ fn prismatic_joint_moves_the_lever() {
     assert_relative_eq!(c[(2, 2)], 0.0625 / 1.0e4, epsilon = 1e-20);
 }
 
-/// The kernels' compiled passes against the definitions: the rigid TCP of `forward` (joints
-/// only, fixed transforms folded across springs) equals the one of the full pass, and the
-/// compliance (3 x 3 blocks per spring) equals `sum J_s K_s^-1 J_s^T` built column by column
-/// from the spring frames, on a chain with spring offsets, a prismatic joint, an oblique
-/// axis and springs between fixed transforms.
-#[test]
-fn compiled_passes_equal_the_definitions() {
+/// Three joints (a revolute one, an oblique one, a prismatic one) and three springs, one
+/// with an offset from its element and two between fixed transforms with rotations.
+fn offset_chain() -> vjm::Model {
     let oblique = Vector3::new(0.3, -0.5, 0.81).normalize();
     let offset = Isometry3::from_parts(
         Vector3::new(0.01, -0.02, 0.03).into(),
         UnitQuaternion::from_euler_angles(0.2, -0.4, 0.9),
     );
-    let model = ModelBuilder::new()
+    ModelBuilder::new()
         .fixed(Isometry3::translation(0.0, 0.0, 0.4))
         .unwrap()
         .revolute(Vector3::z())
@@ -275,7 +271,17 @@ fn compiled_passes_equal_the_definitions() {
         .fixed(Isometry3::translation(0.3, 0.0, -0.1))
         .unwrap()
         .build()
-        .unwrap();
+        .unwrap()
+}
+
+/// The kernels' compiled passes against the definitions: the rigid TCP of `forward` (joints
+/// only, fixed transforms folded across springs) equals the one of the full pass, and the
+/// compliance (3 x 3 blocks per spring) equals `sum J_s K_s^-1 J_s^T` built column by column
+/// from the spring frames, on a chain with spring offsets, a prismatic joint, an oblique
+/// axis and springs between fixed transforms.
+#[test]
+fn compiled_passes_equal_the_definitions() {
+    let model = offset_chain();
     let mut data = Data::new(&model);
     let q = [0.7, -1.2, 0.15];
     let wrench = w([120.0, -80.0, 45.0, 3.0, -2.0, 1.5]);
@@ -340,32 +346,12 @@ fn compiled_passes_equal_the_definitions() {
     );
 }
 
-/// The four-row path of `deflection_batch` on a chain with a prismatic joint, an oblique axis
-/// and springs between fixed transforms: each row the one-row deflection exactly (`==`).
+/// The four-row path of `deflection_batch` on [`offset_chain`] (a prismatic joint, an oblique
+/// axis, a spring offset, springs between fixed transforms): each row the one-row deflection
+/// exactly (`==`).
 #[test]
 fn four_rows_with_a_prismatic_joint_are_the_one_row_path() {
-    let model = ModelBuilder::new()
-        .fixed(Isometry3::translation(0.0, 0.0, 0.4))
-        .unwrap()
-        .revolute(Vector3::z())
-        .unwrap()
-        .spring([2.0e5, 3.0e5, 4.0e4])
-        .unwrap()
-        .prismatic(Vector3::new(0.3, -0.5, 0.81).normalize())
-        .unwrap()
-        .fixed(Isometry3::from_parts(
-            Vector3::new(0.1, 0.0, 0.2).into(),
-            UnitQuaternion::from_euler_angles(-0.3, 0.1, 0.2),
-        ))
-        .unwrap()
-        .spring([5.0e4, INF, 7.0e4])
-        .unwrap()
-        .revolute(Vector3::x())
-        .unwrap()
-        .fixed(Isometry3::translation(0.3, 0.0, -0.1))
-        .unwrap()
-        .build()
-        .unwrap();
+    let model = offset_chain();
     let mut data = Data::new(&model);
     let q = [
         [0.7, 0.2, -1.2],
