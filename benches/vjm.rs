@@ -69,6 +69,9 @@ fn ur5(c: &mut Criterion) {
             b.iter(|| vjm::deflection(model, &mut data, black_box(&q), black_box(&w), load))
         });
     }
+    g.bench_function("linear_deflection_alone", |b| {
+        b.iter(|| vjm::linear_deflection(model, &mut data, black_box(&q), black_box(&w)))
+    });
     g.bench_function("compliance", |b| {
         b.iter(|| vjm::compliance(model, &mut data, black_box(&q)))
     });

@@ -346,6 +346,59 @@ fn compiled_passes_equal_the_definitions() {
     );
 }
 
+/// `linear_deflection` is the linearized `deflection` without its Jacobian and loaded pose:
+/// the same numbers bit for bit (deflection, rigid TCP, springs' moments and angles) and the
+/// same errors, on [`offset_chain`] (a prismatic joint, whose lever the lighter pass still
+/// moves), and `data.jacobian` / `data.tcp_deflected` left as the last call filled them.
+#[test]
+fn linear_deflection_alone_is_the_linearized_pass() {
+    let model = offset_chain();
+    let (mut full, mut alone) = (Data::new(&model), Data::new(&model));
+    let loads = [
+        ([0.7, -1.2, 0.15], [120.0, -80.0, 45.0, 3.0, -2.0, 1.5]),
+        ([-2.9, 0.4, -0.3], [-15.0, 60.0, 210.0, -7.0, 0.5, 4.0]),
+        ([0.0, 0.0, 0.0], [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]),
+    ];
+    for (q, f) in loads {
+        let wrench = w(f);
+        let d = vjm::deflection(&model, &mut full, &q, &wrench, vjm::Load::Linearized).unwrap();
+        let before = (alone.jacobian, alone.tcp_deflected);
+        assert_eq!(
+            vjm::linear_deflection(&model, &mut alone, &q, &wrench),
+            Ok(d)
+        );
+        assert_eq!(alone.tcp, full.tcp);
+        assert_eq!(alone.spring_angles, full.spring_angles);
+        assert_eq!(alone.spring_moments, full.spring_moments);
+        assert_eq!((alone.jacobian, alone.tcp_deflected), before);
+    }
+    let q = [0.7, -1.2, 0.15];
+    let wrench = w([120.0, -80.0, 45.0, 3.0, -2.0, 1.5]);
+    let mut bad = wrench;
+    bad[4] = f64::NAN;
+    let far = wrench * 1.0e6; // turns a spring past MAX_SPRING_ANGLE
+    let one_spring = ModelBuilder::new()
+        .spring([1.0e4; 3])
+        .unwrap()
+        .build()
+        .unwrap();
+    let other = Data::new(&one_spring);
+    for (q, wrench, data) in [
+        (&q[..], bad, &full),
+        (&q[..2], wrench, &full),
+        (&[0.7, f64::INFINITY, 0.15][..], wrench, &full),
+        (&q[..], far, &full),
+        (&q[..], wrench, &other),
+    ] {
+        let expect = vjm::deflection(&model, &mut data.clone(), q, &wrench, vjm::Load::Linearized);
+        assert!(expect.is_err(), "{q:?} {wrench:?}");
+        assert_eq!(
+            vjm::linear_deflection(&model, &mut data.clone(), q, &wrench),
+            expect
+        );
+    }
+}
+
 /// The four-row path of `deflection_batch` on [`offset_chain`] (a prismatic joint, an oblique
 /// axis, a spring offset, springs between fixed transforms): each row the one-row deflection
 /// exactly (`==`).

@@ -233,8 +233,7 @@ impl SerialRobot {
         let model = &self.inner.model;
         let q = joints(q, "q", model.dof())?;
         let w = vector6(wrench, "wrench")?;
-        let d = vjm::deflection(model, &mut self.data(), &q, &w, vjm::Load::Linearized)
-            .map_err(tick_err)?;
+        let d = vjm::linear_deflection(model, &mut self.data(), &q, &w).map_err(tick_err)?;
         emit(py, d.as_slice(), &[6], out)
     }
 

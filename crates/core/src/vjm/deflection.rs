@@ -85,8 +85,9 @@ pub(super) fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64
 }
 
 /// One pass over the chain at `q` (validated by the caller): the rigid TCP pose, and in
-/// `data` the world frames of the springs and the world axes and origins of the joints
-/// (before their own motion), which every kernel below reads. Compiled for AVX2 too and chosen
+/// `data` the world frames of the springs, which every kernel below reads, and with `JOINTS`
+/// the world axes and origins of the joints (before their own motion), which the Jacobian
+/// reads ([`fill_jacobian`]; the compliance and [`linear_deflection`] skip them). Compiled for AVX2 too and chosen
 /// at run time (with `std`): the VEX encoding's three-operand form drops the register copies
 /// of the baseline SSE2 code (UR5 linearized deflection -7 %, KR 300 compliance -3 %; an
 /// AVX-512 version measured the same). The springs' loads and turns that follow run in the
@@ -95,7 +96,11 @@ pub(super) fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64
     feature = "std",
     multiversion::multiversion(targets("x86_64+avx2+fma"))
 )]
-fn rigid_pass<'m, 'd, 'q>(model: &'m Model, data: &'d mut Data, q: &'q [f64]) -> Isometry3<f64> {
+fn rigid_pass<'m, 'd, 'q, const JOINTS: bool>(
+    model: &'m Model,
+    data: &'d mut Data,
+    q: &'q [f64],
+) -> Isometry3<f64> {
     let mut frame = Isometry3::identity();
     for p in model.pass.iter() {
         match p {
@@ -105,18 +110,21 @@ fn rigid_pass<'m, 'd, 'q>(model: &'m Model, data: &'d mut Data, q: &'q [f64]) ->
                 };
                 let i = step.index;
                 frame = compose(&frame, &step.pre, step.pre_shape);
-                let u = rotate_axis(&frame.rotation, step.kind, &step.axis);
-                if let (Some(a), Some(o)) =
-                    (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
-                {
-                    *a = u;
-                    *o = frame.translation.vector;
+                if JOINTS {
+                    let u = rotate_axis(&frame.rotation, step.kind, &step.axis);
+                    if let (Some(a), Some(o)) =
+                        (data.joint_axes.get_mut(i), data.joint_origins.get_mut(i))
+                    {
+                        *a = u;
+                        *o = frame.translation.vector;
+                    }
                 }
                 let qi = q.get(i).copied().unwrap_or(0.0);
                 if step.revolute {
                     let (s, c) = super::trig::sin_cos(qi * 0.5);
                     frame.rotation = turn(&frame.rotation, step.kind, &step.axis, s, c);
                 } else {
+                    let u = rotate_axis(&frame.rotation, step.kind, &step.axis);
                     frame.translation.vector += u * qi;
                 }
             }
@@ -239,7 +247,7 @@ pub fn deflection(
             angles_from_moments(model, data);
             (tcp, None)
         }
-        None => (rigid_pass(model, data, q), Some(wrench)),
+        None => (rigid_pass::<true>(model, data, q), Some(wrench)),
     };
     fill_jacobian(model, data, &tcp);
     let (d, deflected) = match load {
@@ -265,6 +273,29 @@ pub fn deflection(
     check_output("deflection", d.as_slice())?;
     data.tcp = tcp;
     data.tcp_deflected = deflected.unwrap_or_else(|| displaced(&tcp, &d));
+    Ok(d)
+}
+
+/// The linearized TCP deflection `C(q) w` \[m, rad\] at joints `q` \[rad or m\] under the TCP
+/// wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] (base frame, moment about the TCP): the value
+/// of [`deflection`] with [`Load::Linearized`], bit for bit, and its errors, for callers that
+/// want that number alone (the Python `linear_deflection`). It leaves in `data` the rigid TCP
+/// `data.tcp` and the springs' moments and angles, and skips the by-products nobody asked for:
+/// `data.jacobian` and `data.tcp_deflected` keep the values of the last call that filled them
+/// (their assembly was 15 % of the UR5's linearized [`deflection`], `cargo bench --bench
+/// vjm`).
+pub fn linear_deflection(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    wrench: &Vector6,
+) -> Result<Vector6, TickError> {
+    check_q(model, data, q)?;
+    check_finite("wrench", wrench.as_slice())?;
+    let tcp = rigid_pass::<false>(model, data, q);
+    let d = super::turns::linear(model, data, &tcp, Some(wrench))?;
+    check_output("deflection", d.as_slice())?;
+    data.tcp = tcp;
     Ok(d)
 }
 
@@ -296,7 +327,7 @@ pub(super) fn fill_jacobian(model: &Model, data: &mut Data, tcp: &Isometry3<f64>
 /// Also stored in `data.compliance`.
 pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f64>, TickError> {
     check_q(model, data, q)?;
-    let tcp = rigid_pass(model, data, q);
+    let tcp = rigid_pass::<false>(model, data, q);
     // Per spring with world axes R and compliances c, lever r from its origin to the TCP and
     // S = [r]x: the columns [u_a x r; u_a] of J_s give the blocks A = R diag(c) R^T
     // (rotation), -S A (translation-rotation) and S A S^T (translation), summed over springs
@@ -313,7 +344,7 @@ pub fn compliance(model: &Model, data: &mut Data, q: &[f64]) -> Result<Matrix6<f
 /// `data.tcp`. Every [`deflection`] pass leaves the same Jacobian in `data`.
 pub fn joint_jacobian(model: &Model, data: &mut Data, q: &[f64]) -> Result<(), TickError> {
     check_q(model, data, q)?;
-    let tcp = rigid_pass(model, data, q);
+    let tcp = rigid_pass::<true>(model, data, q);
     fill_jacobian(model, data, &tcp);
     data.tcp = tcp;
     Ok(())

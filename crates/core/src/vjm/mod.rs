@@ -34,7 +34,9 @@ pub use correction::{
 pub(crate) use data::check_joint_range;
 pub use data::{Data, MAX_JOINT_POSITION};
 pub(crate) use deflection::rotation_vector;
-pub use deflection::{MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian};
+pub use deflection::{
+    MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian, linear_deflection,
+};
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
 pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};
