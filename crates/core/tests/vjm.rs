@@ -346,10 +346,11 @@ fn compiled_passes_equal_the_definitions() {
     );
 }
 
-/// `linear_deflection` is the linearized `deflection` without its Jacobian and loaded pose:
-/// the same numbers bit for bit (deflection, rigid TCP, springs' moments and angles) and the
-/// same errors, on [`offset_chain`] (a prismatic joint, whose lever the lighter pass still
-/// moves), and `data.jacobian` / `data.tcp_deflected` left as the last call filled them.
+/// `linear_deflection` is the linearized `deflection` without its by-products: the same
+/// deflection and rigid TCP bit for bit and the same errors, on [`offset_chain`] (a prismatic
+/// joint, whose lever the lighter pass still moves), and `data.jacobian`,
+/// `data.tcp_deflected` and the springs' moments and angles left as the last call filled
+/// them.
 #[test]
 fn linear_deflection_alone_is_the_linearized_pass() {
     let model = offset_chain();
@@ -362,21 +363,28 @@ fn linear_deflection_alone_is_the_linearized_pass() {
     for (q, f) in loads {
         let wrench = w(f);
         let d = vjm::deflection(&model, &mut full, &q, &wrench, vjm::Load::Linearized).unwrap();
-        let before = (alone.jacobian, alone.tcp_deflected);
+        let kept = |d: &Data| {
+            (
+                d.jacobian,
+                d.tcp_deflected,
+                d.spring_angles,
+                d.spring_moments,
+            )
+        };
+        let before = kept(&alone);
         assert_eq!(
             vjm::linear_deflection(&model, &mut alone, &q, &wrench),
             Ok(d)
         );
         assert_eq!(alone.tcp, full.tcp);
-        assert_eq!(alone.spring_angles, full.spring_angles);
-        assert_eq!(alone.spring_moments, full.spring_moments);
-        assert_eq!((alone.jacobian, alone.tcp_deflected), before);
+        assert_eq!(kept(&alone), before);
     }
     let q = [0.7, -1.2, 0.15];
     let wrench = w([120.0, -80.0, 45.0, 3.0, -2.0, 1.5]);
     let mut bad = wrench;
     bad[4] = f64::NAN;
     let far = wrench * 1.0e6; // turns a spring past MAX_SPRING_ANGLE
+    let overflow = wrench * 1.0e306; // moments past f64::MAX: infinite and NaN angles
     let one_spring = ModelBuilder::new()
         .spring([1.0e4; 3])
         .unwrap()
@@ -388,6 +396,7 @@ fn linear_deflection_alone_is_the_linearized_pass() {
         (&q[..2], wrench, &full),
         (&[0.7, f64::INFINITY, 0.15][..], wrench, &full),
         (&q[..], far, &full),
+        (&q[..], overflow, &full),
         (&q[..], wrench, &other),
     ] {
         let expect = vjm::deflection(&model, &mut data.clone(), q, &wrench, vjm::Load::Linearized);

@@ -280,10 +280,10 @@ pub fn deflection(
 /// wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] (base frame, moment about the TCP): the value
 /// of [`deflection`] with [`Load::Linearized`], bit for bit, and its errors, for callers that
 /// want that number alone (the Python `linear_deflection`). It leaves in `data` the rigid TCP
-/// `data.tcp` and the springs' moments and angles, and skips the by-products nobody asked for:
-/// `data.jacobian` and `data.tcp_deflected` keep the values of the last call that filled them
-/// (their assembly was 15 % of the UR5's linearized [`deflection`], `cargo bench --bench
-/// vjm`).
+/// `data.tcp` and skips the by-products nobody asked for: `data.jacobian`,
+/// `data.tcp_deflected` and the springs' moments and angles keep the values of the last call
+/// that filled them (their assembly was a fifth of the UR5's linearized [`deflection`],
+/// `cargo bench --bench vjm`).
 pub fn linear_deflection(
     model: &Model,
     data: &mut Data,
@@ -293,7 +293,7 @@ pub fn linear_deflection(
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
     let tcp = rigid_pass::<false>(model, data, q);
-    let d = super::turns::linear(model, data, &tcp, Some(wrench))?;
+    let d = super::turns::linear_alone(model, data, &tcp, wrench)?;
     check_output("deflection", d.as_slice())?;
     data.tcp = tcp;
     Ok(d)

@@ -239,10 +239,12 @@ impl<V: Arith> Frames4<V> {
 }
 
 /// One pass over the springs in lanes: with `LOADS`, the moments and angles of the TCP wrench
-/// (into `data`), else the angles already in `data`; with `EXACT`, the four runs' products of
-/// the turns (lanes of `w, u.x, u.y, u.z, t.x, t.y, t.z`), else the first-order sums
-/// `sum_s [theta_s x L_s; theta_s]` (lanes of the six components; the seventh is zero).
-struct Springs<'a, const LOADS: bool, const EXACT: bool> {
+/// (into `data` with `KEEP`), else the angles already in `data`; with `EXACT`, the four runs'
+/// products of the turns (lanes of `w, u.x, u.y, u.z, t.x, t.y, t.z`), else the first-order
+/// sums `sum_s [theta_s x L_s; theta_s]` (lanes of the six components; the seventh is zero
+/// with `KEEP`, else each lane's largest `|angle|`, in place of [`check_angles`]' pass over
+/// the angles in `data`).
+struct Springs<'a, const LOADS: bool, const EXACT: bool, const KEEP: bool> {
     model: &'a Model,
     data: &'a mut Data,
     p: Vector3<f64>,
@@ -250,7 +252,9 @@ struct Springs<'a, const LOADS: bool, const EXACT: bool> {
     moment: Vector3<f64>,
 }
 
-impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXACT> {
+impl<const LOADS: bool, const EXACT: bool, const KEEP: bool> LaneKernel
+    for Springs<'_, LOADS, EXACT, KEEP>
+{
     type Output = [[f64; 4]; 7];
     #[inline(always)]
     fn run<L: Lanes>(self, l: L) -> [[f64; 4]; 7] {
@@ -276,6 +280,7 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
             t: none,
         };
         let (mut lin, mut rot) = (none, none);
+        let mut largest = zero;
         let identity = Isometry3::identity();
         let still = Vector3::zeros();
         for c in 0..run {
@@ -299,8 +304,10 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
             let a = if LOADS {
                 let c = load3(l, pick(&model.spring_compliance));
                 let (m, a) = frames.loads(lever, force, moment, c, two);
-                scatter(l, m, &mut data.spring_moments, at);
-                scatter(l, a, &mut data.spring_angles, at);
+                if KEEP {
+                    scatter(l, m, &mut data.spring_moments, at);
+                    scatter(l, a, &mut data.spring_angles, at);
+                }
                 a
             } else {
                 load3(l, pick(&data.spring_angles))
@@ -312,6 +319,10 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
                 let theta = frames.world(a, two);
                 lin = add(lin, theta.cross(lever));
                 rot = add(rot, theta);
+                if !KEEP {
+                    let most = l.max(l.abs(a.x), l.max(l.abs(a.y), l.abs(a.z)));
+                    largest = l.max(largest, most);
+                }
             }
         }
         let s = |v: L::V| l.store(v);
@@ -326,7 +337,7 @@ impl<const LOADS: bool, const EXACT: bool> LaneKernel for Springs<'_, LOADS, EXA
                 s(rot.x),
                 s(rot.y),
                 s(rot.z),
-                [0.0; 4],
+                s(largest),
             ]
         }
     }
@@ -342,14 +353,14 @@ fn springs<const EXACT: bool>(
 ) -> [[f64; 4]; 7] {
     let p = tcp.translation.vector;
     match wrench {
-        Some(w) => dispatch(Springs::<true, EXACT> {
+        Some(w) => dispatch(Springs::<true, EXACT, true> {
             model,
             data,
             p,
             force: Vector3::new(w[0], w[1], w[2]),
             moment: Vector3::new(w[3], w[4], w[5]),
         }),
-        None => dispatch(Springs::<false, EXACT> {
+        None => dispatch(Springs::<false, EXACT, true> {
             model,
             data,
             p,
@@ -413,6 +424,45 @@ pub(super) fn linear(
     let [x, y, z, rx, ry, rz, _] = sums.map(total);
     Ok(Vector6::new(x, y, z, rx, ry, rz))
 }
+/// [`linear`] under the TCP `wrench` without storing the springs' moments and angles: the
+/// same deflection bit for bit, with the largest elastic angle taken in the lanes. A load
+/// [`linear`] or the caller's output check would refuse (an angle past [`MAX_SPRING_ANGLE`]
+/// or NaN, a non-finite sum) is passed through [`linear`] again, which returns that error
+/// (or the non-finite value the caller refuses).
+pub(super) fn linear_alone(
+    model: &Model,
+    data: &mut Data,
+    tcp: &Isometry3<f64>,
+    wrench: &Vector6,
+) -> Result<Vector6, TickError> {
+    let sums = dispatch(Springs::<true, false, false> {
+        model,
+        data,
+        p: tcp.translation.vector,
+        force: Vector3::new(wrench[0], wrench[1], wrench[2]),
+        moment: Vector3::new(wrench[3], wrench[4], wrench[5]),
+    });
+    let total = |v: [f64; 4]| {
+        let [a, b, c, d] = v;
+        ((a + b) + c) + d
+    };
+    let [x, y, z, rx, ry, rz, largest] = sums;
+    let largest = largest.into_iter().fold(0.0_f64, f64::max);
+    let d = Vector6::new(
+        total(x),
+        total(y),
+        total(z),
+        total(rx),
+        total(ry),
+        total(rz),
+    );
+    // A NaN angle makes every sum NaN (it enters each component of its world rotation).
+    if largest <= MAX_SPRING_ANGLE && d.iter().all(|v| v.is_finite()) {
+        return Ok(d);
+    }
+    linear(model, data, tcp, Some(wrench))
+}
+
 #[cfg(test)]
 mod tests {
     use nalgebra::{Isometry3, UnitQuaternion, Vector3};
@@ -468,7 +518,7 @@ mod tests {
     fn lanes_agree<const LOADS: bool, const EXACT: bool>(model: &Model, data: &Data) {
         let (mut a, mut b) = (data.clone(), data.clone());
         let p = data.tcp.translation.vector;
-        let kernel = |data| Springs::<LOADS, EXACT> {
+        let kernel = |data| Springs::<LOADS, EXACT, true> {
             model,
             data,
             p,
