@@ -53,6 +53,35 @@ def test_batch_equals_single(kr300):
     np.testing.assert_array_equal(kr300.deflection_batch(Q[::2], W[::2]), out[::2])
 
 
+def test_single_calls_read_every_vector_layout(kr300):
+    """Contiguous float64 vectors are copied at once, anything else element by element or
+    through numpy: the same numbers either way."""
+    q = KR300_POSE + RNG.uniform(-0.3, 0.3, 6)
+    w = RNG.uniform(-500, 500, 6)
+    want = kr300.linear_deflection(q, w)
+    wide = np.zeros((2, 12))
+    wide[0, ::2], wide[1, ::2] = q, w
+    fortran = np.asfortranarray(np.stack([q, w]))
+    layouts = [
+        (wide[0, ::2], wide[1, ::2]),  # strided views
+        (q[::-1].copy()[::-1], w[::-1].copy()[::-1]),  # negative strides
+        (fortran[0], fortran[1]),  # rows of a Fortran-ordered array
+        (list(q), tuple(w)),
+        (np.ascontiguousarray(q), np.ascontiguousarray(w)),
+    ]
+    for a, b in layouts:
+        np.testing.assert_array_equal(kr300.linear_deflection(a, b), want)
+    np.testing.assert_array_equal(kr300.forward(wide[0, ::2]), kr300.forward(q))
+    single = q.astype(np.float32)
+    np.testing.assert_array_equal(
+        kr300.linear_deflection(single, w), kr300.linear_deflection(single.astype(np.float64), w)
+    )
+    with pytest.raises(deflect.DeflectError):
+        kr300.linear_deflection(q[:5], w)
+    with pytest.raises(deflect.DeflectError):
+        kr300.linear_deflection(wide[0, ::2][:5], w)
+
+
 def test_batch_runs_in_threads(kr300):
     Q = np.tile(KR300_POSE, (2000, 1))
     W = np.tile([100.0, 0, 0, 0, 0, 0], (2000, 1))
