@@ -1109,6 +1109,25 @@ DeflectStatus deflect_serial_robot_deflection(struct DeflectSerialRobot *robot,
                                               const double *wrench,
                                               double *out);
 
+// Linearized TCP deflection `out[6] = C(q) wrench` [m, rad] (base frame) at joints
+// `q[q_len]` [rad or m] under the TCP wrench `wrench[6]` [N, N m] (base frame, moment
+// about the TCP): the first-order term of `deflect_serial_robot_deflection`, in one pass
+// without forming the compliance (`deflect_core::vjm::linear_deflection`). Per tick: no
+// allocation.
+//
+// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH`, `DEFLECT_ERR_NON_FINITE`, or
+// `DEFLECT_ERR_INVALID_ARGUMENT` for a load that turns a spring past the small-deflection
+// model's 0.5 rad.
+//
+// # Safety
+// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+// `wrench` 6 and `out` 6 writable doubles (or NULL).
+DeflectStatus deflect_serial_robot_linear_deflection(struct DeflectSerialRobot *robot,
+                                                     const double *q,
+                                                     size_t q_len,
+                                                     const double *wrench,
+                                                     double *out);
+
 // The 6x6 Cartesian compliance of the linearized model at joints `q[q_len]`, written
 // row-major to `out[36]`: `out[6 * i + j] = C[i][j]` with rows and columns ordered
 // `[dx, dy, dz, rx, ry, rz]` x `[Fx, Fy, Fz, Mx, My, Mz]` [m/N, m/(N m), rad/N, rad/(N m)],

@@ -185,6 +185,44 @@ pub unsafe extern "C" fn deflect_serial_robot_deflection(
     })
 }
 
+/// Linearized TCP deflection `out[6] = C(q) wrench` \[m, rad\] (base frame) at joints
+/// `q[q_len]` \[rad or m\] under the TCP wrench `wrench[6]` \[N, N m\] (base frame, moment
+/// about the TCP): the first-order term of `deflect_serial_robot_deflection`, in one pass
+/// without forming the compliance (`deflect_core::vjm::linear_deflection`). Per tick: no
+/// allocation.
+///
+/// Returns `DEFLECT_ERR_NULL`, `DEFLECT_ERR_WRONG_LENGTH`, `DEFLECT_ERR_NON_FINITE`, or
+/// `DEFLECT_ERR_INVALID_ARGUMENT` for a load that turns a spring past the small-deflection
+/// model's 0.5 rad.
+///
+/// # Safety
+/// `robot` is NULL or a live handle not used by another thread; `q` holds `q_len` doubles,
+/// `wrench` 6 and `out` 6 writable doubles (or NULL).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn deflect_serial_robot_linear_deflection(
+    robot: *mut DeflectSerialRobot,
+    q: *const f64,
+    q_len: usize,
+    wrench: *const f64,
+    out: *mut f64,
+) -> DeflectStatus {
+    guard(|| {
+        // SAFETY: pointers valid for the stated lengths (or NULL) by contract.
+        let (r, q, w, out) = unsafe {
+            (
+                handle_mut(robot)?,
+                slice(q, q_len)?,
+                array::<6>(wrench)?,
+                slice_mut(out, 6)?,
+            )
+        };
+        let d = vjm::linear_deflection(&r.robot.model, &mut r.data, q, &Vector6::from(w))
+            .map_err(|e| tick_status(&e))?;
+        out.copy_from_slice(d.as_slice());
+        Ok(())
+    })
+}
+
 /// The 6x6 Cartesian compliance of the linearized model at joints `q[q_len]`, written
 /// row-major to `out[36]`: `out[6 * i + j] = C[i][j]` with rows and columns ordered
 /// `[dx, dy, dz, rx, ry, rz]` x `[Fx, Fy, Fz, Mx, My, Mz]` \[m/N, m/(N m), rad/N, rad/(N m)\],

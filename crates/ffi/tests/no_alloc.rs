@@ -141,6 +141,16 @@ fn per_tick_calls_do_not_allocate() {
                 DEFLECT_OK
             );
             assert_eq!(
+                deflect_serial_robot_linear_deflection(
+                    robot,
+                    q.as_ptr(),
+                    6,
+                    w.as_ptr(),
+                    d.as_mut_ptr()
+                ),
+                DEFLECT_OK
+            );
+            assert_eq!(
                 deflect_serial_robot_joint_correction(
                     robot,
                     q.as_ptr(),

@@ -123,6 +123,48 @@ fn vjm_through_the_c_api_equals_the_rust_api() {
         }
     }
 
+    let mut lin = [0.0; 6];
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    let s = unsafe {
+        deflect_serial_robot_linear_deflection(r, Q.as_ptr(), 6, WRENCH.as_ptr(), lin.as_mut_ptr())
+    };
+    assert_eq!(s, DEFLECT_OK);
+    let want = vjm::deflection(
+        &rust.model,
+        &mut data,
+        &Q,
+        &Vector6::from(WRENCH),
+        vjm::Load::Linearized,
+    )
+    .unwrap();
+    assert_eq!(lin, <[f64; 6]>::from(want));
+    let cw = want - nalgebra::Matrix6::from_row_slice(&cm) * Vector6::from(WRENCH);
+    assert!(cw.amax() <= 1e-14 * want.amax(), "C w: {cw}");
+    let far = WRENCH.map(|v| v * 1e6);
+    let mut bad_q = Q;
+    bad_q[1] = f64::INFINITY;
+    // SAFETY: live handles from this test, arrays of the documented lengths.
+    unsafe {
+        let lin = lin.as_mut_ptr();
+        let w = WRENCH.as_ptr();
+        assert_eq!(
+            deflect_serial_robot_linear_deflection(r, Q.as_ptr(), 6, far.as_ptr(), lin),
+            DEFLECT_ERR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            deflect_serial_robot_linear_deflection(r, bad_q.as_ptr(), 6, w, lin),
+            DEFLECT_ERR_NON_FINITE
+        );
+        assert_eq!(
+            deflect_serial_robot_linear_deflection(r, Q.as_ptr(), 5, w, lin),
+            DEFLECT_ERR_WRONG_LENGTH
+        );
+        assert_eq!(
+            deflect_serial_robot_linear_deflection(r, Q.as_ptr(), 6, w, ptr::null_mut()),
+            DEFLECT_ERR_NULL
+        );
+    }
+
     let mut jc = DeflectJointCorrection::default();
     // SAFETY: live handles from this test, arrays of the documented lengths.
     let s = unsafe {
