@@ -162,27 +162,12 @@ pub unsafe extern "C" fn deflect_serial_robot_deflection(
     wrench: *const f64,
     out: *mut f64,
 ) -> DeflectStatus {
-    guard(|| {
-        // SAFETY: pointers valid for the stated lengths (or NULL) by contract.
-        let (r, q, w, out) = unsafe {
-            (
-                handle_mut(robot)?,
-                slice(q, q_len)?,
-                array::<6>(wrench)?,
-                slice_mut(out, 6)?,
-            )
-        };
-        let d = vjm::deflection(
-            &r.robot.model,
-            &mut r.data,
-            q,
-            &Vector6::from(w),
-            vjm::Load::Exact,
-        )
-        .map_err(|e| tick_status(&e))?;
-        out.copy_from_slice(d.as_slice());
-        Ok(())
-    })
+    // SAFETY: forwarded under this function's contract.
+    unsafe {
+        loaded_tcp(robot, q, q_len, wrench, out, |m, d, q, w| {
+            vjm::deflection(m, d, q, w, vjm::Load::Exact)
+        })
+    }
 }
 
 /// Linearized TCP deflection `out[6] = C(q) wrench` \[m, rad\] (base frame) at joints
@@ -206,6 +191,24 @@ pub unsafe extern "C" fn deflect_serial_robot_linear_deflection(
     wrench: *const f64,
     out: *mut f64,
 ) -> DeflectStatus {
+    // SAFETY: forwarded under this function's contract.
+    unsafe { loaded_tcp(robot, q, q_len, wrench, out, vjm::linear_deflection) }
+}
+
+/// A loaded-TCP call shared by the deflections: the handle and arrays decoded and checked,
+/// `f`'s six numbers into `out`, its error as a status.
+///
+/// # Safety
+/// As the callers': `robot` NULL or a live handle not used by another thread, `q` holding
+/// `q_len` doubles, `wrench` 6 and `out` 6 writable doubles (or NULL).
+unsafe fn loaded_tcp(
+    robot: *mut DeflectSerialRobot,
+    q: *const f64,
+    q_len: usize,
+    wrench: *const f64,
+    out: *mut f64,
+    f: impl FnOnce(&vjm::Model, &mut Data, &[f64], &Vector6) -> Result<Vector6, deflect_core::TickError>,
+) -> DeflectStatus {
     guard(|| {
         // SAFETY: pointers valid for the stated lengths (or NULL) by contract.
         let (r, q, w, out) = unsafe {
@@ -216,8 +219,8 @@ pub unsafe extern "C" fn deflect_serial_robot_linear_deflection(
                 slice_mut(out, 6)?,
             )
         };
-        let d = vjm::linear_deflection(&r.robot.model, &mut r.data, q, &Vector6::from(w))
-            .map_err(|e| tick_status(&e))?;
+        let d =
+            f(&r.robot.model, &mut r.data, q, &Vector6::from(w)).map_err(|e| tick_status(&e))?;
         out.copy_from_slice(d.as_slice());
         Ok(())
     })

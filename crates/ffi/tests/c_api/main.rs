@@ -91,21 +91,30 @@ fn vjm_through_the_c_api_equals_the_rust_api() {
     );
     assert_eq!((dof, springs), (6, 11));
 
-    let mut d = [0.0; 6];
-    // SAFETY: live handles from this test, arrays of the documented lengths.
-    let s = unsafe {
-        deflect_serial_robot_deflection(r, Q.as_ptr(), 6, WRENCH.as_ptr(), d.as_mut_ptr())
-    };
-    assert_eq!(s, DEFLECT_OK);
-    let want = vjm::deflection(
-        &rust.model,
-        &mut data,
-        &Q,
-        &Vector6::from(WRENCH),
-        vjm::Load::Exact,
-    )
-    .unwrap();
-    assert_eq!(d, <[f64; 6]>::from(want));
+    // The exact and the linearized deflection: each the Rust API's numbers.
+    type Call = unsafe extern "C" fn(
+        *mut DeflectSerialRobot,
+        *const f64,
+        usize,
+        *const f64,
+        *mut f64,
+    ) -> DeflectStatus;
+    let calls: [(Call, vjm::Load<'_>); 2] = [
+        (deflect_serial_robot_deflection, vjm::Load::Exact),
+        (
+            deflect_serial_robot_linear_deflection,
+            vjm::Load::Linearized,
+        ),
+    ];
+    let mut both = [[0.0; 6]; 2];
+    for ((call, load), d) in calls.into_iter().zip(&mut both) {
+        // SAFETY: live handles from this test, arrays of the documented lengths.
+        let s = unsafe { call(r, Q.as_ptr(), 6, WRENCH.as_ptr(), d.as_mut_ptr()) };
+        assert_eq!(s, DEFLECT_OK);
+        let want = vjm::deflection(&rust.model, &mut data, &Q, &Vector6::from(WRENCH), load);
+        assert_eq!(*d, <[f64; 6]>::from(want.unwrap()), "{load:?}");
+    }
+    let [mut d, lin] = both;
     assert!(
         (d[0] - (-0.871e-3)).abs() < 1e-6,
         "README figure: dx = -0.871 mm, got {}",
@@ -123,23 +132,10 @@ fn vjm_through_the_c_api_equals_the_rust_api() {
         }
     }
 
+    let lin = Vector6::from(lin);
+    let cw = lin - nalgebra::Matrix6::from_row_slice(&cm) * Vector6::from(WRENCH);
+    assert!(cw.amax() <= 1e-14 * lin.amax(), "C w: {cw}");
     let mut lin = [0.0; 6];
-    // SAFETY: live handles from this test, arrays of the documented lengths.
-    let s = unsafe {
-        deflect_serial_robot_linear_deflection(r, Q.as_ptr(), 6, WRENCH.as_ptr(), lin.as_mut_ptr())
-    };
-    assert_eq!(s, DEFLECT_OK);
-    let want = vjm::deflection(
-        &rust.model,
-        &mut data,
-        &Q,
-        &Vector6::from(WRENCH),
-        vjm::Load::Linearized,
-    )
-    .unwrap();
-    assert_eq!(lin, <[f64; 6]>::from(want));
-    let cw = want - nalgebra::Matrix6::from_row_slice(&cm) * Vector6::from(WRENCH);
-    assert!(cw.amax() <= 1e-14 * want.amax(), "C w: {cw}");
     let far = WRENCH.map(|v| v * 1e6);
     let mut bad_q = Q;
     bad_q[1] = f64::INFINITY;
