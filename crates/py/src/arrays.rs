@@ -168,7 +168,8 @@ pub(crate) fn fill_fast(o: &Bound<'_, PyAny>, out: &mut [f64]) -> bool {
 /// A per-call input of six numbers costs less to copy than to allocate for, to register a
 /// read borrow for, or to read element by element through `get_owned` (13 ns more a vector,
 /// UR5 `linear_deflection` from Python).
-#[allow(unsafe_code)] // reason: `PyArray::as_slice` is unsafe; the SAFETY comment says why this use is sound
+// reason: `PyArray::as_slice` is unsafe; the SAFETY comment below says why this use is sound
+#[allow(unsafe_code)]
 fn contiguous<'a>(a: &'a Bound<'_, PyArray1<f64>>) -> Option<&'a [f64]> {
     // SAFETY: `as_slice` is unsafe because the slice could alias a mutable view of the same
     // memory. The only caller holds the GIL (the `Bound`) and copies the slice before it runs

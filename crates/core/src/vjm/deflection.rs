@@ -87,10 +87,10 @@ pub(super) fn euler_zyx(alpha: f64, beta: f64, gamma: f64) -> UnitQuaternion<f64
 /// One pass over the chain at `q` (validated by the caller): the rigid TCP pose, and in
 /// `data` the world frames of the springs, which every kernel below reads, and with `JOINTS`
 /// the world axes and origins of the joints (before their own motion), which the Jacobian
-/// reads ([`fill_jacobian`]; the compliance and [`linear_deflection`] skip them). Compiled for AVX2 too and chosen
-/// at run time (with `std`): the VEX encoding's three-operand form drops the register copies
-/// of the baseline SSE2 code (UR5 linearized deflection -7 %, KR 300 compliance -3 %; an
-/// AVX-512 version measured the same). The springs' loads and turns that follow run in the
+/// reads ([`fill_jacobian`]; the compliance and [`linear_deflection`] skip them). Compiled
+/// for AVX2 too and chosen at run time (with `std`): the VEX encoding's three-operand form
+/// drops the register copies of the baseline SSE2 code (UR5 linearized deflection -7 %,
+/// KR 300 compliance -3 %; an AVX-512 version measured the same). The springs' loads and turns that follow run in the
 /// explicit lanes of [`super::turns`] and [`super::lanes`].
 #[cfg_attr(
     feature = "std",

@@ -424,6 +424,7 @@ pub(super) fn linear(
     let [x, y, z, rx, ry, rz, _] = sums.map(total);
     Ok(Vector6::new(x, y, z, rx, ry, rz))
 }
+
 /// [`linear`] under the TCP `wrench` without storing the springs' moments and angles: the
 /// same deflection bit for bit, with the largest elastic angle taken in the lanes. A load
 /// [`linear`] or the caller's output check would refuse (an angle past [`MAX_SPRING_ANGLE`]
