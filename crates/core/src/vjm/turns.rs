@@ -344,8 +344,8 @@ impl<const LOADS: bool, const EXACT: bool, const KEEP: bool> LaneKernel
 }
 
 /// Runs [`Springs`] for the TCP at `tcp`, with the TCP `wrench`'s loads or (`None`) the angles
-/// in `data`.
-fn springs<const EXACT: bool>(
+/// in `data`; with `KEEP`, the loads' moments and angles stored in `data`.
+fn springs<const EXACT: bool, const KEEP: bool>(
     model: &Model,
     data: &mut Data,
     tcp: &Isometry3<f64>,
@@ -353,14 +353,14 @@ fn springs<const EXACT: bool>(
 ) -> [[f64; 4]; 7] {
     let p = tcp.translation.vector;
     match wrench {
-        Some(w) => dispatch(Springs::<true, EXACT, true> {
+        Some(w) => dispatch(Springs::<true, EXACT, KEEP> {
             model,
             data,
             p,
             force: Vector3::new(w[0], w[1], w[2]),
             moment: Vector3::new(w[3], w[4], w[5]),
         }),
-        None => dispatch(Springs::<false, EXACT, true> {
+        None => dispatch(Springs::<false, EXACT, KEEP> {
             model,
             data,
             p,
@@ -379,7 +379,7 @@ pub(super) fn exact(
     tcp: &Isometry3<f64>,
     wrench: Option<&Vector6>,
 ) -> Result<(Vector6, Isometry3<f64>), TickError> {
-    let [w, x, y, z, tx, ty, tz] = springs::<true>(model, data, tcp, wrench);
+    let [w, x, y, z, tx, ty, tz] = springs::<true, true>(model, data, tcp, wrench);
     let largest = check_angles(model, data)?;
     let p = tcp.translation.vector;
     let total = if largest < SERIES_ANGLE {
@@ -415,14 +415,28 @@ pub(super) fn linear(
     tcp: &Isometry3<f64>,
     wrench: Option<&Vector6>,
 ) -> Result<Vector6, TickError> {
-    let sums = springs::<false>(model, data, tcp, wrench);
+    let sums = springs::<false, true>(model, data, tcp, wrench);
     check_angles(model, data)?;
+    Ok(first_order(sums).0)
+}
+
+/// The first-order sums' lanes added up (`((l0 + l1) + l2) + l3`): the deflection, and the
+/// seventh row's largest lane (the largest elastic angle without `KEEP`).
+fn first_order(sums: [[f64; 4]; 7]) -> (Vector6, f64) {
     let total = |v: [f64; 4]| {
         let [a, b, c, d] = v;
         ((a + b) + c) + d
     };
-    let [x, y, z, rx, ry, rz, _] = sums.map(total);
-    Ok(Vector6::new(x, y, z, rx, ry, rz))
+    let [x, y, z, rx, ry, rz, largest] = sums;
+    let d = Vector6::new(
+        total(x),
+        total(y),
+        total(z),
+        total(rx),
+        total(ry),
+        total(rz),
+    );
+    (d, largest.into_iter().fold(0.0_f64, f64::max))
 }
 
 /// [`linear`] under the TCP `wrench` without storing the springs' moments and angles: the
@@ -436,27 +450,7 @@ pub(super) fn linear_alone(
     tcp: &Isometry3<f64>,
     wrench: &Vector6,
 ) -> Result<Vector6, TickError> {
-    let sums = dispatch(Springs::<true, false, false> {
-        model,
-        data,
-        p: tcp.translation.vector,
-        force: Vector3::new(wrench[0], wrench[1], wrench[2]),
-        moment: Vector3::new(wrench[3], wrench[4], wrench[5]),
-    });
-    let total = |v: [f64; 4]| {
-        let [a, b, c, d] = v;
-        ((a + b) + c) + d
-    };
-    let [x, y, z, rx, ry, rz, largest] = sums;
-    let largest = largest.into_iter().fold(0.0_f64, f64::max);
-    let d = Vector6::new(
-        total(x),
-        total(y),
-        total(z),
-        total(rx),
-        total(ry),
-        total(rz),
-    );
+    let (d, largest) = first_order(springs::<false, false>(model, data, tcp, Some(wrench)));
     // A NaN angle makes every sum NaN (it enters each component of its world rotation).
     if largest <= MAX_SPRING_ANGLE && d.iter().all(|v| v.is_finite()) {
         return Ok(d);
