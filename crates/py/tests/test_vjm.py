@@ -68,6 +68,11 @@ def test_single_calls_read_every_vector_layout(kr300):
         (fortran[0], fortran[1]),  # rows of a Fortran-ordered array
         (list(q), tuple(w)),
         (np.ascontiguousarray(q), np.ascontiguousarray(w)),
+        # Past the plain-ndarray check: a subclass, a big-endian float64 and an equal float64
+        # dtype that is not numpy's own descriptor go through rust-numpy's checked cast or numpy.
+        (q.view(Subclass), w.view(Subclass)),
+        (q.astype(">f8"), w.astype(">f8")),
+        (q.view(np.dtype("f8", metadata={"unit": "rad"})), w.view(np.dtype("f8", metadata={}))),
     ]
     for a, b in layouts:
         np.testing.assert_array_equal(kr300.linear_deflection(a, b), want)
@@ -80,6 +85,16 @@ def test_single_calls_read_every_vector_layout(kr300):
         kr300.linear_deflection(q[:5], w)
     with pytest.raises(deflect.DeflectError):
         kr300.linear_deflection(wide[0, ::2][:5], w)
+    # A float64 array of one more dimension or none is refused, not read as its numbers.
+    for bad in [q[None, :], np.float64(1.0), np.zeros(())]:
+        with pytest.raises(deflect.DeflectError):
+            kr300.linear_deflection(bad, w)
+        with pytest.raises(deflect.DeflectError):
+            kr300.linear_deflection(q, bad)
+
+
+class Subclass(np.ndarray):
+    """An ndarray subclass: not a plain `numpy.ndarray`, still read as one."""
 
 
 def test_batch_runs_in_threads(kr300):
