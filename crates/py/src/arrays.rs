@@ -315,7 +315,7 @@ fn no_memory_bytes(what: &str, n: usize, bytes: u128) -> PyErr {
 }
 
 /// The `MemoryError` of a refused allocation of `n` float64 numbers.
-fn no_memory(what: &str, n: u128) -> PyErr {
+pub(crate) fn no_memory(what: &str, n: u128) -> PyErr {
     PyMemoryError::new_err(format!(
         "{what}: cannot allocate {n} float64 numbers ({} bytes)",
         n.saturating_mul(8)
