@@ -10,7 +10,7 @@
 use deflect_core::compliance_map::{
     ComplianceMap, ComplianceMapView, Interpolation, OutOfGrid, QueryOptions,
 };
-use deflect_core::{BuildError, TickError};
+use deflect_core::{BuildError, Placement, TickError};
 use proptest::prelude::*;
 
 mod fixtures;
@@ -456,5 +456,66 @@ fn lane_batch_equals_single_for_every_shape() {
                 }
             }
         }
+    }
+}
+
+/// The owning map's single query on an evenly spaced grid (its own path, without a view) and
+/// the view's path give the same bits and the same errors: at the fixed sizes and one generic
+/// size, on every node and either side of it (where `x0 + k step` and the stored node differ
+/// by rounding), between nodes, outside the grid under every policy, with non-finite input
+/// and with a wrong force length.
+#[test]
+fn the_owning_maps_even_grid_query_is_the_views() {
+    let x: Vec<f64> = (0..7).map(|k| 0.1 + 0.1 * k as f64).collect();
+    let y: Vec<f64> = (0..5).map(|k| -0.3 + 0.15 * k as f64).collect();
+    let mut points = Vec::new();
+    for a in &x {
+        for b in &y {
+            for v in [a.next_down(), *a, a.next_up()] {
+                for w in [b.next_down(), *b, b.next_up()] {
+                    points.push([v, w]);
+                }
+            }
+        }
+    }
+    for k in 0..200 {
+        let t = k as f64 * 0.618_033_988_749_895;
+        points.push([0.05 + 0.75 * t.fract(), -0.35 + 0.7 * (t * 1.7).fract()]);
+    }
+    points.extend([[f64::NAN, 0.0], [0.2, f64::INFINITY], [-1e300, 1e300]]);
+    for (nd, nf) in [(2, 2), (3, 3), (6, 6), (3, 2)] {
+        let n = x.len() * y.len() * nd * nf;
+        let coef = |k: usize, s: f64| ((k as f64 * s).sin() * 1e-6) + 1e-7;
+        let slopes: Vec<f64> = (0..n).map(|k| coef(k, 0.37)).collect();
+        let offsets: Vec<f64> = (0..n).map(|k| coef(k, 0.71)).collect();
+        let map = ComplianceMap::new(x.clone(), y.clone(), nf, nd, slopes, offsets).unwrap();
+        let forces = [
+            (0..nf).map(|k| 150.0 - 40.0 * k as f64).collect::<Vec<_>>(),
+            (0..nf)
+                .map(|k| if k == 0 { f64::NAN } else { 1.0 })
+                .collect(),
+            (0..nf)
+                .map(|k| if k == 0 { 1e308 } else { -1e308 })
+                .collect(),
+            vec![1.0; nf + 1],
+        ];
+        let mut checked = 0;
+        for f in &forces {
+            for p in &points {
+                for method in [Interpolation::Bilinear, Interpolation::Bicubic] {
+                    for policy in [OutOfGrid::Error, OutOfGrid::Clamp, OutOfGrid::Extrapolate] {
+                        let o = opts(method, policy);
+                        let (mut a, mut b) = (vec![0.0; nd], vec![0.0; nd]);
+                        let own = map.displacement_with(*p, f, &mut a, o);
+                        let view = map.view().displacement_with(*p, f, &mut b, o);
+                        assert_eq!(own, view, "{nd}x{nf} {p:?} {f:?} {o:?}");
+                        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                        assert_eq!(bits(&a), bits(&b), "{nd}x{nf} {p:?} {f:?} {o:?}");
+                        checked += usize::from(own == Ok(Placement::Inside));
+                    }
+                }
+            }
+        }
+        assert!(checked > 2 * points.len(), "{nd}x{nf}: {checked} inside");
     }
 }

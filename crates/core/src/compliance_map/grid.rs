@@ -292,7 +292,11 @@ impl<'a> Axis<'a> {
 /// saturating float->int cast: negative and NaN become 0).
 #[inline(always)]
 fn even_estimate(v: f64, first: f64, inv_step: f64, last_cell: usize) -> usize {
-    (((v - first) * inv_step) as usize).min(last_cell)
+    // Through i64, the same value as `as usize` for every input (a negative or NaN estimate
+    // is 0 either way, one past 2^63 the last cell either way) in half the instructions: x86
+    // has the signed conversion, the unsigned one takes a second conversion and a select.
+    let estimate = ((v - first) * inv_step) as i64;
+    (estimate.max(0) as usize).min(last_cell)
 }
 
 /// The local coordinate of `v` in the cell `[lo, hi]` of an evenly spaced axis (exactly 1 at
@@ -313,16 +317,54 @@ pub(crate) struct EvenAxis<'a> {
     pub(super) last_cell: usize,
 }
 
+/// The ends, step and last cell of an evenly spaced axis, kept by the owning map so that a
+/// single query makes its [`EvenAxis`] without loading and checking them again.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct EvenEnds {
+    first: f64,
+    last: f64,
+    inv_step: f64,
+    last_cell: usize,
+}
+
+impl EvenEnds {
+    /// The axis over its `nodes` (those it was taken from).
+    #[inline(always)]
+    pub(crate) fn on(self, nodes: &[f64]) -> EvenAxis<'_> {
+        EvenAxis {
+            nodes,
+            first: self.first,
+            last: self.last,
+            inv_step: self.inv_step,
+            last_cell: self.last_cell,
+        }
+    }
+}
+
 impl EvenAxis<'_> {
+    /// What [`EvenEnds::on`] makes this axis from.
+    pub(crate) fn ends(&self) -> EvenEnds {
+        EvenEnds {
+            first: self.first,
+            last: self.last,
+            inv_step: self.inv_step,
+            last_cell: self.last_cell,
+        }
+    }
+
     /// The cell of `v` and its local coordinate, as [`Axis::cell_t_inside`], and whether `v`
     /// is inside the axis and needs no rounding correction: computed without a branch on
     /// the data, the correction left to the single query's path for the rows it refuses.
     #[inline(always)]
     pub(crate) fn cell_t(&self, v: f64) -> (usize, f64, bool) {
         let i = even_estimate(v, self.first, self.inv_step, self.last_cell);
-        let lo = self.nodes.get(i).copied().unwrap_or(f64::NAN);
-        let hi = self.nodes.get(i + 1).copied().unwrap_or(f64::NAN);
-        let ok = (v >= self.first) & (v <= self.last) & (v >= lo) & (v <= hi);
+        let (lo, hi) = match self.nodes.get(i..i + 2) {
+            Some(&[lo, hi]) => (lo, hi),
+            _ => (f64::NAN, f64::NAN),
+        };
+        // Inside the cell is inside the axis (its nodes lie between the axis' ends); NaN is
+        // neither.
+        let ok = (v >= lo) & (v <= hi);
         (i, even_t(v, lo, hi, self.inv_step), ok)
     }
 }

@@ -13,6 +13,7 @@
 
 use super::ComplianceMapView;
 use super::MAX_AXES;
+use super::grid::EvenAxis;
 
 /// Values per node in the packed layout.
 #[inline(always)]
@@ -134,8 +135,7 @@ impl ComplianceMapView<'_> {
     }
 
     /// [`Self::blend_fixed`] over a bilinear cell's nodes `n00, n00 + 1, n00 + ny,
-    /// n00 + ny + 1` from the packed layout (the view must have it), reading the two runs of
-    /// adjacent nodes as two slices (two bounds checks instead of four). Same bits.
+    /// n00 + ny + 1` from the packed layout (the view must have it): [`blend_cell`].
     #[inline(always)]
     pub(super) fn blend_cell_packed<const ND: usize, const NF: usize>(
         &self,
@@ -144,20 +144,7 @@ impl ComplianceMapView<'_> {
         weights: &[f64; 4],
         f: &[f64; NF],
     ) -> Option<[f64; ND]> {
-        let b = packed_block(ND, NF);
-        let near = self.packed.get(n00 * b..n00 * b + 2 * b)?;
-        let far = self.packed.get((n00 + ny) * b..(n00 + ny) * b + 2 * b)?;
-        let (n0, n1) = near.split_at(b);
-        let (n2, n3) = far.split_at(b);
-        let mut acc = [0.0; ND];
-        for (blk, w) in [n0, n1, n2, n3].into_iter().zip(weights) {
-            let (s, o) = blk.split_at(ND * NF);
-            for ((a, s_row), o_d) in acc.iter_mut().zip(s.chunks_exact(NF)).zip(o) {
-                let line = s_row.iter().zip(f).fold(0.0, |a, (s, fk)| a + s * fk);
-                *a += w * (line + o_d);
-            }
-        }
-        Some(acc)
+        blend_cell::<ND, NF>(self.packed, n00, ny, weights, f)
     }
 
     /// The blend for any sizes into `out` (`nd` entries), dispatching to the fixed kernels
@@ -237,4 +224,64 @@ impl ComplianceMapView<'_> {
         let (nodes, weights) = self.bilinear_stencil(i, j, tx, ty);
         Some(self.blend_fixed::<ND, NF>(&nodes, &weights, f))
     }
+}
+
+/// [`ComplianceMapView::blend_fixed`] over a bilinear cell's nodes `n00, n00 + 1, n00 + ny,
+/// n00 + ny + 1` of a `packed` layout, reading the two runs of adjacent nodes as two slices
+/// (two bounds checks instead of four). Same bits.
+#[inline(always)]
+pub(super) fn blend_cell<const ND: usize, const NF: usize>(
+    packed: &[f64],
+    n00: usize,
+    ny: usize,
+    weights: &[f64; 4],
+    f: &[f64; NF],
+) -> Option<[f64; ND]> {
+    let b = packed_block(ND, NF);
+    let near = packed.get(n00 * b..n00 * b + 2 * b)?;
+    let far = packed.get((n00 + ny) * b..(n00 + ny) * b + 2 * b)?;
+    let (n0, n1) = near.split_at(b);
+    let (n2, n3) = far.split_at(b);
+    let mut acc = [0.0; ND];
+    for (blk, w) in [n0, n1, n2, n3].into_iter().zip(weights) {
+        let (s, o) = blk.split_at(ND * NF);
+        for ((a, s_row), o_d) in acc.iter_mut().zip(s.chunks_exact(NF)).zip(o) {
+            // From the first product rather than from 0.0 as the other paths: the two sums
+            // differ at most in the sign of a zero, which `+ o_d`, `w *` and the accumulator
+            // (from +0.0, so never -0.0) do not carry into the result. Same bits.
+            let mut terms = s_row.iter().zip(f).map(|(s, fk)| s * fk);
+            let first = terms.next().unwrap_or(0.0);
+            let line = terms.fold(first, |a, t| a + t);
+            *a += w * (line + o_d);
+        }
+    }
+    Some(acc)
+}
+
+/// The bilinear query on an evenly spaced grid of `packed` coefficients for finite input
+/// inside the grid needing no rounding correction of its cell: the same cell, weights and
+/// blend as [`ComplianceMapView::bilinear_inside`], so the same bits; `None` otherwise, for
+/// the view's path (which corrects the cell, names the error or applies the out-of-grid
+/// policy). The owning map's single query: no view to build, the axes' ends kept, the
+/// inside test folded into the cell's.
+#[inline(always)]
+pub(super) fn even_bilinear<const ND: usize, const NF: usize>(
+    packed: &[f64],
+    x: EvenAxis<'_>,
+    y: EvenAxis<'_>,
+    [px, py]: [f64; 2],
+    f: &[f64; NF],
+) -> Option<[f64; ND]> {
+    // A NaN or infinite force makes this NaN; finite forces make it exactly 0. A NaN or
+    // infinite position lies in no cell.
+    let probe = f.iter().fold(0.0, |a, v| a + v * 0.0);
+    let (i, tx, in_x) = x.cell_t(px);
+    let (j, ty, in_y) = y.cell_t(py);
+    if !(in_x & in_y) || probe != 0.0 {
+        return None;
+    }
+    let ny = y.nodes.len();
+    let (ux, uy) = (1.0 - tx, 1.0 - ty);
+    let weights = [ux * uy, ux * ty, tx * uy, tx * ty];
+    blend_cell::<ND, NF>(packed, i * ny + j, ny, &weights, f)
 }

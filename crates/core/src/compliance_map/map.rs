@@ -4,7 +4,7 @@
 use alloc::vec::Vec;
 
 use super::view::ComplianceMapView;
-use super::{BatchError, BatchSummary, NodeFit, QueryOptions, grid};
+use super::{BatchError, BatchSummary, Interpolation, NodeFit, QueryOptions, grid};
 use crate::error::{BuildError, Placement, TickError};
 
 /// Owning compliance map (`alloc`): grid, per-node line coefficients, default query options
@@ -23,6 +23,9 @@ pub struct ComplianceMap {
     /// Slopes and offset sums node by node, the layout the query kernels read (derived
     /// from `slopes` and `offsets` at build).
     packed: Vec<f64>,
+    /// The two axes' ends and steps when both are evenly spaced (derived at build), for the
+    /// single query's path without a view.
+    even: Option<[grid::EvenEnds; 2]>,
     options: QueryOptions,
     fit: Option<Vec<NodeFit>>,
 }
@@ -40,6 +43,10 @@ impl ComplianceMap {
     ) -> Result<Self, BuildError> {
         let v = ComplianceMapView::new(&x, &y, n_force, n_displacement, &slopes, &offsets)?;
         let (x_inv_step, y_inv_step) = (v.x.inv_step, v.y.inv_step);
+        let even =
+            v.x.even()
+                .zip(v.y.even())
+                .map(|(a, b)| [a.ends(), b.ends()]);
         let packed = super::kernel::pack(n_displacement, n_force, &slopes, &offsets);
         Ok(Self {
             x,
@@ -51,6 +58,7 @@ impl ComplianceMap {
             slopes,
             offsets,
             packed,
+            even,
             options: QueryOptions::default(),
             fit: None,
         })
@@ -87,8 +95,7 @@ impl ComplianceMap {
         force: &[f64],
         out: &mut [f64],
     ) -> Result<Placement, TickError> {
-        self.view()
-            .displacement_with(position, force, out, self.options)
+        self.displacement_with(position, force, out, self.options)
     }
 
     /// [`Self::displacement`] with explicit options for this query.
@@ -100,7 +107,65 @@ impl ComplianceMap {
         out: &mut [f64],
         options: QueryOptions,
     ) -> Result<Placement, TickError> {
+        if let Some(placed) = self.even_bilinear(position, force, out, options) {
+            return placed;
+        }
+        self.displacement_by_view(position, force, out, options)
+    }
+
+    /// Every query [`Self::even_bilinear`] leaves, through the view; not inlined, so that a
+    /// caller's loop around the even-grid path keeps its registers.
+    #[inline(never)]
+    fn displacement_by_view(
+        &self,
+        position: [f64; 2],
+        force: &[f64],
+        out: &mut [f64],
+        options: QueryOptions,
+    ) -> Result<Placement, TickError> {
         self.view().displacement_with(position, force, out, options)
+    }
+
+    /// The bilinear query inside an evenly spaced grid at the kernels' fixed sizes (the
+    /// paper's 2 x 2, 3-D, 6-D, and a field's one load), without building a view ([`super::kernel::even_bilinear`]:
+    /// the same bits as the view's path); `None` for any other query, which the view's path
+    /// answers.
+    #[inline(always)]
+    fn even_bilinear(
+        &self,
+        position: [f64; 2],
+        force: &[f64],
+        out: &mut [f64],
+        options: QueryOptions,
+    ) -> Option<Result<Placement, TickError>> {
+        let [ex, ey] = self.even?;
+        if options.interpolation != Interpolation::Bilinear {
+            return None;
+        }
+        macro_rules! fixed {
+            ($nd:literal, $nf:literal) => {{
+                let f = <&[f64; $nf]>::try_from(force).ok()?;
+                let o = <&mut [f64; $nd]>::try_from(out).ok()?;
+                *o = super::kernel::even_bilinear::<$nd, $nf>(
+                    &self.packed,
+                    ex.on(&self.x),
+                    ey.on(&self.y),
+                    position,
+                    f,
+                )?;
+                Some(crate::error::check_output("displacement", o).map(|()| Placement::Inside))
+            }};
+        }
+        match (self.n_disp, self.n_force) {
+            (2, 2) => fixed!(2, 2),
+            (3, 3) => fixed!(3, 3),
+            (6, 6) => fixed!(6, 6),
+            // A displacement field's map (one unit load).
+            (2, 1) => fixed!(2, 1),
+            (3, 1) => fixed!(3, 1),
+            (6, 1) => fixed!(6, 1),
+            _ => None,
+        }
     }
 
     /// Many queries at once; see [`ComplianceMapView::displacement_batch`].
