@@ -15,6 +15,23 @@ use super::ComplianceMapView;
 use super::MAX_AXES;
 use super::grid::EvenAxis;
 
+/// `$fixed!(nd, nf)` for the shapes with fixed-size kernels (the paper's 2 x 2, 3-D and 6-D
+/// maps, and a displacement field's map of one unit load), `$other` for any other shape.
+macro_rules! fixed_shapes {
+    ($shape:expr, $fixed:ident, $other:expr) => {
+        match $shape {
+            (2, 2) => $fixed!(2, 2),
+            (3, 3) => $fixed!(3, 3),
+            (6, 6) => $fixed!(6, 6),
+            (2, 1) => $fixed!(2, 1),
+            (3, 1) => $fixed!(3, 1),
+            (6, 1) => $fixed!(6, 1),
+            _ => $other,
+        }
+    };
+}
+pub(super) use fixed_shapes;
+
 /// Values per node in the packed layout.
 #[inline(always)]
 pub(crate) const fn packed_block(n_disp: usize, n_force: usize) -> usize {
@@ -162,15 +179,7 @@ impl ComplianceMapView<'_> {
                 }
             };
         }
-        match (self.n_disp, self.n_force) {
-            (2, 2) => fixed!(2, 2),
-            (3, 3) => fixed!(3, 3),
-            (6, 6) => fixed!(6, 6),
-            (2, 1) => fixed!(2, 1),
-            (3, 1) => fixed!(3, 1),
-            (6, 1) => fixed!(6, 1),
-            _ => {}
-        }
+        fixed_shapes!((self.n_disp, self.n_force), fixed, {});
         let mut acc = [0.0; MAX_AXES];
         for (node, w) in nodes.iter().zip(weights) {
             let v = self.node_value_dyn(*node, force);

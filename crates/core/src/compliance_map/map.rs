@@ -156,16 +156,7 @@ impl ComplianceMap {
                 Some(crate::error::check_output("displacement", o).map(|()| Placement::Inside))
             }};
         }
-        match (self.n_disp, self.n_force) {
-            (2, 2) => fixed!(2, 2),
-            (3, 3) => fixed!(3, 3),
-            (6, 6) => fixed!(6, 6),
-            // A displacement field's map (one unit load).
-            (2, 1) => fixed!(2, 1),
-            (3, 1) => fixed!(3, 1),
-            (6, 1) => fixed!(6, 1),
-            _ => None,
-        }
+        super::kernel::fixed_shapes!((self.n_disp, self.n_force), fixed, None)
     }
 
     /// Many queries at once; see [`ComplianceMapView::displacement_batch`].
