@@ -92,8 +92,8 @@ pub(crate) fn emit<'py>(
 }
 
 /// Runs `fill` on the result's buffer (`shape`, row-major): the caller's `out`, or a new
-/// array (from `numpy.empty` past [`SMALL`] values), then returned. A `MemoryError` names the result when it cannot
-/// be allocated (rather than an abort).
+/// array (from `numpy.empty` past [`SMALL`] values), then returned. A `MemoryError` names the
+/// result when it cannot be allocated (rather than an abort).
 pub(crate) fn fill_into<'py>(
     py: Python<'py>,
     shape: &[usize],
@@ -122,7 +122,6 @@ pub(crate) fn fill_into<'py>(
         .as_slice_mut()
         .map_err(|e| InputError::new_err(format!("out: {e}")))?;
     fill(s)?;
-    drop(w);
     Ok(result)
 }
 

@@ -153,7 +153,8 @@ pub(super) fn finish_row<const ND: usize, const NF: usize>(
             <&[f64; NF]>::try_from(f),
             <&mut [f64; ND]>::try_from(&mut *o),
         )
-        && let Some(acc) = view.blend_cell_packed::<ND, NF>(n, view.y.nodes.len(), w, fa)
+        && let Some(acc) =
+            super::kernel::blend_cell::<ND, NF>(view.packed, n, view.y.nodes.len(), w, fa)
         && acc.iter().fold(0.0, |a, v| a + v * 0.0) == 0.0
     {
         *oa = acc;

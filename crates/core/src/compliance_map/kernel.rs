@@ -151,19 +151,6 @@ impl ComplianceMapView<'_> {
         acc
     }
 
-    /// [`Self::blend_fixed`] over a bilinear cell's nodes `n00, n00 + 1, n00 + ny,
-    /// n00 + ny + 1` from the packed layout (the view must have it): [`blend_cell`].
-    #[inline(always)]
-    pub(super) fn blend_cell_packed<const ND: usize, const NF: usize>(
-        &self,
-        n00: usize,
-        ny: usize,
-        weights: &[f64; 4],
-        f: &[f64; NF],
-    ) -> Option<[f64; ND]> {
-        blend_cell::<ND, NF>(self.packed, n00, ny, weights, f)
-    }
-
     /// The blend for any sizes into `out` (`nd` entries), dispatching to the fixed kernels
     /// for the common shapes (the paper's 2 x 2, 3-D, 6-D).
     #[inline(always)]

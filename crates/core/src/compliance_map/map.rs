@@ -127,9 +127,9 @@ impl ComplianceMap {
     }
 
     /// The bilinear query inside an evenly spaced grid at the kernels' fixed sizes (the
-    /// paper's 2 x 2, 3-D, 6-D, and a field's one load), without building a view ([`super::kernel::even_bilinear`]:
-    /// the same bits as the view's path); `None` for any other query, which the view's path
-    /// answers.
+    /// paper's 2 x 2, 3-D, 6-D, and a field's one load), without building a view
+    /// ([`super::kernel::even_bilinear`]: the same bits as the view's path); `None` for any
+    /// other query, which the view's path answers.
     #[inline(always)]
     fn even_bilinear(
         &self,
