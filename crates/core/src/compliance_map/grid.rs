@@ -367,6 +367,24 @@ impl EvenAxis<'_> {
         let ok = (v >= lo) & (v <= hi);
         (i, even_t(v, lo, hi, self.inv_step), ok)
     }
+
+    /// The cell of `v` and its local coordinate `(v - lo) / step`, when `v` lies in `[lo, hi)`
+    /// of the estimated cell: the same cell and bits as [`Axis::cell_t_inside`], which gives
+    /// that cell whenever `v` lies in it. `None` for `v` at that cell's upper node (the last
+    /// node, or one whose estimate rounded down), outside the axis, or NaN, which the view's
+    /// path answers. The single query's test: leaving the upper node out drops the select
+    /// that makes `t` exactly 1 there, and leaving the estimate unclamped lets the node
+    /// pair's bounds check refuse an estimate past the last cell (a third fewer
+    /// instructions than [`Self::cell_t`], and a shorter chain to `t`).
+    #[inline(always)]
+    pub(crate) fn cell_t_below_upper(&self, v: f64) -> Option<(usize, f64)> {
+        // Negative and NaN estimates are 0 (the cast saturates), so `i + 2` cannot wrap.
+        let i = (((v - self.first) * self.inv_step) as i64).max(0) as usize;
+        let &[lo, hi] = self.nodes.get(i..i + 2)? else {
+            return None;
+        };
+        ((v >= lo) & (v < hi)).then_some((i, (v - lo) * self.inv_step))
+    }
 }
 
 /// Up to 4 consecutive node weights along one axis, starting at node `base`.

@@ -234,8 +234,10 @@ pub(super) fn blend_cell<const ND: usize, const NF: usize>(
     f: &[f64; NF],
 ) -> Option<[f64; ND]> {
     let b = packed_block(ND, NF);
-    let near = packed.get(n00 * b..n00 * b + 2 * b)?;
-    let far = packed.get((n00 + ny) * b..(n00 + ny) * b + 2 * b)?;
+    // From the cell's first node on, then the two runs: no range that could wrap around.
+    let cell = packed.get(n00 * b..)?;
+    let far = cell.get(ny * b..)?.get(..2 * b)?;
+    let near = cell.get(..2 * b)?;
     let (n0, n1) = near.split_at(b);
     let (n2, n3) = far.split_at(b);
     let mut acc = [0.0; ND];
@@ -255,11 +257,11 @@ pub(super) fn blend_cell<const ND: usize, const NF: usize>(
 }
 
 /// The bilinear query on an evenly spaced grid of `packed` coefficients for finite input
-/// inside the grid needing no rounding correction of its cell: the same cell, weights and
-/// blend as [`ComplianceMapView::bilinear_inside`], so the same bits; `None` otherwise, for
-/// the view's path (which corrects the cell, names the error or applies the out-of-grid
-/// policy). The owning map's single query: no view to build, the axes' ends kept, the
-/// inside test folded into the cell's.
+/// below the upper nodes of its estimated cell ([`EvenAxis::cell_t_below_upper`]): the same
+/// cell, weights and blend as [`ComplianceMapView::bilinear_inside`], so the same bits;
+/// `None` otherwise, for the view's path (which takes the upper nodes, corrects the cell,
+/// names the error or applies the out-of-grid policy). The owning map's single query: no
+/// view to build, the axes' ends kept, the inside test folded into the cell's.
 #[inline(always)]
 pub(super) fn even_bilinear<const ND: usize, const NF: usize>(
     packed: &[f64],
@@ -271,9 +273,9 @@ pub(super) fn even_bilinear<const ND: usize, const NF: usize>(
     // A NaN or infinite force makes this NaN; finite forces make it exactly 0. A NaN or
     // infinite position lies in no cell.
     let probe = f.iter().fold(0.0, |a, v| a + v * 0.0);
-    let (i, tx, in_x) = x.cell_t(px);
-    let (j, ty, in_y) = y.cell_t(py);
-    if !(in_x & in_y) || probe != 0.0 {
+    let (i, tx) = x.cell_t_below_upper(px)?;
+    let (j, ty) = y.cell_t_below_upper(py)?;
+    if probe != 0.0 {
         return None;
     }
     let ny = y.nodes.len();
