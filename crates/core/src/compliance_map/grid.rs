@@ -317,38 +317,40 @@ pub(crate) struct EvenAxis<'a> {
     pub(super) last_cell: usize,
 }
 
-/// The ends, step and last cell of an evenly spaced axis, kept by the owning map so that a
-/// single query makes its [`EvenAxis`] without loading and checking them again.
+/// The first node and inverse step of an evenly spaced axis: what the owning map keeps for
+/// its single query, which reads nothing else of the axis but its nodes.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct EvenEnds {
+pub(crate) struct EvenStart {
     first: f64,
-    last: f64,
     inv_step: f64,
-    last_cell: usize,
 }
 
-impl EvenEnds {
-    /// The axis over its `nodes` (those it was taken from).
+impl EvenStart {
+    /// The cell of `v` among `nodes` (the axis this was taken from) and its local coordinate
+    /// `(v - lo) / step`, when `v` lies in `[lo, hi)` of the estimated cell: the same cell and
+    /// bits as [`Axis::cell_t_inside`], which gives that cell whenever `v` lies in it. `None`
+    /// for `v` at that cell's upper node (the last node, or one whose estimate rounded down),
+    /// outside the axis, or NaN, which the view's path answers. Leaving the upper node out
+    /// drops the select that makes `t` exactly 1 there, and leaving the estimate unclamped
+    /// lets the node pair's bounds check refuse an estimate past the last cell (a third fewer
+    /// instructions than [`EvenAxis::cell_t`], and a shorter chain to `t`).
     #[inline(always)]
-    pub(crate) fn on(self, nodes: &[f64]) -> EvenAxis<'_> {
-        EvenAxis {
-            nodes,
-            first: self.first,
-            last: self.last,
-            inv_step: self.inv_step,
-            last_cell: self.last_cell,
-        }
+    pub(crate) fn cell_t_below_upper(self, nodes: &[f64], v: f64) -> Option<(usize, f64)> {
+        // Negative and NaN estimates are 0 (the cast saturates), so `i + 2` cannot wrap.
+        let i = (((v - self.first) * self.inv_step) as i64).max(0) as usize;
+        let &[lo, hi] = nodes.get(i..i + 2)? else {
+            return None;
+        };
+        ((v >= lo) & (v < hi)).then_some((i, (v - lo) * self.inv_step))
     }
 }
 
 impl EvenAxis<'_> {
-    /// What [`EvenEnds::on`] makes this axis from.
-    pub(crate) fn ends(&self) -> EvenEnds {
-        EvenEnds {
+    /// What the owning map keeps of this axis for its single query.
+    pub(crate) fn start(&self) -> EvenStart {
+        EvenStart {
             first: self.first,
-            last: self.last,
             inv_step: self.inv_step,
-            last_cell: self.last_cell,
         }
     }
 
@@ -366,24 +368,6 @@ impl EvenAxis<'_> {
         // neither.
         let ok = (v >= lo) & (v <= hi);
         (i, even_t(v, lo, hi, self.inv_step), ok)
-    }
-
-    /// The cell of `v` and its local coordinate `(v - lo) / step`, when `v` lies in `[lo, hi)`
-    /// of the estimated cell: the same cell and bits as [`Axis::cell_t_inside`], which gives
-    /// that cell whenever `v` lies in it. `None` for `v` at that cell's upper node (the last
-    /// node, or one whose estimate rounded down), outside the axis, or NaN, which the view's
-    /// path answers. The single query's test: leaving the upper node out drops the select
-    /// that makes `t` exactly 1 there, and leaving the estimate unclamped lets the node
-    /// pair's bounds check refuse an estimate past the last cell (a third fewer
-    /// instructions than [`Self::cell_t`], and a shorter chain to `t`).
-    #[inline(always)]
-    pub(crate) fn cell_t_below_upper(&self, v: f64) -> Option<(usize, f64)> {
-        // Negative and NaN estimates are 0 (the cast saturates), so `i + 2` cannot wrap.
-        let i = (((v - self.first) * self.inv_step) as i64).max(0) as usize;
-        let &[lo, hi] = self.nodes.get(i..i + 2)? else {
-            return None;
-        };
-        ((v >= lo) & (v < hi)).then_some((i, (v - lo) * self.inv_step))
     }
 }
 

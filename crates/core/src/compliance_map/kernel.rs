@@ -13,7 +13,7 @@
 
 use super::ComplianceMapView;
 use super::MAX_AXES;
-use super::grid::EvenAxis;
+use super::grid::EvenStart;
 
 /// `$fixed!(nd, nf)` for the shapes with fixed-size kernels (the paper's 2 x 2, 3-D and 6-D
 /// maps, and a displacement field's map of one unit load), `$other` for any other shape.
@@ -257,7 +257,7 @@ pub(super) fn blend_cell<const ND: usize, const NF: usize>(
 }
 
 /// The bilinear query on an evenly spaced grid of `packed` coefficients for finite input
-/// below the upper nodes of its estimated cell ([`EvenAxis::cell_t_below_upper`]): the same
+/// below the upper nodes of its estimated cell ([`EvenStart::cell_t_below_upper`]): the same
 /// cell, weights and blend as [`ComplianceMapView::bilinear_inside`], so the same bits;
 /// `None` otherwise, for the view's path (which takes the upper nodes, corrects the cell,
 /// names the error or applies the out-of-grid policy). The owning map's single query: no
@@ -265,20 +265,20 @@ pub(super) fn blend_cell<const ND: usize, const NF: usize>(
 #[inline(always)]
 pub(super) fn even_bilinear<const ND: usize, const NF: usize>(
     packed: &[f64],
-    x: EvenAxis<'_>,
-    y: EvenAxis<'_>,
+    [x, y]: [&[f64]; 2],
+    [ex, ey]: [EvenStart; 2],
     [px, py]: [f64; 2],
     f: &[f64; NF],
 ) -> Option<[f64; ND]> {
     // A NaN or infinite force makes this NaN; finite forces make it exactly 0. A NaN or
     // infinite position lies in no cell.
     let probe = f.iter().fold(0.0, |a, v| a + v * 0.0);
-    let (i, tx) = x.cell_t_below_upper(px)?;
-    let (j, ty) = y.cell_t_below_upper(py)?;
+    let (i, tx) = ex.cell_t_below_upper(x, px)?;
+    let (j, ty) = ey.cell_t_below_upper(y, py)?;
     if probe != 0.0 {
         return None;
     }
-    let ny = y.nodes.len();
+    let ny = y.len();
     let (ux, uy) = (1.0 - tx, 1.0 - ty);
     let weights = [ux * uy, ux * ty, tx * uy, tx * ty];
     blend_cell::<ND, NF>(packed, i * ny + j, ny, &weights, f)

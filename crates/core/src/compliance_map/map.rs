@@ -23,9 +23,9 @@ pub struct ComplianceMap {
     /// Slopes and offset sums node by node, the layout the query kernels read (derived
     /// from `slopes` and `offsets` at build).
     packed: Vec<f64>,
-    /// The two axes' ends and steps when both are evenly spaced (derived at build), for the
-    /// single query's path without a view.
-    even: Option<[grid::EvenEnds; 2]>,
+    /// The two axes' first nodes and steps when both are evenly spaced (derived at build), for
+    /// the single query's path without a view.
+    even: Option<[grid::EvenStart; 2]>,
     options: QueryOptions,
     fit: Option<Vec<NodeFit>>,
 }
@@ -46,7 +46,7 @@ impl ComplianceMap {
         let even =
             v.x.even()
                 .zip(v.y.even())
-                .map(|(a, b)| [a.ends(), b.ends()]);
+                .map(|(a, b)| [a.start(), b.start()]);
         let packed = super::kernel::pack(n_displacement, n_force, &slopes, &offsets);
         Ok(Self {
             x,
@@ -138,7 +138,7 @@ impl ComplianceMap {
         out: &mut [f64],
         options: QueryOptions,
     ) -> Option<Result<Placement, TickError>> {
-        let [ex, ey] = self.even?;
+        let even = self.even?;
         if options.interpolation != Interpolation::Bilinear {
             return None;
         }
@@ -148,8 +148,8 @@ impl ComplianceMap {
                 let o = <&mut [f64; $nd]>::try_from(out).ok()?;
                 *o = super::kernel::even_bilinear::<$nd, $nf>(
                     &self.packed,
-                    ex.on(&self.x),
-                    ey.on(&self.y),
+                    [&self.x, &self.y],
+                    even,
                     position,
                     f,
                 )?;
