@@ -24,6 +24,7 @@ fn bench(c: &mut Criterion) {
         &GcodeOptions {
             start: Vector3::new(0.0, 0.0, 0.02),
             units: LengthUnit::Millimetre,
+            ..GcodeOptions::default()
         },
     )
     .unwrap();
@@ -45,6 +46,7 @@ fn bench(c: &mut Criterion) {
         stock,
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
+        hand_spindle: None,
     };
     let seed = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();

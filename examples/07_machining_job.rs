@@ -36,6 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         &GcodeOptions {
             start: Vector3::new(0.0, 0.0, 0.02),
             units: LengthUnit::Millimetre,
+            ..GcodeOptions::default()
         },
     )?;
     // The workpiece on a table in front of the robot: its origin at (2.45, 0.02, 0.92) m in
@@ -56,6 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         },
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
+        hand_spindle: None,
     };
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup)?;
     // Joints near the first pose (the tool down over the table): they choose the IK branch.

@@ -347,11 +347,13 @@ pub fn kr300_robot() -> &'static SerialRobot {
     )
 }
 
-/// Target `gcode`: a G-code program read in mm from the origin and in inch from an offset
-/// start. Whatever reads is a continuous path of finite moves: each starts where the one
-/// before ended, arcs have a radius > 0 and a sweep in (0, 2 pi], `point(0)` and `point(1)`
-/// are the ends, feeds are finite (0 for rapids, > 0 otherwise), and `Program::validate`
-/// agrees.
+/// Target `gcode`: a G-code program read in mm from the origin (LinuxCNC's dialect) and in
+/// inch from an offset start (the fanuc dialect, block delete on); its word report alongside.
+/// Whatever reads is a continuous path of finite moves: each starts where the one before
+/// ended, arcs have a radius > 0 and a sweep within their turns, dwells stay in place,
+/// `point(0)` and `point(1)` are the ends, feeds are finite (0 for rapids and dwells, > 0
+/// otherwise), and `Program::validate` agrees. No input panics, hangs or runs past a budget
+/// (the reader's budgets are errors).
 pub fn gcode(data: &[u8]) -> bool {
     let text = String::from_utf8_lossy(data);
     let mut loaded = false;
@@ -360,15 +362,20 @@ pub fn gcode(data: &[u8]) -> bool {
         gcode::GcodeOptions {
             start: nalgebra::Vector3::new(0.1, -0.2, 0.3),
             units: LengthUnit::Inch,
+            dialect: gcode::Dialect::Fanuc,
+            block_delete: true,
         },
     ] {
+        if let Ok(words) = gcode::words(&text, &options) {
+            assert!(words.iter().all(|w| w.count >= 1 && w.first_line >= 1));
+        }
         let Ok(program) = gcode::from_str(&text, &options) else {
             continue;
         };
         let mut at = options.start;
         for m in &program.moves {
-            assert_eq!(
-                m.start, at,
+            assert!(
+                (m.start - at).norm() <= 1e-9,
                 "line {}: a move starts where the last ended",
                 m.line
             );
@@ -382,11 +389,20 @@ pub fn gcode(data: &[u8]) -> bool {
             );
             match m.motion {
                 Motion::Rapid => assert_eq!(m.feed, 0.0),
+                Motion::Dwell { seconds } => {
+                    assert!(
+                        seconds > 0.0 && m.feed == 0.0 && m.start == m.end,
+                        "line {}",
+                        m.line
+                    )
+                }
                 Motion::Linear => assert!(m.feed > 0.0),
                 Motion::Arc { sweep, .. } => {
                     assert!(m.feed > 0.0 && m.radius() > 0.0, "line {}", m.line);
+                    let most =
+                        std::f64::consts::TAU * f64::from(deflect_core::machining::MAX_ARC_TURNS);
                     assert!(
-                        sweep != 0.0 && sweep.abs() <= std::f64::consts::TAU,
+                        sweep != 0.0 && sweep.abs() <= most,
                         "line {}: sweep {sweep}",
                         m.line
                     );

@@ -6,7 +6,7 @@ use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use deflect_core::LoadError;
 use deflect_core::io::gcode::{self, GcodeOptions, MAX_PROGRAM_LINES};
-use deflect_core::machining::{Motion, Program};
+use deflect_core::machining::{Motion, Plane, Program};
 use deflect_core::units::LengthUnit;
 use nalgebra::{Vector2, Vector3};
 
@@ -67,6 +67,7 @@ fn incremental_coordinates_inches_and_a_start_offset() {
     let o = GcodeOptions {
         start: Vector3::new(1.0, 2.0, 3.0),
         units: LengthUnit::Inch,
+        ..GcodeOptions::default()
     };
     let p = gcode::from_str("G1 X1 F10\nG91 Z-1\n", &o).unwrap();
     assert_eq!(p.moves[0].start, Vector3::new(1.0, 2.0, 3.0));
@@ -88,10 +89,16 @@ fn incremental_coordinates_inches_and_a_start_offset() {
 fn arcs_from_ij_have_their_centre_and_sweep() {
     // From (50, 0) about (50, 10) clockwise to (60, 10): bottom, left, top, right = 270 deg.
     let p = read("G0 X50 Y0\nG2 X60 Y10 I0 J10 F100\n");
-    let Motion::Arc { center, sweep } = p.moves[1].motion else {
+    let Motion::Arc {
+        plane,
+        center,
+        sweep,
+    } = p.moves[1].motion
+    else {
         panic!("an arc");
     };
-    assert_eq!(center, Vector2::new(0.05, 0.01));
+    assert_eq!(plane, Plane::Xy);
+    assert_eq!(center, Vector3::new(0.05, 0.01, 0.0));
     assert!((sweep + 1.5 * PI).abs() < 1e-15, "{sweep}");
     assert!((p.moves[1].radius() - 0.01).abs() < 1e-17);
     assert!((p.moves[1].length() - 0.01 * 1.5 * PI).abs() < 1e-15);
@@ -142,11 +149,14 @@ fn arcs_from_r_take_the_short_or_the_long_way() {
     // (0, 0) to (10, 10) counter-clockwise with R10: centre (0, 10), 90 deg; R-10: centre
     // (10, 0), 270 deg.
     for (r, centre, sweep) in [
-        ("R10", Vector2::new(0.0, 0.01), FRAC_PI_2),
-        ("R-10", Vector2::new(0.01, 0.0), 1.5 * PI),
+        ("R10", Vector3::new(0.0, 0.01, 0.0), FRAC_PI_2),
+        ("R-10", Vector3::new(0.01, 0.0, 0.0), 1.5 * PI),
     ] {
         let p = read(&format!("G3 X10 Y10 {r} F100\n"));
-        let Motion::Arc { center, sweep: s } = p.moves[0].motion else {
+        let Motion::Arc {
+            center, sweep: s, ..
+        } = p.moves[0].motion
+        else {
             panic!("an arc");
         };
         assert!((center - centre).norm() < 1e-15, "{r}: {center}");
@@ -154,75 +164,75 @@ fn arcs_from_r_take_the_short_or_the_long_way() {
     }
     // Clockwise the sides swap: R10 centre (10, 0), -90 deg.
     let p = read("G2 X10 Y10 R10 F100\n");
-    let Motion::Arc { center, sweep } = p.moves[0].motion else {
+    let Motion::Arc { center, sweep, .. } = p.moves[0].motion else {
         panic!("an arc");
     };
-    assert!((center - Vector2::new(0.01, 0.0)).norm() < 1e-15);
+    assert!((center - Vector3::new(0.01, 0.0, 0.0)).norm() < 1e-15);
     assert!((sweep + FRAC_PI_2).abs() < 1e-12);
 }
 
 #[test]
 fn every_fault_names_its_line_and_column() {
-    let cases: [(&str, usize, usize, &str); 20] = [
-        ("G1 X10 T1 F100\n", 1, 8, "supported word"),
-        ("G1 X F100\n", 1, 6, "a number after X"),
+    // (program, line, column, words of the message)
+    let cases: [(&str, usize, usize, &str); 24] = [
+        ("G1 X F100\n", 1, 6, "got \"f100\""),
         (
             "G0 X0 Y0\nG2 X10 Y0 I4 J0 F100\n",
             2,
             4,
             "on the arc's circle",
         ),
-        (
-            "G21\nG1 X1 F100\nG20\n",
-            3,
-            1,
-            "one unit for the whole program",
-        ),
-        (
-            &format!("G1 X{} F100\n", "9".repeat(400)),
-            1,
-            5,
-            "finite number",
-        ),
-        (
-            "G0 X1\nM30\nG0 X2\n",
-            3,
-            1,
-            "nothing after the program end (line 2)",
-        ),
-        ("G1 X10\n", 1, 4, "feed rate F"),
-        ("X10\n", 1, 1, "motion mode"),
-        ("G1 G0 X1\n", 1, 4, "one G code of its group"),
-        ("G18 G2 X1\n", 1, 1, "G17"),
-        ("M4\n", 1, 1, "supported M code"),
+        (&format!("G1 X{} F100\n", "9".repeat(400)), 1, 5, "a number"),
+        ("G1 X10\n", 1, 1, "feed rate F > 0"),
+        ("X10\n", 1, 1, "no motion mode"),
+        ("G1 G0 X1\n", 1, 1, "one G code of each modal group"),
         ("G1 X1 F100 (unclosed\n", 1, 12, "closing this comment"),
-        ("G1 X1 I2 F100\n", 1, 7, "only on arcs"),
+        ("G1 X1 I2 F100\n", 1, 7, "nothing on the line uses"),
         ("G2 X10 I5 R5 F100\n", 1, 11, "not both"),
-        ("G2 X10 F100\n", 1, 4, "centre"),
+        ("G2 X10 F100\n", 1, 1, "centre"),
         ("G2 X30 R10 F100\n", 1, 8, "at least half the chord"),
-        ("G2 X0 Y0 R10 F100\n", 1, 10, "full circle needs I/J"),
-        ("G0 N10 X1\n", 1, 4, "first word"),
+        ("G2 X0 Y0 R10 F100\n", 1, 1, "a full circle needs I, J, K"),
+        ("G0 N10 X1\n", 1, 4, "only at the start"),
         ("G1 X1.2.3 F100\n", 1, 5, "at most one '.'"),
-        ("G1 X1 F-5\n", 1, 7, "feed F > 0"),
+        ("G1 X1 F-5\n", 1, 7, "F >= 0"),
+        ("G41 G1 X1 F100\n", 1, 1, "cutter radius compensation"),
+        ("G38.2 Z-1 F100\n", 1, 1, "probing"),
+        ("G0 X1 A90\n", 1, 7, "rotary"),
+        (
+            "G17 G2 X1 I0.5 K0 F100\n",
+            1,
+            16,
+            "no K word on an arc in G17",
+        ),
+        ("M101\n", 1, 1, "user M codes"),
+        ("G12 X1\n", 1, 1, "a G code LinuxCNC knows"),
+        ("G0 X1 (a (b) c)\n", 1, 10, "nested comments"),
+        ("G0 X1\n%\n", 2, 1, "'%' alone on the first line"),
+        ("#1=[1/0]\n", 1, 1, "a divisor other than 0"),
     ];
+    let mut wrong = Vec::new();
     for (text, line, column, needle) in cases {
         let (l, c, m) = fault(text);
-        assert_eq!((l, c), (line, column), "{text:?}: {m}");
-        assert!(m.contains(needle), "{text:?}: {m:?} lacks {needle:?}");
+        if (l, c) != (line, column) || !m.contains(needle) {
+            wrong.push(format!(
+                "{text:?}: got ({l}, {c}) {m:?}; expected ({line}, {column}) with {needle:?}"
+            ));
+        }
     }
+    assert!(wrong.is_empty(), "{}", wrong.join("\n"));
     // The message reads as one line naming line and column.
-    let e = gcode::from_str("G1 X10 T1 F100\n", &GcodeOptions::default()).unwrap_err();
+    let e = gcode::from_str("G0 X1\nG1 X10 D1 F100\n", &GcodeOptions::default()).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "program line 1, column 8: expected a supported word (N, G, M, X, Y, Z, I, J, R, F, \
-         S), got T"
+        "program line 2, column 8: expected D: a word nothing on the line uses; only G41 or G42 \
+         (not modelled) use it (this line's is G1)"
     );
     // Out of range: 2 km.
     let (_, _, m) = fault("G1 X2000000 F100\n");
     assert!(m.contains("within +-1000 m"), "{m}");
     // Non-ASCII, a stray character.
     assert_eq!(fault("G1 X1 F100 é\n").1, 12);
-    assert_eq!(fault("G1 X1 F100 #5\n").1, 12);
+    assert_eq!(fault("G1 X1 F100 =5\n").1, 12);
 }
 
 #[test]

@@ -28,6 +28,7 @@ fn program(text: &str) -> deflect_core::machining::Program {
         &GcodeOptions {
             start: Vector3::new(0.0, 0.0, 0.02),
             units: LengthUnit::Millimetre,
+            ..GcodeOptions::default()
         },
     )
     .unwrap()
@@ -184,6 +185,7 @@ fn kr300_job() -> (Job, Vec<f64>) {
         },
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
+        hand_spindle: None,
     };
     (
         Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap(),
@@ -294,6 +296,7 @@ fn the_compensated_gcode_reads_back_onto_the_commanded_path() {
         &GcodeOptions {
             start: r.samples[0].commanded.translation.vector,
             units: LengthUnit::Millimetre,
+            ..GcodeOptions::default()
         },
     )
     .unwrap();
@@ -336,6 +339,7 @@ fn a_points_csv_is_a_program_of_straight_moves_in_its_units() {
     let o = GcodeOptions {
         start: Vector3::zeros(),
         units: LengthUnit::Millimetre,
+        ..GcodeOptions::default()
     };
     let p = points_csv::from_str(
         "x_mm,y_mm,z_mm,feed_mm_min,spindle_rpm\n0,0,5,0,0\n10,0,-2,1500,13000\n",
@@ -379,14 +383,10 @@ fn a_points_csv_is_a_program_of_straight_moves_in_its_units() {
 
 #[test]
 fn a_hand_built_program_is_checked_like_a_read_one() {
-    use deflect_core::machining::{Motion, Move, Program};
+    use deflect_core::machining::{Motion, Move, Plane, Program};
     let line = |start: Vector3<f64>, end: Vector3<f64>| Move {
-        line: 1,
-        motion: Motion::Linear,
-        start,
-        end,
-        feed: 0.01,
         spindle: 100.0,
+        ..Move::new(1, Motion::Linear, start, end, 0.01)
     };
     let (a, b, c) = (
         Vector3::zeros(),
@@ -415,13 +415,15 @@ fn a_hand_built_program_is_checked_like_a_read_one() {
     assert!(text(&nan).contains("finite"), "{}", text(&nan));
     let mut arc = ok.clone();
     arc.moves[1].motion = Motion::Arc {
-        center: Vector2::new(0.01, 0.005),
+        plane: Plane::Xy,
+        center: Vector3::new(0.01, 0.005, 0.0),
         sweep: PI / 2.0,
     };
     assert!(text(&arc).contains("ARC_TOLERANCE"), "{}", text(&arc));
     // A half turn about the chord's midpoint is consistent.
     arc.moves[1].motion = Motion::Arc {
-        center: Vector2::new(0.01, 0.005),
+        plane: Plane::Xy,
+        center: Vector3::new(0.01, 0.005, 0.0),
         sweep: PI,
     };
     arc.validate().unwrap();

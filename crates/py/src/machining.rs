@@ -2,10 +2,10 @@
 //! `io::gcode`) and the mechanistic end-milling force (`milling_force`, deflect-core's
 //! `machining::cutting`). Everything SI: m, m/s, rev/s, N.
 
-use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::io::gcode::{self, Dialect, GcodeOptions, WordStatus, WordUse};
 use deflect_core::io::points_csv;
 use deflect_core::machining::cutting::{self, Coefficients, Engagement, MAX_DISCS, Tool};
-use deflect_core::machining::{Motion, Move, Program};
+use deflect_core::machining::{Motion, Move, PathControl, Plane, Program};
 use deflect_core::motion::MAX_SAMPLES;
 use deflect_core::units::LengthUnit;
 use nalgebra::Vector3;
@@ -18,22 +18,55 @@ use crate::arrays::{try_rows, vector, vector_upto};
 use crate::errors::{build_err, load_err, tick_err};
 use crate::scalars::{count, real};
 
-/// One move as pickled: line, kind (0 rapid, 1 linear, 2 arc), start, end, arc centre (NaN
-/// for straight moves), sweep, feed, spindle.
-type MoveState = (usize, u8, [f64; 3], [f64; 3], [f64; 2], f64, f64, f64);
+/// One move as pickled: line, kind (0 rapid, 1 linear, 2 arc, 3 dwell), start, end, arc
+/// centre (NaN for other moves), (plane 0 xy / 1 zx / 2 yz, sweep [rad] or dwell [s]),
+/// (feed, spindle, tool), (path control 0 G61 / 1 G61.1 / 2 G64, P, Q).
+type MoveState = (
+    usize,
+    u8,
+    [f64; 3],
+    [f64; 3],
+    [f64; 3],
+    (u8, f64),
+    (f64, f64, u32),
+    (u8, f64, f64),
+);
 
-/// A machining program read from ISO G-code: its moves as arrays, SI, workpiece frame.
-/// Supported: G0-G3 in G17 (arcs by I/J or R), G20/G21 (before the first length; mm
-/// without either), G90/G91, F (per minute), S (rpm), M3/M5, M2/M30, N, comments and %;
-/// G40/G49/G54/G80/G94 are accepted with no effect. Anything else raises `LoadError` naming
-/// the line and the column. At most 1,000,000 lines.
+/// A word of the report: word, status, count, first line, meaning.
+type WordState = (String, String, usize, usize, String);
+
+/// A program as pickled: its moves and its word report.
+type ProgramState = (Vec<MoveState>, Vec<WordState>);
+
+/// A machining program read from RS274/NGC G-code as LinuxCNC reads it (tools, work
+/// offsets, planes, canned cycles, parameters, subroutines, control flow): its moves as
+/// arrays, SI, in the program's machine frame (= its own coordinates unless it sets work
+/// offsets). `dialect`: "linuxcnc" (default), "grbl" (ignores an arc's off-plane centre
+/// word), "fanuc" (axis words after G80 move in the last G0-G3 mode; '%' lines anywhere).
+/// What has no meaning on a robot (cutter compensation, probing, threading, lathe modes,
+/// rotary axes) raises `LoadError` naming the word, the line and the column. `words` lists
+/// every word the program uses and what the reader does with it.
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct GcodeProgram {
     pub(crate) inner: Program,
+    words: Vec<WordUse>,
 }
 
-fn options(start: Option<&Bound<'_, PyAny>>, units: &str) -> PyResult<GcodeOptions> {
+fn dialect(name: &str) -> PyResult<Dialect> {
+    Dialect::parse(name).ok_or_else(|| {
+        InputError::new_err(format!(
+            "dialect must be \"linuxcnc\", \"grbl\" or \"fanuc\", got {name:?}"
+        ))
+    })
+}
+
+fn options(
+    start: Option<&Bound<'_, PyAny>>,
+    units: &str,
+    dialect_name: &str,
+    block_delete: bool,
+) -> PyResult<GcodeOptions> {
     let units = match units {
         "mm" => LengthUnit::Millimetre,
         "in" => LengthUnit::Inch,
@@ -47,32 +80,88 @@ fn options(start: Option<&Bound<'_, PyAny>>, units: &str) -> PyResult<GcodeOptio
         Some(s) => Vector3::from_column_slice(&vector(s, "start", 3)?),
         None => Vector3::zeros(),
     };
-    Ok(GcodeOptions { start, units })
+    Ok(GcodeOptions {
+        start,
+        units,
+        dialect: dialect(dialect_name)?,
+        block_delete,
+    })
+}
+
+fn word_state(w: &WordUse) -> WordState {
+    (
+        w.word.clone(),
+        w.status.name().to_string(),
+        w.count,
+        w.first_line,
+        w.meaning.clone(),
+    )
+}
+
+/// The word report of a G-code program's text: `(word, status, count, first_line,
+/// meaning)` per word, status "honoured" (it shapes the moves), "recorded" (no motion) or
+/// "refused"; also for a program the reader refuses.
+#[pyfunction]
+#[pyo3(signature = (text, *, dialect="linuxcnc"))]
+fn gcode_words(py: Python<'_>, text: &str, dialect: &str) -> PyResult<Vec<WordState>> {
+    let o = GcodeOptions {
+        dialect: self::dialect(dialect)?,
+        ..GcodeOptions::default()
+    };
+    let words = py.detach(|| gcode::words(text, &o)).map_err(load_err)?;
+    Ok(words.iter().map(word_state).collect())
+}
+
+impl GcodeProgram {
+    fn read(py: Python<'_>, text: &str, o: &GcodeOptions) -> PyResult<Self> {
+        let (inner, words) = py
+            .detach(|| {
+                Ok::<_, deflect_core::LoadError>((
+                    gcode::from_str(text, o)?,
+                    gcode::words(text, o)?,
+                ))
+            })
+            .map_err(load_err)?;
+        Ok(Self { inner, words })
+    }
 }
 
 #[pymethods]
 impl GcodeProgram {
     /// Reads a G-code file. `start` (3,) [m]: where the tool is before the first move
-    /// (default the origin); `units`: "mm" or "in" until the program says G21 or G20.
+    /// (default the origin); `units`: "mm" or "in" until the program says G21 or G20;
+    /// `dialect`: "linuxcnc", "grbl" or "fanuc"; `block_delete`: skip the lines starting with
+    /// '/' (default False: they run, as on LinuxCNC).
     #[staticmethod]
-    #[pyo3(signature = (path, *, start=None, units="mm"))]
+    #[pyo3(signature = (path, *, start=None, units="mm", dialect="linuxcnc", block_delete=false))]
     fn from_file(
+        py: Python<'_>,
         path: std::path::PathBuf,
         start: Option<&Bound<'_, PyAny>>,
         units: &str,
+        dialect: &str,
+        block_delete: bool,
     ) -> PyResult<Self> {
-        let o = options(start, units)?;
-        let inner = gcode::from_path(&path, &o).map_err(load_err)?;
-        Ok(Self { inner })
+        let o = options(start, units, dialect, block_delete)?;
+        let text = py
+            .detach(|| deflect_core::io::read_text_file(&path))
+            .map_err(load_err)?;
+        Self::read(py, &text, &o)
     }
 
     /// Same as `from_file`, from the program's text.
     #[staticmethod]
-    #[pyo3(signature = (text, *, start=None, units="mm"))]
-    fn from_text(text: &str, start: Option<&Bound<'_, PyAny>>, units: &str) -> PyResult<Self> {
-        let o = options(start, units)?;
-        let inner = gcode::from_str(text, &o).map_err(load_err)?;
-        Ok(Self { inner })
+    #[pyo3(signature = (text, *, start=None, units="mm", dialect="linuxcnc", block_delete=false))]
+    fn from_text(
+        py: Python<'_>,
+        text: &str,
+        start: Option<&Bound<'_, PyAny>>,
+        units: &str,
+        dialect: &str,
+        block_delete: bool,
+    ) -> PyResult<Self> {
+        let o = options(start, units, dialect, block_delete)?;
+        Self::read(py, text, &o)
     }
 
     /// Reads a tool points CSV file: one straight move per row from the previous point (the
@@ -84,83 +173,70 @@ impl GcodeProgram {
         path: std::path::PathBuf,
         start: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let o = options(start, "mm")?;
+        let o = options(start, "mm", "linuxcnc", false)?;
         let inner = points_csv::from_path(&path, &o).map_err(load_err)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            words: Vec::new(),
+        })
     }
 
     /// Same as `from_points_file`, from the CSV text.
     #[staticmethod]
     #[pyo3(signature = (text, *, start=None))]
     fn from_points_text(text: &str, start: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
-        let o = options(start, "mm")?;
+        let o = options(start, "mm", "linuxcnc", false)?;
         let inner = points_csv::from_str(text, &o).map_err(load_err)?;
-        Ok(Self { inner })
+        Ok(Self {
+            inner,
+            words: Vec::new(),
+        })
     }
 
-    /// Pickling and copy.deepcopy: the moves as plain values, rebuilt bit for bit and
-    /// checked (`Program::validate`).
-    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, (Vec<MoveState>,))> {
+    /// Pickling and copy.deepcopy: the moves and the word report as plain values, rebuilt bit
+    /// for bit and checked (`Program::validate`).
+    fn __reduce__<'py>(
+        slf: &Bound<'py, Self>,
+    ) -> PyResult<(Bound<'py, PyAny>, ProgramState)> {
         let rebuild = slf.get_type().getattr("_from_state")?;
-        let state = slf
-            .get()
-            .inner
-            .moves
-            .iter()
-            .map(|m| {
-                let (kind, center, sweep) = match m.motion {
-                    Motion::Rapid => (0u8, [f64::NAN; 2], 0.0),
-                    Motion::Linear => (1, [f64::NAN; 2], 0.0),
-                    Motion::Arc { center, sweep } => (2, [center.x, center.y], sweep),
-                };
-                (
-                    m.line,
-                    kind,
-                    [m.start.x, m.start.y, m.start.z],
-                    [m.end.x, m.end.y, m.end.z],
-                    center,
-                    sweep,
-                    m.feed,
-                    m.spindle,
-                )
-            })
-            .collect();
-        Ok((rebuild, (state,)))
+        let me = slf.get();
+        let state = me.inner.moves.iter().map(move_state).collect();
+        Ok((rebuild, (state, me.words.iter().map(word_state).collect())))
     }
 
     /// The program of a pickled state (see `__reduce__`), checked.
     #[staticmethod]
-    fn _from_state(state: Vec<MoveState>) -> PyResult<Self> {
+    fn _from_state(state: Vec<MoveState>, words: Vec<WordState>) -> PyResult<Self> {
         let moves = state
             .into_iter()
             .enumerate()
-            .map(|(i, (line, kind, start, end, center, sweep, feed, spindle))| {
-                let motion = match kind {
-                    0 => Motion::Rapid,
-                    1 => Motion::Linear,
-                    2 => Motion::Arc {
-                        center: nalgebra::Vector2::new(center[0], center[1]),
-                        sweep,
-                    },
-                    k => {
-                        return Err(InputError::new_err(format!(
-                            "pickled program, move {i}: kind {k}; expected 0 (rapid), 1 (linear) or 2 (arc)"
-                        )));
-                    }
-                };
-                Ok(Move {
-                    line,
-                    motion,
-                    start: Vector3::from(start),
-                    end: Vector3::from(end),
-                    feed,
-                    spindle,
-                })
-            })
+            .map(|(i, m)| from_move_state(i, m))
             .collect::<PyResult<Vec<_>>>()?;
         let inner = Program { moves };
         inner.validate().map_err(build_err)?;
-        Ok(Self { inner })
+        let words = words
+            .into_iter()
+            .map(|(word, status, count, first_line, meaning)| {
+                let status = match status.as_str() {
+                    "honoured" => WordStatus::Honoured,
+                    "recorded" => WordStatus::Recorded,
+                    "refused" => WordStatus::Refused,
+                    other => {
+                        return Err(InputError::new_err(format!(
+                            "pickled word report: status {other:?}; expected honoured, recorded or refused"
+                        )));
+                    }
+                };
+                Ok(WordUse {
+                    word,
+                    status,
+                    count,
+                    first_line,
+                    meaning,
+                })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        Ok(Self { inner, words })
     }
 
     fn __eq__(&self, other: &Self) -> bool {
@@ -185,7 +261,7 @@ impl GcodeProgram {
         Array1::from_iter(self.inner.moves.iter().map(|m| m.line as u64)).into_pyarray(py)
     }
 
-    /// Each move's kind: "rapid", "linear" or "arc", (n,) list.
+    /// Each move's kind: "rapid", "linear", "arc" or "dwell", (n,) list.
     #[getter]
     fn kind(&self) -> Vec<&'static str> {
         self.inner
@@ -195,6 +271,7 @@ impl GcodeProgram {
                 Motion::Rapid => "rapid",
                 Motion::Linear => "linear",
                 Motion::Arc { .. } => "arc",
+                Motion::Dwell { .. } => "dwell",
             })
             .collect()
     }
@@ -211,16 +288,35 @@ impl GcodeProgram {
         self.rows(py, 3, |m, o| o.copy_from_slice(m.end.as_slice()))
     }
 
-    /// Arc centres (n, 2) [m] (x, y); NaN for straight moves.
+    /// Arc centres (n, 3) [m], level with the arc's start along its plane's normal; NaN for
+    /// other moves.
     #[getter]
     fn center<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
-        self.rows(py, 2, |m, o| match m.motion {
+        self.rows(py, 3, |m, o| match m.motion {
             Motion::Arc { center, .. } => o.copy_from_slice(center.as_slice()),
             _ => o.fill(f64::NAN),
         })
     }
 
-    /// Signed arc sweeps (n,) [rad] (> 0 counter-clockwise, G3); 0 for straight moves.
+    /// Each arc's plane: "xy" (G17), "zx" (G18), "yz" (G19); None for other moves.
+    #[getter]
+    fn plane(&self) -> Vec<Option<&'static str>> {
+        self.inner
+            .moves
+            .iter()
+            .map(|m| match m.motion {
+                Motion::Arc { plane, .. } => Some(match plane {
+                    Plane::Xy => "xy",
+                    Plane::Zx => "zx",
+                    Plane::Yz => "yz",
+                }),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Signed arc sweeps (n,) [rad] about the plane's normal (> 0 counter-clockwise, G3; a
+    /// helix of P turns sweeps P turns); 0 for other moves.
     #[getter]
     fn sweep<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from_iter(self.inner.moves.iter().map(|m| match m.motion {
@@ -230,16 +326,63 @@ impl GcodeProgram {
         .into_pyarray(py)
     }
 
-    /// Programmed feeds (n,) [m/s]; 0 for rapid moves.
+    /// Dwell times (n,) [s] (G4, a cycle's P); 0 for other moves.
+    #[getter]
+    fn dwell<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.inner.moves.iter().map(|m| match m.motion {
+            Motion::Dwell { seconds } => seconds,
+            _ => 0.0,
+        }))
+        .into_pyarray(py)
+    }
+
+    /// Programmed feeds (n,) [m/s] (inverse-time and per-revolution feeds as path speed);
+    /// 0 for rapid moves and dwells.
     #[getter]
     fn feed<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from_iter(self.inner.moves.iter().map(|m| m.feed)).into_pyarray(py)
     }
 
-    /// Spindle speeds (n,) [rev/s]; 0 while the spindle is off.
+    /// Spindle speeds (n,) [rev/s]: > 0 clockwise (M3), < 0 counter-clockwise (M4), 0 off.
     #[getter]
     fn spindle<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         Array1::from_iter(self.inner.moves.iter().map(|m| m.spindle)).into_pyarray(py)
+    }
+
+    /// The tool in the spindle at each move (n,) (T and M6, or M61 Q); 0 for none.
+    #[getter]
+    fn tool<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        Array1::from_iter(self.inner.moves.iter().map(|m| m.tool)).into_pyarray(py)
+    }
+
+    /// The tool numbers the moves use, ascending.
+    #[getter]
+    fn tools(&self) -> Vec<u32> {
+        self.inner.tools()
+    }
+
+    /// The path control mode of each move: "G61", "G61.1" or "G64" (n,) list.
+    #[getter]
+    fn path_control(&self) -> Vec<&'static str> {
+        self.inner
+            .moves
+            .iter()
+            .map(|m| match m.path_control {
+                PathControl::ExactPath => "G61",
+                PathControl::ExactStop => "G61.1",
+                PathControl::Blend { .. } => "G64",
+            })
+            .collect()
+    }
+
+    /// The G64 P tolerance of each move (n,) [m] (0: none given, or G61/G61.1).
+    #[getter]
+    fn blend_tolerance<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.inner.moves.iter().map(|m| match m.path_control {
+            PathControl::Blend { tolerance, .. } => tolerance,
+            _ => 0.0,
+        }))
+        .into_pyarray(py)
     }
 
     /// Path lengths of the moves (n,) [m] (arcs and helices along the curve).
@@ -248,11 +391,108 @@ impl GcodeProgram {
         Array1::from_iter(self.inner.moves.iter().map(|m| m.length())).into_pyarray(py)
     }
 
-    /// Total length of the feed moves [m] (rapids excluded).
+    /// Total length of the feed moves [m] (rapids and dwells excluded).
     #[getter]
     fn cutting_length(&self) -> f64 {
         self.inner.cutting_length()
     }
+
+    /// Every word the program uses: `(word, status, count, first_line, meaning)`, status
+    /// "honoured" (it shapes the moves), "recorded" (read without motion: coolant,
+    /// overrides, tool lengths) or "refused"; empty for a points CSV.
+    #[getter]
+    fn words(&self) -> Vec<WordState> {
+        self.words.iter().map(word_state).collect()
+    }
+}
+
+fn move_state(m: &Move) -> MoveState {
+    let nan = [f64::NAN; 3];
+    let (kind, center, plane, sweep) = match m.motion {
+        Motion::Rapid => (0u8, nan, 0u8, 0.0),
+        Motion::Linear => (1, nan, 0, 0.0),
+        Motion::Arc {
+            plane,
+            center,
+            sweep,
+        } => (
+            2,
+            center.into(),
+            match plane {
+                Plane::Xy => 0,
+                Plane::Zx => 1,
+                Plane::Yz => 2,
+            },
+            sweep,
+        ),
+        Motion::Dwell { seconds } => (3, nan, 0, seconds),
+    };
+    let control = match m.path_control {
+        PathControl::ExactPath => (0u8, 0.0, 0.0),
+        PathControl::ExactStop => (1, 0.0, 0.0),
+        PathControl::Blend {
+            tolerance,
+            naive_tolerance,
+        } => (2, tolerance, naive_tolerance),
+    };
+    (
+        m.line,
+        kind,
+        m.start.into(),
+        m.end.into(),
+        center,
+        (plane, sweep),
+        (m.feed, m.spindle, m.tool),
+        control,
+    )
+}
+
+fn from_move_state(i: usize, s: MoveState) -> PyResult<Move> {
+    let (line, kind, start, end, center, (plane, sweep), (feed, spindle, tool), (control, p, q)) =
+        s;
+    let bad = |what: &str, got: u8, expected: &str| {
+        InputError::new_err(format!(
+            "pickled program, move {i}: {what} {got}; expected {expected}"
+        ))
+    };
+    let plane = match plane {
+        0 => Plane::Xy,
+        1 => Plane::Zx,
+        2 => Plane::Yz,
+        k => return Err(bad("plane", k, "0 (xy), 1 (zx) or 2 (yz)")),
+    };
+    let motion = match kind {
+        0 => Motion::Rapid,
+        1 => Motion::Linear,
+        2 => Motion::Arc {
+            plane,
+            center: Vector3::from(center),
+            sweep,
+        },
+        3 => Motion::Dwell { seconds: sweep },
+        k => {
+            return Err(bad(
+                "kind",
+                k,
+                "0 (rapid), 1 (linear), 2 (arc) or 3 (dwell)",
+            ));
+        }
+    };
+    let path_control = match control {
+        0 => PathControl::ExactPath,
+        1 => PathControl::ExactStop,
+        2 => PathControl::Blend {
+            tolerance: p,
+            naive_tolerance: q,
+        },
+        k => return Err(bad("path control", k, "0 (G61), 1 (G61.1) or 2 (G64)")),
+    };
+    Ok(Move {
+        spindle,
+        tool,
+        path_control,
+        ..Move::new(line, motion, Vector3::from(start), Vector3::from(end), feed)
+    })
 }
 
 impl GcodeProgram {
@@ -358,6 +598,7 @@ pub(crate) fn coefficients(c: Option<&Bound<'_, PyAny>>) -> PyResult<Coefficient
 /// Adds the machining classes and functions to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<GcodeProgram>()?;
+    m.add_function(wrap_pyfunction!(gcode_words, m)?)?;
     m.add_function(wrap_pyfunction!(milling_force, m)?)?;
     let k = Coefficients::AL7075_T6_CARBIDE;
     m.add(

@@ -140,6 +140,7 @@ impl MachiningJob {
                 corner_angle: or(corner_angle, "corner_angle", d.corner_angle)?,
             },
             ik: PoseIkOptions::default(),
+            hand_spindle: None,
         };
         Self::build(robot.unbind(), setup)
     }
@@ -206,6 +207,7 @@ impl MachiningJob {
                 corner_angle: p[4],
             },
             ik: PoseIkOptions::default(),
+            hand_spindle: None,
         };
         Self::build(robot, setup)
     }

@@ -42,6 +42,11 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
     let command = cli.command.as_ref().unwrap_or(&default);
     let out = &cli.out;
     command.check()?;
+    if let Command::Job(a) = command
+        && let Some(path) = &a.explain
+    {
+        return job::explain(a, path);
+    }
     let fit_input = match command {
         Command::Fit { input: Some(p), .. } => Some(fit::load_input(p)?),
         _ => None,

@@ -19,6 +19,7 @@ fn a_short_groove_five_ways() {
         &GcodeOptions {
             start: Vector3::new(-12.0e-3, 20.0e-3, 5.0e-3),
             units: LengthUnit::Millimetre,
+            ..GcodeOptions::default()
         },
     )
     .unwrap();
@@ -35,6 +36,7 @@ fn a_short_groove_five_ways() {
         },
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
+        hand_spindle: None,
     };
     let opts = MillingOptions::short();
     // On a thread with a 16 MB stack: in a debug build the scenario's frames hold the 70 KB

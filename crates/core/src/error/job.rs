@@ -30,6 +30,15 @@ pub enum JobError {
         /// Time into the program \[s\].
         time: f64,
     },
+    /// The tool in the spindle cuts, and the job's tool table does not have it.
+    UnknownTool {
+        /// Program line (1-based).
+        line: usize,
+        /// Time into the program \[s\].
+        time: f64,
+        /// The program's tool number (`T`).
+        tool: u32,
+    },
     /// A rapid move (`G0`) runs into the stock: a crash on the machine.
     RapidInStock {
         /// Program line (1-based).
@@ -48,6 +57,7 @@ impl JobError {
             Self::Setup(_) => None,
             Self::AtLine { line, .. }
             | Self::SpindleOff { line, .. }
+            | Self::UnknownTool { line, .. }
             | Self::RapidInStock { line, .. } => Some(line),
         }
     }
@@ -69,7 +79,13 @@ impl fmt::Display for JobError {
             Self::SpindleOff { line, time } => write!(
                 f,
                 "program line {line} (t = {time:.3} s): the tool cuts the stock with the spindle \
-                 off (expected M3 with an S word before the cut)"
+                 off (expected M3 or M4 with an S word before the cut; a program for a \
+                 hand-started spindle needs its speed: CLI --spindle-rpm, Python spindle_rpm=)"
+            ),
+            Self::UnknownTool { line, time, tool } => write!(
+                f,
+                "program line {line} (t = {time:.3} s): tool T{tool} cuts, and the tool table \
+                 has no T{tool} (expected a [[tool]] or a T{tool} line for it)"
             ),
             Self::RapidInStock { line, time, depth } => write!(
                 f,

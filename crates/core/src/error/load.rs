@@ -138,6 +138,17 @@ pub enum LoadError {
         /// What was expected, and what was found.
         message: String,
     },
+    /// A G-code program ran past a documented budget of the reader (lines run, call depth).
+    ProgramBudget {
+        /// 1-based line where the budget ran out.
+        line: usize,
+        /// What was counted.
+        what: String,
+        /// The budget's name ("MAX_BLOCKS").
+        budget: &'static str,
+        /// Its value.
+        limit: usize,
+    },
     /// The CSV reader failed (malformed record, wrong field count).
     Csv {
         /// 1-based line, when known.
@@ -267,6 +278,15 @@ impl fmt::Display for LoadError {
             } => write!(
                 f,
                 "program line {line}, column {column}: expected {message}"
+            ),
+            Self::ProgramBudget {
+                line,
+                what,
+                budget,
+                limit,
+            } => write!(
+                f,
+                "program line {line}: {what}: more than {budget} = {limit}"
             ),
             Self::Csv { line, message } => match line {
                 Some(l) => write!(f, "CSV line {l}: {message}"),

@@ -10,6 +10,7 @@
 //! | [`drive`] (`urdf`) | drive-train TOML `[[joint]]` + URDF masses | [`crate::drivetrain::Model`] |
 //! | [`gcode`] | ISO G-code (G0-G3, G17, G20/G21, G90/G91, F, S, M3/M5/M30) | [`crate::machining::Program`] |
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
+//! | [`tool_table`] | LinuxCNC `.tbl`, or TOML | [`crate::machining::tools::ToolTable`] |
 //! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |
 //! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
 //! | [`map_json`] | versioned JSON of a map (version 2: an N-D grid map) | [`crate::ComplianceMap`], [`crate::compliance_map::GridMap`] |
@@ -25,6 +26,7 @@ pub mod map_json;
 pub mod points_csv;
 #[cfg(feature = "urdf")]
 pub mod stiffness;
+pub mod tool_table;
 #[cfg(feature = "urdf")]
 pub mod urdf;
 #[cfg(feature = "urdf")]
@@ -50,6 +52,13 @@ pub(crate) fn check_size(what: &str, text: &str) -> Result<(), LoadError> {
         });
     }
     Ok(())
+}
+
+/// Reads a whole text file of at most [`MAX_FILE_BYTES`] (UTF-8), naming it in the error:
+/// what every loader reads its file with, for callers that keep the text (a program and its
+/// word report).
+pub fn read_text_file(path: &Path) -> Result<String, LoadError> {
+    read_text(path)
 }
 
 /// Reads a whole text file, naming it in the error; reads at most [`MAX_FILE_BYTES`] + 1

@@ -116,17 +116,14 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
         let line = rec
             .position()
             .map_or(row + 2, |p| usize::try_from(p.line()).unwrap_or(usize::MAX));
+        let motion = if f > 0.0 {
+            Motion::Linear
+        } else {
+            Motion::Rapid
+        };
         moves.push(Move {
-            line,
-            motion: if f > 0.0 {
-                Motion::Linear
-            } else {
-                Motion::Rapid
-            },
-            start: at,
-            end,
-            feed: f,
             spindle: s / 60.0,
+            ..Move::new(line, motion, at, end, f)
         });
         at = end;
     }

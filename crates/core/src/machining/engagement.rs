@@ -88,9 +88,23 @@ impl Contact {
 }
 
 /// The contact of a vertical flat end mill of `radius` \[m\] with its tip at `tip` \[m\],
-/// moving along `feed` (any length; only its horizontal part counts), workpiece frame. A feed
-/// whose horizontal part is below 1e-9 of its length is a plunge (or air).
+/// moving along `feed` (any length; only its horizontal part counts), workpiece frame, its
+/// spindle turning clockwise seen from above (`M3`). A feed whose horizontal part is below
+/// 1e-9 of its length is a plunge (or air).
 pub fn contact(stock: &ZMap, radius: f64, tip: &Vector3<f64>, feed: &Vector3<f64>) -> Contact {
+    contact_turning(stock, radius, tip, feed, false)
+}
+
+/// [`contact`] for either spindle direction: `counter_clockwise` (`M4`, a left-hand cutter)
+/// mirrors the cutter's angles about the feed direction (`phi` clockwise from the tool frame's
+/// -y), so [`super::cutting`]'s model of a clockwise cutter applies to the mirror image.
+pub fn contact_turning(
+    stock: &ZMap,
+    radius: f64,
+    tip: &Vector3<f64>,
+    feed: &Vector3<f64>,
+    counter_clockwise: bool,
+) -> Contact {
     let horizontal = feed.xy();
     let n = horizontal.norm();
     if n.is_nan() || n <= 1.0e-9 * feed.norm() {
@@ -100,7 +114,8 @@ pub fn contact(stock: &ZMap, radius: f64, tip: &Vector3<f64>, feed: &Vector3<f64
         };
     }
     let x = horizontal / n;
-    let y = Vector2::new(-x.y, x.x);
+    let left = Vector2::new(-x.y, x.x);
+    let y = if counter_clockwise { -left } else { left };
     let rho = radius + 0.75 * stock.cell();
     let step = core::f64::consts::PI / (ANGLES - 1) as f64;
     let mut arcs = [Arc::default(); MAX_ARCS];

@@ -22,8 +22,15 @@
 //!    (one sample of lag at 250 Hz-2 kHz), so a deflected tool cuts shallower and feels
 //!    less force, as on the robot.
 //!
-//! The tool axis is the workpiece's z (a 2.5-D program in G17); the deflected tool's tilt
+//! The tool axis is the workpiece's z (a 2.5-D program); the deflected tool's tilt
 //! (milliradians) is not carried into the z-maps.
+//!
+//! A program of several tools cuts and feels the force of the tool in the spindle at each
+//! move ([`crate::machining::Move::tool`]), looked up in the job's tool table
+//! ([`Job::with_tools`]; without one, [`Setup::tool`] serves every `T`). A counter-clockwise
+//! spindle (`M4`) cuts as the mirror image of a clockwise one about the feed direction. A
+//! program that never starts its spindle (posts for hand-started spindles) cuts at
+//! [`Setup::hand_spindle`].
 
 use alloc::vec::Vec;
 
@@ -35,6 +42,7 @@ use super::engagement::{self, Contact};
 use super::path::{self, PathOptions, PathSample};
 pub use super::report::{ErrorStats, JobSample, LineForce, Report, SurfaceError};
 use super::stock::{Cutter, ZMap};
+use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
 use crate::mechanism::{PoseIkOptions, pose_ik};
 use crate::vjm::{self, Data, Load, MAX_DOF, Model, Vector6};
@@ -73,6 +81,10 @@ pub struct Setup {
     pub path: PathOptions,
     /// Pose IK settings (rigid and loaded).
     pub ik: PoseIkOptions,
+    /// Speed of a spindle the program does not start \[rev/s\] (a hand-started spindle: posts
+    /// for such machines write no `M3`): it turns clockwise at this speed wherever the
+    /// program's spindle is off. `None`: the program's spindle only.
+    pub hand_spindle: Option<f64>,
 }
 
 impl Setup {
@@ -110,6 +122,14 @@ impl Setup {
         self.tool.validate()?;
         self.coefficients.validate()?;
         self.path.validate()?;
+        if let Some(v) = self.hand_spindle {
+            crate::error::param(
+                "hand spindle speed (rev/s)",
+                v,
+                v > 0.0 && v <= super::MAX_SPINDLE_RPM / 60.0,
+                "in (0, MAX_SPINDLE_RPM / 60] rev/s",
+            )?;
+        }
         self.ik.validate()
     }
 }
@@ -120,6 +140,7 @@ pub struct Job {
     model: Model,
     limits: Vec<(f64, f64)>,
     setup: Setup,
+    tools: Option<ToolTable>,
 }
 
 impl Job {
@@ -147,7 +168,38 @@ impl Job {
             model,
             limits: limits.to_vec(),
             setup,
+            tools: None,
         })
+    }
+
+    /// The job with a tool table: each move cuts with the tool its program line put in the
+    /// spindle (a program's `T` missing from the table is an error where that tool cuts).
+    #[must_use]
+    pub fn with_tools(mut self, tools: ToolTable) -> Self {
+        self.tools = Some(tools);
+        self
+    }
+
+    /// The tool table, if the job has one.
+    pub fn tools(&self) -> Option<&ToolTable> {
+        self.tools.as_ref()
+    }
+
+    /// The cutter of tool number `t`: from the table, or [`Setup::tool`] without a table;
+    /// `None` when the table lacks it.
+    pub fn tool(&self, t: u32) -> Option<(Tool, Cutter)> {
+        let flat = |tool: Tool| {
+            (
+                tool,
+                Cutter::Flat {
+                    radius: 0.5 * tool.diameter,
+                },
+            )
+        };
+        match &self.tools {
+            None => Some(flat(self.setup.tool)),
+            Some(table) => table.get(t).map(|spec| (spec.tool, spec.cutter())),
+        }
     }
 
     /// The arm.
@@ -162,16 +214,39 @@ impl Job {
 }
 
 /// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece
-/// frame) of a contact of `setup`'s tool moving along `feed` (workpiece frame, any length):
-/// each engaged arc's per-revolution force acting at half its depth up the axis, plus the
-/// cutting torque about the axis; zero in air, for plunges and without a horizontal feed.
-/// What the offline pass uses, and what a simulation calls with the contact where its tool
-/// really is.
+/// frame) of a contact of `setup`'s tool, turning clockwise, moving along `feed` (workpiece
+/// frame, any length): [`tool_wrench`] with the setup's tool and material. What a simulation
+/// calls with the contact where its tool really is.
 pub fn contact_wrench(
     setup: &Setup,
     contact: &Contact,
     feed: &Vector3<f64>,
     feed_per_tooth: f64,
+) -> Result<(Vector3<f64>, Vector6), TickError> {
+    tool_wrench(
+        &setup.coefficients,
+        &setup.tool,
+        contact,
+        feed,
+        feed_per_tooth,
+        false,
+    )
+}
+
+/// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece
+/// frame) of `tool` in `contact`, moving along `feed` (workpiece frame, any length): each
+/// engaged arc's per-revolution force acting at half its depth up the axis, plus the cutting
+/// torque about the axis; zero in air, for plunges and without a horizontal feed. A
+/// `counter_clockwise` spindle (`M4`; its contact read by [`engagement::contact_turning`])
+/// gives the mirror image about the feed direction: the lateral force and the torques turn
+/// sign.
+pub fn tool_wrench(
+    coefficients: &Coefficients,
+    tool: &Tool,
+    contact: &Contact,
+    feed: &Vector3<f64>,
+    feed_per_tooth: f64,
+    counter_clockwise: bool,
 ) -> Result<(Vector3<f64>, Vector6), TickError> {
     let Some(frame) = cutting::tool_frame(&Vector3::z(), feed) else {
         return Ok((Vector3::zeros(), Vector6::zeros()));
@@ -184,10 +259,17 @@ pub fn contact_wrench(
             depth: arc.depth,
             feed_per_tooth,
         };
-        let f = cutting::average(&setup.coefficients, &setup.tool, &e)?;
-        let torque = cutting::average_torque(&setup.coefficients, &setup.tool, &e)?;
+        let f = cutting::average(coefficients, tool, &e)?;
+        let torque = cutting::average_torque(coefficients, tool, &e)?;
         m_tool += Vector3::new(0.0, 0.0, 0.5 * arc.depth).cross(&f) + Vector3::z() * torque;
         f_tool += f;
+    }
+    if counter_clockwise {
+        // The mirror about the tool frame's xz plane: a force's y and a moment's x and z
+        // (a pseudovector) turn sign.
+        f_tool.y = -f_tool.y;
+        m_tool.x = -m_tool.x;
+        m_tool.z = -m_tool.z;
     }
     let (f, m) = (frame * f_tool, frame * m_tool);
     Ok((f, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)))
@@ -196,8 +278,13 @@ pub fn contact_wrench(
 /// Feed per tooth \[m\] of `setup`'s tool at a path sample: horizontal speed over spindle
 /// speed times flutes (0 at rest or with the spindle off).
 pub fn feed_per_tooth(setup: &Setup, s: &PathSample) -> f64 {
+    tooth_feed(&setup.tool, s, s.spindle)
+}
+
+/// [`feed_per_tooth`] of `tool` at spindle speed `spindle` \[rev/s\] (either sign).
+fn tooth_feed(tool: &Tool, s: &PathSample, spindle: f64) -> f64 {
     let v = s.speed * s.direction.xy().norm();
-    let teeth = s.spindle * f64::from(setup.tool.flutes);
+    let teeth = spindle.abs() * f64::from(tool.flutes);
     if teeth > 0.0 { v / teeth } else { 0.0 }
 }
 
@@ -216,10 +303,6 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     let mut nominal = zmap()?;
     let (mut unc, mut comp) = (Predicted::new(zmap()?), Predicted::new(zmap()?));
     let path = path::sample(program, &setup.path)?;
-    let cutter = Cutter::Flat {
-        radius: 0.5 * setup.tool.diameter,
-    };
-    let radius = cutter.radius();
     let mut samples = Vec::new();
     samples
         .try_reserve_exact(path.len())
@@ -251,8 +334,8 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         job,
         to_base,
         to_work,
-        cutter,
     };
+    let mut tool_in_spindle: Option<(u32, Option<(Tool, Cutter)>)> = None;
     for s in &path {
         let at = |error: TickError| JobError::AtLine {
             line: s.line,
@@ -261,9 +344,36 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         };
         let p = s.position;
         let from = prev_nom.unwrap_or(p);
+        let looked_up = match tool_in_spindle {
+            Some((t, found)) if t == s.tool => found,
+            _ => {
+                let found = job.tool(s.tool);
+                tool_in_spindle = Some((s.tool, found));
+                found
+            }
+        };
+        let known = looked_up.is_some();
+        let (tool, cutter) = looked_up.unwrap_or((
+            setup.tool,
+            Cutter::Flat {
+                radius: 0.5 * setup.tool.diameter,
+            },
+        ));
+        let spindle = match (s.spindle, setup.hand_spindle) {
+            (0.0, Some(hand)) => hand,
+            (v, _) => v,
+        };
+        let ccw = spindle < 0.0;
         // 2. The nominal contact, checked before the cut lowers the stock.
-        let contact = engagement::contact(&nominal, radius, &p, &s.direction);
+        let contact = engagement::contact_turning(&nominal, cutter.radius(), &p, &s.direction, ccw);
         let removed = nominal.cut(&cutter, &from, &p).map_err(at)?;
+        if !known && (contact != Contact::Air || removed.cells > 0) {
+            return Err(JobError::UnknownTool {
+                line: s.line,
+                time: s.time,
+                tool: s.tool,
+            });
+        }
         if !s.feed_move {
             let area = st.cell * st.cell;
             if removed.cells > 0
@@ -276,7 +386,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
                 });
             }
         }
-        if contact != Contact::Air && s.spindle <= 0.0 {
+        if contact != Contact::Air && spindle == 0.0 {
             return Err(JobError::SpindleOff {
                 line: s.line,
                 time: s.time,
@@ -285,8 +395,9 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         if matches!(contact, Contact::Plunge { .. }) {
             plunge_samples += 1;
         }
-        let fz = feed_per_tooth(setup, s);
-        let (force, wrench_w) = contact_wrench(setup, &contact, &s.direction, fz).map_err(at)?;
+        let fz = tooth_feed(&tool, s, spindle);
+        let (force, wrench_w) =
+            tool_wrench(&setup.coefficients, &tool, &contact, &s.direction, fz, ccw).map_err(at)?;
         let wrench = rotate(&to_base, &wrench_w);
         // 1. The programmed pose and its rigid joints.
         let target = to_base * Isometry3::from_parts(Translation3::from(p), setup.tool_orientation);
@@ -331,6 +442,9 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
             sample: s,
             step: p - from,
             feed_per_tooth: fz,
+            tool,
+            cutter,
+            counter_clockwise: ccw,
         };
         let q_rigid = q.get(..dof).unwrap_or(&[]);
         let (force_unc, actual_unc, r_unc) =
@@ -368,20 +482,22 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     })
 }
 
-/// What every prediction shares: the job, the frames and the cutter.
+/// What every prediction shares: the job and the frames.
 struct Frame<'a> {
     job: &'a Job,
     to_base: Isometry3<f64>,
     to_work: Isometry3<f64>,
-    cutter: Cutter,
 }
 
 /// One sample as a prediction sees it: the programmed sample, the programmed step since the
-/// last one \[m\] and the feed per tooth \[m\].
+/// last one \[m\], the feed per tooth \[m\], the tool in the spindle and its direction.
 struct Tick<'a> {
     sample: &'a PathSample,
     step: Vector3<f64>,
     feed_per_tooth: f64,
+    tool: Tool,
+    cutter: Cutter,
+    counter_clockwise: bool,
 }
 
 /// One predicted arm (uncompensated or compensated): its own stock and where its tool is.
@@ -407,10 +523,22 @@ impl Predicted {
     ) -> Result<(Vector3<f64>, Vector3<f64>, usize), TickError> {
         let s = t.sample;
         let probe = self.tip.map_or(s.position, |tip| tip + t.step);
-        let radius = f.cutter.radius();
-        let contact = engagement::contact(&self.stock, radius, &probe, &s.direction);
-        let (force, wrench) =
-            contact_wrench(&f.job.setup, &contact, &s.direction, t.feed_per_tooth)?;
+        let radius = t.cutter.radius();
+        let contact = engagement::contact_turning(
+            &self.stock,
+            radius,
+            &probe,
+            &s.direction,
+            t.counter_clockwise,
+        );
+        let (force, wrench) = tool_wrench(
+            &f.job.setup.coefficients,
+            &t.tool,
+            &contact,
+            &s.direction,
+            t.feed_per_tooth,
+            t.counter_clockwise,
+        )?;
         vjm::deflection(
             &f.job.model,
             data,
@@ -419,7 +547,7 @@ impl Predicted {
             Load::Exact,
         )?;
         let tip = (f.to_work * Point3::from(data.tcp_deflected.translation.vector)).coords;
-        let removed = self.stock.cut(&f.cutter, &self.tip.unwrap_or(tip), &tip)?;
+        let removed = self.stock.cut(&t.cutter, &self.tip.unwrap_or(tip), &tip)?;
         self.tip = Some(tip);
         Ok((force, tip, removed.cells))
     }

@@ -21,9 +21,11 @@ mod program;
 pub mod report;
 #[cfg(feature = "alloc")]
 pub mod stock;
+#[cfg(feature = "alloc")]
+pub mod tools;
 
 #[cfg(feature = "alloc")]
 pub use program::{
-    ARC_TOLERANCE, MAX_COORDINATE, MAX_FEED, MAX_GAP, MAX_MOVES, MAX_SPINDLE_RPM, Motion, Move,
-    Program,
+    ARC_TOLERANCE, MAX_ARC_TURNS, MAX_COORDINATE, MAX_DWELL, MAX_FEED, MAX_GAP, MAX_MOVES,
+    MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, PathControl, Plane, Program,
 };

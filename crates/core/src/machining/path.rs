@@ -17,7 +17,9 @@
 //!
 //! The tool therefore stays exactly on the programmed geometry (no corner rounding), which
 //! is what a prediction of the machined part needs; the price is the stop at each corner,
-//! which a real controller's blending would shorten.
+//! which a real controller's blending would shorten (the program's `G64` tolerance is
+//! recorded per move, [`super::PathControl`], not yet used here). A dwell (`G4`, a drilling
+//! cycle's pause) holds the tool at rest for its time between two runs.
 
 use alloc::vec::Vec;
 
@@ -102,17 +104,27 @@ pub struct PathSample {
     pub acceleration: f64,
     /// Whether the move is a feed move (`G1`-`G3`), not a rapid.
     pub feed_move: bool,
-    /// Spindle speed \[rev/s\].
+    /// Spindle speed \[rev/s\] (< 0 counter-clockwise, `M4`).
     pub spindle: f64,
+    /// The tool in the spindle (the move's [`super::Move::tool`]).
+    pub tool: u32,
 }
 
-/// One rest-to-rest profile over the moves `segs[first..=last]`.
+/// One rest-to-rest profile over the moves `segs[first..=last]`, or a dwell of `hold`
+/// seconds at the one move `segs[first]` (then `profile` is the zero-length profile).
 #[derive(Debug, Clone, Copy)]
 struct Run {
     first: usize,
     last: usize,
     t0: f64,
     profile: Profile,
+    hold: f64,
+}
+
+impl Run {
+    fn duration(&self) -> f64 {
+        self.profile.duration() + self.hold
+    }
 }
 
 /// The program planned: the moves with motion (`segs`, indices into the program), the arc
@@ -126,9 +138,7 @@ struct Plan {
 
 impl Plan {
     fn duration(&self) -> f64 {
-        self.runs
-            .last()
-            .map_or(0.0, |r| r.t0 + r.profile.duration())
+        self.runs.last().map_or(0.0, |r| r.t0 + r.duration())
     }
 }
 
@@ -147,27 +157,42 @@ fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
         let Some(m) = p.segs.get(first).and_then(|&i| program.moves.get(i)) else {
             return Ok(());
         };
-        let speed = if m.motion == Motion::Rapid {
-            options.rapid_speed
-        } else {
-            m.feed
+        let (speed, hold) = match m.motion {
+            Motion::Rapid => (options.rapid_speed, 0.0),
+            Motion::Dwell { seconds } => (options.rapid_speed, seconds),
+            _ => (m.feed, 0.0),
         };
         let profile = Profile::new(
             length,
             &Limits::new(speed, options.acceleration, options.jerk)?,
         )?;
-        p.runs.push(Run {
+        let run = Run {
             first,
             last,
             t0,
             profile,
-        });
-        t0 += profile.duration();
+            hold,
+        };
+        p.runs.push(run);
+        t0 += run.duration();
         Ok(())
     };
     let mut first = 0usize;
     for (i, m) in program.moves.iter().enumerate() {
         let length = m.length();
+        if let Motion::Dwell { .. } = m.motion {
+            // A dwell is a run of its own: what runs before it stops there.
+            if !p.segs.is_empty() && first < p.segs.len() {
+                close(&mut p, first, s)?;
+            }
+            first = p.segs.len();
+            p.segs.push(i);
+            p.s0.push(0.0);
+            close(&mut p, first, 0.0)?;
+            first = p.segs.len();
+            s = 0.0;
+            continue;
+        }
         if length.is_nan() || length <= MIN_MOVE_LENGTH {
             continue;
         }
@@ -179,7 +204,12 @@ fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
                 expected: "an F word before the first G1/G2/G3",
             });
         }
-        if let Some(prev) = p.segs.last().and_then(|&j| program.moves.get(j)) {
+        if let Some(prev) = p
+            .segs
+            .get(first..)
+            .and_then(<[usize]>::last)
+            .and_then(|&j| program.moves.get(j))
+        {
             let joins = (prev.motion == Motion::Rapid) == (m.motion == Motion::Rapid)
                 && prev.feed == m.feed
                 && prev.tangent(1.0).dot(&m.tangent(0.0)) >= cos_corner;
@@ -195,12 +225,14 @@ fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
     }
     if p.segs.is_empty() {
         return Err(BuildError::TooFew {
-            what: "moves with motion (longer than 1e-12 m)",
+            what: "moves with motion (longer than 1e-12 m) or dwells",
             needed: 1,
             got: 0,
         });
     }
-    close(&mut p, first, s)?;
+    if first < p.segs.len() {
+        close(&mut p, first, s)?;
+    }
     Ok(p)
 }
 
@@ -241,7 +273,7 @@ pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample
             && plan
                 .runs
                 .get(r)
-                .is_some_and(|run| t > run.t0 + run.profile.duration())
+                .is_some_and(|run| t > run.t0 + run.duration())
         {
             r += 1;
         }
@@ -258,7 +290,12 @@ pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample
         let Some(mv) = program.moves.get(m) else {
             break;
         };
-        let fraction = (state.s - s) / mv.length();
+        let length = mv.length();
+        let fraction = if length > 0.0 {
+            (state.s - s) / length
+        } else {
+            0.0
+        };
         out.push(PathSample {
             time: t,
             move_index: m,
@@ -267,8 +304,9 @@ pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample
             direction: mv.tangent(fraction.clamp(0.0, 1.0)),
             speed: state.v,
             acceleration: state.a,
-            feed_move: mv.motion != Motion::Rapid,
+            feed_move: mv.is_feed(),
             spindle: mv.spindle,
+            tool: mv.tool,
         });
     }
     Ok(out)

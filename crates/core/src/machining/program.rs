@@ -1,10 +1,15 @@
-//! A machining program as straight and circular moves in the workpiece frame, SI: what the
-//! G-code reader ([`crate::io::gcode`]) produces and the path, the cutting-force model and
+//! A machining program as straight, circular and dwell moves in the workpiece frame, SI: what
+//! the G-code reader ([`crate::io::gcode`]) produces and the path, the cutting-force model and
 //! the material removal consume.
+//!
+//! The workpiece frame is the frame of the program's machine coordinates (LinuxCNC's: the
+//! program's coordinates plus its work and axis offsets, `G54`-`G59.3` and `G92`, which a
+//! program that never sets them leaves at zero). A robot's TCP is the tool tip, so a move's
+//! points are the tool tip's, whatever tool length (`G43`) the program selects.
 
 use alloc::vec::Vec;
 
-use nalgebra::{ComplexField, Vector2, Vector3};
+use nalgebra::{ComplexField, Vector3};
 
 use crate::error::BuildError;
 
@@ -21,14 +26,89 @@ pub const MAX_FEED: f64 = 100.0;
 /// Largest spindle speed \[rpm\].
 pub const MAX_SPINDLE_RPM: f64 = 1.0e6;
 
-/// Tolerance on an `I`/`J` arc whose end is not exactly on the circle through its start: the
-/// radii may differ by 0.002 mm or 0.1 % of the radius, whichever is larger (LinuxCNC's
-/// rule); more is an error, not a silently moved centre.
-pub const ARC_TOLERANCE: (f64, f64) = (2.0e-6, 1.0e-3);
+/// Most full turns one arc may sweep (a helix programmed with `P` turns): 1,000.
+pub const MAX_ARC_TURNS: u32 = 1_000;
+
+/// Longest dwell \[s\] (one hour; `G4 P`).
+pub const MAX_DWELL: f64 = 3600.0;
+
+/// Largest tool number (`T`): 99,999 (LinuxCNC's tool numbers are 32-bit; tables rarely pass
+/// 1,000).
+pub const MAX_TOOL_NUMBER: u32 = 99_999;
+
+/// Tolerance on an arc whose end is not exactly on the circle through its start: the radii
+/// at the start and the end may differ by 0.0718 mm or 0.1 % of the larger radius, whichever
+/// is larger (what LinuxCNC accepts in either unit; its reader, [`crate::io::gcode`], applies
+/// LinuxCNC's own rule in the program's unit: 0.028 mm or 0.0028 in, or 0.1 % up to 100 times
+/// that). Such an arc is driven as LinuxCNC drives it: a spiral, its radius linear in the
+/// angle. More is an error, not a silently moved centre.
+pub const ARC_TOLERANCE: (f64, f64) = (7.2e-5, 1.0e-3);
 
 /// Largest gap between a move's start and the previous move's end \[m\] that
 /// [`Program::validate`] accepts (a program is one path).
 pub const MAX_GAP: f64 = 1.0e-9;
+
+/// The plane of an arc (`G17`, `G18`, `G19`) and its axes: arcs turn about the plane's normal,
+/// counter-clockwise (sweep > 0) as seen from the normal's positive side.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Plane {
+    /// `G17`: the XY plane, about +z.
+    #[default]
+    Xy,
+    /// `G18`: the ZX plane, about +y (first axis z, second x).
+    Zx,
+    /// `G19`: the YZ plane, about +x (first axis y, second z).
+    Yz,
+}
+
+impl Plane {
+    /// The indices (0 x, 1 y, 2 z) of the plane's first axis, its second axis and its normal,
+    /// a right-handed triple: XY (x, y, z), ZX (z, x, y), YZ (y, z, x).
+    pub fn axes(self) -> (usize, usize, usize) {
+        match self {
+            Self::Xy => (0, 1, 2),
+            Self::Zx => (2, 0, 1),
+            Self::Yz => (1, 2, 0),
+        }
+    }
+
+    /// The G code that selects the plane.
+    pub fn gcode(self) -> &'static str {
+        match self {
+            Self::Xy => "G17",
+            Self::Zx => "G18",
+            Self::Yz => "G19",
+        }
+    }
+
+    /// `v`'s coordinates along the first and second axes.
+    fn split(self, v: &Vector3<f64>) -> (f64, f64) {
+        let (a, b, _) = self.axes();
+        (
+            v.get(a).copied().unwrap_or(0.0),
+            v.get(b).copied().unwrap_or(0.0),
+        )
+    }
+
+    /// `v` with its first and second coordinates replaced.
+    fn with(self, v: &Vector3<f64>, first: f64, second: f64) -> Vector3<f64> {
+        let (a, b, _) = self.axes();
+        let mut out = *v;
+        if let Some(x) = out.get_mut(a) {
+            *x = first;
+        }
+        if let Some(x) = out.get_mut(b) {
+            *x = second;
+        }
+        out
+    }
+
+    /// The coordinate along the normal.
+    fn normal(self, v: &Vector3<f64>) -> f64 {
+        let (_, _, n) = self.axes();
+        v.get(n).copied().unwrap_or(0.0)
+    }
+}
 
 /// How a move goes from its start to its end.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,15 +117,52 @@ pub enum Motion {
     Rapid,
     /// `G1`: straight, at the programmed feed.
     Linear,
-    /// `G2` / `G3` in the XY plane (`G17`): a circle about `center` (x, y) \[m\] through
-    /// `sweep` \[rad\] (> 0 counter-clockwise, `G3`; < 0 clockwise, `G2`; a full turn is
-    /// +-2 pi), with z linear in the angle (a helix when z changes).
+    /// `G2` / `G3` in `plane`: a circle about `center` through `sweep` \[rad\] about the
+    /// plane's normal (> 0 counter-clockwise, `G3`; < 0 clockwise, `G2`; a full turn is
+    /// +-2 pi, a helix of `P` turns up to +-2 pi [`MAX_ARC_TURNS`]), with the coordinate
+    /// along the normal linear in the angle (a helix when it changes).
     Arc {
-        /// Centre (x, y) \[m\], workpiece frame.
-        center: Vector2<f64>,
-        /// Signed angle swept about +z \[rad\], `0 < |sweep| <= 2 pi`.
+        /// The plane (`G17`, `G18`, `G19`).
+        plane: Plane,
+        /// Centre \[m\], workpiece frame; its coordinate along the normal is the start's.
+        center: Vector3<f64>,
+        /// Signed angle swept about the plane's normal \[rad\], `0 < |sweep| <= 2 pi turns`.
         sweep: f64,
     },
+    /// `G4` (or a canned cycle's dwell): the tool stays at its point for `seconds` \[s\].
+    Dwell {
+        /// Duration \[s\], in `(0, MAX_DWELL]`.
+        seconds: f64,
+    },
+}
+
+/// The path control mode in effect for a move (`G61`, `G61.1`, `G64 P Q`): recorded for the
+/// path model; the path of [`super::path`] stops at every corner whatever the mode.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum PathControl {
+    /// `G61`: exact path (the tool follows the corners, slowing as needed).
+    ExactPath,
+    /// `G61.1`: exact stop at the end of each move.
+    ExactStop,
+    /// `G64 P Q`: blending; `tolerance` \[m\] is how far the path may leave the corner (`P`;
+    /// 0: no limit, as fast as possible) and `naive_tolerance` \[m\] the collinear-move
+    /// merge tolerance (`Q`; 0: none).
+    Blend {
+        /// `P` \[m\], >= 0.
+        tolerance: f64,
+        /// `Q` \[m\], >= 0.
+        naive_tolerance: f64,
+    },
+}
+
+impl Default for PathControl {
+    /// `G64` without `P` or `Q`, LinuxCNC's state at the program start.
+    fn default() -> Self {
+        Self::Blend {
+            tolerance: 0.0,
+            naive_tolerance: 0.0,
+        }
+    }
 }
 
 /// One move of a program.
@@ -53,41 +170,85 @@ pub enum Motion {
 pub struct Move {
     /// The program line it comes from (1-based), for every error and report about it.
     pub line: usize,
-    /// Straight, circular or rapid.
+    /// Straight, circular, rapid or a dwell.
     pub motion: Motion,
     /// Start point \[m\], workpiece frame.
     pub start: Vector3<f64>,
     /// End point \[m\], workpiece frame (as programmed).
     pub end: Vector3<f64>,
-    /// Programmed feed along the path \[m/s\]; 0 for a rapid move.
+    /// Programmed feed along the path \[m/s\] (inverse-time and per-revolution feeds turned
+    /// into the path speed); 0 for a rapid move and a dwell.
     pub feed: f64,
-    /// Spindle speed \[rev/s\]; 0 while the spindle is off (`M5`, or before `M3`).
+    /// Spindle speed \[rev/s\]: > 0 clockwise (`M3`), < 0 counter-clockwise (`M4`), 0 off
+    /// (`M5`, or before `M3`/`M4`).
     pub spindle: f64,
+    /// The tool in the spindle (`T` and `M6`, or `M61 Q`); 0 for none.
+    pub tool: u32,
+    /// The path control mode in effect.
+    pub path_control: PathControl,
 }
 
 impl Move {
-    /// Arc radius \[m\] (from the start point; 0 for straight moves).
+    /// A move with the spindle off, no tool and the default path control.
+    pub fn new(
+        line: usize,
+        motion: Motion,
+        start: Vector3<f64>,
+        end: Vector3<f64>,
+        feed: f64,
+    ) -> Self {
+        Self {
+            line,
+            motion,
+            start,
+            end,
+            feed,
+            spindle: 0.0,
+            tool: 0,
+            path_control: PathControl::default(),
+        }
+    }
+
+    /// Arc radius \[m\] (from the start point, in the arc's plane; 0 for other moves).
     pub fn radius(&self) -> f64 {
         match self.motion {
-            Motion::Arc { center, .. } => (self.start.xy() - center).norm(),
+            Motion::Arc { plane, center, .. } => {
+                let (a, b) = plane.split(&(self.start - center));
+                ComplexField::sqrt(a * a + b * b)
+            }
             _ => 0.0,
         }
     }
 
-    /// Path length \[m\]: the chord of a straight move, `sqrt((r sweep)^2 + dz^2)` of an arc.
+    /// Arc radius \[m\] at the end point (equal to [`Self::radius`] but for a spiral within
+    /// [`ARC_TOLERANCE`]; 0 for other moves).
+    pub fn end_radius(&self) -> f64 {
+        match self.motion {
+            Motion::Arc { plane, center, .. } => {
+                let (a, b) = plane.split(&(self.end - center));
+                ComplexField::sqrt(a * a + b * b)
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Path length \[m\]: the chord of a straight move, `sqrt((r sweep)^2 + dn^2)` of an arc
+    /// (`r` its mean radius, `dn` its rise along the normal), 0 for a dwell.
     pub fn length(&self) -> f64 {
         match self.motion {
-            Motion::Arc { sweep, .. } => {
-                let arc = self.radius() * ComplexField::abs(sweep);
-                let dz = self.end.z - self.start.z;
-                ComplexField::sqrt(arc * arc + dz * dz)
+            Motion::Arc { plane, sweep, .. } => {
+                let arc = 0.5 * (self.radius() + self.end_radius()) * ComplexField::abs(sweep);
+                let dn = plane.normal(&self.end) - plane.normal(&self.start);
+                ComplexField::sqrt(arc * arc + dn * dn)
             }
+            Motion::Dwell { .. } => 0.0,
             _ => (self.end - self.start).norm(),
         }
     }
 
-    /// The point at the fraction `s` in \[0, 1\] of the move \[m\] (by angle on an arc, so
-    /// by length): `s <= 0` is the start, `s >= 1` the end, exactly.
+    /// The point at the fraction `s` in \[0, 1\] of the move \[m\] (by angle on an arc, its
+    /// radius linear in the angle as LinuxCNC drives a spiral within tolerance): `s <= 0` is
+    /// the start, `s >= 1` the end, exactly.
     pub fn point(&self, s: f64) -> Vector3<f64> {
         // The ends exactly (an arc's rotation about its centre rounds them).
         if s <= 0.0 {
@@ -97,32 +258,79 @@ impl Move {
             return self.end;
         }
         match self.motion {
-            Motion::Arc { center, sweep } => {
-                let r0 = self.start.xy() - center;
+            Motion::Arc {
+                plane,
+                center,
+                sweep,
+            } => {
+                let (c1, c2) = plane.split(&center);
+                let (mut r1, mut r2) = plane.split(&(self.start - center));
+                let (r0, re) = (self.radius(), self.end_radius());
+                if r0 > 0.0 && re != r0 {
+                    let k = (r0 + (re - r0) * s) / r0;
+                    r1 *= k;
+                    r2 *= k;
+                }
                 let (sin, cos) = ComplexField::sin_cos(sweep * s);
-                let xy = center + Vector2::new(cos * r0.x - sin * r0.y, sin * r0.x + cos * r0.y);
-                let z = self.start.z + (self.end.z - self.start.z) * s;
-                Vector3::new(xy.x, xy.y, z)
+                let n0 = plane.normal(&self.start);
+                let n = n0 + (plane.normal(&self.end) - n0) * s;
+                let (_, _, k) = plane.axes();
+                let mut p = plane.with(
+                    &self.start,
+                    c1 + cos * r1 - sin * r2,
+                    c2 + sin * r1 + cos * r2,
+                );
+                if let Some(x) = p.get_mut(k) {
+                    *x = n;
+                }
+                p
             }
+            Motion::Dwell { .. } => self.start,
             _ => self.start + (self.end - self.start) * s,
         }
     }
 
     /// Unit tangent (feed direction) at the fraction `s`, workpiece frame; zero for a
-    /// zero-length move.
+    /// zero-length move and a dwell.
     pub fn tangent(&self, s: f64) -> Vector3<f64> {
         let t = match self.motion {
-            Motion::Arc { center, sweep } => {
+            Motion::Arc {
+                plane,
+                center,
+                sweep,
+            } => {
                 let p = self.point(s);
-                let r = p.xy() - center;
-                // d/d(angle) of the circle, times the sign of the sweep; z rises linearly.
-                let dxy = Vector2::new(-r.y, r.x) * sweep;
-                Vector3::new(dxy.x, dxy.y, self.end.z - self.start.z)
+                let (r1, r2) = plane.split(&(p - center));
+                let r = ComplexField::sqrt(r1 * r1 + r2 * r2);
+                // d/ds of the spiral: the radius' change outwards, the turn times the sweep;
+                // the normal coordinate rises linearly.
+                let dr = self.end_radius() - self.radius();
+                let (u1, u2) = if r > 0.0 {
+                    (r1 / r, r2 / r)
+                } else {
+                    (0.0, 0.0)
+                };
+                let (_, _, k) = plane.axes();
+                let mut t = plane.with(
+                    &Vector3::zeros(),
+                    -r2 * sweep + dr * u1,
+                    r1 * sweep + dr * u2,
+                );
+                if let Some(x) = t.get_mut(k) {
+                    *x = plane.normal(&self.end) - plane.normal(&self.start);
+                }
+                t
             }
+            Motion::Dwell { .. } => Vector3::zeros(),
             _ => self.end - self.start,
         };
         let n = t.norm();
         if n > 0.0 { t / n } else { Vector3::zeros() }
+    }
+
+    /// Whether the move cuts at a feed (`G1`-`G3`): not a rapid, not a dwell.
+    pub fn is_feed(&self) -> bool {
+        matches!(self.motion, Motion::Linear | Motion::Arc { .. })
     }
 }
 
@@ -137,9 +345,12 @@ impl Program {
     /// Checks a program however it was made (read, built by hand, unpickled): at most
     /// [`MAX_MOVES`] moves, lines >= 1, points finite within [`MAX_COORDINATE`], each move
     /// starting where the one before ends (within [`MAX_GAP`]), feeds in `[0, MAX_FEED]`,
-    /// spindle speeds in `[0, MAX_SPINDLE_RPM / 60]` rev/s, arcs with `0 < |sweep| <= 2 pi`
-    /// whose end lies where the sweep takes the start (within [`ARC_TOLERANCE`]).
-    /// [`BuildError::InvalidEntry`] naming the move (its index) and what is wrong.
+    /// spindle speeds within `MAX_SPINDLE_RPM / 60` rev/s either way, tools up to
+    /// [`MAX_TOOL_NUMBER`], path control tolerances finite and >= 0, arcs with
+    /// `0 < |sweep| <= 2 pi MAX_ARC_TURNS`, their centre level with the start along the
+    /// normal and their end where the sweep takes the start (within [`ARC_TOLERANCE`]),
+    /// dwells in place for `(0, MAX_DWELL]` s. [`BuildError::InvalidEntry`] naming the move
+    /// (its index) and what is wrong.
     pub fn validate(&self) -> Result<(), BuildError> {
         if self.moves.len() > MAX_MOVES {
             return Err(BuildError::Budget {
@@ -149,31 +360,8 @@ impl Program {
                 requested: self.moves.len(),
             });
         }
-        let bad = |index: usize, value: f64, expected: &'static str| {
-            Err(BuildError::InvalidEntry {
-                what: "program moves (index: the move)",
-                index,
-                value,
-                expected,
-            })
-        };
         let mut previous: Option<Vector3<f64>> = None;
         for (i, m) in self.moves.iter().enumerate() {
-            if m.line == 0 {
-                return bad(i, 0.0, "a program line >= 1");
-            }
-            if let Some(v) = m
-                .start
-                .iter()
-                .chain(m.end.iter())
-                .find(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
-            {
-                return bad(
-                    i,
-                    *v,
-                    "start and end finite, within +-MAX_COORDINATE (1000 m)",
-                );
-            }
             if let Some(p) = previous {
                 let gap = (m.start - p).norm();
                 if gap > MAX_GAP {
@@ -185,54 +373,168 @@ impl Program {
                 }
             }
             previous = Some(m.end);
-            if !(0.0..=MAX_FEED).contains(&m.feed) {
-                return bad(i, m.feed, "a feed in [0, MAX_FEED] m/s");
-            }
-            if !(0.0..=MAX_SPINDLE_RPM / 60.0).contains(&m.spindle) {
-                return bad(
-                    i,
-                    m.spindle,
-                    "a spindle speed in [0, MAX_SPINDLE_RPM / 60] rev/s",
-                );
-            }
-            if let Motion::Arc { center, sweep } = m.motion {
-                if !(center
-                    .iter()
-                    .all(|v| v.is_finite() && v.abs() <= MAX_COORDINATE))
-                {
-                    return bad(
-                        i,
-                        center.x + center.y,
-                        "an arc centre finite, within 1000 m",
-                    );
-                }
-                let tau = core::f64::consts::TAU;
-                if !(sweep.is_finite() && sweep != 0.0 && ComplexField::abs(sweep) <= tau) {
-                    return bad(i, sweep, "an arc sweep with 0 < |sweep| <= 2 pi");
-                }
-                let r = m.radius();
-                let (sin, cos) = ComplexField::sin_cos(sweep);
-                let r0 = m.start.xy() - center;
-                let swept = center + Vector2::new(cos * r0.x - sin * r0.y, sin * r0.x + cos * r0.y);
-                let miss = (swept - m.end.xy()).norm();
-                if miss > ARC_TOLERANCE.0.max(ARC_TOLERANCE.1 * r) {
-                    return bad(
-                        i,
-                        miss,
-                        "an arc end where the sweep takes the start (within ARC_TOLERANCE)",
-                    );
-                }
-            }
+            check_move(i, m)?;
         }
         Ok(())
     }
 
-    /// Total path length \[m\] of the feed moves (rapids excluded).
+    /// Total path length \[m\] of the feed moves (rapids and dwells excluded).
     pub fn cutting_length(&self) -> f64 {
         self.moves
             .iter()
-            .filter(|m| m.motion != Motion::Rapid)
+            .filter(|m| m.is_feed())
             .map(Move::length)
             .sum()
     }
+
+    /// The tool numbers the program's moves use, ascending, each once.
+    pub fn tools(&self) -> Vec<u32> {
+        let mut t: Vec<u32> = self.moves.iter().map(|m| m.tool).collect();
+        t.sort_unstable();
+        t.dedup();
+        t
+    }
+}
+
+fn bad(index: usize, value: f64, expected: &'static str) -> Result<(), BuildError> {
+    Err(BuildError::InvalidEntry {
+        what: "program moves (index: the move)",
+        index,
+        value,
+        expected,
+    })
+}
+
+/// One move's own checks (see [`Program::validate`]).
+fn check_move(i: usize, m: &Move) -> Result<(), BuildError> {
+    if m.line == 0 {
+        return bad(i, 0.0, "a program line >= 1");
+    }
+    if let Some(v) = m
+        .start
+        .iter()
+        .chain(m.end.iter())
+        .find(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
+    {
+        return bad(
+            i,
+            *v,
+            "start and end finite, within +-MAX_COORDINATE (1000 m)",
+        );
+    }
+    if !(0.0..=MAX_FEED).contains(&m.feed) {
+        return bad(i, m.feed, "a feed in [0, MAX_FEED] m/s");
+    }
+    if m.spindle.is_nan() || m.spindle.abs() > MAX_SPINDLE_RPM / 60.0 {
+        return bad(
+            i,
+            m.spindle,
+            "a spindle speed within +-MAX_SPINDLE_RPM / 60 rev/s",
+        );
+    }
+    if m.tool > MAX_TOOL_NUMBER {
+        return bad(i, f64::from(m.tool), "a tool number in 0..=MAX_TOOL_NUMBER");
+    }
+    if let PathControl::Blend {
+        tolerance,
+        naive_tolerance,
+    } = m.path_control
+        && !(tolerance.is_finite()
+            && tolerance >= 0.0
+            && naive_tolerance.is_finite()
+            && naive_tolerance >= 0.0)
+    {
+        return bad(
+            i,
+            tolerance + naive_tolerance,
+            "G64 tolerances finite and >= 0 m",
+        );
+    }
+    match m.motion {
+        Motion::Rapid if m.feed != 0.0 => bad(i, m.feed, "a feed of 0 on a rapid move"),
+        Motion::Dwell { seconds } => {
+            if !(seconds > 0.0 && seconds <= MAX_DWELL) {
+                return bad(i, seconds, "a dwell in (0, MAX_DWELL] s");
+            }
+            if m.start != m.end || m.feed != 0.0 {
+                return bad(
+                    i,
+                    (m.end - m.start).norm(),
+                    "a dwell in place with a feed of 0",
+                );
+            }
+            Ok(())
+        }
+        Motion::Arc {
+            plane,
+            center,
+            sweep,
+        } => check_arc(i, m, plane, &center, sweep),
+        _ => Ok(()),
+    }
+}
+
+fn check_arc(
+    i: usize,
+    m: &Move,
+    plane: Plane,
+    center: &Vector3<f64>,
+    sweep: f64,
+) -> Result<(), BuildError> {
+    if !(center
+        .iter()
+        .all(|v| v.is_finite() && v.abs() <= MAX_COORDINATE))
+    {
+        return bad(i, center.sum(), "an arc centre finite, within 1000 m");
+    }
+    let rise = ComplexField::abs(plane.normal(center) - plane.normal(&m.start));
+    if rise > MAX_GAP {
+        return bad(
+            i,
+            rise,
+            "an arc centre level with the start along the plane's normal",
+        );
+    }
+    let most = core::f64::consts::TAU * f64::from(MAX_ARC_TURNS);
+    if !(sweep.is_finite() && sweep != 0.0 && ComplexField::abs(sweep) <= most) {
+        return bad(
+            i,
+            sweep,
+            "an arc sweep with 0 < |sweep| <= 2 pi MAX_ARC_TURNS",
+        );
+    }
+    let (r0, re) = (m.radius(), m.end_radius());
+    if !(r0 > 0.0 && re > 0.0) {
+        return bad(
+            i,
+            r0.min(re),
+            "an arc of radius > 0 at its start and its end",
+        );
+    }
+    let spiral = ComplexField::abs(re - r0);
+    if spiral > ARC_TOLERANCE.0.max(ARC_TOLERANCE.1 * r0.max(re)) {
+        return bad(
+            i,
+            spiral,
+            "an arc end as far from the centre as the start (within ARC_TOLERANCE)",
+        );
+    }
+    // The end's direction from the centre is where the sweep turns the start's.
+    let (sin, cos) = ComplexField::sin_cos(sweep);
+    let (c1, c2) = plane.split(center);
+    let (r1, r2) = plane.split(&(m.start - center));
+    let (e1, e2) = plane.split(&m.end);
+    let k = re / r0;
+    let miss = ComplexField::sqrt(
+        (c1 + (cos * r1 - sin * r2) * k - e1).powi(2)
+            + (c2 + (sin * r1 + cos * r2) * k - e2).powi(2),
+    );
+    if miss > MAX_GAP + 1.0e-12 * re * (1.0 + ComplexField::abs(sweep)) {
+        return bad(
+            i,
+            miss,
+            "an arc end where the sweep takes the start (within ARC_TOLERANCE)",
+        );
+    }
+    Ok(())
 }

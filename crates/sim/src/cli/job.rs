@@ -7,14 +7,60 @@ use std::path::PathBuf;
 use super::range::*;
 use super::{CliError, ToolArgs, count};
 
+/// The control a G-code program is written for.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DialectArg {
+    /// LinuxCNC's RS274/NGC, word for word.
+    #[default]
+    Linuxcnc,
+    /// grbl: the off-plane centre word of an arc (K0 on a G17 arc) is ignored.
+    Grbl,
+    /// Fanuc, Haas, Mach3: axis words after G80 move in the last G0-G3 mode, '%' lines
+    /// anywhere, nested comments.
+    Fanuc,
+}
+
+impl DialectArg {
+    /// The reader's dialect.
+    pub fn dialect(self) -> deflect_core::io::gcode::Dialect {
+        use deflect_core::io::gcode::Dialect;
+        match self {
+            Self::Linuxcnc => Dialect::LinuxCnc,
+            Self::Grbl => Dialect::Grbl,
+            Self::Fanuc => Dialect::Fanuc,
+        }
+    }
+}
+
 // Arguments of `job` (help texts with their ranges in the `help` attributes).
 #[derive(clap::Args, Debug)]
 pub struct JobArgs {
-    /// G-code program (ISO subset: G0-G3 in G17, G20/G21, G90/G91, F, S, M3/M5/M30), in the
-    /// workpiece frame; default: data/groove_and_pocket.nc, built in (a groove, a ramp and a
-    /// circular pocket in mm).
+    /// RS274/NGC G-code program, read as LinuxCNC reads it (tools, work offsets, planes,
+    /// canned cycles, parameters, subroutines, control flow; see --explain), in mm unless it
+    /// says G20; its moves in the program's machine frame = the workpiece frame. Default:
+    /// data/groove_and_pocket.nc, built in (a groove, a ramp and a circular pocket in mm).
     #[arg(long, conflicts_with = "points")]
     pub program: Option<PathBuf>,
+    /// Print the word report of a G-code program (every word it uses: honoured, recorded
+    /// without motion, or refused; count and first line) and whether it reads, then stop.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["program", "points"])]
+    pub explain: Option<PathBuf>,
+    /// The control the program is written for: linuxcnc (default), grbl (ignores an arc's
+    /// off-plane centre word, as FreeCAD's grbl post writes it), fanuc (Fanuc, Haas, Mach3:
+    /// axis words after G80 move in the last G0-G3 mode; '%' lines anywhere).
+    #[arg(long, value_enum, default_value_t = DialectArg::Linuxcnc)]
+    pub dialect: DialectArg,
+    /// Tool table: LinuxCNC's .tbl (`T1 P1 D6 Z0 ;comment`, mm; flutes and helix from
+    /// --flutes/--helix, flat ends) or a TOML table (*.toml: diameter, flutes, helix, flat /
+    /// ball / bull-nose). The tool in the spindle at each move cuts and feels the force.
+    /// Default: the --diameter/--flutes/--helix tool serves every T.
+    #[arg(long, value_name = "FILE")]
+    pub tools: Option<PathBuf>,
+    #[arg(long, allow_negative_numbers = true, help = SPINDLE_RPM.help(
+        "Spindle speed of a program that never starts its spindle (a hand-started spindle) [rpm]",
+        " It turns clockwise at this speed wherever the program's spindle is off"
+    ))]
+    pub spindle_rpm: Option<f64>,
     /// Tool points CSV instead of G-code (columns x_mm,y_mm,z_mm or x_m,y_m,z_m,
     /// feed_mm_min or feed_m_s, spindle_rpm; one straight move per row, feed 0 for rapid).
     #[arg(long)]
@@ -93,6 +139,9 @@ impl JobArgs {
         RAPID_SPEED.check(self.rapid_speed)?;
         LEAD_MS.check(self.lead_ms)?;
         TOLERANCE_MM.check(self.tolerance)?;
+        if let Some(rpm) = self.spindle_rpm {
+            SPINDLE_RPM.check(rpm)?;
+        }
         let list = |flag: &str, v: &Option<Vec<f64>>, n: usize, what: &str| match v {
             Some(v) if v.len() != n => Err(CliError::Usage(format!(
                 "{flag}: {} values; expected {n} ({what})",

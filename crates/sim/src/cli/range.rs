@@ -159,6 +159,8 @@ pub const CELL_MM: Range = Range::closed("--cell", 0.01, 10.0, "mm");
 pub const DIAMETER_MM: Range = Range::closed("--diameter", 0.1, 200.0, "mm");
 /// `job --flutes`.
 pub const FLUTES: Range = Range::closed("--flutes", 1.0, 16.0, "");
+/// A hand-started spindle's speed.
+pub const SPINDLE_RPM: Range = Range::closed("--spindle-rpm", 1.0, 1.0e6, "rpm");
 /// `job --helix`.
 pub const HELIX_DEG: Range = Range::closed("--helix", 0.0, 60.0, "deg");
 /// `job --rate`: sampling rate of the program.

@@ -8,6 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use deflect_core::io::gcode::{self, GcodeOptions};
+use deflect_core::io::tool_table::{self, TblOptions};
 use deflect_core::io::{job_out, points_csv};
 use deflect_core::machining::cutting::{Coefficients, Tool};
 use deflect_core::machining::job::{self, Job, Report, Setup, Stock};
@@ -47,19 +48,74 @@ pub(crate) fn default_stock(
 ) -> Option<(Vector2<f64>, Vector2<f64>)> {
     let mut lo = Vector2::repeat(f64::INFINITY);
     let mut hi = Vector2::repeat(f64::NEG_INFINITY);
-    for m in program.moves.iter().filter(|m| m.motion != Motion::Rapid) {
-        let r = m.radius();
+    for m in program.moves.iter().filter(|m| m.is_feed()) {
         for p in [m.start.xy(), m.end.xy()] {
             lo = lo.inf(&p);
             hi = hi.sup(&p);
         }
-        if let Motion::Arc { center, .. } = m.motion {
-            lo = lo.inf(&(center - Vector2::repeat(r)));
-            hi = hi.sup(&(center + Vector2::repeat(r)));
+        if let Motion::Arc { sweep, .. } = m.motion {
+            // Points along the arc (a spiral in any plane) every 5 degrees.
+            let n = ((sweep.abs() / 5f64.to_radians()).ceil() as usize).clamp(2, 10_000);
+            for k in 1..n {
+                let p = m.point(k as f64 / n as f64).xy();
+                lo = lo.inf(&p);
+                hi = hi.sup(&p);
+            }
         }
     }
     (lo.x.is_finite() && hi.x.is_finite())
         .then(|| (lo - Vector2::repeat(radius), hi + Vector2::repeat(radius)))
+}
+
+/// `job --explain FILE`: the program's word report and whether it reads, on stdout.
+pub fn explain(a: &JobArgs, path: &Path) -> Result<(), CliError> {
+    let text = read_text("--explain", path, "G-code program")?;
+    let options = GcodeOptions {
+        dialect: a.dialect.dialect(),
+        ..GcodeOptions::default()
+    };
+    let words = gcode::words(&text, &options)
+        .map_err(|e| CliError::Failure(format!("--explain {}: {e}", path.display())))?;
+    let mut out = format!(
+        "{}: the words of the program ({} dialect)\n{:<22} {:<9} {:>7} {:>6}  meaning\n",
+        path.display(),
+        options.dialect.name(),
+        "word",
+        "status",
+        "count",
+        "line"
+    );
+    for w in &words {
+        let _ = writeln!(
+            out,
+            "{:<22} {:<9} {:>7} {:>6}  {}",
+            w.word,
+            w.status.name(),
+            w.count,
+            w.first_line,
+            w.meaning
+        );
+    }
+    match gcode::from_str(&text, &options) {
+        Ok(p) => {
+            let tools: Vec<String> = p.tools().iter().map(|t| format!("T{t}")).collect();
+            let _ = writeln!(
+                out,
+                "reads: {} moves, {:.3} m of feed moves, tools {}",
+                p.moves.len(),
+                p.cutting_length(),
+                if tools.is_empty() {
+                    "none".to_string()
+                } else {
+                    tools.join(", ")
+                }
+            );
+        }
+        Err(e) => {
+            let _ = writeln!(out, "refused: {e}");
+        }
+    }
+    stdout(format_args!("{out}")).map_err(CliError::from)
 }
 
 /// Reads the program and the arm, checks the seed and the placement, builds the job.
@@ -67,6 +123,8 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     let options = GcodeOptions {
         start: Vector3::from(START),
         units: LengthUnit::Millimetre,
+        dialect: a.dialect.dialect(),
+        ..GcodeOptions::default()
     };
     let (program, program_name) = match (&a.program, &a.points) {
         (Some(p), _) => {
@@ -130,6 +188,37 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         })?,
     };
     let (tool, coefficients) = tool_and_material(&a.tool)?;
+    let table = match &a.tools {
+        Some(path) => {
+            let o = TblOptions {
+                units: LengthUnit::Millimetre,
+                flutes: a.tool.flutes,
+                helix: a.tool.helix.to_radians(),
+            };
+            let table = tool_table::from_path(path, &o)
+                .map_err(|e| CliError::Failure(format!("--tools {}: {e}", path.display())))?;
+            if let Some(m) = program
+                .moves
+                .iter()
+                .find(|m| m.is_feed() && table.get(m.tool).is_none())
+            {
+                return Err(CliError::Failure(format!(
+                    "--tools {}: {program_name} line {} cuts with T{}, which the table does not \
+                     have{}",
+                    path.display(),
+                    m.line,
+                    m.tool,
+                    if m.tool == 0 {
+                        " (T0: no tool selected; number the tool, or leave out --tools)"
+                    } else {
+                        ""
+                    }
+                )));
+            }
+            Some(table)
+        }
+        None => None,
+    };
     let setup = Setup {
         placement,
         tool_orientation: Setup::tool_down(),
@@ -149,9 +238,13 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             ..PathOptions::default()
         },
         ik: PoseIkOptions::default(),
+        hand_spindle: a.spindle_rpm.map(|rpm| rpm / 60.0),
     };
-    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
+    let mut job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
         .map_err(|e| CliError::Usage(format!("--stock/--cell and the job's settings: {e}")))?;
+    if let Some(t) = table {
+        job = job.with_tools(t);
+    }
     Ok(JobTask {
         job,
         program,
@@ -159,6 +252,81 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         robot_name: loaded.name,
         seed,
     })
+}
+
+/// Which tool cuts each `T` of the program, and which spindle: the summary's words.
+fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
+    let used = t.program.tools();
+    let setup = t.job.setup();
+    let mut json = Vec::new();
+    let mut text = match t.job.tools() {
+        Some(table) => {
+            let mut parts = Vec::new();
+            for n in &used {
+                if let Some(spec) = table.get(*n) {
+                    parts.push(format!(
+                        "T{n} {:.3} mm {} {} flutes{}",
+                        spec.tool.diameter * 1e3,
+                        spec.shape.name(),
+                        spec.tool.flutes,
+                        if spec.name.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" ({})", spec.name)
+                        }
+                    ));
+                    json.push(serde_json::json!({
+                        "tool": n, "diameter_m": spec.tool.diameter, "shape": spec.shape.name(),
+                        "flutes": spec.tool.flutes, "helix_rad": spec.tool.helix, "length_m": spec.length,
+                    }));
+                }
+            }
+            let ends = table
+                .tools()
+                .iter()
+                .any(|s| s.shape != deflect_core::machining::tools::ToolShape::Flat);
+            format!(
+                "tools (from the tool table): {}{}",
+                if parts.is_empty() {
+                    "none cut".to_string()
+                } else {
+                    parts.join("; ")
+                },
+                if ends {
+                    "; ball and bull-nose ends cut the z-map as ball and flat ends and feel the flat \
+                     end mill's force"
+                } else {
+                    ""
+                }
+            )
+        }
+        None => {
+            let names: Vec<String> = used.iter().map(|n| format!("T{n}")).collect();
+            json.push(serde_json::json!({
+                "tool": "every", "diameter_m": setup.tool.diameter, "shape": "flat",
+                "flutes": setup.tool.flutes, "helix_rad": setup.tool.helix,
+            }));
+            format!(
+                "tool: no tool table; the --diameter/--flutes tool ({:.3} mm flat, {} flutes) serves \
+                 every T of the program ({})",
+                setup.tool.diameter * 1e3,
+                setup.tool.flutes,
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        }
+    };
+    if let Some(hand) = setup.hand_spindle {
+        let _ = write!(
+            text,
+            "\nspindle: hand-started at {:.0} rpm wherever the program's spindle is off",
+            hand * 60.0
+        );
+    }
+    (text, json)
 }
 
 /// The summary as text lines and JSON.
@@ -183,6 +351,8 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
         r.cell_updates as f64 / wall.max(1e-9),
         r.plunge_samples
     );
+    let (tools, tools_json) = tools_text(t);
+    let _ = writeln!(text, "{tools}");
     let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
     let _ = writeln!(text, "line  samples  mean |F| [N]  max |F| [N]");
     let lines = r.line_forces();
@@ -226,6 +396,8 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
         "cell_updates": r.cell_updates,
         "plunge_samples": r.plunge_samples,
         "max_force_n": fmax,
+        "tools": tools_json,
+        "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
         "lines": lines.iter().map(|l| serde_json::json!({
             "line": l.line, "samples": l.samples,
             "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,

@@ -55,6 +55,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
     let options = GcodeOptions {
         start: Vector3::new(0.0, 0.0, 0.02),
         units: LengthUnit::Millimetre,
+        ..GcodeOptions::default()
     };
     let (program, name, builtin) = match a.program.as_deref() {
         Some("groove") if a.urdf.is_some() => {
@@ -162,6 +163,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
             ..PathOptions::default()
         },
         ik: PoseIkOptions::default(),
+        hand_spindle: None,
     };
     setup
         .validate()

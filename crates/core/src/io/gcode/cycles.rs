@@ -1,0 +1,408 @@
+//! Canned cycles (`G73`, `G74`, `G81`-`G89`) expanded into the moves LinuxCNC makes (its
+//! `interp_cycles.cc`): the rise to R when the tool starts below it, the clear height (`G99`:
+//! R; `G98`: the series' initial level, not below R), `L` repeats with `G91` increments, the
+//! modal R, depth, P, Q and I/J/K, the pecks of `G73`/`G83` (retract 0.254 mm = 0.010 in), in
+//! any plane (the drilling axis is the plane's normal). Arithmetic is in the program's unit,
+//! as LinuxCNC's, so the number of pecks is the same.
+
+use nalgebra::Vector3;
+
+use super::interp::{Fault, FeedMode, Machine, fault};
+use super::words::{Words, g_name};
+use crate::machining::{Motion, Plane};
+
+/// The peck retract of `G73` and the approach gap of `G83` \[m\] (0.010 in = 0.254 mm).
+pub const PECK_CLEARANCE: f64 = 0.254e-3;
+
+/// What a cycle's body does.
+struct Geometry {
+    /// Plane axes: the two positioning axes and the drilling axis (indices 0 x, 1 y, 2 z).
+    axes: (usize, usize, usize),
+    /// R, bottom and clear heights along the drilling axis, program units.
+    r: f64,
+    bottom: f64,
+    clear: f64,
+}
+
+impl Machine {
+    /// A point at plane coordinates (`a`, `b`) and height `c`, all in program units.
+    fn cycle_point(&self, g: &Geometry, a: f64, b: f64, c: f64) -> Vector3<f64> {
+        let mut p = Vector3::zeros();
+        let (ia, ib, ic) = g.axes;
+        for (k, v) in [(ia, a), (ib, b), (ic, c)] {
+            if let Some(x) = p.get_mut(k) {
+                *x = v * self.units;
+            }
+        }
+        p
+    }
+
+    fn rapid_to(
+        &mut self,
+        g: &Geometry,
+        a: f64,
+        b: f64,
+        c: f64,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let p = self.cycle_point(g, a, b, c);
+        self.emit(Motion::Rapid, p, 0.0, column)
+    }
+
+    fn feed_to(
+        &mut self,
+        g: &Geometry,
+        a: f64,
+        b: f64,
+        c: f64,
+        w: &Words,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let p = self.cycle_point(g, a, b, c);
+        self.straight(Motion::Linear, p, w, column)
+    }
+
+    /// A canned cycle block (see the module docs).
+    pub(super) fn cycle(&mut self, w: &mut Words, code: u16, column: usize) -> Result<(), Fault> {
+        let name = g_name(code);
+        if self.feed_mode == FeedMode::InverseTime {
+            return fault(
+                column,
+                std::format!("{name}: no inverse time feed (G93) with a canned cycle"),
+            );
+        }
+        let same = self.motion == Some(code);
+        let repeats = match w.take(b'l') {
+            None => 1,
+            Some(l) => match super::expr::integer(l) {
+                Some(l) if (1..=100_000).contains(&l) => l as u32,
+                _ => {
+                    return fault(
+                        w.column(b'l'),
+                        std::format!("{name}: repeats L in 1..=100000, got L{l}"),
+                    );
+                }
+            },
+        };
+        let (axes, depth_letter, a_letter, b_letter) = match self.plane {
+            Plane::Xy => ((0, 1, 2), b'z', b'x', b'y'),
+            Plane::Zx => ((2, 0, 1), b'y', b'z', b'x'),
+            Plane::Yz => ((1, 2, 0), b'x', b'y', b'z'),
+        };
+        let axis_name = char::from(depth_letter.to_ascii_uppercase());
+        let Some(r_word) = w.take(b'r').or(if same { self.cycle.r } else { None }) else {
+            return fault(
+                column,
+                std::format!("{name}: R, the retract plane (needed on a cycle's first block)"),
+            );
+        };
+        let Some(depth_word) = w
+            .take(depth_letter)
+            .or(if same { self.cycle.depth } else { None })
+        else {
+            return fault(
+                column,
+                std::format!(
+                    "{name}: {axis_name}, the hole's depth (needed on a cycle's first block)"
+                ),
+            );
+        };
+        let u = self.units;
+        let (ia, ib, ic) = axes;
+        let coord = |p: &Vector3<f64>, k: usize| p.get(k).copied().unwrap_or(0.0) / u;
+        let initial = match self.cycle.initial {
+            Some(v) => v,
+            None => {
+                let v = self.pos.get(ic).copied().unwrap_or(0.0);
+                self.cycle.initial = Some(v);
+                v
+            }
+        };
+        let mut old_c = initial / u;
+        let (aw, bw) = (w.take(a_letter), w.take(b_letter));
+        let (radius, theta) = (w.take(b'@'), w.take(b'^').map(f64::to_radians));
+        let polar = radius.is_some() || theta.is_some();
+        if polar && (self.plane != Plane::Xy || aw.is_some() || bw.is_some()) {
+            return fault(
+                w.first_of(b"@^").unwrap_or(column),
+                std::format!("{name}: polar coordinates (@, ^) in G17 only, without X and Y"),
+            );
+        }
+        let (mut a, mut b) = (coord(&self.pos, ia), coord(&self.pos, ib));
+        let mut polar_step = (0.0, 0.0);
+        let (r, bottom, step) = if self.absolute {
+            if polar {
+                let rad = radius.unwrap_or(a.hypot(b));
+                let th = theta.unwrap_or(b.atan2(a));
+                (a, b) = (rad * th.cos(), rad * th.sin());
+            } else {
+                a = aw.unwrap_or(a);
+                b = bw.unwrap_or(b);
+            }
+            (r_word, depth_word, (0.0, 0.0))
+        } else {
+            polar_step = (radius.unwrap_or(0.0), theta.unwrap_or(0.0));
+            (
+                r_word + old_c,
+                r_word + old_c + depth_word,
+                (aw.unwrap_or(0.0), bw.unwrap_or(0.0)),
+            )
+        };
+        if r < bottom {
+            return fault(
+                w.column(b'r'),
+                std::format!(
+                    "{name}: R at or above the depth {axis_name} (R {r}, {axis_name} {bottom})"
+                ),
+            );
+        }
+        let mut g = Geometry {
+            axes,
+            r,
+            bottom,
+            clear: r,
+        };
+        if old_c < r {
+            let here = (coord(&self.pos, ia), coord(&self.pos, ib));
+            self.rapid_to(&g, here.0, here.1, r, column)?;
+            old_c = r;
+        }
+        g.clear = if self.retract_old_z { old_c } else { r };
+        let body = self.cycle_words(w, code, same, &name, column)?;
+        for rep in 0..repeats {
+            a += step.0;
+            b += step.1;
+            for (k, inc) in [polar_step.0, polar_step.1].into_iter().enumerate() {
+                if inc != 0.0 {
+                    if a == 0.0 && b == 0.0 {
+                        return fault(
+                            column,
+                            std::format!(
+                                "{name}: incremental polar coordinates away from the origin (the angle is undefined there)"
+                            ),
+                        );
+                    }
+                    let (mut rad, mut th) = (a.hypot(b), b.atan2(a));
+                    if k == 0 {
+                        rad += inc;
+                    } else {
+                        th += inc;
+                    }
+                    (a, b) = (rad * th.cos(), rad * th.sin());
+                }
+            }
+            let c = coord(&self.pos, ic);
+            if rep == 0 && c > r {
+                let p = self.cycle_point(&g, a, b, c);
+                self.emit(Motion::Rapid, p, 0.0, column)?;
+                self.rapid_to(&g, a, b, r, column)?;
+            } else {
+                self.rapid_to(&g, a, b, g.clear, column)?;
+                if g.clear > r {
+                    self.rapid_to(&g, a, b, r, column)?;
+                }
+            }
+            self.cycle_body(&g, &body, a, b, w, code, column)?;
+        }
+        self.cycle.r = Some(r_word);
+        self.cycle.depth = Some(depth_word);
+        Ok(())
+    }
+
+    /// The P, Q and I/J/K a cycle needs, checked and remembered.
+    fn cycle_words(
+        &mut self,
+        w: &mut Words,
+        code: u16,
+        same: bool,
+        name: &str,
+        column: usize,
+    ) -> Result<Body, Fault> {
+        let mut body = Body::default();
+        if matches!(code, 820 | 840 | 860 | 880 | 890) {
+            let p = w.take(b'p').filter(|p| *p != -1.0);
+            if let Some(p) = p {
+                self.cycle.p = Some(p);
+            } else if code != 840 && !same {
+                return fault(
+                    column,
+                    std::format!("{name}: P, the dwell time (needed on its first block)"),
+                );
+            }
+            body.dwell = self.cycle.p.unwrap_or(0.0);
+        }
+        if matches!(code, 730 | 830) {
+            let q = w.take(b'q').filter(|q| *q != -1.0);
+            if let Some(q) = q {
+                self.cycle.q = Some(q);
+            } else if !same {
+                return fault(
+                    column,
+                    std::format!("{name}: Q, the peck depth (needed on its first block)"),
+                );
+            }
+            let q = self.cycle.q.unwrap_or(0.0);
+            if q <= 0.0 {
+                return fault(
+                    w.column(b'q'),
+                    std::format!("{name}: a peck depth Q > 0, got Q{q}"),
+                );
+            }
+            body.q = q;
+        }
+        if code == 870 {
+            for (letter, slot) in [(b'i', 0), (b'j', 1), (b'k', 2)] {
+                let v = w.take(letter);
+                let stored = match slot {
+                    0 => &mut self.cycle.i,
+                    1 => &mut self.cycle.j,
+                    _ => &mut self.cycle.k,
+                };
+                if v.is_some() {
+                    *stored = v;
+                } else if !same {
+                    return fault(
+                        column,
+                        std::format!(
+                            "G87: {} (needed on its first block)",
+                            char::from(letter.to_ascii_uppercase())
+                        ),
+                    );
+                }
+            }
+        }
+        if matches!(code, 740 | 840 | 860 | 870 | 880) {
+            let want = if code == 740 { -1 } else { 1 };
+            if self.spindle_dir == 0 || (matches!(code, 740 | 840) && self.spindle_dir != want) {
+                return fault(
+                    column,
+                    std::format!(
+                        "{name}: the spindle turning {} before the cycle",
+                        if code == 740 {
+                            "counter-clockwise (M4)"
+                        } else if code == 840 {
+                            "clockwise (M3)"
+                        } else {
+                            "(M3 or M4)"
+                        }
+                    ),
+                );
+            }
+        }
+        Ok(body)
+    }
+
+    #[allow(clippy::too_many_arguments)] // reason: the cycle's geometry, its words and where it runs
+    fn cycle_body(
+        &mut self,
+        g: &Geometry,
+        body: &Body,
+        a: f64,
+        b: f64,
+        w: &Words,
+        code: u16,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let (r, bottom, clear) = (g.r, g.bottom, g.clear);
+        let dwell = |m: &mut Self| m.dwell(body.dwell, column);
+        match code {
+            810 => {
+                self.feed_to(g, a, b, bottom, w, column)?;
+                self.rapid_to(g, a, b, clear, column)?;
+            }
+            820 => {
+                self.feed_to(g, a, b, bottom, w, column)?;
+                dwell(self)?;
+                self.rapid_to(g, a, b, clear, column)?;
+            }
+            730 | 830 => {
+                let delta = PECK_CLEARANCE / self.units;
+                let mut d = r - body.q;
+                let mut pecks = 0u32;
+                while d > bottom {
+                    pecks += 1;
+                    if pecks > 100_000 {
+                        return fault(column, "at most 100000 pecks in one hole");
+                    }
+                    self.feed_to(g, a, b, d, w, column)?;
+                    if code == 830 {
+                        self.rapid_to(g, a, b, r, column)?;
+                    }
+                    self.rapid_to(g, a, b, d + delta, column)?;
+                    d -= body.q;
+                }
+                self.feed_to(g, a, b, bottom, w, column)?;
+                self.rapid_to(g, a, b, clear, column)?;
+            }
+            740 | 840 => {
+                // Tapping: feed in, reverse, dwell, feed out, restore.
+                self.feed_to(g, a, b, bottom, w, column)?;
+                self.spindle_dir = -self.spindle_dir;
+                dwell(self)?;
+                self.feed_to(g, a, b, clear, w, column)?;
+                self.spindle_dir = -self.spindle_dir;
+            }
+            850 => {
+                self.feed_to(g, a, b, bottom, w, column)?;
+                self.feed_to(g, a, b, r, w, column)?;
+                self.rapid_to(g, a, b, clear, column)?;
+            }
+            860 => {
+                let dir = self.spindle_dir;
+                self.feed_to(g, a, b, bottom, w, column)?;
+                dwell(self)?;
+                self.spindle_dir = 0;
+                self.rapid_to(g, a, b, clear, column)?;
+                self.spindle_dir = dir;
+            }
+            870 => {
+                let dir = self.spindle_dir;
+                let (i, j, k) = (
+                    self.cycle.i.unwrap_or(0.0),
+                    self.cycle.j.unwrap_or(0.0),
+                    self.cycle.k.unwrap_or(0.0),
+                );
+                // The offset words of the plane's axes and the middle (counterbore top).
+                let (oa, ob, mid) = match self.plane {
+                    Plane::Xy => (i, j, k),
+                    Plane::Zx => (k, i, j),
+                    Plane::Yz => (j, k, i),
+                };
+                let mid = if self.absolute { mid } else { bottom + mid };
+                self.rapid_to(g, a + oa, b + ob, r, column)?;
+                self.spindle_dir = 0;
+                self.rapid_to(g, a + oa, b + ob, bottom, column)?;
+                self.rapid_to(g, a, b, bottom, column)?;
+                self.spindle_dir = dir;
+                self.feed_to(g, a, b, mid, w, column)?;
+                self.feed_to(g, a, b, bottom, w, column)?;
+                self.spindle_dir = 0;
+                self.rapid_to(g, a + oa, b + ob, bottom, column)?;
+                self.rapid_to(g, a + oa, b + ob, clear, column)?;
+                self.rapid_to(g, a, b, clear, column)?;
+                self.spindle_dir = dir;
+            }
+            880 => {
+                // Feed, dwell, spindle stop, operator stop: the operator retracts by hand, and
+                // the interpreter takes the tool to be at the clear height (no move).
+                self.feed_to(g, a, b, bottom, w, column)?;
+                dwell(self)?;
+                self.pos = self.cycle_point(g, a, b, clear);
+            }
+            890 => {
+                self.feed_to(g, a, b, bottom, w, column)?;
+                dwell(self)?;
+                self.feed_to(g, a, b, clear, w, column)?;
+            }
+            _ => return fault(column, std::format!("{}: not a canned cycle", g_name(code))),
+        }
+        Ok(())
+    }
+}
+
+/// A cycle's dwell \[s\] and peck \[program units\].
+#[derive(Debug, Clone, Copy, Default)]
+struct Body {
+    dwell: f64,
+    q: f64,
+}

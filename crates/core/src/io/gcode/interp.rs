@@ -1,0 +1,809 @@
+//! The machine a block runs on: LinuxCNC's modal state and its order of execution within a
+//! block (comment, feed mode, F, S, T, M codes by group, dwell, plane, units, cutter radius
+//! and tool length compensation, coordinate system, path control, distance modes, retract
+//! mode, the non-modal codes, motion, stops), each code checked as LinuxCNC checks it.
+//!
+//! Positions are kept as LinuxCNC keeps them, in the program frame `P` (SI here), with the
+//! active work offset `G5x`, its XY rotation `R` and the axis offset `G92`; the moves are
+//! the tool tip's in the machine frame, `Rot(R) (P + G92) + G5x`. Tool length offsets are
+//! recorded and not applied: a robot's TCP is the tool tip.
+
+use std::string::String;
+use std::vec::Vec;
+
+use nalgebra::{Vector2, Vector3};
+
+use super::Dialect;
+use super::params::Params;
+use super::words::{Words, g_name};
+use crate::machining::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Move, PathControl, Plane};
+
+/// A fault inside a block: the column and the message.
+pub(super) type Fault = (usize, String);
+
+pub(super) fn fault<T>(column: usize, message: impl Into<String>) -> Result<T, Fault> {
+    Err((column, message.into()))
+}
+
+/// Millimetres per inch.
+pub(super) const INCH: f64 = 25.4e-3;
+
+/// Feed rate modes (`G93`, `G94`, `G95`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum FeedMode {
+    InverseTime,
+    PerMinute,
+    PerRevolution,
+}
+
+/// The modal state `M70`/`M73` save and `M72` restores.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Modal {
+    units: f64,
+    plane: Plane,
+    absolute: bool,
+    ijk_absolute: bool,
+    feed_mode: FeedMode,
+    feed: f64,
+    motion: Option<u16>,
+    retract_old_z: bool,
+    path_control: PathControl,
+    spindle_rpm: f64,
+    spindle_dir: i8,
+    mist: bool,
+    flood: bool,
+    system: usize,
+}
+
+/// What the canned cycles remember between blocks (LinuxCNC's `cycle_*` settings).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(super) struct CycleMemory {
+    /// The initial level of the series (the drilling-axis coordinate before its first block),
+    /// program frame \[m\]; `None` outside a series.
+    pub initial: Option<f64>,
+    /// The raw R, depth, P, Q, I, J, K words (program units; I/J/K of G87).
+    pub r: Option<f64>,
+    pub depth: Option<f64>,
+    pub p: Option<f64>,
+    pub q: Option<f64>,
+    pub i: Option<f64>,
+    pub j: Option<f64>,
+    pub k: Option<f64>,
+}
+
+/// The interpreter's machine.
+#[derive(Debug, Clone)]
+pub(super) struct Machine {
+    pub dialect: Dialect,
+    /// Program-frame position \[m\].
+    pub pos: Vector3<f64>,
+    /// Active coordinate system, 1 (G54) ..= 9 (G59.3).
+    pub system: usize,
+    /// Active work offset \[m\] and its XY rotation \[deg\].
+    pub g5x: Vector3<f64>,
+    pub rotation: f64,
+    /// Axis offset (G92/G52) \[m\].
+    pub g92: Vector3<f64>,
+    /// Metres per program unit.
+    pub units: f64,
+    pub plane: Plane,
+    pub absolute: bool,
+    pub ijk_absolute: bool,
+    pub feed_mode: FeedMode,
+    /// The F word as given (program units per minute, or per revolution in G95).
+    pub feed: f64,
+    /// Modal motion, ten times its G number; `None` after G80 and at the start.
+    pub motion: Option<u16>,
+    /// The last G0-G3 mode (the Fanuc dialect's motion after G80).
+    pub plain_motion: Option<u16>,
+    pub retract_old_z: bool,
+    pub path_control: PathControl,
+    pub spindle_rpm: f64,
+    /// 1 clockwise, -1 counter-clockwise, 0 stopped.
+    pub spindle_dir: i8,
+    pub tool: u32,
+    pub selected: u32,
+    /// Recorded tool length offset \[m\] (not applied) and whether one is in effect.
+    pub tool_offset: Vector3<f64>,
+    pub mist: bool,
+    pub flood: bool,
+    pub feed_override: bool,
+    pub speed_override: bool,
+    pub cycle: CycleMemory,
+    /// The last G5's P and Q (program units), for a G5 without I and J.
+    pub spline_pq: Option<(f64, f64)>,
+    /// M70/M73 saved states.
+    pub saved: Option<Modal>,
+    pub moves: Vec<Move>,
+    /// The line of M2/M30 (or an M99 at the top level), once read.
+    pub ended: Option<usize>,
+    /// The physical line being run (1-based).
+    pub line: usize,
+    /// `#<_value>`, `#<_value_returned>`, `#<_call_level>`.
+    pub value: f64,
+    pub value_returned: bool,
+    pub call_level: usize,
+}
+
+/// Rotates (x, y) by `deg` counter-clockwise.
+pub(super) fn rotate(v: Vector2<f64>, deg: f64) -> Vector2<f64> {
+    if deg == 0.0 {
+        return v;
+    }
+    let (s, c) = deg.to_radians().sin_cos();
+    Vector2::new(v.x * c - v.y * s, v.x * s + v.y * c)
+}
+
+impl Machine {
+    pub(super) fn new(dialect: Dialect, start: Vector3<f64>, units: f64) -> Self {
+        Self {
+            dialect,
+            pos: start,
+            system: 1,
+            g5x: Vector3::zeros(),
+            rotation: 0.0,
+            g92: Vector3::zeros(),
+            units,
+            plane: Plane::Xy,
+            absolute: true,
+            ijk_absolute: false,
+            feed_mode: FeedMode::PerMinute,
+            feed: 0.0,
+            motion: None,
+            plain_motion: None,
+            retract_old_z: false,
+            path_control: PathControl::default(),
+            spindle_rpm: 0.0,
+            spindle_dir: 0,
+            tool: 0,
+            selected: 0,
+            tool_offset: Vector3::zeros(),
+            mist: false,
+            flood: false,
+            feed_override: true,
+            speed_override: true,
+            cycle: CycleMemory::default(),
+            spline_pq: None,
+            saved: None,
+            moves: Vec::new(),
+            ended: None,
+            line: 0,
+            value: 0.0,
+            value_returned: false,
+            call_level: 0,
+        }
+    }
+
+    /// The machine-frame tool tip of program-frame point `p` \[m\].
+    pub(super) fn to_machine(&self, p: &Vector3<f64>) -> Vector3<f64> {
+        let xy = rotate(p.xy() + self.g92.xy(), self.rotation) + self.g5x.xy();
+        Vector3::new(xy.x, xy.y, p.z + self.g92.z + self.g5x.z)
+    }
+
+    /// The program-frame point of machine-frame point `m` \[m\].
+    pub(super) fn to_program(&self, m: &Vector3<f64>) -> Vector3<f64> {
+        let xy = rotate(m.xy() - self.g5x.xy(), -self.rotation) - self.g92.xy();
+        Vector3::new(xy.x, xy.y, m.z - self.g5x.z - self.g92.z)
+    }
+
+    /// The machine's modal state (M70).
+    fn modal(&self) -> Modal {
+        Modal {
+            units: self.units,
+            plane: self.plane,
+            absolute: self.absolute,
+            ijk_absolute: self.ijk_absolute,
+            feed_mode: self.feed_mode,
+            feed: self.feed,
+            motion: self.motion,
+            retract_old_z: self.retract_old_z,
+            path_control: self.path_control,
+            spindle_rpm: self.spindle_rpm,
+            spindle_dir: self.spindle_dir,
+            mist: self.mist,
+            flood: self.flood,
+            system: self.system,
+        }
+    }
+
+    /// Restores a saved modal state (M72; the automatic restore of M73 at a sub's return).
+    pub(super) fn restore(&mut self, m: &Modal, params: &Params) {
+        self.units = m.units;
+        self.plane = m.plane;
+        self.absolute = m.absolute;
+        self.ijk_absolute = m.ijk_absolute;
+        self.feed_mode = m.feed_mode;
+        self.feed = m.feed;
+        self.motion = m.motion;
+        self.retract_old_z = m.retract_old_z;
+        self.path_control = m.path_control;
+        self.spindle_rpm = m.spindle_rpm;
+        self.spindle_dir = m.spindle_dir;
+        self.mist = m.mist;
+        self.flood = m.flood;
+        if m.system != self.system {
+            self.select_system(m.system, params);
+        }
+    }
+
+    /// The moves' spindle \[rev/s\], signed by direction.
+    pub(super) fn spindle(&self) -> f64 {
+        f64::from(self.spindle_dir) * self.spindle_rpm / 60.0
+    }
+
+    /// Switches to coordinate system `n` (1..=9), loading its offsets from the parameters
+    /// (stored in mm) and keeping the machine position.
+    pub(super) fn select_system(&mut self, n: usize, params: &Params) {
+        let m = self.to_machine(&self.pos);
+        let base = 5200 + 20 * n;
+        self.system = n;
+        self.g5x = Vector3::new(
+            params.get(base + 1) * 1e-3,
+            params.get(base + 2) * 1e-3,
+            params.get(base + 3) * 1e-3,
+        );
+        self.rotation = params.get(base + 10);
+        self.pos = self.to_program(&m);
+    }
+
+    /// Runs a block (see the module docs for the order). `params` for the offset and home
+    /// parameters.
+    pub(super) fn execute(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
+        check_groups(w, self.dialect)?;
+        self.refuse_unsupported(w)?;
+        self.modes_before_motion(w, params)?;
+        let consumed = self.non_modal(w, params)?;
+        self.motion(w, consumed, params)?;
+        self.stops(w);
+        if let Some((letter, column)) = w.unused() {
+            return fault(column, unused_message(letter, w));
+        }
+        Ok(())
+    }
+
+    /// Refuses what has no meaning on a robot or is not modelled, by name.
+    fn refuse_unsupported(&self, w: &Words) -> Result<(), Fault> {
+        for &(g, column) in &w.g {
+            let why = match g {
+                330 | 331 | 760 => "threading (G33, G33.1, G76) is not modelled",
+                382..=385 => "probing (G38.2-G38.5) needs a probe; it is not modelled",
+                410 | 411 | 420 | 421 => {
+                    "cutter radius compensation (G41, G42) is not modelled: have the CAM \
+                     system write the compensated tool path"
+                }
+                70 => "lathe diameter mode (G7) is a lathe's",
+                700 | 710 | 711 | 712 | 720 | 721 | 722 => "lathe cycles (G70-G72) are a lathe's",
+                960 => "constant surface speed (G96) is a lathe's",
+                171 | 181 | 191 => "the UVW planes (G17.1, G18.1, G19.1) need UVW axes",
+                52 | 53 => "NURBS (G5.2, G5.3) are not modelled",
+                880 => "G88 (boring with the operator's retract by hand) needs an operator",
+                _ => continue,
+            };
+            return fault(column, std::format!("{}: {why}", g_name(g)));
+        }
+        for (letter, what) in [
+            (b'a', "A"),
+            (b'b', "B"),
+            (b'c', "C"),
+            (b'u', "U"),
+            (b'v', "V"),
+            (b'w', "W"),
+        ] {
+            if w.has(letter) {
+                return fault(
+                    w.column(letter),
+                    std::format!(
+                        "{what}: rotary and secondary axes (A, B, C, U, V, W) are not modelled; \
+                         a 3-axis program moves X, Y and Z"
+                    ),
+                );
+            }
+        }
+        if w.has(b'$') {
+            return fault(
+                w.column(b'$'),
+                "$ (spindle selection): the robot has one spindle",
+            );
+        }
+        if let Some(&(m, column)) = w.m.iter().find(|m| (100..=199).contains(&m.0)) {
+            return fault(
+                column,
+                std::format!(
+                    "M{m}: user M codes (M100-M199) run programs of the controller; none is \
+                     available"
+                ),
+            );
+        }
+        Ok(())
+    }
+
+    /// Steps 2-23 of LinuxCNC's order: modes, F, S, T, M codes, dwell, plane, units,
+    /// compensation, coordinate system, path control, distance and retract modes.
+    fn modes_before_motion(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
+        if w.g(970).is_some() {
+            // G97: RPM mode, the only one.
+        }
+        if w.g(930).is_some() {
+            self.feed_mode = FeedMode::InverseTime;
+        } else if w.g(940).is_some() {
+            self.feed_mode = FeedMode::PerMinute;
+            self.feed = 0.0;
+        } else if w.g(950).is_some() {
+            self.feed_mode = FeedMode::PerRevolution;
+            self.feed = 0.0;
+        }
+        if let Some(f) = w.peek(b'f') {
+            if f < 0.0 {
+                return fault(w.column(b'f'), std::format!("a feed F >= 0, got F{f}"));
+            }
+            w.take(b'f');
+            if self.feed_mode != FeedMode::InverseTime {
+                self.feed = f;
+            }
+        }
+        if let Some(s) = w.take(b's') {
+            if !(0.0..=MAX_SPINDLE_RPM).contains(&s) {
+                return fault(
+                    w.column(b's'),
+                    std::format!("a spindle speed S in [0, {MAX_SPINDLE_RPM}] rpm, got S{s}"),
+                );
+            }
+            self.spindle_rpm = s;
+        }
+        if let Some(t) = w.take(b't') {
+            self.selected = tool_number(t, w.column(b't'), "T")?;
+        }
+        self.io_codes(w)?;
+        if w.m(6).is_some() {
+            self.tool = self.selected;
+            self.spindle_dir = 0;
+        } else if let Some(column) = w.m(61) {
+            let Some(q) = w.take(b'q').filter(|q| *q >= 0.0) else {
+                return fault(column, "M61 needs Q, the tool number (>= 0)");
+            };
+            self.tool = tool_number(q, w.column(b'q'), "M61 Q")?;
+        }
+        self.spindle_codes(w, params)?;
+        if w.m(7).is_some() {
+            self.mist = true;
+        } else if w.m(8).is_some() {
+            self.flood = true;
+        } else if w.m(9).is_some() {
+            self.mist = false;
+            self.flood = false;
+        }
+        for (m, feed, speed) in [(48, true, true), (49, false, false)] {
+            if w.m(m).is_some() {
+                self.feed_override = feed;
+                self.speed_override = speed;
+            }
+        }
+        for m in 50..=53 {
+            if w.m(m).is_some() {
+                let on = w.take(b'p') != Some(0.0);
+                match m {
+                    50 => self.feed_override = on,
+                    51 => self.speed_override = on,
+                    _ => {}
+                }
+            }
+        }
+        if let Some(column) = w.g(40) {
+            if w.first_of(b"ijk").is_some() && !w.has(b'g') {
+                return fault(column, "G4 takes P only");
+            }
+            let p = w.take(b'p').filter(|p| *p != -1.0);
+            let Some(p) = p else {
+                return fault(column, "G4 needs P, the dwell time in seconds");
+            };
+            self.dwell(p, w.column(b'p'))?;
+        }
+        for (code, plane) in [(170, Plane::Xy), (180, Plane::Zx), (190, Plane::Yz)] {
+            if w.g(code).is_some() {
+                self.plane = plane;
+            }
+        }
+        if w.g(200).is_some() {
+            self.units = INCH;
+        } else if w.g(210).is_some() {
+            self.units = 1.0e-3;
+        }
+        if w.g(430).is_some() || w.g(432).is_some() {
+            // Recorded: the TCP carries the tool length. H names the tool (0: the one in
+            // the spindle).
+            if let Some(h) = w.take(b'h') {
+                tool_number(h, w.column(b'h'), "H")?;
+            }
+            if w.g(432).is_some() && w.peek(b'h').is_none() && w.first_of(b"xyz").is_none() {
+                return fault(w.g(432).unwrap_or(1), "G43.2 needs H or axis words");
+            }
+        } else if w.g(431).is_some() {
+            for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
+                if let (Some(v), Some(o)) = (w.peek(l), self.tool_offset.get_mut(k)) {
+                    *o = v * self.units;
+                }
+            }
+        } else if w.g(490).is_some() {
+            self.tool_offset = Vector3::zeros();
+        }
+        let systems = [540, 550, 560, 570, 580, 590, 591, 592, 593];
+        if let Some(n) = systems.iter().position(|&g| w.g(g).is_some())
+            && n + 1 != self.system
+        {
+            self.select_system(n + 1, params);
+        }
+        if w.g(610).is_some() {
+            self.path_control = PathControl::ExactPath;
+        } else if w.g(611).is_some() {
+            self.path_control = PathControl::ExactStop;
+        } else if w.g(640).is_some() {
+            let p = w.take(b'p').filter(|p| *p > 0.0).unwrap_or(0.0) * self.units;
+            let q = w.take(b'q').map_or(p, |q| q.max(0.0) * self.units);
+            self.path_control = PathControl::Blend {
+                tolerance: p,
+                naive_tolerance: q,
+            };
+        }
+        if w.g(900).is_some() {
+            self.absolute = true;
+        } else if w.g(910).is_some() {
+            self.absolute = false;
+        }
+        if w.g(901).is_some() {
+            self.ijk_absolute = true;
+        } else if w.g(911).is_some() {
+            self.ijk_absolute = false;
+        }
+        if w.g(980).is_some() {
+            self.retract_old_z = true;
+        } else if w.g(990).is_some() {
+            self.retract_old_z = false;
+        }
+        Ok(())
+    }
+
+    /// M62-M68 (outputs and inputs, recorded) and M19 (spindle orientation, recorded): their
+    /// words are read and checked, nothing moves.
+    fn io_codes(&mut self, w: &mut Words) -> Result<(), Fault> {
+        for m in 62..=65 {
+            if let Some(column) = w.m(m)
+                && w.take(b'p').is_none()
+            {
+                return fault(column, std::format!("M{m} needs P, the output number"));
+            }
+        }
+        if let Some(column) = w.m(66) {
+            let (p, e) = (w.take(b'p'), w.take(b'e'));
+            w.take(b'l');
+            w.take(b'q');
+            if p.is_some() == e.is_some() {
+                return fault(
+                    column,
+                    "M66 needs either P (digital input) or E (analog input)",
+                );
+            }
+        }
+        for m in [67, 68] {
+            if let Some(column) = w.m(m) {
+                if w.take(b'e').is_none() {
+                    return fault(
+                        column,
+                        std::format!("M{m} needs E, the analog output number"),
+                    );
+                }
+                w.take(b'q');
+            }
+        }
+        if w.m(19).is_some() {
+            w.take(b'r');
+            w.take(b'p');
+            w.take(b'q');
+        }
+        Ok(())
+    }
+
+    fn spindle_codes(&mut self, w: &mut Words, params: &Params) -> Result<(), Fault> {
+        if w.m(3).is_some() {
+            self.spindle_dir = 1;
+        } else if w.m(4).is_some() {
+            self.spindle_dir = -1;
+        } else if w.m(5).is_some() {
+            self.spindle_dir = 0;
+        } else if w.m(70).is_some() || w.m(73).is_some() {
+            self.saved = Some(self.modal());
+        } else if w.m(71).is_some() {
+            self.saved = None;
+        } else if let Some(column) = w.m(72) {
+            let Some(m) = self.saved else {
+                return fault(column, "M72 restores the state M70 saved: no M70 before it");
+            };
+            self.restore(&m, params);
+        }
+        Ok(())
+    }
+
+    /// Group 0 and 16: G10, G28/G30 (and .1), G52, G92 (and .1-.3). Returns whether the
+    /// axis words were used here (they then move nothing else).
+    fn non_modal(&mut self, w: &mut Words, params: &mut Params) -> Result<bool, Fault> {
+        let axis_users = [100, 280, 300, 520, 920];
+        let user = axis_users.iter().find_map(|&g| w.g(g).map(|c| (g, c)));
+        if let Some((g, column)) = user
+            && let Some(&(m, _)) =
+                w.g.iter()
+                    .find(|x| super::words_group(x.0) == Some(1) && x.0 != 800)
+        {
+            return fault(
+                column,
+                std::format!(
+                    "{} and {}: two codes that both use the axis words",
+                    g_name(g),
+                    g_name(m)
+                ),
+            );
+        }
+        if w.g(281).is_some() || w.g(301).is_some() {
+            let base = if w.g(281).is_some() { 5161 } else { 5181 };
+            let m = self.to_machine(&self.pos);
+            for (k, v) in m.iter().enumerate() {
+                params.set(base + k, v * 1e3);
+            }
+        }
+        match user {
+            Some((100, column)) => self.g10(w, params, column).map(|()| true),
+            Some((280 | 300, column)) => {
+                let base = if w.g(280).is_some() { 5161 } else { 5181 };
+                self.home(w, params, base, column).map(|()| true)
+            }
+            Some((520 | 920, column)) => self.g92(w, params, column).map(|()| true),
+            _ => {
+                for (g, keep_params) in [(921, false), (922, true)] {
+                    if w.g(g).is_some() {
+                        self.pos += self.g92;
+                        self.g92 = Vector3::zeros();
+                        params.set(5210, 0.0);
+                        if !keep_params {
+                            for k in 5211..=5219 {
+                                params.set(k, 0.0);
+                            }
+                        }
+                    }
+                }
+                if w.g(923).is_some() {
+                    let stored =
+                        Vector3::new(params.get(5211), params.get(5212), params.get(5213)) * 1e-3;
+                    self.pos += self.g92 - stored;
+                    self.g92 = stored;
+                    params.set(5210, 1.0);
+                }
+                Ok(false)
+            }
+        }
+    }
+
+    /// G92 (set the axis offset so the current point has the given coordinates) and G52 (set
+    /// the axis offset itself).
+    fn g92(&mut self, w: &mut Words, params: &mut Params, column: usize) -> Result<(), Fault> {
+        let local = w.g(520).is_some();
+        if w.first_of(b"xyz").is_none() {
+            return fault(column, "G92/G52 need at least one axis word (X, Y, Z)");
+        }
+        for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
+            if let Some(v) = w.take(l) {
+                let v = v * self.units;
+                let (Some(p), Some(o)) = (self.pos.get_mut(k), self.g92.get_mut(k)) else {
+                    continue;
+                };
+                if local {
+                    *p += *o - v;
+                    *o = v;
+                } else {
+                    *o += *p - v;
+                    *p = v;
+                }
+            }
+        }
+        params.set(5210, 1.0);
+        for k in 0..3 {
+            params.set(5211 + k, self.g92.get(k).copied().unwrap_or(0.0) * 1e3);
+        }
+        Ok(())
+    }
+
+    /// G10 L2 / L20 (work offsets); L1, L10, L11 (tool table entries) and L0 (reload) are
+    /// read and recorded: deflect takes the tools from its own table.
+    fn g10(&mut self, w: &mut Words, params: &mut Params, column: usize) -> Result<(), Fault> {
+        let l = w.take(b'l').map(|l| l.round() as i64);
+        let p = w.take(b'p');
+        match l {
+            Some(2 | 20) => {}
+            Some(0 | 1 | 10 | 11) => {
+                for letter in *b"xyzrijq" {
+                    w.take(letter);
+                }
+                return Ok(());
+            }
+            _ => {
+                return fault(
+                    column,
+                    "G10 needs L2 or L20 (work offsets), or L0, L1, L10, L11",
+                );
+            }
+        }
+        let Some(p) = p else {
+            return fault(
+                column,
+                "G10 L2/L20 needs P, the coordinate system (0: the active one, 1-9)",
+            );
+        };
+        if p + 0.0001 - p.round() > 0.0002 || !(-0.0001..9.0001).contains(&p) {
+            return fault(
+                w.column(b'p'),
+                std::format!("a coordinate system P in 0..=9 with G10, got P{p}"),
+            );
+        }
+        let n = match (p + 0.0001) as usize {
+            0 => self.system,
+            n => n,
+        };
+        let l20 = l == Some(20);
+        if w.has(b'i') || w.has(b'j') {
+            return fault(
+                w.first_of(b"ij").unwrap_or(column),
+                "no I or J with G10 L2/L20",
+            );
+        }
+        let base = 5200 + 20 * n;
+        let r = match w.take(b'r') {
+            Some(_) if l20 => return fault(w.column(b'r'), "no R with G10 L20"),
+            Some(r) => {
+                params.set(base + 10, r);
+                r
+            }
+            None => params.get(base + 10),
+        };
+        let old = Vector3::new(
+            params.get(base + 1),
+            params.get(base + 2),
+            params.get(base + 3),
+        ) * 1e-3;
+        let mut new = old;
+        let (x, y, z) = (w.take(b'x'), w.take(b'y'), w.take(b'z'));
+        if l20 {
+            let m = self.to_machine(&self.pos);
+            // The current point in system n, then the offset that gives it the words.
+            let cur = rotate(m.xy() - old.xy(), -r) - self.g92.xy();
+            let want = Vector2::new(
+                x.map_or(cur.x, |v| v * self.units),
+                y.map_or(cur.y, |v| v * self.units),
+            );
+            if x.is_some() || y.is_some() {
+                let o = m.xy() - rotate(want + self.g92.xy(), r);
+                new.x = o.x;
+                new.y = o.y;
+            }
+            if let Some(z) = z {
+                new.z = m.z - self.g92.z - z * self.units;
+            }
+        } else {
+            for (k, v) in [x, y, z].into_iter().enumerate() {
+                if let (Some(v), Some(o)) = (v, new.get_mut(k)) {
+                    *o = v * self.units;
+                }
+            }
+        }
+        for k in 0..3 {
+            params.set(base + 1 + k, new.get(k).copied().unwrap_or(0.0) * 1e3);
+        }
+        if n == self.system {
+            // LinuxCNC keeps the point given by P, the old offset and rotation (not G92).
+            let c = rotate(self.pos.xy(), self.rotation) + self.g5x.xy();
+            let xy = rotate(c - new.xy(), -r);
+            self.pos = Vector3::new(xy.x, xy.y, self.pos.z + self.g5x.z - new.z);
+            self.g5x = new;
+            self.rotation = r;
+        }
+        Ok(())
+    }
+
+    fn stops(&mut self, w: &Words) {
+        if w.m(2).is_some() || w.m(30).is_some() {
+            self.ended = Some(self.line);
+        }
+    }
+}
+
+/// A tool number: an integer within 0.0001, 0..=MAX_TOOL_NUMBER.
+fn tool_number(v: f64, column: usize, what: &str) -> Result<u32, Fault> {
+    match super::expr::integer(v) {
+        Some(t) if (0..=i64::from(MAX_TOOL_NUMBER)).contains(&t) => Ok(t as u32),
+        _ => fault(
+            column,
+            std::format!("a tool number {what} in 0..={MAX_TOOL_NUMBER} (an integer), got {v}"),
+        ),
+    }
+}
+
+/// The G and M codes of a block grouped as LinuxCNC groups them: one per group (G80 may
+/// join another motion code and is then dropped; M7 and M8 share group 8 but LinuxCNC
+/// refuses them together too), at most 4 M codes.
+fn check_groups(w: &mut Words, dialect: Dialect) -> Result<(), Fault> {
+    let has_other_motion =
+        w.g.iter()
+            .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
+    if has_other_motion {
+        w.g.retain(|g| g.0 != 800);
+    }
+    let _ = dialect;
+    for (i, &(a, ca)) in w.g.iter().enumerate() {
+        let ga = super::words_group(a);
+        if let Some(&(b, _)) =
+            w.g.iter()
+                .skip(i + 1)
+                .find(|&&(b, _)| super::words_group(b) == ga)
+        {
+            return fault(
+                ca,
+                std::format!(
+                    "one G code of each modal group per line, got {} and {}",
+                    g_name(a),
+                    g_name(b)
+                ),
+            );
+        }
+    }
+    if w.m.len() > 4 {
+        return fault(w.m.get(4).map_or(1, |m| m.1), "at most 4 M codes on a line");
+    }
+    for (i, &(a, ca)) in w.m.iter().enumerate() {
+        let ga = super::m_group(a);
+        if let Some(&(b, _)) =
+            w.m.iter()
+                .skip(i + 1)
+                .find(|&&(b, _)| super::m_group(b) == ga)
+        {
+            return fault(
+                ca,
+                std::format!("one M code of each modal group per line, got M{a} and M{b}"),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Why a word nothing used is on the line.
+fn unused_message(letter: char, w: &Words) -> String {
+    let motion = w.g.iter().find(|g| super::words_group(g.0) == Some(1));
+    let users = match letter {
+        'X' | 'Y' | 'Z' | '@' | '^' => {
+            return std::format!(
+                "{letter}: axis words with no motion mode to use them (G0, G1, G2, G3 or a \
+                 cycle; after G80 or at the start, the line needs one)"
+            );
+        }
+        'I' | 'J' | 'K' => "G2, G3, G5, G5.1 or G87",
+        'R' => "G2, G3, a canned cycle or G10 L2",
+        'P' => "G2, G3, G4, G5, G10, G64, G82, G86, G88, G89, M50-M53, M62-M66 or M98",
+        'Q' => "G5, G10, G64, G73, G83, M61, M66-M68 or M19",
+        'L' => "G10, a canned cycle or M98",
+        'H' => "G43 or G43.2",
+        'D' => "G41 or G42 (not modelled)",
+        'E' => "M66, M67 or M68",
+        _ => "any code",
+    };
+    let context = motion.map_or(String::new(), |m| {
+        std::format!(" (this line's is {})", g_name(m.0))
+    });
+    std::format!("{letter}: a word nothing on the line uses; only {users} use it{context}")
+}
+
+impl Machine {
+    /// The tool offset in effect is recorded only; whether one is set (`#<_tool_offset>`).
+    pub(super) fn has_tool_offset(&self) -> bool {
+        self.tool_offset != Vector3::zeros()
+    }
+
+    /// A description of the unit, for messages.
+    pub(super) fn unit_name(&self) -> &'static str {
+        if self.units == INCH { "in" } else { "mm" }
+    }
+}

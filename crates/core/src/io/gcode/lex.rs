@@ -1,0 +1,845 @@
+//! One line of RS274/NGC read into a [`Block`]: LinuxCNC's lexical rules (its
+//! `interp_read.cc`, described in the module docs of [`super`]): spaces, tabs and CR dropped
+//! and letters lower-cased outside comments, `(...)` and `;` comments (only the last paren
+//! comment of a line counts), an optional `/` and `N` number, then either one O-word
+//! statement or words and parameter settings whose values are numbers, `[expressions]`,
+//! `#parameters` or functions. Values are parsed into an arena of [`Node`]s and evaluated
+//! when the block runs (a loop runs a line many times; it is lexed each time it runs).
+
+use std::string::{String, ToString};
+use std::vec::Vec;
+
+use super::Dialect;
+
+/// Deepest nesting of brackets, functions and unary signs in one value: 128 (LinuxCNC's
+/// 253-byte lines allow about 120). Past it the line is refused, so evaluation recursion is
+/// bounded.
+pub const MAX_EXPRESSION_DEPTH: usize = 128;
+
+/// A binary operator, by LinuxCNC's precedence (all left-associative).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Op {
+    Pow,
+    Mul,
+    Div,
+    Mod,
+    Add,
+    Sub,
+    Eq,
+    Ne,
+    Gt,
+    Ge,
+    Lt,
+    Le,
+    And,
+    Or,
+    Xor,
+}
+
+impl Op {
+    fn precedence(self) -> u8 {
+        match self {
+            Self::Pow => 6,
+            Self::Mul | Self::Div | Self::Mod => 5,
+            Self::Add | Self::Sub => 4,
+            Self::Eq | Self::Ne | Self::Gt | Self::Ge | Self::Lt | Self::Le => 3,
+            Self::And | Self::Or | Self::Xor => 2,
+        }
+    }
+}
+
+/// A one-argument function (angles in degrees).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Func {
+    Abs,
+    Acos,
+    Asin,
+    Cos,
+    Exp,
+    Fix,
+    Fup,
+    Round,
+    Ln,
+    Sin,
+    Sqrt,
+    Tan,
+}
+
+/// A parameter: numbered (its index is a value) or named (a range of [`Block::names`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Param {
+    Numbered(u32),
+    Named(u32, u32),
+}
+
+/// A node of a value's expression tree; children are indices into [`Block::nodes`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Node {
+    Num(f64),
+    Param(Param),
+    Neg(u32),
+    Bin(Op, u32, u32),
+    Func(Func, u32),
+    Atan(u32, u32),
+    Exists(Param),
+}
+
+/// A word or a parameter setting, in the line's order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Item {
+    /// A letter (lower case, or `@` `^` `$`) and its value.
+    Word {
+        letter: u8,
+        value: u32,
+        column: usize,
+    },
+    /// `#... = value`.
+    Set {
+        target: Param,
+        value: u32,
+        column: usize,
+    },
+}
+
+/// An O-word's label.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Label {
+    /// `O100`, `O[50*2]`, `O#5`: a value, named `<100>` when run.
+    Value(u32),
+    /// `O<name>` (lower case, no spaces).
+    Name(u32, u32),
+}
+
+/// An O-word's keyword.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Keyword {
+    Sub,
+    Endsub,
+    Call,
+    Do,
+    While,
+    Repeat,
+    If,
+    Elseif,
+    Else,
+    Endif,
+    Break,
+    Continue,
+    Endwhile,
+    Endrepeat,
+    Return,
+    /// A bare `O100`: a Fanuc-style program number.
+    Header,
+}
+
+impl Keyword {
+    /// The keyword as written.
+    pub(super) fn name(self) -> &'static str {
+        match self {
+            Self::Sub => "sub",
+            Self::Endsub => "endsub",
+            Self::Call => "call",
+            Self::Do => "do",
+            Self::While => "while",
+            Self::Repeat => "repeat",
+            Self::If => "if",
+            Self::Elseif => "elseif",
+            Self::Else => "else",
+            Self::Endif => "endif",
+            Self::Break => "break",
+            Self::Continue => "continue",
+            Self::Endwhile => "endwhile",
+            Self::Endrepeat => "endrepeat",
+            Self::Return => "return",
+            Self::Header => "(program number)",
+        }
+    }
+}
+
+/// An O-word statement: label, keyword, its bracketed arguments (values) and column.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct OWord {
+    pub label: Label,
+    pub keyword: Keyword,
+    pub args: Vec<u32>,
+    pub column: usize,
+}
+
+/// What a paren comment asks for (`(MSG,...)`, `(DEBUG,...)`, ...); plain comments are
+/// kept for the word report only.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum CommentKind {
+    Plain,
+    Msg,
+    Debug,
+    Print,
+    Log,
+    /// `(ABORT,...)`: the program stops with its text as the error.
+    Abort,
+}
+
+/// The last paren comment of a line.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Comment {
+    pub kind: CommentKind,
+    /// Its text after the keyword's comma, case kept.
+    pub text: String,
+    pub column: usize,
+}
+
+/// One line, lexed.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(super) struct Block {
+    /// The line starts with `/` (block delete).
+    pub delete: bool,
+    pub nodes: Vec<Node>,
+    pub names: String,
+    pub items: Vec<Item>,
+    pub o_word: Option<OWord>,
+    pub comment: Option<Comment>,
+    /// The normalised text (lower case, no spaces, comments out) and each byte's column.
+    text: Vec<u8>,
+    cols: Vec<usize>,
+    /// Column one past the line's end.
+    end_column: usize,
+}
+
+/// A lexical error: column and message.
+pub(super) type LexError = (usize, String);
+
+impl Block {
+    /// Empties the block, keeping its buffers.
+    pub(super) fn clear(&mut self) {
+        self.delete = false;
+        self.nodes.clear();
+        self.names.clear();
+        self.items.clear();
+        self.o_word = None;
+        self.comment = None;
+        self.text.clear();
+        self.cols.clear();
+        self.end_column = 1;
+    }
+
+    /// A named parameter's or label's name.
+    pub(super) fn name(&self, start: u32, end: u32) -> &str {
+        self.names.get(start as usize..end as usize).unwrap_or("")
+    }
+
+    /// The words' letters with their columns (for the word report).
+    pub(super) fn words(&self) -> impl Iterator<Item = (u8, u32, usize)> + '_ {
+        self.items.iter().filter_map(|i| match *i {
+            Item::Word {
+                letter,
+                value,
+                column,
+            } => Some((letter, value, column)),
+            Item::Set { .. } => None,
+        })
+    }
+}
+
+/// Lexes `raw` into `block` (cleared first). A line is read whole: its errors come before
+/// any of it runs, as in LinuxCNC.
+pub(super) fn lex(raw: &str, dialect: Dialect, block: &mut Block) -> Result<(), LexError> {
+    block.clear();
+    normalise(raw, dialect, block)?;
+    let mut p = Parser {
+        b: block,
+        at: 0,
+        depth: 0,
+    };
+    p.line()
+}
+
+/// Whether a raw line is an O-word line (after an optional `/` and `N` number), read without
+/// lexing it: what the reader checks while it skips lines.
+pub(super) fn is_o_line(raw: &str) -> bool {
+    let mut bytes = raw
+        .bytes()
+        .filter(|b| !matches!(b, b' ' | b'\t' | b'\r'))
+        .peekable();
+    if bytes.peek() == Some(&b'/') {
+        bytes.next();
+    }
+    if matches!(bytes.peek(), Some(b'n' | b'N')) {
+        bytes.next();
+        while matches!(bytes.peek(), Some(b) if b.is_ascii_digit() || *b == b'.') {
+            bytes.next();
+        }
+    }
+    matches!(bytes.peek(), Some(b'o' | b'O'))
+}
+
+/// Drops spaces, tabs and CR outside comments, lower-cases, takes out the comments (the last
+/// paren comment kept) and stops at `;`.
+fn normalise(raw: &str, dialect: Dialect, b: &mut Block) -> Result<(), LexError> {
+    let bytes = raw.as_bytes();
+    b.end_column = bytes.len() + 1;
+    let mut i = 0;
+    while let Some(&c) = bytes.get(i) {
+        let column = i + 1;
+        match c {
+            0 => break,
+            b' ' | b'\t' | b'\r' => i += 1,
+            b';' => break,
+            b'(' => {
+                let close = comment_end(bytes, i, dialect)?;
+                let inner = raw.get(i + 1..close).unwrap_or("");
+                b.comment = Some(classify_comment(inner, column));
+                i = close + 1;
+            }
+            _ => {
+                b.text.push(c.to_ascii_lowercase());
+                b.cols.push(column);
+                i += 1;
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The index of the `)` closing the comment opened at `open`. LinuxCNC refuses a `(` inside
+/// a comment; the Fanuc dialect nests them.
+fn comment_end(bytes: &[u8], open: usize, dialect: Dialect) -> Result<usize, LexError> {
+    let mut depth = 0usize;
+    for (k, &c) in bytes.iter().enumerate().skip(open) {
+        match c {
+            b'(' if depth > 0 && !dialect.nested_comments() => {
+                return Err((
+                    k + 1,
+                    "no '(' inside a comment (nested comments are refused by LinuxCNC; the \
+                     fanuc dialect reads them)"
+                        .to_string(),
+                ));
+            }
+            b'(' => depth += 1,
+            b')' => {
+                depth -= 1;
+                if depth == 0 {
+                    return Ok(k);
+                }
+            }
+            0 => break,
+            _ => {}
+        }
+    }
+    Err((open + 1, "a ')' closing this comment".to_string()))
+}
+
+fn classify_comment(inner: &str, column: usize) -> Comment {
+    let trimmed = inner.trim_start();
+    for (key, kind) in [
+        ("msg,", CommentKind::Msg),
+        ("debug,", CommentKind::Debug),
+        ("print,", CommentKind::Print),
+        ("log,", CommentKind::Log),
+        ("abort,", CommentKind::Abort),
+    ] {
+        if let Some(head) = trimmed.get(..key.len())
+            && head.eq_ignore_ascii_case(key)
+        {
+            return Comment {
+                kind,
+                text: trimmed.get(key.len()..).unwrap_or("").to_string(),
+                column,
+            };
+        }
+    }
+    Comment {
+        kind: CommentKind::Plain,
+        text: trimmed.to_string(),
+        column,
+    }
+}
+
+/// What may start a value, for messages.
+const VALUE: &str = "a number, a [bracketed expression], a #parameter or a function";
+
+struct Parser<'a> {
+    b: &'a mut Block,
+    at: usize,
+    depth: usize,
+}
+
+impl Parser<'_> {
+    fn peek(&self) -> Option<u8> {
+        self.b.text.get(self.at).copied()
+    }
+
+    fn peek_at(&self, k: usize) -> Option<u8> {
+        self.b.text.get(self.at + k).copied()
+    }
+
+    fn column(&self) -> usize {
+        self.b
+            .cols
+            .get(self.at)
+            .copied()
+            .unwrap_or(self.b.end_column)
+    }
+
+    fn column_of(&self, at: usize) -> usize {
+        self.b.cols.get(at).copied().unwrap_or(self.b.end_column)
+    }
+
+    fn err<T>(&self, message: String) -> Result<T, LexError> {
+        Err((self.column(), message))
+    }
+
+    /// What follows, for messages: up to 12 bytes of the normalised text.
+    fn got(&self) -> String {
+        match self.b.text.get(self.at..) {
+            Some(rest) if !rest.is_empty() => {
+                let s: String = rest.iter().take(12).map(|&c| char::from(c)).collect();
+                std::format!("{s:?}")
+            }
+            _ => "the end of the line".to_string(),
+        }
+    }
+
+    fn push(&mut self, n: Node) -> u32 {
+        self.b.nodes.push(n);
+        (self.b.nodes.len() - 1) as u32
+    }
+
+    fn line(&mut self) -> Result<(), LexError> {
+        if self.peek() == Some(b'/') {
+            self.b.delete = true;
+            self.at += 1;
+        }
+        if self.peek() == Some(b'n') {
+            self.at += 1;
+            let from = self.at;
+            while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
+                self.at += 1;
+            }
+            if self.at == from {
+                return self.err(std::format!(
+                    "digits after N (a line number), got {}",
+                    self.got()
+                ));
+            }
+            if self.peek() == Some(b'.') {
+                self.at += 1;
+                let frac = self.at;
+                while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
+                    self.at += 1;
+                }
+                if self.at == frac {
+                    return self.err("digits after the '.' of a line number".to_string());
+                }
+            }
+        }
+        if self.peek() == Some(b'o') {
+            return self.o_word();
+        }
+        while let Some(c) = self.peek() {
+            let column = self.column();
+            match c {
+                b'#' => {
+                    self.at += 1;
+                    let target = self.param()?;
+                    if self.peek() != Some(b'=') {
+                        return self.err(std::format!(
+                            "'=' after the parameter (a parameter setting #n=value), got {}",
+                            self.got()
+                        ));
+                    }
+                    self.at += 1;
+                    let value = self.value()?;
+                    self.b.items.push(Item::Set {
+                        target,
+                        value,
+                        column,
+                    });
+                }
+                b'a'..=b'z' | b'@' | b'^' | b'$' if c != b'n' && c != b'o' => {
+                    self.at += 1;
+                    if c != b'g'
+                        && c != b'm'
+                        && let Some(prev) = self.b.words().find(|w| w.0 == c).map(|w| w.2)
+                    {
+                        return Err((
+                            column,
+                            std::format!(
+                                "one {} word per line (also at column {prev})",
+                                char::from(c.to_ascii_uppercase())
+                            ),
+                        ));
+                    }
+                    let value = self.value()?;
+                    self.b.items.push(Item::Word {
+                        letter: c,
+                        value,
+                        column,
+                    });
+                }
+                b'n' => {
+                    return self.err("N (a line number) only at the start of the line".to_string());
+                }
+                b'o' => {
+                    return self.err("an O-word only at the start of the line, alone".to_string());
+                }
+                _ => {
+                    return self.err(std::format!(
+                        "a word (a letter and a value), a #parameter setting or a comment, \
+                         got {}",
+                        self.got()
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn o_word(&mut self) -> Result<(), LexError> {
+        let column = self.column();
+        self.at += 1;
+        let label = if self.peek() == Some(b'<') {
+            self.at += 1;
+            let (s, e) = self.name()?;
+            Label::Name(s, e)
+        } else {
+            Label::Value(self.value()?)
+        };
+        let from = self.at;
+        while matches!(self.peek(), Some(b'a'..=b'z')) {
+            self.at += 1;
+        }
+        let word: String = self
+            .b
+            .text
+            .get(from..self.at)
+            .unwrap_or(&[])
+            .iter()
+            .map(|&c| char::from(c))
+            .collect();
+        let keyword = match word.as_str() {
+            "sub" => Keyword::Sub,
+            "endsub" => Keyword::Endsub,
+            "call" => Keyword::Call,
+            "do" => Keyword::Do,
+            "while" => Keyword::While,
+            "repeat" => Keyword::Repeat,
+            "if" => Keyword::If,
+            "elseif" => Keyword::Elseif,
+            "else" => Keyword::Else,
+            "endif" => Keyword::Endif,
+            "break" => Keyword::Break,
+            "continue" => Keyword::Continue,
+            "endwhile" => Keyword::Endwhile,
+            "endrepeat" => Keyword::Endrepeat,
+            "return" => Keyword::Return,
+            "" => Keyword::Header,
+            other => {
+                return Err((
+                    self.column_of(from),
+                    std::format!(
+                        "an O-word keyword (sub, endsub, call, return, if, elseif, else, \
+                         endif, while, endwhile, do, repeat, endrepeat, break, continue), got \
+                         {other:?}"
+                    ),
+                ));
+            }
+        };
+        let mut args = Vec::new();
+        match keyword {
+            Keyword::If | Keyword::Elseif | Keyword::While | Keyword::Repeat => {
+                if self.peek() != Some(b'[') {
+                    return self.err(std::format!(
+                        "a [condition] after '{}', got {}",
+                        keyword.name(),
+                        self.got()
+                    ));
+                }
+                args.push(self.value()?);
+            }
+            Keyword::Call => {
+                while self.peek() == Some(b'[') {
+                    if args.len() >= 30 {
+                        return self
+                            .err("at most 30 arguments to a subroutine (#1-#30)".to_string());
+                    }
+                    args.push(self.value()?);
+                }
+            }
+            Keyword::Endsub | Keyword::Return if self.peek() == Some(b'[') => {
+                args.push(self.value()?);
+            }
+            _ => {}
+        }
+        if self.peek().is_some() {
+            return self.err(std::format!(
+                "nothing after the O-word '{}' but a comment, got {}",
+                keyword.name(),
+                self.got()
+            ));
+        }
+        self.b.o_word = Some(OWord {
+            label,
+            keyword,
+            args,
+            column,
+        });
+        Ok(())
+    }
+
+    /// A name up to `>` (the `<` consumed); lower case, no spaces (normalised).
+    fn name(&mut self) -> Result<(u32, u32), LexError> {
+        let from = self.at;
+        while let Some(c) = self.peek() {
+            if c == b'>' {
+                let start = self.b.names.len() as u32;
+                for &c in self.b.text.get(from..self.at).unwrap_or(&[]) {
+                    self.b.names.push(char::from(c));
+                }
+                self.at += 1;
+                return Ok((start, self.b.names.len() as u32));
+            }
+            self.at += 1;
+        }
+        Err((
+            self.column_of(from.saturating_sub(1)),
+            "a '>' closing the name <...>".to_string(),
+        ))
+    }
+
+    /// A parameter after its `#`: `<name>` or a value (its index).
+    fn param(&mut self) -> Result<Param, LexError> {
+        if self.peek() == Some(b'<') {
+            self.at += 1;
+            let (s, e) = self.name()?;
+            return Ok(Param::Named(s, e));
+        }
+        Ok(Param::Numbered(self.value()?))
+    }
+
+    fn enter(&mut self) -> Result<(), LexError> {
+        self.depth += 1;
+        if self.depth > MAX_EXPRESSION_DEPTH {
+            return self.err(std::format!(
+                "at most {MAX_EXPRESSION_DEPTH} nested brackets, functions and signs in one \
+                 value (MAX_EXPRESSION_DEPTH)"
+            ));
+        }
+        Ok(())
+    }
+
+    /// A real value: a number, `[expression]`, `#parameter`, a function, or a sign before one.
+    fn value(&mut self) -> Result<u32, LexError> {
+        self.enter()?;
+        let v = self.value_inner();
+        self.depth -= 1;
+        v
+    }
+
+    fn value_inner(&mut self) -> Result<u32, LexError> {
+        match self.peek() {
+            Some(b'[') => {
+                self.at += 1;
+                let e = self.binary(0)?;
+                if self.peek() != Some(b']') {
+                    return self.err(std::format!(
+                        "']' closing the expression, got {}",
+                        self.got()
+                    ));
+                }
+                self.at += 1;
+                Ok(e)
+            }
+            Some(b'#') => {
+                self.at += 1;
+                let p = self.param()?;
+                Ok(self.push(Node::Param(p)))
+            }
+            Some(b'a'..=b'z') => self.function(),
+            Some(s @ (b'+' | b'-')) if !matches!(self.peek_at(1), Some(c) if c.is_ascii_digit() || c == b'.') =>
+            {
+                self.at += 1;
+                let v = self.value()?;
+                Ok(if s == b'-' {
+                    self.push(Node::Neg(v))
+                } else {
+                    v
+                })
+            }
+            Some(c) if c.is_ascii_digit() || matches!(c, b'.' | b'+' | b'-') => self.number(),
+            _ => self.err(std::format!("{VALUE}, got {}", self.got())),
+        }
+    }
+
+    /// A literal: an optional sign, then digits with at most one '.' (no exponent).
+    fn number(&mut self) -> Result<u32, LexError> {
+        let from = self.at;
+        if matches!(self.peek(), Some(b'+' | b'-')) {
+            self.at += 1;
+        }
+        let digits = self.at;
+        while matches!(self.peek(), Some(c) if c.is_ascii_digit() || c == b'.') {
+            self.at += 1;
+        }
+        let run = self.b.text.get(digits..self.at).unwrap_or(&[]);
+        let text: String = self
+            .b
+            .text
+            .get(from..self.at)
+            .unwrap_or(&[])
+            .iter()
+            .map(|&c| char::from(c))
+            .collect();
+        let ok =
+            run.iter().any(u8::is_ascii_digit) && run.iter().filter(|&&c| c == b'.').count() <= 1;
+        match text.parse::<f64>() {
+            Ok(v) if ok && v.is_finite() => Ok(self.push(Node::Num(v))),
+            _ => Err((
+                self.column_of(from),
+                std::format!("a number (digits with at most one '.'), got {text:?}"),
+            )),
+        }
+    }
+
+    /// A function: its name, then `[argument]` (`ATAN[y]/[x]`, `EXISTS[#param]`).
+    fn function(&mut self) -> Result<u32, LexError> {
+        let column = self.column();
+        let from = self.at;
+        while matches!(self.peek(), Some(b'a'..=b'z')) {
+            self.at += 1;
+        }
+        let name: String = self
+            .b
+            .text
+            .get(from..self.at)
+            .unwrap_or(&[])
+            .iter()
+            .map(|&c| char::from(c))
+            .collect();
+        let func = match name.as_str() {
+            "abs" => Some(Func::Abs),
+            "acos" => Some(Func::Acos),
+            "asin" => Some(Func::Asin),
+            "cos" => Some(Func::Cos),
+            "exp" => Some(Func::Exp),
+            "fix" => Some(Func::Fix),
+            "fup" => Some(Func::Fup),
+            "round" => Some(Func::Round),
+            "ln" => Some(Func::Ln),
+            "sin" => Some(Func::Sin),
+            "sqrt" => Some(Func::Sqrt),
+            "tan" => Some(Func::Tan),
+            "atan" | "exists" => None,
+            _ => {
+                self.at = from;
+                return Err((
+                    column,
+                    std::format!(
+                        "{VALUE} (ABS, ACOS, ASIN, ATAN, COS, EXISTS, EXP, FIX, FUP, LN, ROUND, \
+                         SIN, SQRT, TAN), got {}",
+                        self.got()
+                    ),
+                ));
+            }
+        };
+        if self.peek() != Some(b'[') {
+            return self.err(std::format!(
+                "'[' after the function {}, got {}",
+                name.to_ascii_uppercase(),
+                self.got()
+            ));
+        }
+        if name == "exists" {
+            self.at += 1;
+            if self.peek() != Some(b'#') {
+                return self.err(std::format!(
+                    "a #parameter in EXISTS[...], got {}",
+                    self.got()
+                ));
+            }
+            self.at += 1;
+            let p = self.param()?;
+            if self.peek() != Some(b']') {
+                return self.err(std::format!("']' closing EXISTS[#...], got {}", self.got()));
+            }
+            self.at += 1;
+            return Ok(self.push(Node::Exists(p)));
+        }
+        let arg = self.value()?;
+        match func {
+            Some(f) => Ok(self.push(Node::Func(f, arg))),
+            None => {
+                if self.peek() != Some(b'/') {
+                    return self.err(std::format!(
+                        "'/' after ATAN's first argument (ATAN[y]/[x]), got {}",
+                        self.got()
+                    ));
+                }
+                self.at += 1;
+                if self.peek() != Some(b'[') {
+                    return self.err(std::format!(
+                        "'[' for ATAN's second argument (ATAN[y]/[x]), got {}",
+                        self.got()
+                    ));
+                }
+                let x = self.value()?;
+                Ok(self.push(Node::Atan(arg, x)))
+            }
+        }
+    }
+
+    /// An operator, if one follows (`**`, `*`, `/`, `+`, `-`, `MOD`, `EQ`, `NE`, `GT`, `GE`,
+    /// `LT`, `LE`, `AND`, `OR`, `XOR`), and its length.
+    fn operator(&self) -> Result<Option<(Op, usize)>, LexError> {
+        let rest = self.b.text.get(self.at..).unwrap_or(&[]);
+        let starts = |s: &[u8]| rest.starts_with(s);
+        let op = match rest.first() {
+            None | Some(b']') => return Ok(None),
+            Some(b'*') if starts(b"**") => (Op::Pow, 2),
+            Some(b'*') => (Op::Mul, 1),
+            Some(b'/') => (Op::Div, 1),
+            Some(b'+') => (Op::Add, 1),
+            Some(b'-') => (Op::Sub, 1),
+            _ => {
+                let words: [(&[u8], Op); 11] = [
+                    (b"mod", Op::Mod),
+                    (b"eq", Op::Eq),
+                    (b"ne", Op::Ne),
+                    (b"gt", Op::Gt),
+                    (b"ge", Op::Ge),
+                    (b"lt", Op::Lt),
+                    (b"le", Op::Le),
+                    (b"and", Op::And),
+                    (b"or", Op::Or),
+                    (b"xor", Op::Xor),
+                    (b"**", Op::Pow),
+                ];
+                match words.iter().find(|(w, _)| starts(w)) {
+                    Some(&(w, op)) => (op, w.len()),
+                    None => {
+                        return self.err(std::format!(
+                            "an operator (** * / MOD + - EQ NE GT GE LT LE AND OR XOR) or ']', \
+                             got {}",
+                            self.got()
+                        ));
+                    }
+                }
+            }
+        };
+        Ok(Some(op))
+    }
+
+    /// Values joined by operators of precedence `min` and above, left to right.
+    fn binary(&mut self, min: u8) -> Result<u32, LexError> {
+        let mut lhs = self.value()?;
+        while let Some((op, len)) = self.operator()? {
+            if op.precedence() < min {
+                break;
+            }
+            self.at += len;
+            self.enter()?;
+            let rhs = self.binary(op.precedence() + 1);
+            self.depth -= 1;
+            lhs = self.push(Node::Bin(op, lhs, rhs?));
+        }
+        Ok(lhs)
+    }
+}

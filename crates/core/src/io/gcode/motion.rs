@@ -1,0 +1,679 @@
+//! The moves a block makes: straight moves (`G0`, `G1`, `G53`), arcs in the three planes
+//! with LinuxCNC's centre rules and tolerances (`G2`, `G3`, `I J K`, `R`, `P` turns,
+//! `G90.1`), splines (`G5`, `G5.1`, as lines within 1 um), dwells (`G4`) and the return to a
+//! stored point (`G28`, `G30`); the feed of each in the program's feed mode.
+
+use std::string::ToString;
+
+use nalgebra::{Vector2, Vector3};
+
+use super::interp::{Fault, FeedMode, INCH, Machine, fault};
+use super::params::Params;
+use super::words::{Words, g_name};
+use crate::LoadError;
+use crate::machining::{MAX_COORDINATE, MAX_DWELL, MAX_FEED, MAX_MOVES, Motion, Move, Plane};
+
+/// Largest distance \[m\] of a spline's chords from the spline (`G5`, `G5.1` become lines).
+pub const SPLINE_TOLERANCE: f64 = 1.0e-6;
+/// Most chords one spline becomes.
+pub const MAX_SPLINE_CHORDS: usize = 1_000;
+
+/// LinuxCNC's radius tolerances of arcs, in the program's unit: the zero-radius and `R`
+/// reach tolerance (0.00005 in, 0.00127 mm) and the spiral tolerance of a centre arc
+/// (`2 x 0.001 sqrt 2` in, `2 x 0.01 sqrt 2` mm).
+fn arc_tolerances(units: f64) -> (f64, f64) {
+    if units == INCH {
+        (
+            0.00005 * INCH,
+            2.0 * 0.001 * core::f64::consts::SQRT_2 * INCH,
+        )
+    } else {
+        (0.00127e-3, 2.0 * 0.01 * core::f64::consts::SQRT_2 * 1.0e-3)
+    }
+}
+
+/// Words that make a motion run.
+const AXES: &[u8] = b"xyz@^";
+
+/// Whether a motion code is a canned cycle.
+pub(super) fn is_cycle(code: u16) -> bool {
+    code == 730 || code == 740 || (810..=890).contains(&code)
+}
+
+impl Machine {
+    /// Step 26: the motion of the line (its own group-1 code, or the modal one when axis
+    /// words are given), `G53` applied.
+    pub(super) fn motion(
+        &mut self,
+        w: &mut Words,
+        consumed: bool,
+        params: &Params,
+    ) -> Result<(), Fault> {
+        let explicit =
+            w.g.iter()
+                .find(|g| super::words_group(g.0) == Some(1))
+                .copied();
+        let has_axes = !consumed && w.first_of(AXES).is_some();
+        let code = match explicit {
+            Some((800, column)) => {
+                if has_axes {
+                    return fault(
+                        w.first_of(AXES).unwrap_or(column),
+                        "no axis words with G80 (it cancels the motion mode)",
+                    );
+                }
+                self.motion = None;
+                self.cycle.initial = None;
+                return Ok(());
+            }
+            Some((code, column)) => {
+                if is_cycle(code) && !has_axes {
+                    return fault(
+                        column,
+                        std::format!("{}: a cycle needs axis words", g_name(code)),
+                    );
+                }
+                code
+            }
+            None => {
+                let arc_words =
+                    matches!(self.motion, Some(20 | 30)) && w.first_of(b"ijk").is_some();
+                if consumed || !(has_axes || arc_words) {
+                    if let Some(column) = w.g(530) {
+                        return fault(column, "G53 needs axis words and G0 or G1");
+                    }
+                    return Ok(());
+                }
+                match self.motion.or(if self.dialect.motion_after_g80() {
+                    self.plain_motion
+                } else {
+                    None
+                }) {
+                    Some(code) => code,
+                    None => {
+                        return fault(
+                            w.first_of(AXES).unwrap_or(1),
+                            "axis words with no motion mode to use them (the line needs G0, G1, \
+                             G2, G3 or a cycle: G80 and the program start leave none; the fanuc \
+                             dialect moves in the last G0-G3 mode instead)",
+                        );
+                    }
+                }
+            }
+        };
+        let column = explicit.map_or_else(|| w.first_of(AXES).unwrap_or(1), |e| e.1);
+        if let Some(g53) = w.g(530) {
+            if !matches!(code, 0 | 10) {
+                return fault(g53, "G53 moves with G0 or G1 only");
+            }
+            if w.g(910).is_some() || (!self.absolute && w.g(900).is_none()) {
+                return fault(
+                    g53,
+                    "G53 takes machine coordinates: not with G91 (incremental)",
+                );
+            }
+        }
+        if !is_cycle(code) {
+            self.cycle.initial = None;
+        }
+        if code != 50 {
+            self.spline_pq = None;
+        }
+        match code {
+            0 | 10 => {
+                let end = if w.g(530).is_some() {
+                    self.machine_target(w)?
+                } else {
+                    self.target(w)?
+                };
+                let motion = if code == 0 {
+                    Motion::Rapid
+                } else {
+                    Motion::Linear
+                };
+                self.straight(motion, end, w, column)?;
+            }
+            20 | 30 => self.arc(w, code == 20, column)?,
+            50 | 51 => self.spline(w, code == 50, column)?,
+            _ if is_cycle(code) => self.cycle(w, code, column)?,
+            _ => {
+                return fault(
+                    column,
+                    std::format!("{}: not a motion this reader runs", g_name(code)),
+                );
+            }
+        }
+        if code != 50 && code != 51 {
+            self.motion = Some(code);
+        }
+        if code <= 30 {
+            self.plain_motion = Some(code);
+        }
+        let _ = params;
+        Ok(())
+    }
+
+    /// The end point of the axis words (and `@` `^` polar words, G17 only), program frame.
+    pub(super) fn target(&mut self, w: &mut Words) -> Result<Vector3<f64>, Fault> {
+        let mut p = self.pos;
+        if w.has(b'@') || w.has(b'^') {
+            let column = w.first_of(b"@^").unwrap_or(1);
+            if self.plane != Plane::Xy {
+                return fault(
+                    column,
+                    "polar coordinates (@, ^) in G17 (the XY plane) only",
+                );
+            }
+            if w.has(b'x') || w.has(b'y') {
+                return fault(
+                    column,
+                    "either polar coordinates (@, ^) or X and Y, not both",
+                );
+            }
+            let (r0, a0) = (p.xy().norm(), p.y.atan2(p.x).to_degrees());
+            let at_origin = p.x == 0.0 && p.y == 0.0;
+            let radius = w.take(b'@').map(|r| r * self.units);
+            let angle = w.take(b'^');
+            if at_origin && (angle.is_none() || !self.absolute) {
+                return fault(
+                    column,
+                    "a polar angle (^) from the origin, where the angle is undefined",
+                );
+            }
+            let (r, a) = if self.absolute {
+                (radius.unwrap_or(r0), angle.unwrap_or(a0))
+            } else {
+                (r0 + radius.unwrap_or(0.0), a0 + angle.unwrap_or(0.0))
+            };
+            let (s, c) = a.to_radians().sin_cos();
+            p.x = r * c;
+            p.y = r * s;
+        }
+        for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
+            if let (Some(v), Some(e)) = (w.take(l), p.get_mut(k)) {
+                *e = if self.absolute {
+                    v * self.units
+                } else {
+                    *e + v * self.units
+                };
+            }
+        }
+        Ok(p)
+    }
+
+    /// The end point of `G53`'s machine coordinates, program frame (axes without words stay).
+    fn machine_target(&mut self, w: &mut Words) -> Result<Vector3<f64>, Fault> {
+        if w.has(b'@') || w.has(b'^') {
+            return fault(
+                w.first_of(b"@^").unwrap_or(1),
+                "no polar coordinates with G53",
+            );
+        }
+        let mut m = self.to_machine(&self.pos);
+        for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
+            if let (Some(v), Some(e)) = (w.take(l), m.get_mut(k)) {
+                *e = v * self.units;
+            }
+        }
+        Ok(self.to_program(&m))
+    }
+
+    /// The feed \[m/s\] of a feed move `length` \[m\] long in the current feed mode.
+    fn speed(&self, w: &Words, length: f64, column: usize) -> Result<f64, Fault> {
+        let per_minute = match self.feed_mode {
+            FeedMode::PerMinute => {
+                if self.feed <= 0.0 {
+                    return fault(column, "a feed rate F > 0 before a feed move (G1, G2, G3)");
+                }
+                self.feed
+            }
+            FeedMode::InverseTime => {
+                let Some(f) = w.peek(b'f') else {
+                    return fault(column, "F on every feed move in inverse time (G93)");
+                };
+                (length / self.units * f).max(0.1)
+            }
+            FeedMode::PerRevolution => {
+                if self.feed <= 0.0 {
+                    return fault(
+                        column,
+                        "a feed per revolution F > 0 before a feed move (G95)",
+                    );
+                }
+                if self.spindle_rpm <= 0.0 {
+                    return fault(
+                        column,
+                        "a spindle speed S > 0 for a feed per revolution (G95)",
+                    );
+                }
+                self.feed * self.spindle_rpm
+            }
+        };
+        let v = per_minute * self.units / 60.0;
+        if v.is_nan() || v > MAX_FEED {
+            return fault(
+                w.first_of(b"f").unwrap_or(column),
+                std::format!("a feed of at most {MAX_FEED} m/s, got {v} m/s"),
+            );
+        }
+        Ok(v)
+    }
+
+    /// A straight move to `end` (program frame).
+    pub(super) fn straight(
+        &mut self,
+        motion: Motion,
+        end: Vector3<f64>,
+        w: &Words,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let feed = if motion == Motion::Rapid {
+            0.0
+        } else {
+            self.speed(w, (end - self.pos).norm(), column)?
+        };
+        self.emit(motion, end, feed, column)
+    }
+
+    /// Appends a move from the current point to `end` (program frame) and moves there; a
+    /// straight move that goes nowhere is not stored.
+    pub(super) fn emit(
+        &mut self,
+        motion: Motion,
+        end: Vector3<f64>,
+        feed: f64,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let (start, stop) = (self.to_machine(&self.pos), self.to_machine(&end));
+        if let Some(v) = stop
+            .iter()
+            .find(|v| !(v.is_finite() && v.abs() <= MAX_COORDINATE))
+        {
+            return fault(
+                column,
+                std::format!("an end point within +-{MAX_COORDINATE} m, got {v} m"),
+            );
+        }
+        self.pos = end;
+        if matches!(motion, Motion::Rapid | Motion::Linear) && start == stop {
+            return Ok(());
+        }
+        let motion = match motion {
+            Motion::Arc {
+                plane,
+                center,
+                sweep,
+            } => Motion::Arc {
+                plane,
+                center: self.to_machine(&center),
+                sweep,
+            },
+            m => m,
+        };
+        if self.moves.len() >= MAX_MOVES {
+            return Err((
+                0,
+                LoadError::TooLarge {
+                    what: std::format!("G-code program moves (at line {})", self.line),
+                    limit: MAX_MOVES,
+                    got: self.moves.len() + 1,
+                }
+                .to_string(),
+            ));
+        }
+        self.moves.push(Move {
+            spindle: self.spindle(),
+            tool: self.tool,
+            path_control: self.path_control,
+            ..Move::new(self.line, motion, start, stop, feed)
+        });
+        Ok(())
+    }
+
+    /// A dwell of `seconds` (`G4 P`, a cycle's `P`).
+    pub(super) fn dwell(&mut self, seconds: f64, column: usize) -> Result<(), Fault> {
+        if !(0.0..=MAX_DWELL).contains(&seconds) {
+            return fault(
+                column,
+                std::format!("a dwell time P in [0, {MAX_DWELL}] s, got P{seconds}"),
+            );
+        }
+        if seconds > 0.0 {
+            self.emit(Motion::Dwell { seconds }, self.pos, 0.0, column)?;
+        }
+        Ok(())
+    }
+
+    /// `G28`/`G30`: a rapid to the intermediate point of the axis words, then to the stored
+    /// point (parameters `base..base + 3`, machine frame, mm) on the axes named (all without
+    /// axis words).
+    pub(super) fn home(
+        &mut self,
+        w: &mut Words,
+        params: &Params,
+        base: usize,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let named: [bool; 3] = [w.has(b'x'), w.has(b'y'), w.has(b'z')];
+        let any = named.iter().any(|&b| b) || w.has(b'@') || w.has(b'^');
+        let mid = self.target(w)?;
+        self.emit(Motion::Rapid, mid, 0.0, column)?;
+        let mut m = self.to_machine(&mid);
+        for (k, &given) in named.iter().enumerate() {
+            if (given || !any)
+                && let Some(e) = m.get_mut(k)
+            {
+                *e = params.get(base + k) * 1e-3;
+            }
+        }
+        let end = self.to_program(&m);
+        self.emit(Motion::Rapid, end, 0.0, column)
+    }
+
+    /// `G2`/`G3` in the selected plane.
+    fn arc(&mut self, w: &mut Words, clockwise: bool, column: usize) -> Result<(), Fault> {
+        let plane = self.plane;
+        if plane != Plane::Xy && self.rotation != 0.0 {
+            return fault(
+                column,
+                "G18/G19 arcs in a rotated coordinate system (G10 L2 R) are not modelled",
+            );
+        }
+        // The centre words of the plane's first and second axes, and the one of its normal.
+        let (first, second, off) = match plane {
+            Plane::Xy => (b'i', b'j', b'k'),
+            Plane::Zx => (b'k', b'i', b'j'),
+            Plane::Yz => (b'j', b'k', b'i'),
+        };
+        if w.has(off) {
+            if self.dialect.ignores_off_plane_offset() {
+                w.take(off);
+            } else {
+                return fault(
+                    w.column(off),
+                    std::format!(
+                        "{}: no {} word on an arc in {} (the plane's centre words are {} and {}; \
+                         grbl ignores it: the grbl dialect reads it so)",
+                        char::from(off.to_ascii_uppercase()),
+                        char::from(off.to_ascii_uppercase()),
+                        plane.gcode(),
+                        char::from(first.to_ascii_uppercase()),
+                        char::from(second.to_ascii_uppercase())
+                    ),
+                );
+            }
+        }
+        let has_ij = w.has(first) || w.has(second);
+        let radius_word = w.peek(b'r');
+        if has_ij && radius_word.is_some() {
+            return fault(
+                w.column(b'r'),
+                "either a centre (I, J, K) or a radius R on an arc, not both",
+            );
+        }
+        if !has_ij && radius_word.is_none() {
+            return fault(
+                column,
+                "an arc needs its centre (I, J, K in its plane) or its radius R",
+            );
+        }
+        let turns = match w.take(b'p') {
+            None => 1,
+            Some(p) => match super::expr::integer(p) {
+                Some(t) if (1..=i64::from(crate::machining::MAX_ARC_TURNS)).contains(&t) => {
+                    t as u32
+                }
+                _ => {
+                    return fault(
+                        w.column(b'p'),
+                        std::format!(
+                            "a number of turns P in 1..={} (an integer) on an arc, got P{p}",
+                            crate::machining::MAX_ARC_TURNS
+                        ),
+                    );
+                }
+            },
+        };
+        let (a, b, n) = plane.axes();
+        let in_plane_words = [b'x', b'y', b'z']
+            .iter()
+            .enumerate()
+            .any(|(k, l)| (k == a || k == b) && w.has(*l))
+            || w.has(b'@')
+            || w.has(b'^');
+        let start = self.pos;
+        let end_column = w.first_of(b"xyz@^").unwrap_or(column);
+        let end = self.target(w)?;
+        let get = |v: &Vector3<f64>, k: usize| v.get(k).copied().unwrap_or(0.0);
+        let (s2, e2) = (
+            Vector2::new(get(&start, a), get(&start, b)),
+            Vector2::new(get(&end, a), get(&end, b)),
+        );
+        let (zero_tol, spiral_tol) = arc_tolerances(self.units);
+        let centre = if let Some(r) = radius_word {
+            w.take(b'r');
+            if !in_plane_words {
+                return fault(
+                    column,
+                    std::format!(
+                        "an R arc needs an end point in its plane ({})",
+                        plane.gcode()
+                    ),
+                );
+            }
+            if s2 == e2 {
+                return fault(
+                    column,
+                    "an R arc needs an end point other than its start (a full circle needs I, J, K)",
+                );
+            }
+            let r = r * self.units;
+            let chord = e2 - s2;
+            let half = chord.norm() / 2.0;
+            if half - r.abs() > zero_tol {
+                return fault(
+                    w.column(b'r'),
+                    std::format!(
+                        "an arc radius R at least half the chord ({:.4} {}), got {:.4}",
+                        half / self.units,
+                        self.unit_name(),
+                        r.abs() / self.units
+                    ),
+                );
+            }
+            let u = chord / chord.norm();
+            let right = (clockwise && r > 0.0) || (!clockwise && r < 0.0);
+            let side = if right {
+                Vector2::new(u.y, -u.x)
+            } else {
+                Vector2::new(-u.y, u.x)
+            };
+            let ratio = half / r.abs();
+            let d = if ratio > 1.0 - 1.0e-12 {
+                0.0
+            } else {
+                r.abs() * ratio.asin().cos()
+            };
+            (s2 + e2) / 2.0 + side * d
+        } else {
+            let c1 = w.take(first);
+            let c2 = w.take(second);
+            if self.ijk_absolute {
+                let (Some(c1), Some(c2)) = (c1, c2) else {
+                    return fault(
+                        column,
+                        std::format!(
+                            "both centre words {} and {} in absolute arc centre mode (G90.1)",
+                            char::from(first.to_ascii_uppercase()),
+                            char::from(second.to_ascii_uppercase())
+                        ),
+                    );
+                };
+                Vector2::new(c1, c2) * self.units
+            } else {
+                s2 + Vector2::new(c1.unwrap_or(0.0), c2.unwrap_or(0.0)) * self.units
+            }
+        };
+        let (r1, r2) = ((s2 - centre).norm(), (e2 - centre).norm());
+        if r1 < zero_tol || r2 < zero_tol {
+            return fault(
+                column,
+                "an arc of radius > 0 (its centre is at its start or its end)",
+            );
+        }
+        let err = (r1 - r2).abs();
+        if radius_word.is_none()
+            && (err > 100.0 * spiral_tol || (err / r1.max(r2) > 0.001 && err > spiral_tol))
+        {
+            return fault(
+                end_column,
+                std::format!(
+                    "an end point on the arc's circle: the radius is {:.4} {u} at the start and \
+                     {:.4} {u} at the end (LinuxCNC's tolerance: {:.4} {u}, or 0.1 % up to {:.2} {u})",
+                    r1 / self.units,
+                    r2 / self.units,
+                    spiral_tol / self.units,
+                    100.0 * spiral_tol / self.units,
+                    u = self.unit_name()
+                ),
+            );
+        }
+        let base = sweep(&s2, &e2, &centre, clockwise);
+        let extra = f64::from(turns - 1) * core::f64::consts::TAU;
+        let sweep = if clockwise {
+            base - extra
+        } else {
+            base + extra
+        };
+        let rise = get(&end, n) - get(&start, n);
+        let length = (r1 * sweep.abs()).hypot(rise);
+        let feed = self.speed(w, length, column)?;
+        let mut c = start;
+        if let Some(x) = c.get_mut(a) {
+            *x = centre.x;
+        }
+        if let Some(x) = c.get_mut(b) {
+            *x = centre.y;
+        }
+        if let Some(v) = self
+            .to_machine(&c)
+            .iter()
+            .find(|v| v.is_nan() || v.abs() > MAX_COORDINATE)
+        {
+            return fault(
+                column,
+                std::format!("an arc centre within +-{MAX_COORDINATE} m, got {v} m"),
+            );
+        }
+        self.emit(
+            Motion::Arc {
+                plane,
+                center: c,
+                sweep,
+            },
+            end,
+            feed,
+            column,
+        )
+    }
+
+    /// `G5` (cubic, `I J P Q`) and `G5.1` (quadratic, `I J`) B-splines in the XY plane, as
+    /// chords within [`SPLINE_TOLERANCE`].
+    fn spline(&mut self, w: &mut Words, cubic: bool, column: usize) -> Result<(), Fault> {
+        let name = if cubic { "G5" } else { "G5.1" };
+        if self.plane != Plane::Xy {
+            return fault(
+                column,
+                std::format!("{name}: splines in G17 (the XY plane) only"),
+            );
+        }
+        if w.has(b'z') {
+            return fault(
+                w.column(b'z'),
+                std::format!("{name}: a spline moves X and Y only"),
+            );
+        }
+        let start = self.pos;
+        let (i, j) = (w.take(b'i'), w.take(b'j'));
+        let end = self.target(w)?;
+        let u = self.units;
+        let (s, e) = (start.xy(), end.xy());
+        let points: [Vector2<f64>; 4] = if cubic {
+            let (Some(p), Some(q)) = (w.take(b'p'), w.take(b'q')) else {
+                return fault(
+                    column,
+                    "G5 needs both P and Q (the second control point's offset from the end)",
+                );
+            };
+            let first = match (i, j, self.spline_pq) {
+                (Some(i), Some(j), _) => Vector2::new(i, j),
+                (None, None, Some((pp, qq))) => Vector2::new(-pp, -qq),
+                _ => {
+                    return fault(
+                        column,
+                        "G5 needs I and J (the first control point's offset from the start), except \
+                         right after another G5",
+                    );
+                }
+            };
+            self.spline_pq = Some((p, q));
+            [s, s + first * u, e + Vector2::new(p, q) * u, e]
+        } else {
+            let (Some(i), Some(j)) = (i, j) else {
+                return fault(
+                    column,
+                    "G5.1 needs both I and J (the control point's offset from the start)",
+                );
+            };
+            let c = s + Vector2::new(i, j) * u;
+            // A quadratic as a cubic: the same curve.
+            [s, s + (c - s) * (2.0 / 3.0), e + (c - e) * (2.0 / 3.0), e]
+        };
+        let [p0, p1, p2, p3] = points;
+        let point = |t: f64| {
+            let m = 1.0 - t;
+            p0 * (m * m * m) + p1 * (3.0 * m * m * t) + p2 * (3.0 * m * t * t) + p3 * (t * t * t)
+        };
+        // Chord error <= max|B''| dt^2 / 8 for uniform steps dt.
+        let curvature = ((p0 - p1 * 2.0 + p2).norm()).max((p1 - p2 * 2.0 + p3).norm()) * 6.0;
+        let chords = ((curvature / (8.0 * SPLINE_TOLERANCE)).sqrt().ceil() as usize)
+            .clamp(1, MAX_SPLINE_CHORDS);
+        let length: f64 = (0..chords)
+            .map(|k| {
+                (point((k + 1) as f64 / chords as f64) - point(k as f64 / chords as f64)).norm()
+            })
+            .sum();
+        let feed = self.speed(w, length, column)?;
+        for k in 1..=chords {
+            let p = if k == chords {
+                e
+            } else {
+                point(k as f64 / chords as f64)
+            };
+            self.emit(
+                Motion::Linear,
+                Vector3::new(p.x, p.y, start.z),
+                feed,
+                column,
+            )?;
+        }
+        Ok(())
+    }
+}
+
+/// Signed sweep about the plane's normal from `a` to `b` around `c` (> 0 counter-clockwise);
+/// equal ends make a full turn.
+pub(super) fn sweep(a: &Vector2<f64>, b: &Vector2<f64>, c: &Vector2<f64>, clockwise: bool) -> f64 {
+    let tau = core::f64::consts::TAU;
+    let (ra, rb) = (a - c, b - c);
+    let angle = |v: Vector2<f64>| v.y.atan2(v.x);
+    let ccw = (angle(rb) - angle(ra)).rem_euclid(tau);
+    if clockwise {
+        let cw = (tau - ccw).rem_euclid(tau);
+        return -(if a == b || cw == 0.0 { tau } else { cw });
+    }
+    if a == b || ccw == 0.0 { tau } else { ccw }
+}
+
+#[allow(dead_code)]
+fn _unused(_: Params) {}
