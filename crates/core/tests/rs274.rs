@@ -77,7 +77,7 @@ fn workdir(name: &str) -> PathBuf {
 }
 
 fn numbers(args: &str) -> Vec<f64> {
-    args.split(|c| c == ',' || c == ' ')
+    args.split([',', ' '])
         .filter(|s| !s.is_empty())
         .filter_map(|s| s.parse().ok())
         .collect()
