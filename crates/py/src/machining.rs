@@ -195,9 +195,7 @@ impl GcodeProgram {
 
     /// Pickling and copy.deepcopy: the moves and the word report as plain values, rebuilt bit
     /// for bit and checked (`Program::validate`).
-    fn __reduce__<'py>(
-        slf: &Bound<'py, Self>,
-    ) -> PyResult<(Bound<'py, PyAny>, ProgramState)> {
+    fn __reduce__<'py>(slf: &Bound<'py, Self>) -> PyResult<(Bound<'py, PyAny>, ProgramState)> {
         let rebuild = slf.get_type().getattr("_from_state")?;
         let me = slf.get();
         let state = me.inner.moves.iter().map(move_state).collect();

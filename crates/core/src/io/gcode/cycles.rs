@@ -219,11 +219,11 @@ impl Machine {
         column: usize,
     ) -> Result<Body, Fault> {
         let mut body = Body::default();
-        if matches!(code, 820 | 840 | 860 | 880 | 890) {
+        if matches!(code, 740 | 820 | 840 | 860 | 880 | 890) {
             let p = w.take(b'p').filter(|p| *p != -1.0);
             if let Some(p) = p {
                 self.cycle.p = Some(p);
-            } else if code != 840 && !same {
+            } else if !matches!(code, 740 | 840) && !same {
                 return fault(
                     column,
                     std::format!("{name}: P, the dwell time (needed on its first block)"),

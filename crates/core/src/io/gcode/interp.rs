@@ -418,8 +418,14 @@ impl Machine {
                 return fault(w.g(432).unwrap_or(1), "G43.2 needs H or axis words");
             }
         } else if w.g(431).is_some() {
+            // G43.1 reads every axis word as an offset; they move the tool only with a motion
+            // code on the same line (LinuxCNC).
+            let motion_here =
+                w.g.iter()
+                    .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
             for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
-                if let (Some(v), Some(o)) = (w.peek(l), self.tool_offset.get_mut(k)) {
+                let v = if motion_here { w.peek(l) } else { w.take(l) };
+                if let (Some(v), Some(o)) = (v, self.tool_offset.get_mut(k)) {
                     *o = v * self.units;
                 }
             }
@@ -695,12 +701,13 @@ impl Machine {
             params.set(base + 1 + k, new.get(k).copied().unwrap_or(0.0) * 1e3);
         }
         if n == self.system {
-            // LinuxCNC keeps the point given by P, the old offset and rotation (not G92).
-            let c = rotate(self.pos.xy(), self.rotation) + self.g5x.xy();
-            let xy = rotate(c - new.xy(), -r);
-            self.pos = Vector3::new(xy.x, xy.y, self.pos.z + self.g5x.z - new.z);
+            // The tool stays where it is: its program coordinates change. (LinuxCNC leaves G92
+            // out of this, so with G92 set and a new rotation its tool would jump without a
+            // move; a robot's path is continuous, so the machine position is kept.)
+            let m = self.to_machine(&self.pos);
             self.g5x = new;
             self.rotation = r;
+            self.pos = self.to_program(&m);
         }
         Ok(())
     }

@@ -53,7 +53,7 @@ impl Machine {
             w.g.iter()
                 .find(|g| super::words_group(g.0) == Some(1))
                 .copied();
-        let has_axes = !consumed && w.first_of(AXES).is_some();
+        let has_axes = !consumed && w.any_unused(AXES);
         let code = match explicit {
             Some((800, column)) => {
                 if has_axes {
@@ -345,8 +345,8 @@ impl Machine {
     }
 
     /// `G28`/`G30`: a rapid to the intermediate point of the axis words, then to the stored
-    /// point (parameters `base..base + 3`, machine frame, mm) on the axes named (all without
-    /// axis words).
+    /// point (parameters `base..base + 3`, machine frame, mm) on the axes named, in the
+    /// program frame (all three without axis words).
     pub(super) fn home(
         &mut self,
         w: &mut Words,
@@ -358,15 +358,18 @@ impl Machine {
         let any = named.iter().any(|&b| b) || w.has(b'@') || w.has(b'^');
         let mid = self.target(w)?;
         self.emit(Motion::Rapid, mid, 0.0, column)?;
-        let mut m = self.to_machine(&mid);
+        // The stored point in the program frame; the axes named go there, in that frame.
+        let stored =
+            Vector3::new(params.get(base), params.get(base + 1), params.get(base + 2)) * 1e-3;
+        let home = self.to_program(&stored);
+        let mut end = mid;
         for (k, &given) in named.iter().enumerate() {
             if (given || !any)
-                && let Some(e) = m.get_mut(k)
+                && let (Some(e), Some(h)) = (end.get_mut(k), home.get(k))
             {
-                *e = params.get(base + k) * 1e-3;
+                *e = *h;
             }
         }
-        let end = self.to_program(&m);
         self.emit(Motion::Rapid, end, 0.0, column)
     }
 

@@ -100,6 +100,15 @@ impl Words {
         best
     }
 
+    /// Whether any of `letters` is on the line and not used yet.
+    pub(super) fn any_unused(&self, letters: &[u8]) -> bool {
+        letters.iter().any(|&l| {
+            slot(l).is_some_and(|s| {
+                self.values.get(s).copied().flatten().is_some() && self.used & (1 << s) == 0
+            })
+        })
+    }
+
     /// The column of the first of `letters` on the line.
     pub(super) fn first_of(&self, letters: &[u8]) -> Option<usize> {
         letters
