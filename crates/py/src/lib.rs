@@ -36,6 +36,7 @@ mod pickle;
 mod pose_motion;
 mod posture;
 mod scalars;
+mod tools;
 mod vjm;
 
 pub use errors::{ConvergenceError, DeflectError, InputError, LoadError, SingularError};
@@ -76,5 +77,6 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     posture::register(m)?;
     machining::register(m)?;
     machining_job::register(m)?;
+    tools::register(m)?;
     Ok(())
 }

@@ -18,10 +18,14 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::arrays::{pose, put_pose, rotation, try_array, try_rows, vector};
-use crate::errors::{build_err, job_err};
+use crate::errors::{build_err, job_err, load_err};
 use crate::machining::{GcodeProgram, coefficients};
 use crate::scalars::{count, pair, real};
+use crate::tools::{ToolState, ToolTable, from_states, tool_state};
 use crate::vjm::SerialRobot;
+use deflect_core::io::tool_table::{self, TblOptions};
+use deflect_core::machining::tools::ToolTable as CoreTable;
+use deflect_core::units::LengthUnit;
 
 /// A robot-machining job without its program: the arm (a `SerialRobot`, its tip the tool
 /// tip), the workpiece frame in the robot's base frame (`placement`, 4x4), the TCP
@@ -31,7 +35,11 @@ use crate::vjm::SerialRobot;
 /// `milling_force`), the stock block (`stock_min`, `stock_max` (x, y) [m], `stock_top` [m],
 /// `cell` [m]), and how the program is driven: sampled at `rate_hz` (default 250, the 4 ms
 /// cycle), path `acceleration` [m/s^2] and `jerk` [m/s^3], `rapid_speed` [m/s] and the
-/// `corner_angle` [rad] driven through without a stop.
+/// `corner_angle` [rad] driven through without a stop. `tools`: a `ToolTable` (or the path of a
+/// `.tbl` / `.toml` table, its `.tbl` tools taking `flutes` and `helix`): each move cuts with
+/// the tool its program put in the spindle; without one the `diameter` tool serves every `T`.
+/// `spindle_rpm`: the speed of a spindle the program never starts (a hand-started spindle),
+/// clockwise, wherever the program's spindle is off.
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct MachiningJob {
@@ -42,8 +50,8 @@ pub struct MachiningJob {
 
 /// A job as pickled: the robot, the placement (translation, quaternion i j k w), the tool
 /// orientation (quaternion), the stock (min x, min y, max x, max y, top, cell), the tool
-/// (diameter, flutes, helix), the coefficients and the path options (rate, acceleration,
-/// jerk, rapid speed, corner angle).
+/// (diameter, flutes, helix), the coefficients, the path options (rate, acceleration, jerk,
+/// rapid speed, corner angle), the tool table and the hand spindle [rev/s].
 type JobState = (
     Py<SerialRobot>,
     [f64; 3],
@@ -53,6 +61,8 @@ type JobState = (
     (f64, u32, f64),
     [f64; 6],
     [f64; 5],
+    Option<Vec<ToolState>>,
+    Option<f64>,
 );
 
 /// A unit quaternion from pickled coordinates, bit for bit (norm checked to 1e-12).
@@ -69,20 +79,44 @@ fn unit(q: [f64; 4], what: &str) -> PyResult<UnitQuaternion<f64>> {
 }
 
 impl MachiningJob {
-    fn build(robot: Py<SerialRobot>, setup: Setup) -> PyResult<Self> {
-        let inner = {
+    fn build(robot: Py<SerialRobot>, setup: Setup, tools: Option<CoreTable>) -> PyResult<Self> {
+        let mut inner = {
             let r = &robot.get().inner;
             Job::new(r.model.clone(), &r.joint_limits, setup).map_err(build_err)?
         };
+        if let Some(t) = tools {
+            inner = inner.with_tools(t);
+        }
         Ok(Self { inner, robot })
     }
+}
+
+/// `tools=`: a `ToolTable`, or the path of a table file.
+fn tool_table(t: &Bound<'_, PyAny>, flutes: u32, helix: f64) -> PyResult<CoreTable> {
+    if let Ok(table) = t.cast::<ToolTable>() {
+        return Ok(table.get().inner.clone());
+    }
+    let path: std::path::PathBuf = t.extract().map_err(|_| {
+        InputError::new_err(format!(
+            "tools must be a ToolTable or the path of a .tbl / .toml table, got {}",
+            t.get_type()
+                .name()
+                .map_or_else(|_| "?".to_string(), |n| n.to_string())
+        ))
+    })?;
+    let o = TblOptions {
+        units: LengthUnit::Millimetre,
+        flutes,
+        helix,
+    };
+    tool_table::from_path(&path, &o).map_err(load_err)
 }
 
 #[pymethods]
 impl MachiningJob {
     #[new]
-    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None),
-           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295)")]
+    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None),
+           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None)")]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: Bound<'_, SerialRobot>,
@@ -101,6 +135,8 @@ impl MachiningJob {
         jerk: Option<&Bound<'_, PyAny>>,
         rapid_speed: Option<&Bound<'_, PyAny>>,
         corner_angle: Option<&Bound<'_, PyAny>>,
+        tools: Option<&Bound<'_, PyAny>>,
+        spindle_rpm: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         // The documented defaults (shown in the text signature).
         let or = |o: Option<&Bound<'_, PyAny>>, what: &str, default: f64| {
@@ -140,9 +176,15 @@ impl MachiningJob {
                 corner_angle: or(corner_angle, "corner_angle", d.corner_angle)?,
             },
             ik: PoseIkOptions::default(),
-            hand_spindle: None,
+            hand_spindle: spindle_rpm
+                .map(|r| real(r, "spindle_rpm"))
+                .transpose()?
+                .map(|rpm| rpm / 60.0),
         };
-        Self::build(robot.unbind(), setup)
+        let tools = tools
+            .map(|t| tool_table(t, setup.tool.flutes, setup.tool.helix))
+            .transpose()?;
+        Self::build(robot.unbind(), setup, tools)
     }
 
     /// Pickling and copy.deepcopy: the robot and the setup as plain values, rebuilt bit for
@@ -176,6 +218,10 @@ impl MachiningJob {
                 s.path.rapid_speed,
                 s.path.corner_angle,
             ],
+            me.inner
+                .tools()
+                .map(|t| t.tools().iter().map(tool_state).collect()),
+            s.hand_spindle,
         );
         Ok((rebuild, (state,)))
     }
@@ -183,7 +229,7 @@ impl MachiningJob {
     /// The job of a pickled state (see `__reduce__`).
     #[staticmethod]
     fn _from_state(state: JobState) -> PyResult<Self> {
-        let (robot, t, pq, tq, st, (d, flutes, helix), k, p) = state;
+        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand) = state;
         let setup = Setup {
             placement: Isometry3::from_parts(
                 Translation3::from(Vector3::from(t)),
@@ -207,13 +253,15 @@ impl MachiningJob {
                 corner_angle: p[4],
             },
             ik: PoseIkOptions::default(),
-            hand_spindle: None,
+            hand_spindle: hand,
         };
-        Self::build(robot, setup)
+        Self::build(robot, setup, tools.map(from_states).transpose()?)
     }
 
     fn __eq__(&self, other: &Self) -> bool {
-        self.inner.setup() == other.inner.setup() && self.inner.model() == other.inner.model()
+        self.inner.setup() == other.inner.setup()
+            && self.inner.model() == other.inner.model()
+            && self.inner.tools() == other.inner.tools()
     }
 
     /// Runs the offline pass over `program` (a `GcodeProgram`) from the joints `seed` (dof,)
@@ -316,6 +364,19 @@ impl MachiningResult {
     #[getter]
     fn line<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {
         Array1::from_iter(self.report.samples.iter().map(|s| s.path.line as u64)).into_pyarray(py)
+    }
+
+    /// The tool in the spindle at each sample (n,) (its program's T; 0 for none).
+    #[getter]
+    fn tool<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u32>> {
+        Array1::from_iter(self.report.samples.iter().map(|s| s.path.tool)).into_pyarray(py)
+    }
+
+    /// The program's spindle speed at each sample (n,) [rev/s]: > 0 clockwise (M3), < 0
+    /// counter-clockwise (M4), 0 off (a hand-started spindle's speed is not in it).
+    #[getter]
+    fn spindle<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |s| s.path.spindle)
     }
 
     /// Programmed tool tip (n, 3) [m].

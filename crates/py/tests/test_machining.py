@@ -30,7 +30,8 @@ def test_a_program_reads_into_si_arrays():
     np.testing.assert_array_equal(p.end[0], [0.01, 0.0, 0.005])
     np.testing.assert_array_equal(p.end[2], [0.05, 0.0, -0.002])
     # The full circle about (60, 0) mm, clockwise, back at its start.
-    np.testing.assert_allclose(p.center[3], [0.06, 0.0], rtol=0, atol=1e-17)
+    np.testing.assert_allclose(p.center[3], [0.06, 0.0, -0.002], rtol=0, atol=1e-17)
+    assert p.plane == [None, None, None, "xy", None]
     assert np.isnan(p.center[0]).all()
     assert p.sweep[3] == -2 * math.pi
     np.testing.assert_array_equal(p.end[3], p.start[3])
@@ -54,17 +55,68 @@ def test_files_inches_and_a_start_point(tmp_path):
 @pytest.mark.parametrize(
     "text, match",
     [
-        ("G1 X10 T1 F100\n", "line 1, column 8: expected a supported word"),
-        ("G21\nG1 X1 F100\nG20\n", "line 3, column 1: expected one unit for the whole program"),
+        ("G1 X10 D1 F100\n", "line 1, column 8: expected D: a word nothing on the line uses"),
+        ("G41 G1 X1 F100\n", "line 1, column 1: expected G41: cutter radius compensation"),
         ("G0 X0 Y0\nG2 X10 Y0 I4 J0 F100\n", "line 2, column 4: expected an end point on the arc"),
         ("G1 X10\n", "feed rate F"),
-        ("G0 X1\nM30\nG0 X2\n", "nothing after the program end"),
+        ("G0 X1 A5\n", "line 1, column 7: expected A: rotary"),
+        ("o1 while [1]\no1 endwhile\n", "MAX_BLOCKS"),
     ],
 )
 def test_faults_are_load_errors_naming_line_and_column(text, match):
     with pytest.raises(deflect.LoadError, match=match) as e:
         deflect.GcodeProgram.from_text(text)
     assert isinstance(e.value, deflect.DeflectError)
+
+
+def test_the_cam_dialect_tools_cycles_and_the_word_report():
+    text = """%
+G21 G90 G17 G94
+T2 M6
+S8000 M4
+G0 X0 Y0 Z5
+G98 G81 X10 Y0 Z-3 R1 F300
+G80
+G18 G2 X20 Z5 I5 K0
+T5 M6 (G43 H5)
+G43 H5 M3 M8
+G4 P0.5
+G1 X30 F600
+M30
+%
+"""
+    p = deflect.GcodeProgram.from_text(text)
+    # The cycle: rapid over the hole at the start height, down to R, feed to Z, back up.
+    assert p.kind[:5] == ["rapid", "rapid", "rapid", "linear", "rapid"]
+    np.testing.assert_allclose(p.end[1], [0.01, 0.0, 0.005], atol=1e-15)
+    np.testing.assert_allclose(p.end[3], [0.01, 0.0, -0.003], atol=1e-15)
+    assert p.plane[5] == "zx" and p.kind[6] == "dwell" and p.dwell[6] == 0.5
+    # M4 turns counter-clockwise (< 0); M6 stops the spindle; M3 turns it clockwise again.
+    assert p.spindle[3] == -8000 / 60 and p.spindle[7] == 8000 / 60
+    assert p.tools == [2, 5] and p.tool[0] == 2 and p.tool[-1] == 5
+    words = {w[0]: w for w in p.words}
+    assert words["G81"][1] == "honoured" and words["G81"][3] == 6
+    assert words["G43"][1] == "recorded" and "TCP carries the tool length" in words["G43"][4]
+    assert words["M8"][1] == "recorded" and words["M6"][2] == 2
+    # A refused program still has its report.
+    refused = deflect.gcode_words("G41 G1 X1 F100\nG0 B90\n")
+    assert ("G41", "refused") == refused[0][:2] and any(w[0] == "B" and w[1] == "refused" for w in refused)
+
+
+def test_the_grbl_and_fanuc_dialects():
+    freecad = "G0 X0 Y0\nG2 X10 Y0 I5 J0 K0.000 F200\n"
+    with pytest.raises(deflect.LoadError, match="line 2, column 17: expected K: no K word on an arc in G17"):
+        deflect.GcodeProgram.from_text(freecad)
+    p = deflect.GcodeProgram.from_text(freecad, dialect="grbl")
+    np.testing.assert_allclose(p.center[0], [0.005, 0.0, 0.0])  # G0 X0 Y0 goes nowhere
+    haas = "G0 X0 Y0 Z5\nG81 X1 Y1 Z-1 R1 F100\nG80\nX5 Y5\n"
+    with pytest.raises(deflect.LoadError, match="line 4.*no motion mode"):
+        deflect.GcodeProgram.from_text(haas)
+    # Fanuc: after G80 the axis words move in the last G0-G3 mode (here G0).
+    p = deflect.GcodeProgram.from_text(haas, dialect="fanuc")
+    assert p.kind[-1] == "rapid" and p.line[-1] == 4
+    with pytest.raises(deflect.InputError, match="dialect"):
+        deflect.GcodeProgram.from_text("G0 X1\n", dialect="mach3")
 
 
 def test_bad_options_are_input_errors(tmp_path):

@@ -142,10 +142,69 @@ def test_programs_and_jobs_pickle_bit_for_bit(kr300):
     slot = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
     np.testing.assert_array_equal(again.run(slot, KR300_POSE).q_commanded, job.run(slot, KR300_POSE).q_commanded)
     # A tampered state is checked like any program: a gap between moves.
-    fn, (state,) = program.__reduce__()
+    fn, (state, words) = program.__reduce__()
     state[3] = (state[3][0], state[3][1], (1.0, 1.0, 1.0), *state[3][3:])
     with pytest.raises(deflect.InputError, match="MAX_GAP"):
-        fn(state)
+        fn(state, words)
+    # A job with a tool table and a hand-started spindle, and the table alone.
+    table = deflect.ToolTable.from_text("T1 P1 D16\nT2 P2 D10 Z42 ;ten\n")
+    job = slot_job(kr300, tools=table, spindle_rpm=12000.0)
+    again = pickle.loads(pickle.dumps(job))
+    assert again == job and again != slot_job(kr300, tools=table)
+    assert pickle.loads(pickle.dumps(table)) == table and len(table) == 2
+
+
+def slot_force(flutes, feed_per_tooth, depth=0.002):
+    """Altintas' closed form of a slot's per-revolution force, tool frame (feed along x)."""
+    ktc, krc, kac, kte, kre, kae = deflect.AL7075_T6_CARBIDE
+    n, a, c = flutes, depth, feed_per_tooth
+    return np.array(
+        [
+            -n * a * krc * c / 4 - n * a * kre / math.pi,
+            n * a * ktc * c / 4 + n * a * kte / math.pi,
+            n * a * kac * c / math.pi + n * a * kae / 2,
+        ]
+    )
+
+
+def test_each_tool_cuts_with_its_own_cutter_and_m4_mirrors_the_force(kr300, tmp_path):
+    program = deflect.GcodeProgram.from_text(
+        "T1 M6\nS13000 M3\nG0 X-10 Y-15 Z5\nG1 Z-2 F1500\nX70\nG0 Z5\n"
+        "T2 M6\nS13000 M4\nG0 X-10 Y15\nG1 Z-2\nX70\nG0 Z5\n",
+        start=[0.0, 0.0, 0.02],
+    )
+    table = deflect.ToolTable.from_text("T1 P1 D16 ;16 mm\nT2 P2 D10 ;10 mm\n", flutes=3)
+    r = slot_job(kr300, tools=table).run(program, KR300_POSE)
+    v, rev = 0.025, 13000 / 60
+    for line, flutes, mirror in [(5, 3, 1.0), (11, 3, -1.0)]:
+        mid = np.flatnonzero((r.line == line) & (r.position[:, 0] > 0.035))[0]
+        expected = slot_force(flutes, v / (rev * flutes)) * [1.0, mirror, 1.0]
+        np.testing.assert_allclose(r.force[mid], expected, rtol=1e-9)
+    assert set(r.tool.tolist()) == {1, 2} and r.spindle.min() == -rev
+    # The 10 mm slot is 10 mm wide: the nominal part's floor at y = 15 +- 4 mm, stock at 6 mm.
+    z = r.nominal_surface
+    j = lambda y: int(round((y + 0.03) / 5e-4 - 0.5))  # noqa: E731
+    i = int(round((0.04) / 5e-4 - 0.5))
+    assert z[j(0.019), i] == -0.002 and z[j(0.021), i] == 0.0
+    assert z[j(-0.022), i] == -0.002 and z[j(-0.0235), i] == 0.0
+    # Without the table the 16 mm tool serves both; a T the table lacks is refused where it cuts.
+    with pytest.raises(deflect.InputError, match="program line 11 .*T2"):
+        slot_job(kr300, tools=deflect.ToolTable.from_text("T1 P1 D16\n")).run(program, KR300_POSE)
+    f = tmp_path / "tools.toml"
+    f.write_text('units = "mm"\n[[tool]]\nnumber = 1\ndiameter = 16\nflutes = 3\n[[tool]]\nnumber = 2\ndiameter = 10\nflutes = 3\nshape = "ball"\n')
+    r2 = slot_job(kr300, tools=f).run(program, KR300_POSE)
+    assert r2.nominal_surface.min() == pytest.approx(-0.002)
+
+
+def test_a_hand_started_spindle_cuts_at_its_speed(kr300):
+    off = deflect.GcodeProgram.from_text("G0 X-10 Y0 Z5\nG1 Z-2 F1500\nX70\nG0 Z5\n", start=[0, 0, 0.02])
+    with pytest.raises(deflect.InputError, match="--spindle-rpm, Python spindle_rpm="):
+        slot_job(kr300).run(off, KR300_POSE)
+    r = slot_job(kr300, spindle_rpm=13000.0).run(off, KR300_POSE)
+    mid = np.flatnonzero((r.line == 3) & (r.position[:, 0] > 0.035))[0]
+    np.testing.assert_allclose(r.force[mid], slot_force(3, 0.025 / (13000 / 60 * 3)), rtol=1e-9)
+    with pytest.raises(deflect.InputError, match="hand spindle"):
+        slot_job(kr300, spindle_rpm=-5.0)
 
 
 def test_a_points_csv_program_runs_like_its_gcode_twin(kr300):

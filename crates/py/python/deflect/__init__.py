@@ -7,6 +7,8 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 from ._deflect import (
     AL7075_T6_CARBIDE,
     GcodeProgram,
+    ToolTable,
+    gcode_words,
     MachiningJob,
     MachiningResult,
     milling_force,
@@ -70,6 +72,8 @@ from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
 __all__ = [
     "AL7075_T6_CARBIDE",
     "GcodeProgram",
+    "ToolTable",
+    "gcode_words",
     "MachiningJob",
     "MachiningResult",
     "milling_force",

@@ -60,6 +60,8 @@ __all__ = [
     "MAX_GRID_NODES",
     "AL7075_T6_CARBIDE",
     "GcodeProgram",
+    "ToolTable",
+    "gcode_words",
     "MachiningJob",
     "MachiningResult",
     "milling_force",
@@ -984,15 +986,27 @@ def _atlas_chunk(
 
 @final
 class GcodeProgram:
-    """A machining program read from ISO G-code: its moves as arrays, SI, workpiece frame."""
+    """A machining program read from RS274/NGC G-code as LinuxCNC reads it: its moves as
+    arrays, SI, in the program's machine frame."""
     @staticmethod
     def from_file(
-        path: _StrPath, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+        path: _StrPath,
+        *,
+        start: Optional[_ArrayLike] = None,
+        units: str = "mm",
+        dialect: str = "linuxcnc",
+        block_delete: bool = False,
     ) -> "GcodeProgram":
-        """Reads a G-code file; ``start`` (3,) [m] before the first move, ``units`` "mm" | "in"."""
+        """Reads a G-code file; ``start`` (3,) [m] before the first move, ``units`` "mm" | "in",
+        ``dialect`` "linuxcnc" | "grbl" | "fanuc", ``block_delete`` skips "/" lines."""
     @staticmethod
     def from_text(
-        text: str, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+        text: str,
+        *,
+        start: Optional[_ArrayLike] = None,
+        units: str = "mm",
+        dialect: str = "linuxcnc",
+        block_delete: bool = False,
     ) -> "GcodeProgram":
         """Same as ``from_file``, from the program's text."""
     @staticmethod
@@ -1002,10 +1016,10 @@ class GcodeProgram:
     @staticmethod
     def from_points_text(text: str, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
         """Same as ``from_points_file``, from the CSV text."""
-    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
-        """Pickling and copy.deepcopy: the moves as plain values, rebuilt bit for bit."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, Any]]:
+        """Pickling and copy.deepcopy: the moves and the word report, rebuilt bit for bit."""
     @staticmethod
-    def _from_state(state: Any) -> "GcodeProgram": ...
+    def _from_state(state: Any, words: Any) -> "GcodeProgram": ...
     def __eq__(self, value: object, /) -> bool: ...
     __hash__: ClassVar[None]  # type: ignore[assignment]
     def __len__(self) -> int: ...
@@ -1014,7 +1028,7 @@ class GcodeProgram:
         """The program line of each move (1-based), (n,)."""
     @property
     def kind(self) -> List[str]:
-        """"rapid", "linear" or "arc" per move."""
+        """"rapid", "linear", "arc" or "dwell" per move."""
     @property
     def start(self) -> _FloatArray:
         """Start points (n, 3) [m]."""
@@ -1023,22 +1037,73 @@ class GcodeProgram:
         """End points (n, 3) [m]."""
     @property
     def center(self) -> _FloatArray:
-        """Arc centres (n, 2) [m]; NaN for straight moves."""
+        """Arc centres (n, 3) [m]; NaN for other moves."""
+    @property
+    def plane(self) -> List[Optional[str]]:
+        """Each arc's plane, "xy" | "zx" | "yz"; None for other moves."""
     @property
     def sweep(self) -> _FloatArray:
-        """Signed arc sweeps (n,) [rad], > 0 counter-clockwise; 0 for straight moves."""
+        """Signed arc sweeps (n,) [rad] about the plane's normal; 0 for other moves."""
+    @property
+    def dwell(self) -> _FloatArray:
+        """Dwell times (n,) [s]; 0 for other moves."""
     @property
     def feed(self) -> _FloatArray:
-        """Programmed feeds (n,) [m/s]; 0 for rapids."""
+        """Programmed feeds (n,) [m/s]; 0 for rapids and dwells."""
     @property
     def spindle(self) -> _FloatArray:
-        """Spindle speeds (n,) [rev/s]; 0 while off."""
+        """Spindle speeds (n,) [rev/s]; < 0 counter-clockwise (M4), 0 while off."""
+    @property
+    def tool(self) -> npt.NDArray[np.uint32]:
+        """The tool in the spindle at each move (n,); 0 for none."""
+    @property
+    def tools(self) -> List[int]:
+        """The tool numbers the moves use, ascending."""
+    @property
+    def path_control(self) -> List[str]:
+        """"G61", "G61.1" or "G64" per move."""
+    @property
+    def blend_tolerance(self) -> _FloatArray:
+        """The G64 P tolerance of each move (n,) [m]."""
     @property
     def length(self) -> _FloatArray:
         """Path lengths (n,) [m]."""
     @property
     def cutting_length(self) -> float:
         """Total length of the feed moves [m]."""
+    @property
+    def words(self) -> List[Tuple[str, str, int, int, str]]:
+        """Every word the program uses: (word, status, count, first_line, meaning)."""
+
+def gcode_words(text: str, *, dialect: str = "linuxcnc") -> List[Tuple[str, str, int, int, str]]:
+    """The word report of a program's text (also of one the reader refuses)."""
+
+@final
+class ToolTable:
+    """Tools by number: cutter, end shape, length, name (LinuxCNC .tbl or TOML)."""
+    @staticmethod
+    def from_file(
+        path: _StrPath, *, units: str = "mm", flutes: int = 3, helix: float = 0.0
+    ) -> "ToolTable":
+        """Reads a .tbl (or a .toml table)."""
+    @staticmethod
+    def from_text(
+        text: str, *, format: str = "tbl", units: str = "mm", flutes: int = 3, helix: float = 0.0
+    ) -> "ToolTable":
+        """Same as ``from_file``, from the text; ``format`` "tbl" | "toml"."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
+        """Pickling and copy.deepcopy: the tools as plain values."""
+    @staticmethod
+    def _from_state(state: Any) -> "ToolTable": ...
+    def __eq__(self, value: object, /) -> bool: ...
+    __hash__: ClassVar[None]  # type: ignore[assignment]
+    def __len__(self) -> int: ...
+    @property
+    def numbers(self) -> List[int]:
+        """The tool numbers, ascending."""
+    @property
+    def tools(self) -> List[Tuple[int, float, int, float, str, float, float, str]]:
+        """(number, diameter [m], flutes, helix [rad], shape, corner radius [m], length [m], name)."""
 
 @final
 class MachiningJob:
@@ -1063,6 +1128,8 @@ class MachiningJob:
         jerk: float = 20.0,
         rapid_speed: float = 0.25,
         corner_angle: float = 0.017453292519943295,
+        tools: Union[ToolTable, _StrPath, None] = None,
+        spindle_rpm: Optional[float] = None,
     ) -> Self: ...
     def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
         """The offline pass: forces, deflection, compensated joints, the part three ways."""
@@ -1083,6 +1150,12 @@ class MachiningResult:
     @property
     def line(self) -> npt.NDArray[np.uint64]:
         """Program line of each sample (n,)."""
+    @property
+    def tool(self) -> npt.NDArray[np.uint32]:
+        """The tool in the spindle at each sample (n,)."""
+    @property
+    def spindle(self) -> _FloatArray:
+        """The program's spindle speed at each sample (n,) [rev/s]."""
     @property
     def position(self) -> _FloatArray:
         """Programmed tool tip (n, 3) [m]."""
