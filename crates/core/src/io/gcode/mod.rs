@@ -91,9 +91,10 @@ pub const MAX_PROGRAM_LINES: usize = 1_000_000;
 /// Most nested subroutine calls (LinuxCNC's: a tenth level is refused).
 pub const MAX_CALL_DEPTH: usize = 9;
 
-/// Most lines one reading runs or skips: 10,000,000 (about 5 s; a loop that never ends, or
-/// one that runs a billion times, is refused with [`LoadError::ProgramBudget`]).
-pub const MAX_BLOCKS: usize = 10_000_000;
+/// Most lines one reading runs or skips: 5,000,000 (five times the longest program, about
+/// 1 s of reading; a loop that never ends, or one that runs a billion times, is refused
+/// with [`LoadError::ProgramBudget`]).
+pub const MAX_BLOCKS: usize = 5_000_000;
 
 /// The control a program is read for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -311,8 +311,9 @@ impl Machine {
             m => m,
         };
         if self.moves.len() >= MAX_MOVES {
+            // The column says "the moves budget" to the reading loop (a LoadError::TooLarge).
             return Err((
-                0,
+                usize::MAX,
                 LoadError::TooLarge {
                     what: std::format!("G-code program moves (at line {})", self.line),
                     limit: MAX_MOVES,
