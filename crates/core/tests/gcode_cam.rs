@@ -109,9 +109,13 @@ fn canned_cycles_make_linuxcncs_moves() {
     let p = read("G21 G18 G90 G94 F100 S1000 M3\nG0 X10 Y10 Z0\nG98 G81 X1 Z2 Y-5 R2\nM2\n");
     assert!(trace(&p).contains(&('L', [1.0, -5.0, 2.0])));
     // Starting below R: straight up to R first; the retract is R.
-    let p = read(&format!(
-        "G21 G90 F100 S1000 M3\nG0 X0 Y0 Z0\nG98 G81 X1 Y2 Z-5 R2\nM2\n"
-    ));
+    let p = read(
+        "G21 G90 F100 S1000 M3
+G0 X0 Y0 Z0
+G98 G81 X1 Y2 Z-5 R2
+M2
+",
+    );
     assert_eq!(trace(&p)[0], ('R', [0.0, 0.0, 2.0]));
     assert_eq!(trace(&p).last().unwrap().1, [1.0, 2.0, 2.0]);
     // After G80 an axis word has no motion mode (LinuxCNC); the fanuc dialect moves in G0,
