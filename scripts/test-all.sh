@@ -8,6 +8,26 @@ PY="${PYTHON:-python3}"
 # A clean CI checkout builds everything once: incremental caches would only take disk.
 if [ "${CI:-}" = true ]; then export CARGO_INCREMENTAL=0; fi
 
+# LinuxCNC's RS274/NGC interpreter `rs274` (Debian's linuxcnc-uspace) is the reference of the
+# G-code reader (crates/core/tests/rs274.rs compares their moves live): installed where it can
+# be (as root with apt-get, as CI runs), else that comparison is skipped and says so here.
+if ! command -v rs274 >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+  echo "== installing linuxcnc-uspace (rs274, the G-code reference) =="
+  mkdir -p target
+  if ! (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+          --no-install-recommends linuxcnc-uspace) > target/apt-linuxcnc.log 2>&1; then
+    echo "linuxcnc-uspace could not be installed (target/apt-linuxcnc.log)"
+  fi
+fi
+if command -v rs274 >/dev/null 2>&1; then
+  echo "rs274 found: the G-code reader is compared with LinuxCNC's interpreter"
+else
+  echo "rs274 not found: the comparison with LinuxCNC's interpreter (rs274.rs) is skipped"
+fi
+if [ ! -d ../shared/machining/real ] && [ -z "${DEFLECT_SHARED:-}" ]; then
+  echo "../shared/machining/real not found: the real-CAM-program comparison is skipped"
+fi
+
 echo "== Rust: format, lints, tests =="
 cargo fmt --all -- --check
 cargo clippy --workspace --all-targets --quiet -- -D warnings
