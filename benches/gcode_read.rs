@@ -24,7 +24,9 @@ fn surface(x: f64, y: f64) -> f64 {
 
 /// The raster as a CAM post writes it: one line per point, modal G1 and F.
 fn raster() -> String {
-    let mut p = String::from("%\n(raster finishing, ball end mill)\nG21 G90 G17 G94\nT1 M6\nS12000 M3 M8\nG0 Z10\n");
+    let mut p = String::from(
+        "%\n(raster finishing, ball end mill)\nG21 G90 G17 G94\nT1 M6\nS12000 M3 M8\nG0 Z10\n",
+    );
     for r in 0..ROWS {
         let y = r as f64 * 0.8;
         let dir = if r % 2 == 0 { 1.0 } else { -1.0 };
@@ -51,12 +53,17 @@ fn parametric() -> String {
     let _ = writeln!(p, "  o2 while [#5 LT {POINTS}]");
     p.push_str("    #6 = [#4 + #3 * #5 * 0.8]\n");
     p.push_str("    X#6 Z[-5 - 3 * SIN[#6 / 17 * 57.29577951308232] * COS[#2 / 23 * 57.29577951308232] - 0.002 * [#6 - 60] * [#2 - 40]] F2400\n");
-    p.push_str("    #5 = [#5 + 1]\n  o2 endwhile\n  G0 Z10\n  #1 = [#1 + 1]\no1 endwhile\nM5 M9\nM30\n%\n");
+    p.push_str(
+        "    #5 = [#5 + 1]\n  o2 endwhile\n  G0 Z10\n  #1 = [#1 + 1]\no1 endwhile\nM5 M9\nM30\n%\n",
+    );
     p
 }
 
 fn rs274() -> Option<String> {
-    let out = Command::new("sh").args(["-c", "command -v rs274"]).output().ok()?;
+    let out = Command::new("sh")
+        .args(["-c", "command -v rs274"])
+        .output()
+        .ok()?;
     let p = String::from_utf8(out.stdout).ok()?.trim().to_string();
     (!p.is_empty()).then_some(p)
 }
@@ -75,7 +82,9 @@ fn bench(c: &mut Criterion) {
         g.sample_size(20);
         // Lines per second of the CAM program; moves per second of the parametric one (its
         // 24 lines run about 80,000 times).
-        g.throughput(Throughput::Elements(if name == "raster" { lines } else { moves } as u64));
+        g.throughput(Throughput::Elements(
+            if name == "raster" { lines } else { moves } as u64,
+        ));
         g.bench_function("deflect", |b| {
             b.iter(|| gcode::from_str(black_box(&text), &options).unwrap())
         });

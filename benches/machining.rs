@@ -47,6 +47,7 @@ fn bench(c: &mut Criterion) {
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
         hand_spindle: None,
+        rapid_skim: job::RAPID_SKIM,
     };
     let seed = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();

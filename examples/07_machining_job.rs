@@ -58,6 +58,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
         hand_spindle: None,
+        rapid_skim: job::RAPID_SKIM,
     };
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup)?;
     // Joints near the first pose (the tool down over the table): they choose the IK branch.

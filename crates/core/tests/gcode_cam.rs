@@ -280,6 +280,9 @@ fn tools_and_the_spindle_follow_the_program() {
     assert_eq!(tools, [3, 3, 4, 4, 7]);
     assert_eq!(spindle, [9000.0, 9000.0, -9000.0, 0.0, 9000.0]);
     assert_eq!(p.tools(), [3, 4, 7]);
+    // Before any change, the tool the program selected: a post for manual tool changes.
+    let p = read("T5\nS9000 M3\nG1 X1 F100\n");
+    assert_eq!(p.moves[0].tool, 5);
     // Tool length offsets are recorded, not applied: the tip follows the program.
     let with = read("T1 M6 G43 H1\nG43.1 Z5\nG0 X1 Y1 Z1\nG49\nG0 X2\n");
     let without = read("T1 M6\nG0 X1 Y1 Z1\nG0 X2\n");

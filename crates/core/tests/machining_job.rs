@@ -186,6 +186,7 @@ fn kr300_job() -> (Job, Vec<f64>) {
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
         hand_spindle: None,
+        rapid_skim: job::RAPID_SKIM,
     };
     (
         Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap(),

@@ -39,7 +39,9 @@ use deflect_core::units::LengthUnit;
 /// `.tbl` / `.toml` table, its `.tbl` tools taking `flutes` and `helix`): each move cuts with
 /// the tool its program put in the spindle; without one the `diameter` tool serves every `T`.
 /// `spindle_rpm`: the speed of a spindle the program never starts (a hand-started spindle),
-/// clockwise, wherever the program's spindle is off.
+/// clockwise, wherever the program's spindle is off. `rapid_skim` [m]: how deep a rapid may run
+/// into the predicted stock before the run refuses it as a crash (default 1e-4 m; the deepest
+/// contact within it is `MachiningResult.rapid_contact`).
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct MachiningJob {
@@ -51,7 +53,8 @@ pub struct MachiningJob {
 /// A job as pickled: the robot, the placement (translation, quaternion i j k w), the tool
 /// orientation (quaternion), the stock (min x, min y, max x, max y, top, cell), the tool
 /// (diameter, flutes, helix), the coefficients, the path options (rate, acceleration, jerk,
-/// rapid speed, corner angle), the tool table and the hand spindle [rev/s].
+/// rapid speed, corner angle), the tool table, the hand spindle [rev/s] and the rapid skim
+/// [m].
 type JobState = (
     Py<SerialRobot>,
     [f64; 3],
@@ -63,6 +66,7 @@ type JobState = (
     [f64; 5],
     Option<Vec<ToolState>>,
     Option<f64>,
+    f64,
 );
 
 /// A unit quaternion from pickled coordinates, bit for bit (norm checked to 1e-12).
@@ -115,8 +119,8 @@ fn tool_table(t: &Bound<'_, PyAny>, flutes: u32, helix: f64) -> PyResult<CoreTab
 #[pymethods]
 impl MachiningJob {
     #[new]
-    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None),
-           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None)")]
+    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None, rapid_skim=None),
+           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None, rapid_skim=0.0001)")]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: Bound<'_, SerialRobot>,
@@ -137,6 +141,7 @@ impl MachiningJob {
         corner_angle: Option<&Bound<'_, PyAny>>,
         tools: Option<&Bound<'_, PyAny>>,
         spindle_rpm: Option<&Bound<'_, PyAny>>,
+        rapid_skim: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
         // The documented defaults (shown in the text signature).
         let or = |o: Option<&Bound<'_, PyAny>>, what: &str, default: f64| {
@@ -180,6 +185,7 @@ impl MachiningJob {
                 .map(|r| real(r, "spindle_rpm"))
                 .transpose()?
                 .map(|rpm| rpm / 60.0),
+            rapid_skim: or(rapid_skim, "rapid_skim", job::RAPID_SKIM)?,
         };
         let tools = tools
             .map(|t| tool_table(t, setup.tool.flutes, setup.tool.helix))
@@ -222,6 +228,7 @@ impl MachiningJob {
                 .tools()
                 .map(|t| t.tools().iter().map(tool_state).collect()),
             s.hand_spindle,
+            s.rapid_skim,
         );
         Ok((rebuild, (state,)))
     }
@@ -229,7 +236,7 @@ impl MachiningJob {
     /// The job of a pickled state (see `__reduce__`).
     #[staticmethod]
     fn _from_state(state: JobState) -> PyResult<Self> {
-        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand) = state;
+        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand, skim) = state;
         let setup = Setup {
             placement: Isometry3::from_parts(
                 Translation3::from(Vector3::from(t)),
@@ -254,6 +261,7 @@ impl MachiningJob {
             },
             ik: PoseIkOptions::default(),
             hand_spindle: hand,
+            rapid_skim: skim,
         };
         Self::build(robot, setup, tools.map(from_states).transpose()?)
     }
@@ -377,6 +385,13 @@ impl MachiningResult {
     #[getter]
     fn spindle<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         self.column(py, |s| s.path.spindle)
+    }
+
+    /// The deepest a rapid move ran into the predicted stock (within the job's
+    /// `rapid_skim`): `(line, time [s], depth [m])`, or None.
+    #[getter]
+    fn rapid_contact(&self) -> Option<(usize, f64, f64)> {
+        self.report.rapid_contact.map(|c| (c.line, c.time, c.depth))
     }
 
     /// Programmed tool tip (n, 3) [m].

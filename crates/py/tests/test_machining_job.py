@@ -207,6 +207,16 @@ def test_a_hand_started_spindle_cuts_at_its_speed(kr300):
         slot_job(kr300, spindle_rpm=-5.0)
 
 
+def test_a_rapid_may_skim_the_stock_and_is_reported(kr300):
+    skim = deflect.GcodeProgram.from_text("G0 X-10 Y0 Z-0.05\nS13000 M3\nG0 X70\n", start=[0, 0, 0.02])
+    r = slot_job(kr300).run(skim, KR300_POSE)
+    line, _, depth = r.rapid_contact
+    assert line == 3 and depth == pytest.approx(5e-5, abs=1e-15)
+    with pytest.raises(deflect.InputError, match="program line 3 .*rapid move .*0.050 mm into"):
+        slot_job(kr300, rapid_skim=4e-5).run(skim, KR300_POSE)
+    assert slot_job(kr300).run(deflect.GcodeProgram.from_text(SLOT, start=[0, 0, 0.02]), KR300_POSE).rapid_contact is None
+
+
 def test_a_points_csv_program_runs_like_its_gcode_twin(kr300):
     job = slot_job(kr300)
     points = deflect.GcodeProgram.from_points_text(

@@ -37,6 +37,7 @@ fn a_short_groove_five_ways() {
         path: PathOptions::default(),
         ik: PoseIkOptions::default(),
         hand_spindle: None,
+        rapid_skim: deflect_core::machining::job::RAPID_SKIM,
     };
     let opts = MillingOptions::short();
     // On a thread with a 16 MB stack: in a debug build the scenario's frames hold the 70 KB

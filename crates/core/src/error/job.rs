@@ -39,7 +39,8 @@ pub enum JobError {
         /// The program's tool number (`T`).
         tool: u32,
     },
-    /// A rapid move (`G0`) runs into the stock: a crash on the machine.
+    /// A rapid move (`G0`) runs more than [`crate::machining::job::RAPID_SKIM`] into the
+    /// stock: a crash on the machine.
     RapidInStock {
         /// Program line (1-based).
         line: usize,

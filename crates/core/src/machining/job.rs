@@ -40,7 +40,7 @@ use super::Program;
 use super::cutting::{self, Coefficients, Engagement, Tool};
 use super::engagement::{self, Contact};
 use super::path::{self, PathOptions, PathSample};
-pub use super::report::{ErrorStats, JobSample, LineForce, Report, SurfaceError};
+pub use super::report::{ErrorStats, JobSample, LineForce, RapidContact, Report, SurfaceError};
 use super::stock::{Cutter, ZMap};
 use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
@@ -48,6 +48,13 @@ use crate::mechanism::{PoseIkOptions, pose_ik};
 use crate::vjm::{self, Data, Load, MAX_DOF, Model, Vector6};
 
 pub use crate::mechanism::JOINT_LIMIT_TOLERANCE;
+
+/// How deep a rapid move (`G0`) may run into the predicted stock before the job refuses it
+/// as a crash \[m\], by default ([`Setup::rapid_skim`]): 0.1 mm. The stops between runs are
+/// sampled at the controller rate, so the predicted floor where a cut stopped may stand a few
+/// micrometres above the programmed one (tens at 125 Hz), and CAM programs rapid down to the
+/// last cut's depth.
+pub const RAPID_SKIM: f64 = 1.0e-4;
 
 /// The stock: a block over `[min, max]` (x, y) with its top at `top`, workpiece frame \[m\],
 /// resolved in square cells of `cell` \[m\] (see [`super::stock::MAX_CELLS`]).
@@ -85,6 +92,10 @@ pub struct Setup {
     /// for such machines write no `M3`): it turns clockwise at this speed wherever the
     /// program's spindle is off. `None`: the program's spindle only.
     pub hand_spindle: Option<f64>,
+    /// How deep a rapid move may run into the predicted stock \[m\] before the job refuses
+    /// it ([`JobError::RapidInStock`]); the deepest contact within it is reported
+    /// ([`Report::rapid_contact`]). Default [`RAPID_SKIM`].
+    pub rapid_skim: f64,
 }
 
 impl Setup {
@@ -122,6 +133,12 @@ impl Setup {
         self.tool.validate()?;
         self.coefficients.validate()?;
         self.path.validate()?;
+        crate::error::param(
+            "rapid skim (m)",
+            self.rapid_skim,
+            self.rapid_skim.is_finite() && (0.0..=0.1).contains(&self.rapid_skim),
+            "in [0, 0.1] m",
+        )?;
         if let Some(v) = self.hand_spindle {
             crate::error::param(
                 "hand spindle speed (rev/s)",
@@ -336,6 +353,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         to_work,
     };
     let mut tool_in_spindle: Option<(u32, Option<(Tool, Cutter)>)> = None;
+    let mut rapid_contact: Option<RapidContact> = None;
     for s in &path {
         let at = |error: TickError| JobError::AtLine {
             line: s.line,
@@ -374,15 +392,19 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
                 tool: s.tool,
             });
         }
-        if !s.feed_move {
-            let area = st.cell * st.cell;
-            if removed.cells > 0
-                && removed.volume > removed.cells as f64 * area * engagement::MIN_DEPTH
-            {
+        if !s.feed_move && removed.deepest > engagement::MIN_DEPTH {
+            if rapid_contact.is_none_or(|c: RapidContact| removed.deepest > c.depth) {
+                rapid_contact = Some(RapidContact {
+                    line: s.line,
+                    time: s.time,
+                    depth: removed.deepest,
+                });
+            }
+            if removed.deepest > setup.rapid_skim {
                 return Err(JobError::RapidInStock {
                     line: s.line,
                     time: s.time,
-                    depth: removed.volume / (removed.cells as f64 * area),
+                    depth: removed.deepest,
                 });
             }
         }
@@ -471,6 +493,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
     }
     Ok(Report {
         samples,
+        rapid_contact,
         nominal,
         uncompensated: unc.stock,
         compensated: comp.stock,

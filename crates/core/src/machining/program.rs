@@ -182,7 +182,9 @@ pub struct Move {
     /// Spindle speed \[rev/s\]: > 0 clockwise (`M3`), < 0 counter-clockwise (`M4`), 0 off
     /// (`M5`, or before `M3`/`M4`).
     pub spindle: f64,
-    /// The tool in the spindle (`T` and `M6`, or `M61 Q`); 0 for none.
+    /// The tool in the spindle (`T` and `M6`, or `M61 Q`); before the program's first tool
+    /// change, the tool it selected with `T` (posts for manual tool changes write `T` without
+    /// `M6`); 0 for none.
     pub tool: u32,
     /// The path control mode in effect.
     pub path_control: PathControl,

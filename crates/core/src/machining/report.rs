@@ -101,6 +101,9 @@ pub struct LineForce {
 pub struct Report {
     /// Every sample, in time order.
     pub samples: Vec<JobSample>,
+    /// The deepest a rapid move ran into the stock within [`super::job::Setup::rapid_skim`]
+    /// (none if no rapid touched it).
+    pub rapid_contact: Option<RapidContact>,
     /// The part as programmed.
     pub nominal: ZMap,
     /// The part the uncompensated arm cuts.
@@ -117,6 +120,17 @@ pub struct Report {
     pub dof: usize,
     /// The stock's top \[m\].
     pub top: f64,
+}
+
+/// Where a rapid move ran into the predicted stock.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RapidContact {
+    /// Program line (1-based).
+    pub line: usize,
+    /// Time into the program \[s\].
+    pub time: f64,
+    /// The deepest cell it lowered \[m\].
+    pub depth: f64,
 }
 
 impl Report {

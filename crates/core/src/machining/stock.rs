@@ -52,6 +52,8 @@ pub struct Removal {
     pub cells: usize,
     /// Volume removed \[m^3\] (height drops times the cell area).
     pub volume: f64,
+    /// The largest height drop of a cell \[m\].
+    pub deepest: f64,
 }
 
 /// A rectangular stock of square cells, heights \[m\] in the workpiece frame.
@@ -257,6 +259,7 @@ impl ZMap {
                 {
                     removal.cells += 1;
                     removal.volume += (*h - z) * area;
+                    removal.deepest = removal.deepest.max(*h - z);
                     *h = z;
                 }
             }

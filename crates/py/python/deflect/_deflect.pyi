@@ -1130,6 +1130,7 @@ class MachiningJob:
         corner_angle: float = 0.017453292519943295,
         tools: Union[ToolTable, _StrPath, None] = None,
         spindle_rpm: Optional[float] = None,
+        rapid_skim: float = 0.0001,
     ) -> Self: ...
     def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
         """The offline pass: forces, deflection, compensated joints, the part three ways."""
@@ -1150,6 +1151,9 @@ class MachiningResult:
     @property
     def line(self) -> npt.NDArray[np.uint64]:
         """Program line of each sample (n,)."""
+    @property
+    def rapid_contact(self) -> Optional[Tuple[int, float, float]]:
+        """The deepest rapid contact with the stock: (line, time [s], depth [m]), or None."""
     @property
     def tool(self) -> npt.NDArray[np.uint32]:
         """The tool in the spindle at each sample (n,)."""

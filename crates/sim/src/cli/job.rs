@@ -58,9 +58,14 @@ pub struct JobArgs {
     pub tools: Option<PathBuf>,
     #[arg(long, allow_negative_numbers = true, help = SPINDLE_RPM.help(
         "Spindle speed of a program that never starts its spindle (a hand-started spindle) [rpm]",
-        " It turns clockwise at this speed wherever the program's spindle is off"
+        "It turns clockwise at this speed wherever the program's spindle is off"
     ))]
     pub spindle_rpm: Option<f64>,
+    #[arg(long, default_value_t = 0.1, allow_negative_numbers = true, help = RAPID_SKIM_MM.help(
+        "How deep a rapid move (G0) may run into the predicted stock before the job refuses it as a crash [mm]",
+        "The deepest contact within it is in the summary"
+    ))]
+    pub rapid_skim: f64,
     /// Tool points CSV instead of G-code (columns x_mm,y_mm,z_mm or x_m,y_m,z_m,
     /// feed_mm_min or feed_m_s, spindle_rpm; one straight move per row, feed 0 for rapid).
     #[arg(long)]
@@ -139,6 +144,7 @@ impl JobArgs {
         RAPID_SPEED.check(self.rapid_speed)?;
         LEAD_MS.check(self.lead_ms)?;
         TOLERANCE_MM.check(self.tolerance)?;
+        RAPID_SKIM_MM.check(self.rapid_skim)?;
         if let Some(rpm) = self.spindle_rpm {
             SPINDLE_RPM.check(rpm)?;
         }

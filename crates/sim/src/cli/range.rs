@@ -159,6 +159,8 @@ pub const CELL_MM: Range = Range::closed("--cell", 0.01, 10.0, "mm");
 pub const DIAMETER_MM: Range = Range::closed("--diameter", 0.1, 200.0, "mm");
 /// `job --flutes`.
 pub const FLUTES: Range = Range::closed("--flutes", 1.0, 16.0, "");
+/// How deep a rapid may run into the stock.
+pub const RAPID_SKIM_MM: Range = Range::closed("--rapid-skim", 0.0, 100.0, "mm");
 /// A hand-started spindle's speed.
 pub const SPINDLE_RPM: Range = Range::closed("--spindle-rpm", 1.0, 1.0e6, "rpm");
 /// `job --helix`.

@@ -239,6 +239,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         },
         ik: PoseIkOptions::default(),
         hand_spindle: a.spindle_rpm.map(|rpm| rpm / 60.0),
+        rapid_skim: a.rapid_skim * 1e-3,
     };
     let mut job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
         .map_err(|e| CliError::Usage(format!("--stock/--cell and the job's settings: {e}")))?;
@@ -353,6 +354,17 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
     );
     let (tools, tools_json) = tools_text(t);
     let _ = writeln!(text, "{tools}");
+    if let Some(c) = r.rapid_contact {
+        let _ = writeln!(
+            text,
+            "rapids in the stock: the deepest {:.3} mm at line {} (t = {:.2} s), within --rapid-skim \
+             {:.3} mm",
+            c.depth * 1e3,
+            c.line,
+            c.time,
+            t.job.setup().rapid_skim * 1e3
+        );
+    }
     let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
     let _ = writeln!(text, "line  samples  mean |F| [N]  max |F| [N]");
     let lines = r.line_forces();
@@ -397,6 +409,9 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
         "plunge_samples": r.plunge_samples,
         "max_force_n": fmax,
         "tools": tools_json,
+        "rapid_contact": r.rapid_contact.map(|c| serde_json::json!({
+            "line": c.line, "time_s": c.time, "depth_m": c.depth,
+        })),
         "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
         "lines": lines.iter().map(|l| serde_json::json!({
             "line": l.line, "samples": l.samples,

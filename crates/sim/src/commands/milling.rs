@@ -164,6 +164,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         },
         ik: PoseIkOptions::default(),
         hand_spindle: None,
+        rapid_skim: deflect_core::machining::job::RAPID_SKIM,
     };
     setup
         .validate()

@@ -324,7 +324,13 @@ impl Machine {
         }
         self.moves.push(Move {
             spindle: self.spindle(),
-            tool: self.tool,
+            // Before the first tool change, the tool the program selected (posts for manual
+            // tool changes write T without M6: the operator puts that tool in).
+            tool: if self.tool == 0 {
+                self.selected
+            } else {
+                self.tool
+            },
             path_control: self.path_control,
             ..Move::new(self.line, motion, start, stop, feed)
         });
