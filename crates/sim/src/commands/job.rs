@@ -195,8 +195,16 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
                 flutes: a.tool.flutes,
                 helix: a.tool.helix.to_radians(),
             };
-            let table = tool_table::from_path(path, &o)
-                .map_err(|e| CliError::Failure(format!("--tools {}: {e}", path.display())))?;
+            let text = read_text("--tools", path, "tool table")?;
+            let toml = path
+                .extension()
+                .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+            let table = if toml {
+                tool_table::toml_from_str(&text)
+            } else {
+                tool_table::tbl_from_str(&text, &o)
+            }
+            .map_err(|e| CliError::Failure(format!("--tools {}: {e}", path.display())))?;
             if let Some(m) = program
                 .moves
                 .iter()

@@ -48,6 +48,66 @@ fn job_refuses_bad_flags_and_files_before_any_work() {
         2,
         &["--program", "missing.nc"],
     );
+    out_of_range(
+        &d,
+        &["job", "--spindle-rpm", "0"],
+        "--spindle-rpm",
+        "0",
+        "[1, 1000000] rpm",
+    );
+    out_of_range(
+        &d,
+        &["job", "--rapid-skim", "-1"],
+        "--rapid-skim",
+        "-1",
+        "[0, 100] mm",
+    );
+    refused(
+        &d,
+        &["job", "--dialect", "mach3"],
+        2,
+        &["--dialect", "mach3"],
+    );
+    refused(
+        &d,
+        &["job", "--tools", d.join("missing.tbl").to_str().unwrap()],
+        2,
+        &["--tools", "missing.tbl"],
+    );
+    // A tool table without the program's tool, a malformed one.
+    let two = d.join("two.nc");
+    std::fs::write(
+        &two,
+        "T1 M6\nS9000 M3\nG0 X0 Y0 Z5\nG1 Z-1 F300\nT2 M6\nM3\nG1 X5\n",
+    )
+    .unwrap();
+    let tbl = d.join("one.tbl");
+    std::fs::write(&tbl, "T1 P1 D6\n").unwrap();
+    refused(
+        &d,
+        &[
+            "job",
+            "--program",
+            two.to_str().unwrap(),
+            "--tools",
+            tbl.to_str().unwrap(),
+        ],
+        1,
+        &["--tools", "one.tbl", "line 7 cuts with T2"],
+    );
+    std::fs::write(&tbl, "T1 P1\n").unwrap();
+    refused(
+        &d,
+        &[
+            "job",
+            "--program",
+            two.to_str().unwrap(),
+            "--tools",
+            tbl.to_str().unwrap(),
+        ],
+        1,
+        &["--tools", "one.tbl", "line 1", "D"],
+    );
     // A stock of more than 2^24 cells.
     refused(
         &d,
@@ -102,4 +162,84 @@ fn job_writes_the_compensated_program_samples_heat_map_and_summary() {
     assert!(csv.starts_with("time_s,line,x_m"));
     let png = std::fs::read(out.join("job_part.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
+}
+
+#[test]
+fn job_explains_a_programs_words_and_runs_two_tools_on_a_hand_started_spindle() {
+    let d = scratch("job-tools");
+    let program = d.join("two.nc");
+    std::fs::write(
+        &program,
+        "%\nG21 G90 G17\nT1 M6\nG0 X-10 Y-8 Z5\nG1 Z-1 F600\nX40\nG0 Z5\nT2 M6 M8\n\
+         G0 X-10 Y8\nG1 Z-1\nX40\nG0 Z5\nG41 D2\n%\n",
+    )
+    .unwrap();
+    // The word report: every word, and where the reader refuses the program.
+    let o = sim(&["job", "--explain", program.to_str().unwrap()]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout.contains("M8                     recorded"),
+        "{}",
+        o.stdout
+    );
+    assert!(
+        o.stdout.contains("G41                    refused"),
+        "{}",
+        o.stdout
+    );
+    assert!(
+        o.stdout.contains("refused: program line 13, column 1"),
+        "{}",
+        o.stdout
+    );
+    let text = std::fs::read_to_string(&program)
+        .unwrap()
+        .replace("G41 D2\n", "");
+    std::fs::write(&program, text).unwrap();
+    let tools = d.join("tools.toml");
+    std::fs::write(
+        &tools,
+        "units = \"mm\"\n[[tool]]\nnumber = 1\ndiameter = 10\nflutes = 3\n\
+         [[tool]]\nnumber = 2\ndiameter = 6\nflutes = 2\nshape = \"ball\"\n",
+    )
+    .unwrap();
+    let out = d.join("out");
+    let o = sim(&[
+        "job",
+        "--program",
+        program.to_str().unwrap(),
+        "--tools",
+        tools.to_str().unwrap(),
+        "--spindle-rpm",
+        "12000",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("T1 10.000 mm flat 3 flutes; T2 6.000 mm ball 2 flutes"),
+        "{}",
+        o.stdout
+    );
+    assert!(
+        o.stdout.contains("spindle: hand-started at 12000 rpm"),
+        "{}",
+        o.stdout
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("job_summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["hand_spindle_rpm"].as_f64(), Some(12000.0));
+    assert_eq!(summary["tools"][1]["shape"], "ball");
+    // Both lines cut: the 10 mm slot (file line 6) and the 6 mm one (line 11).
+    let lines = summary["lines"].as_array().unwrap();
+    for l in [6, 11] {
+        assert!(
+            lines
+                .iter()
+                .any(|x| x["line"] == l && x["max_force_n"].as_f64().unwrap() > 20.0),
+            "{l}"
+        );
+    }
 }
