@@ -105,6 +105,21 @@ fn canned_cycles_make_linuxcncs_moves() {
     let p = read(&format!("{head}G99 G89 X1 Y2 Z-5 R2 P0.5\nM2\n"));
     assert_eq!(p.moves[4].motion, Motion::Dwell { seconds: 0.5 });
     assert_eq!(trace(&p)[5], ('L', [1.0, 2.0, 2.0]));
+    // G88: rs274 feeds, dwells, stops for the operator's retract by hand; here the retract
+    // is a rapid to the clear height (the one move LinuxCNC does not make).
+    let p = read(&format!(
+        "{head}G98 G88 X1 Y2 Z-5 R2 P0.5\nG80\nG91 G0 X1\nM2\n"
+    ));
+    let t = trace(&p);
+    assert_eq!(
+        t[3..],
+        [
+            ('L', [1.0, 2.0, -5.0]),
+            ('D', [1.0, 2.0, -5.0]),
+            ('R', [1.0, 2.0, 10.0]),
+            ('R', [2.0, 2.0, 10.0])
+        ]
+    );
     // G18: the cycle drills along Y.
     let p = read("G21 G18 G90 G94 F100 S1000 M3\nG0 X10 Y10 Z0\nG98 G81 X1 Z2 Y-5 R2\nM2\n");
     assert!(trace(&p).contains(&('L', [1.0, -5.0, 2.0])));

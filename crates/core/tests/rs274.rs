@@ -8,7 +8,7 @@
 //! where they are; `DEFLECT_SHARED` overrides the folder) and LinuxCNC's mill samples in
 //! `/usr/share/linuxcnc/ncfiles/`. Every program `rs274` runs to its end must read here with
 //! the same moves, or be refused by name for what item 3 of the reader's docs refuses
-//! (cutter compensation, probing, threading, lathe, rotary axes, G88). The tool table holds
+//! (cutter compensation, probing, threading, lathe, rotary axes). The tool table holds
 //! tools 1-99, every length zero (a robot's TCP carries the tool length).
 //!
 //! Without `rs274` (Debian's `linuxcnc-uspace`) the comparison prints that it was skipped.
@@ -376,13 +376,12 @@ fn compare(canon: &[Canon], moves: &[Move], prefix: bool) -> Result<usize, Strin
 }
 
 /// The refusals item 3 of the reader's docs allows for a program rs274 runs.
-const ASIDE: [&str; 7] = [
+const ASIDE: [&str; 6] = [
     "cutter radius compensation",
     "probing",
     "threading",
     "lathe",
     "rotary and secondary axes",
-    "G88",
     "$ (spindle selection)",
 ];
 

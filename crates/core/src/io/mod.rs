@@ -8,7 +8,7 @@
 //! | [`urdf`] (`urdf`) | URDF + stiffness TOML | [`crate::SerialRobot`] |
 //! | [`stiffness`] (`urdf`) | stiffness TOML `[[virtual_joint]]` | specs |
 //! | [`drive`] (`urdf`) | drive-train TOML `[[joint]]` + URDF masses | [`crate::drivetrain::Model`] |
-//! | [`gcode`] | ISO G-code (G0-G3, G17, G20/G21, G90/G91, F, S, M3/M5/M30) | [`crate::machining::Program`] |
+//! | [`gcode`] | RS274/NGC G-code as LinuxCNC reads it (the CAM dialect and the NGC language) | [`crate::machining::Program`], a word report |
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
 //! | [`tool_table`] | LinuxCNC `.tbl`, or TOML | [`crate::machining::tools::ToolTable`] |
 //! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |

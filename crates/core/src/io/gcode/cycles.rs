@@ -383,11 +383,16 @@ impl Machine {
                 self.spindle_dir = dir;
             }
             880 => {
-                // Feed, dwell, spindle stop, operator stop: the operator retracts by hand, and
-                // the interpreter takes the tool to be at the clear height (no move).
+                // Feed, dwell, spindle stop, operator stop: LinuxCNC's operator retracts by
+                // hand and its interpreter takes the tool to be at the clear height. A robot has
+                // no operator's hand: the retract is a rapid (the one move LinuxCNC does not
+                // make), the spindle restarting after it.
+                let dir = self.spindle_dir;
                 self.feed_to(g, a, b, bottom, w, column)?;
                 dwell(self)?;
-                self.pos = self.cycle_point(g, a, b, clear);
+                self.spindle_dir = 0;
+                self.rapid_to(g, a, b, clear, column)?;
+                self.spindle_dir = dir;
             }
             890 => {
                 self.feed_to(g, a, b, bottom, w, column)?;

@@ -276,7 +276,6 @@ impl Machine {
                 960 => "constant surface speed (G96) is a lathe's",
                 171 | 181 | 191 => "the UVW planes (G17.1, G18.1, G19.1) need UVW axes",
                 52 | 53 => "NURBS (G5.2, G5.3) are not modelled",
-                880 => "G88 (boring with the operator's retract by hand) needs an operator",
                 _ => continue,
             };
             return fault(column, std::format!("{}: {why}", g_name(g)));

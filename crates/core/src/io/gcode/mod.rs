@@ -10,7 +10,7 @@
 //! | words | meaning here |
 //! |---|---|
 //! | `G0` `G1` `G2` `G3` `G5` `G5.1` | rapid, line, arcs in `G17`/`G18`/`G19` (`I J K` or `R`, `P` turns, helices), cubic and quadratic splines (lines within 1 um) |
-//! | `G73` `G74` `G81`-`G87` `G89` `G80` `G98` `G99` | canned cycles expanded into LinuxCNC's moves (`R`, `Q`, `P`, `L`, `G91`) |
+//! | `G73` `G74` `G81`-`G89` `G80` `G98` `G99` | canned cycles expanded into LinuxCNC's moves (`R`, `Q`, `P`, `L`, `G91`; `G88`'s retract by the operator's hand is a rapid) |
 //! | `G4` | dwell `P` seconds: a timed stop |
 //! | `G17` `G18` `G19` `G90.1` `G91.1` | arc plane, absolute / incremental arc centres |
 //! | `G20` `G21` `G90` `G91` `G93` `G94` `G95` | units anywhere, distance modes, feed per minute, inverse time, per revolution (turned into path speed) |
@@ -25,8 +25,8 @@
 //! | `N`, `/`, `(...)`, `;`, `(MSG,...)` `(DEBUG,...)` `(PRINT,...)` `(ABORT,...)` | line numbers, block delete, comments |
 //!
 //! Refused by name: cutter radius compensation (`G41`, `G42`), probing (`G38.x`), threading
-//! (`G33`, `G76`), lathe modes and cycles (`G7`, `G70`-`G72`, `G96`), `G88` (an operator's
-//! retract), NURBS (`G5.2`), rotary and secondary axes (`A B C U V W`), user M codes
+//! (`G33`, `G76`), lathe modes and cycles (`G7`, `G70`-`G72`, `G96`), NURBS (`G5.2`), rotary
+//! and secondary axes (`A B C U V W`), user M codes
 //! (`M100`-`M199`); and every word LinuxCNC refuses, with its reason.
 //!
 //! # The frame

@@ -230,6 +230,9 @@ fn g_class(code: u16) -> (WordStatus, String) {
         730 | 740 | 810 | 820 | 830 | 840 | 850 | 860 | 870 | 890 => {
             honoured("canned cycle, expanded into LinuxCNC's moves")
         }
+        880 => {
+            honoured("canned cycle; the operator's retract by hand is a rapid to the clear height")
+        }
         800 => honoured("cancel the motion mode"),
         900 | 910 => honoured("absolute, incremental coordinates"),
         901 | 911 => honoured("absolute, incremental arc centres"),
@@ -237,7 +240,6 @@ fn g_class(code: u16) -> (WordStatus, String) {
         930 | 940 | 950 => honoured("feed: inverse time, per minute, per revolution"),
         970 => recorded("spindle in RPM"),
         980 | 990 => honoured("cycle retract to the initial level, to R"),
-        880 => refused("boring with the operator's retract by hand"),
         330 | 331 | 760 => refused("threading: not modelled"),
         382..=385 => refused("probing: not modelled"),
         410 | 411 | 420 | 421 => {
