@@ -251,6 +251,9 @@ impl Machine {
     pub(super) fn execute(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
         check_groups(w, self.dialect)?;
         self.refuse_unsupported(w)?;
+        for letter in [b'a', b'b', b'c'] {
+            w.take(letter);
+        }
         self.modes_before_motion(w, params)?;
         let consumed = self.non_modal(w, params)?;
         self.motion(w, consumed, params)?;
@@ -262,7 +265,7 @@ impl Machine {
     }
 
     /// Refuses what has no meaning on a robot or is not modelled, by name.
-    fn refuse_unsupported(&self, w: &Words) -> Result<(), Fault> {
+    fn refuse_unsupported(&self, w: &mut Words) -> Result<(), Fault> {
         for &(g, column) in &w.g {
             let why = match g {
                 330 | 331 | 760 => "threading (G33, G33.1, G76) is not modelled",
@@ -288,12 +291,15 @@ impl Machine {
             (b'v', "V"),
             (b'w', "W"),
         ] {
-            if w.has(letter) {
+            // A rotary axis held at 0 (a post for a machine with a rotary table that this
+            // program does not turn) moves nothing; one that turns is refused.
+            let held = matches!(letter, b'a' | b'b' | b'c') && w.peek(letter) == Some(0.0);
+            if w.has(letter) && !held {
                 return fault(
                     w.column(letter),
                     std::format!(
                         "{what}: rotary and secondary axes (A, B, C, U, V, W) are not modelled; \
-                         a 3-axis program moves X, Y and Z"
+                         a 3-axis program moves X, Y and Z (A, B, C may only stay at 0)"
                     ),
                 );
             }

@@ -175,17 +175,18 @@ impl Reader<'_> {
             self.m.line = line;
             let here = pc;
             pc += 1;
+            let trimmed = raw.trim();
+            if percent && trimmed == "%" {
+                // The program's end, even inside a block being skipped (an error below).
+                break;
+            }
             if self.skip.is_some() {
                 if let Some(next) = self.skipping(raw, here)? {
                     pc = next;
                 }
                 continue;
             }
-            let trimmed = raw.trim();
             if trimmed.starts_with('%') {
-                if percent && trimmed == "%" {
-                    break;
-                }
                 if self.options.dialect.percent_anywhere() {
                     continue;
                 }

@@ -148,6 +148,10 @@ pub fn words(text: &str, options: &GcodeOptions) -> Result<Vec<WordUse>, LoadErr
                             std::format!("{}[...]", char::from(letter.to_ascii_uppercase())),
                             (WordStatus::Honoured, "a code given by an expression".into()),
                         ),
+                        (b'a' | b'b' | b'c', Some(v)) if v != 0.0 => (
+                            char::from(letter.to_ascii_uppercase()).to_string(),
+                            refused("rotary axis turning: not modelled"),
+                        ),
                         _ => (
                             char::from(letter.to_ascii_uppercase()).to_string(),
                             letter_class(letter),
@@ -289,7 +293,7 @@ fn letter_class(letter: u8) -> (WordStatus, String) {
         b'e' => recorded("analog I/O number"),
         b'@' | b'^' => honoured("polar radius, angle"),
         b'd' => refused("cutter radius compensation number"),
-        b'a' | b'b' | b'c' => refused("rotary axis: not modelled"),
+        b'a' | b'b' | b'c' => recorded("rotary axis: held at 0 only (refused where it turns)"),
         b'u' | b'v' | b'w' => refused("secondary axis: not modelled"),
         b'$' => refused("spindle selection: one spindle"),
         _ => refused("a word LinuxCNC does not know"),
