@@ -347,7 +347,11 @@ impl Machine {
                 self.feed_to(g, a, b, r, w, column)?;
                 self.rapid_to(g, a, b, clear, column)?;
             }
-            860 => {
+            860 | 880 => {
+                // Feed, dwell, spindle stop, out at rapid, spindle on again. G88 stops for
+                // LinuxCNC's operator to retract by hand, its interpreter taking the tool to be
+                // at the clear height: a robot has no operator's hand, so its retract is this
+                // rapid (the one move LinuxCNC does not make).
                 let dir = self.spindle_dir;
                 self.feed_to(g, a, b, bottom, w, column)?;
                 dwell(self)?;
@@ -379,18 +383,6 @@ impl Machine {
                 self.spindle_dir = 0;
                 self.rapid_to(g, a + oa, b + ob, bottom, column)?;
                 self.rapid_to(g, a + oa, b + ob, clear, column)?;
-                self.rapid_to(g, a, b, clear, column)?;
-                self.spindle_dir = dir;
-            }
-            880 => {
-                // Feed, dwell, spindle stop, operator stop: LinuxCNC's operator retracts by
-                // hand and its interpreter takes the tool to be at the clear height. A robot has
-                // no operator's hand: the retract is a rapid (the one move LinuxCNC does not
-                // make), the spindle restarting after it.
-                let dir = self.spindle_dir;
-                self.feed_to(g, a, b, bottom, w, column)?;
-                dwell(self)?;
-                self.spindle_dir = 0;
                 self.rapid_to(g, a, b, clear, column)?;
                 self.spindle_dir = dir;
             }

@@ -493,6 +493,16 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// The run of letters from here (a keyword, a function's name) and where it starts.
+    fn letters(&mut self) -> (usize, String) {
+        let from = self.at;
+        while matches!(self.peek(), Some(b'a'..=b'z')) {
+            self.at += 1;
+        }
+        let run = self.b.text.get(from..self.at).unwrap_or(&[]);
+        (from, run.iter().map(|&c| char::from(c)).collect())
+    }
+
     fn o_word(&mut self) -> Result<(), LexError> {
         let column = self.column();
         self.at += 1;
@@ -503,18 +513,7 @@ impl Parser<'_> {
         } else {
             Label::Value(self.value()?)
         };
-        let from = self.at;
-        while matches!(self.peek(), Some(b'a'..=b'z')) {
-            self.at += 1;
-        }
-        let word: String = self
-            .b
-            .text
-            .get(from..self.at)
-            .unwrap_or(&[])
-            .iter()
-            .map(|&c| char::from(c))
-            .collect();
+        let (from, word) = self.letters();
         let keyword = match word.as_str() {
             "sub" => Keyword::Sub,
             "endsub" => Keyword::Endsub,
@@ -702,18 +701,7 @@ impl Parser<'_> {
     /// A function: its name, then `[argument]` (`ATAN[y]/[x]`, `EXISTS[#param]`).
     fn function(&mut self) -> Result<u32, LexError> {
         let column = self.column();
-        let from = self.at;
-        while matches!(self.peek(), Some(b'a'..=b'z')) {
-            self.at += 1;
-        }
-        let name: String = self
-            .b
-            .text
-            .get(from..self.at)
-            .unwrap_or(&[])
-            .iter()
-            .map(|&c| char::from(c))
-            .collect();
+        let (from, name) = self.letters();
         let func = match name.as_str() {
             "abs" => Some(Func::Abs),
             "acos" => Some(Func::Acos),
