@@ -55,6 +55,7 @@
 //! program may end without `M2`, `M30` or `%` (LinuxCNC refuses one that does), and lines may
 //! be longer than LinuxCNC's 252 characters.
 
+mod arc;
 mod cycles;
 mod expr;
 mod flow;

@@ -1,13 +1,12 @@
-//! The moves a block makes: straight moves (`G0`, `G1`, `G53`), arcs in the three planes
-//! with LinuxCNC's centre rules and tolerances (`G2`, `G3`, `I J K`, `R`, `P` turns,
-//! `G90.1`), splines (`G5`, `G5.1`, as lines within 1 um), dwells (`G4`) and the return to a
-//! stored point (`G28`, `G30`); the feed of each in the program's feed mode.
+//! The moves a block makes: straight moves (`G0`, `G1`, `G53`), splines (`G5`, `G5.1`, as
+//! lines within 1 um), dwells (`G4`) and the return to a stored point (`G28`, `G30`), the feed
+//! of each in the program's feed mode; arcs are [`super::arc`]'s.
 
 use std::string::ToString;
 
 use nalgebra::{Vector2, Vector3};
 
-use super::interp::{Fault, FeedMode, INCH, Machine, fault};
+use super::interp::{Fault, FeedMode, Machine, fault};
 use super::params::Params;
 use super::words::{Words, g_name};
 use crate::LoadError;
@@ -17,20 +16,6 @@ use crate::machining::{MAX_COORDINATE, MAX_DWELL, MAX_FEED, MAX_MOVES, Motion, M
 pub const SPLINE_TOLERANCE: f64 = 1.0e-6;
 /// Most chords one spline becomes.
 pub const MAX_SPLINE_CHORDS: usize = 1_000;
-
-/// LinuxCNC's radius tolerances of arcs, in the program's unit: the zero-radius and `R`
-/// reach tolerance (0.00005 in, 0.00127 mm) and the spiral tolerance of a centre arc
-/// (`2 x 0.001 sqrt 2` in, `2 x 0.01 sqrt 2` mm).
-fn arc_tolerances(units: f64) -> (f64, f64) {
-    if units == INCH {
-        (
-            0.00005 * INCH,
-            2.0 * 0.001 * core::f64::consts::SQRT_2 * INCH,
-        )
-    } else {
-        (0.00127e-3, 2.0 * 0.01 * core::f64::consts::SQRT_2 * 1.0e-3)
-    }
-}
 
 /// Words that make a motion run.
 const AXES: &[u8] = b"xyz@^";
@@ -219,7 +204,7 @@ impl Machine {
     }
 
     /// The feed \[m/s\] of a feed move `length` \[m\] long in the current feed mode.
-    fn speed(&self, w: &Words, length: f64, column: usize) -> Result<f64, Fault> {
+    pub(super) fn speed(&self, w: &Words, length: f64, column: usize) -> Result<f64, Fault> {
         let per_minute = match self.feed_mode {
             FeedMode::PerMinute => {
                 if self.feed <= 0.0 {
@@ -380,213 +365,6 @@ impl Machine {
         self.emit(Motion::Rapid, end, 0.0, column)
     }
 
-    /// `G2`/`G3` in the selected plane.
-    fn arc(&mut self, w: &mut Words, clockwise: bool, column: usize) -> Result<(), Fault> {
-        let plane = self.plane;
-        if plane != Plane::Xy && self.rotation != 0.0 {
-            return fault(
-                column,
-                "G18/G19 arcs in a rotated coordinate system (G10 L2 R) are not modelled",
-            );
-        }
-        // The centre words of the plane's first and second axes, and the one of its normal.
-        let (first, second, off) = match plane {
-            Plane::Xy => (b'i', b'j', b'k'),
-            Plane::Zx => (b'k', b'i', b'j'),
-            Plane::Yz => (b'j', b'k', b'i'),
-        };
-        if w.has(off) {
-            if self.dialect.ignores_off_plane_offset() {
-                w.take(off);
-            } else {
-                return fault(
-                    w.column(off),
-                    std::format!(
-                        "{}: no {} word on an arc in {} (the plane's centre words are {} and {}; \
-                         grbl ignores it: the grbl dialect reads it so)",
-                        char::from(off.to_ascii_uppercase()),
-                        char::from(off.to_ascii_uppercase()),
-                        plane.gcode(),
-                        char::from(first.to_ascii_uppercase()),
-                        char::from(second.to_ascii_uppercase())
-                    ),
-                );
-            }
-        }
-        let has_ij = w.has(first) || w.has(second);
-        let radius_word = w.peek(b'r');
-        if has_ij && radius_word.is_some() {
-            return fault(
-                w.column(b'r'),
-                "either a centre (I, J, K) or a radius R on an arc, not both",
-            );
-        }
-        if !has_ij && radius_word.is_none() {
-            return fault(
-                column,
-                "an arc needs its centre (I, J, K in its plane) or its radius R",
-            );
-        }
-        let turns = match w.take(b'p') {
-            None => 1,
-            Some(p) => match super::expr::integer(p) {
-                Some(t) if (1..=i64::from(crate::machining::MAX_ARC_TURNS)).contains(&t) => {
-                    t as u32
-                }
-                _ => {
-                    return fault(
-                        w.column(b'p'),
-                        std::format!(
-                            "a number of turns P in 1..={} (an integer) on an arc, got P{p}",
-                            crate::machining::MAX_ARC_TURNS
-                        ),
-                    );
-                }
-            },
-        };
-        let (a, b, n) = plane.axes();
-        let in_plane_words = [b'x', b'y', b'z']
-            .iter()
-            .enumerate()
-            .any(|(k, l)| (k == a || k == b) && w.has(*l))
-            || w.has(b'@')
-            || w.has(b'^');
-        let start = self.pos;
-        let end_column = w.first_of(b"xyz@^").unwrap_or(column);
-        let end = self.target(w)?;
-        let get = |v: &Vector3<f64>, k: usize| v.get(k).copied().unwrap_or(0.0);
-        let (s2, e2) = (
-            Vector2::new(get(&start, a), get(&start, b)),
-            Vector2::new(get(&end, a), get(&end, b)),
-        );
-        let (zero_tol, spiral_tol) = arc_tolerances(self.units);
-        let centre = if let Some(r) = radius_word {
-            w.take(b'r');
-            if !in_plane_words {
-                return fault(
-                    column,
-                    std::format!(
-                        "an R arc needs an end point in its plane ({})",
-                        plane.gcode()
-                    ),
-                );
-            }
-            if s2 == e2 {
-                return fault(
-                    column,
-                    "an R arc needs an end point other than its start (a full circle needs I, J, K)",
-                );
-            }
-            let r = r * self.units;
-            let chord = e2 - s2;
-            let half = chord.norm() / 2.0;
-            if half - r.abs() > zero_tol {
-                return fault(
-                    w.column(b'r'),
-                    std::format!(
-                        "an arc radius R at least half the chord ({:.4} {}), got {:.4}",
-                        half / self.units,
-                        self.unit_name(),
-                        r.abs() / self.units
-                    ),
-                );
-            }
-            let u = chord / chord.norm();
-            let right = (clockwise && r > 0.0) || (!clockwise && r < 0.0);
-            let side = if right {
-                Vector2::new(u.y, -u.x)
-            } else {
-                Vector2::new(-u.y, u.x)
-            };
-            let ratio = half / r.abs();
-            let d = if ratio > 1.0 - 1.0e-12 {
-                0.0
-            } else {
-                r.abs() * ratio.asin().cos()
-            };
-            (s2 + e2) / 2.0 + side * d
-        } else {
-            let c1 = w.take(first);
-            let c2 = w.take(second);
-            if self.ijk_absolute {
-                let (Some(c1), Some(c2)) = (c1, c2) else {
-                    return fault(
-                        column,
-                        std::format!(
-                            "both centre words {} and {} in absolute arc centre mode (G90.1)",
-                            char::from(first.to_ascii_uppercase()),
-                            char::from(second.to_ascii_uppercase())
-                        ),
-                    );
-                };
-                Vector2::new(c1, c2) * self.units
-            } else {
-                s2 + Vector2::new(c1.unwrap_or(0.0), c2.unwrap_or(0.0)) * self.units
-            }
-        };
-        let (r1, r2) = ((s2 - centre).norm(), (e2 - centre).norm());
-        if r1 < zero_tol || r2 < zero_tol {
-            return fault(
-                column,
-                "an arc of radius > 0 (its centre is at its start or its end)",
-            );
-        }
-        let err = (r1 - r2).abs();
-        if radius_word.is_none()
-            && (err > 100.0 * spiral_tol || (err / r1.max(r2) > 0.001 && err > spiral_tol))
-        {
-            return fault(
-                end_column,
-                std::format!(
-                    "an end point on the arc's circle: the radius is {:.4} {u} at the start and \
-                     {:.4} {u} at the end (LinuxCNC's tolerance: {:.4} {u}, or 0.1 % up to {:.2} {u})",
-                    r1 / self.units,
-                    r2 / self.units,
-                    spiral_tol / self.units,
-                    100.0 * spiral_tol / self.units,
-                    u = self.unit_name()
-                ),
-            );
-        }
-        let base = sweep(&s2, &e2, &centre, clockwise);
-        let extra = f64::from(turns - 1) * core::f64::consts::TAU;
-        let sweep = if clockwise {
-            base - extra
-        } else {
-            base + extra
-        };
-        let rise = get(&end, n) - get(&start, n);
-        let length = (r1 * sweep.abs()).hypot(rise);
-        let feed = self.speed(w, length, column)?;
-        let mut c = start;
-        if let Some(x) = c.get_mut(a) {
-            *x = centre.x;
-        }
-        if let Some(x) = c.get_mut(b) {
-            *x = centre.y;
-        }
-        if let Some(v) = self
-            .to_machine(&c)
-            .iter()
-            .find(|v| v.is_nan() || v.abs() > MAX_COORDINATE)
-        {
-            return fault(
-                column,
-                std::format!("an arc centre within +-{MAX_COORDINATE} m, got {v} m"),
-            );
-        }
-        self.emit(
-            Motion::Arc {
-                plane,
-                center: c,
-                sweep,
-            },
-            end,
-            feed,
-            column,
-        )
-    }
-
     /// `G5` (cubic, `I J P Q`) and `G5.1` (quadratic, `I J`) B-splines in the XY plane, as
     /// chords within [`SPLINE_TOLERANCE`].
     fn spline(&mut self, w: &mut Words, cubic: bool, column: usize) -> Result<(), Fault> {
@@ -670,20 +448,3 @@ impl Machine {
         Ok(())
     }
 }
-
-/// Signed sweep about the plane's normal from `a` to `b` around `c` (> 0 counter-clockwise);
-/// equal ends make a full turn.
-pub(super) fn sweep(a: &Vector2<f64>, b: &Vector2<f64>, c: &Vector2<f64>, clockwise: bool) -> f64 {
-    let tau = core::f64::consts::TAU;
-    let (ra, rb) = (a - c, b - c);
-    let angle = |v: Vector2<f64>| v.y.atan2(v.x);
-    let ccw = (angle(rb) - angle(ra)).rem_euclid(tau);
-    if clockwise {
-        let cw = (tau - ccw).rem_euclid(tau);
-        return -(if a == b || cw == 0.0 { tau } else { cw });
-    }
-    if a == b || ccw == 0.0 { tau } else { ccw }
-}
-
-#[allow(dead_code)]
-fn _unused(_: Params) {}
