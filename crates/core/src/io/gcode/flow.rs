@@ -154,15 +154,36 @@ impl Reader<'_> {
         let Some(o) = self.block.o_word.clone() else {
             return Ok(here + 1);
         };
-        let column = o.column;
         let label = self.label()?;
-        let cond = |r: &Self| -> Result<f64, Fault> {
-            match o.args.first() {
-                Some(&n) => expr::eval(&r.block, n, r).map_err(|e| (column, e)),
-                None => Ok(0.0),
+        match o.keyword {
+            Keyword::Sub | Keyword::Endsub | Keyword::Return | Keyword::Call | Keyword::Header => {
+                self.sub_word(&o, label, here)
             }
-        };
-        let next = here + 1;
+            Keyword::If | Keyword::Elseif | Keyword::Else | Keyword::Endif => {
+                self.branch(&o, &label, here, by_skip)
+            }
+            Keyword::While => {
+                let c = self.condition(&o)?;
+                self.while_line(label, here, c)
+            }
+            Keyword::Break | Keyword::Continue => self.loop_exit(&o, &label, here),
+            Keyword::Do | Keyword::Repeat | Keyword::Endwhile | Keyword::Endrepeat => {
+                self.loop_word(&o, &label, here)
+            }
+        }
+    }
+
+    /// The value of an O-word's bracketed argument (0 without one).
+    fn condition(&self, o: &lex::OWord) -> Result<f64, Fault> {
+        match o.args.first() {
+            Some(&n) => expr::eval(&self.block, n, self).map_err(|e| (o.column, e)),
+            None => Ok(0.0),
+        }
+    }
+
+    /// `sub` (its definition is skipped), `endsub`/`return` (back to the caller with a
+    /// value), `call`, and a bare program number.
+    fn sub_word(&mut self, o: &lex::OWord, label: String, here: usize) -> Result<usize, Fault> {
         match o.keyword {
             Keyword::Sub => {
                 self.skip = Some(Skip {
@@ -172,78 +193,57 @@ impl Reader<'_> {
                     definition: true,
                     from: here,
                 });
-                Ok(next)
+                Ok(here + 1)
             }
             Keyword::Endsub | Keyword::Return => {
                 if self.frames.last().is_none_or(|f| f.fanuc.is_some()) {
                     return Err((
-                        column,
+                        o.column,
                         std::format!(
                             "o<{label}> {} inside a called subroutine (this one was not called)",
                             o.keyword.name()
                         ),
                     ));
                 }
-                match o.args.first() {
-                    Some(_) => {
-                        self.m.value = cond(self)?;
-                        self.m.value_returned = true;
-                    }
-                    None => {
-                        self.m.value = 0.0;
-                        self.m.value_returned = false;
-                    }
-                }
+                self.m.value_returned = !o.args.is_empty();
+                self.m.value = self.condition(o)?;
                 Ok(self.leave())
             }
-            Keyword::Call => self.call(&o, label, here),
-            Keyword::If => {
-                let scoped = self.scoped(&label);
-                if cond(self)? != 0.0 {
-                    Ok(next)
-                } else {
+            Keyword::Call => self.call(o, label, here),
+            _ => Ok(here + 1),
+        }
+    }
+
+    /// `if`, `elseif`, `else`, `endif`: a false condition skips to the label's next O-word; a
+    /// branch reached by running (not by a skip) means an earlier one ran: on to `endif`.
+    fn branch(
+        &mut self,
+        o: &lex::OWord,
+        label: &str,
+        here: usize,
+        by_skip: bool,
+    ) -> Result<usize, Fault> {
+        let scoped = self.scoped(label);
+        match o.keyword {
+            Keyword::If | Keyword::Elseif if o.keyword == Keyword::If || by_skip => {
+                if self.condition(o)? == 0.0 {
                     self.skip_to(scoped, None, true, here);
-                    Ok(next)
                 }
             }
-            Keyword::Elseif => {
-                let scoped = self.scoped(&label);
-                if !by_skip {
-                    self.skip_to(scoped, Some(Keyword::Endif), false, here);
-                } else if cond(self)? == 0.0 {
-                    self.skip_to(scoped, None, true, here);
-                }
-                Ok(next)
+            Keyword::Elseif | Keyword::Else if !by_skip => {
+                self.skip_to(scoped, Some(Keyword::Endif), false, here);
             }
-            Keyword::Else => {
-                if !by_skip {
-                    let scoped = self.scoped(&label);
-                    self.skip_to(scoped, Some(Keyword::Endif), false, here);
-                }
-                Ok(next)
-            }
-            Keyword::Endif | Keyword::Header => Ok(next),
-            Keyword::While => self.while_line(label, here, cond(self)?),
-            Keyword::Endwhile => {
-                let scoped = self.scoped(&label);
-                match self
-                    .loops
-                    .iter()
-                    .rposition(|l| l.label == scoped && l.kind == Keyword::While)
-                {
-                    Some(k) => {
-                        let line = self.loops.get(k).map_or(next, |l| l.line);
-                        self.loops.truncate(k + 1);
-                        Ok(line)
-                    }
-                    None => Err((
-                        column,
-                        std::format!("o<{label}> while before o<{label}> endwhile"),
-                    )),
-                }
-            }
+            _ => {}
+        }
+        Ok(here + 1)
+    }
+
+    /// `do`, `repeat` (its count rounded half to even), `endwhile`, `endrepeat`.
+    fn loop_word(&mut self, o: &lex::OWord, label: &str, here: usize) -> Result<usize, Fault> {
+        let scoped = self.scoped(label);
+        let next = here + 1;
+        match o.keyword {
             Keyword::Do => {
-                let scoped = self.scoped(&label);
                 if self
                     .loops
                     .last()
@@ -259,8 +259,7 @@ impl Reader<'_> {
                 Ok(next)
             }
             Keyword::Repeat => {
-                let scoped = self.scoped(&label);
-                let n = round_half_even(cond(self)?);
+                let n = round_half_even(self.condition(o)?);
                 if n <= 0 {
                     self.skip_to(scoped, Some(Keyword::Endrepeat), false, here);
                 } else {
@@ -273,20 +272,30 @@ impl Reader<'_> {
                 }
                 Ok(next)
             }
-            Keyword::Endrepeat => {
-                let scoped = self.scoped(&label);
+            _ => {
+                let kind = if o.keyword == Keyword::Endwhile {
+                    Keyword::While
+                } else {
+                    Keyword::Repeat
+                };
                 let Some(k) = self
                     .loops
                     .iter()
-                    .rposition(|l| l.label == scoped && l.kind == Keyword::Repeat)
+                    .rposition(|l| l.label == scoped && l.kind == kind)
                 else {
                     return Err((
-                        column,
-                        std::format!("o<{label}> repeat before o<{label}> endrepeat"),
+                        o.column,
+                        std::format!(
+                            "o<{label}> {} before o<{label}> {}",
+                            kind.name(),
+                            o.keyword.name()
+                        ),
                     ));
                 };
                 self.loops.truncate(k + 1);
                 match self.loops.last_mut() {
+                    // endwhile: back to the while line, which tests again.
+                    Some(l) if kind == Keyword::While => Ok(l.line),
                     Some(l) if l.remaining > 1 => {
                         l.remaining -= 1;
                         Ok(l.line + 1)
@@ -297,50 +306,46 @@ impl Reader<'_> {
                     }
                 }
             }
-            Keyword::Break | Keyword::Continue => {
-                let scoped = self.scoped(&label);
-                let Some(k) = self.loops.iter().rposition(|l| l.label == scoped) else {
-                    return Err((
-                        column,
-                        std::format!(
-                            "o<{label}> {} inside a while or do loop o<{label}>",
-                            o.keyword.name()
-                        ),
-                    ));
-                };
-                let (kind, line) = self
-                    .loops
-                    .get(k)
-                    .map_or((Keyword::While, here), |l| (l.kind, l.line));
-                if kind == Keyword::Repeat {
-                    return Err((
-                        column,
-                        std::format!(
-                            "o<{label}> {} inside a while or do loop (LinuxCNC has none in repeat)",
-                            o.keyword.name()
-                        ),
-                    ));
-                }
-                self.loops.truncate(k + 1);
-                match (o.keyword, kind) {
-                    (Keyword::Continue, Keyword::While) => Ok(line),
-                    (Keyword::Continue, _) => {
-                        self.skip_to(scoped, Some(Keyword::While), true, here);
-                        Ok(next)
-                    }
-                    (_, Keyword::While) => {
-                        self.loops.pop();
-                        self.skip_to(scoped, Some(Keyword::Endwhile), false, here);
-                        Ok(next)
-                    }
-                    _ => {
-                        self.loops.pop();
-                        self.skip_to(scoped, Some(Keyword::While), false, here);
-                        Ok(next)
-                    }
-                }
+        }
+    }
+
+    /// `break` (past the loop's end) and `continue` (to its test); none in a `repeat`
+    /// (LinuxCNC's rule).
+    fn loop_exit(&mut self, o: &lex::OWord, label: &str, here: usize) -> Result<usize, Fault> {
+        let scoped = self.scoped(label);
+        let name = o.keyword.name();
+        let Some(k) = self.loops.iter().rposition(|l| l.label == scoped) else {
+            return Err((
+                o.column,
+                std::format!("o<{label}> {name} inside a while or do loop o<{label}>"),
+            ));
+        };
+        let (kind, line) = self
+            .loops
+            .get(k)
+            .map_or((Keyword::While, here), |l| (l.kind, l.line));
+        if kind == Keyword::Repeat {
+            return Err((
+                o.column,
+                std::format!(
+                    "o<{label}> {name} inside a while or do loop (LinuxCNC has none in repeat)"
+                ),
+            ));
+        }
+        self.loops.truncate(k + 1);
+        match (o.keyword, kind) {
+            (Keyword::Continue, Keyword::While) => return Ok(line),
+            (Keyword::Continue, _) => self.skip_to(scoped, Some(Keyword::While), true, here),
+            (_, Keyword::While) => {
+                self.loops.pop();
+                self.skip_to(scoped, Some(Keyword::Endwhile), false, here);
+            }
+            _ => {
+                self.loops.pop();
+                self.skip_to(scoped, Some(Keyword::While), false, here);
             }
         }
+        Ok(here + 1)
     }
 
     /// A `while` line: the head of a while loop, or the tail of a do loop.
