@@ -224,16 +224,13 @@ impl Reader<'_> {
         by_skip: bool,
     ) -> Result<usize, Fault> {
         let scoped = self.scoped(label);
-        match o.keyword {
-            Keyword::If | Keyword::Elseif if o.keyword == Keyword::If || by_skip => {
-                if self.condition(o)? == 0.0 {
-                    self.skip_to(scoped, None, true, here);
-                }
+        let tested = o.keyword == Keyword::If || (o.keyword == Keyword::Elseif && by_skip);
+        if tested {
+            if self.condition(o)? == 0.0 {
+                self.skip_to(scoped, None, true, here);
             }
-            Keyword::Elseif | Keyword::Else if !by_skip => {
-                self.skip_to(scoped, Some(Keyword::Endif), false, here);
-            }
-            _ => {}
+        } else if matches!(o.keyword, Keyword::Elseif | Keyword::Else) && !by_skip {
+            self.skip_to(scoped, Some(Keyword::Endif), false, here);
         }
         Ok(here + 1)
     }

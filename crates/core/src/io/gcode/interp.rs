@@ -231,25 +231,10 @@ impl Machine {
         f64::from(self.spindle_dir) * self.spindle_rpm / 60.0
     }
 
-    /// Switches to coordinate system `n` (1..=9), loading its offsets from the parameters
-    /// (stored in mm) and keeping the machine position.
-    pub(super) fn select_system(&mut self, n: usize, params: &Params) {
-        let m = self.to_machine(&self.pos);
-        let base = 5200 + 20 * n;
-        self.system = n;
-        self.g5x = Vector3::new(
-            params.get(base + 1) * 1e-3,
-            params.get(base + 2) * 1e-3,
-            params.get(base + 3) * 1e-3,
-        );
-        self.rotation = params.get(base + 10);
-        self.pos = self.to_program(&m);
-    }
-
     /// Runs a block (see the module docs for the order). `params` for the offset and home
     /// parameters.
     pub(super) fn execute(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
-        check_groups(w, self.dialect)?;
+        super::words::check_groups(w)?;
         self.refuse_unsupported(w)?;
         for letter in [b'a', b'b', b'c'] {
             w.take(letter);
@@ -259,7 +244,7 @@ impl Machine {
         self.motion(w, consumed, params)?;
         self.stops(w);
         if let Some((letter, column)) = w.unused() {
-            return fault(column, unused_message(letter, w));
+            return fault(column, super::words::unused_message(letter, w));
         }
         Ok(())
     }
@@ -325,9 +310,22 @@ impl Machine {
     /// Steps 2-23 of LinuxCNC's order: modes, F, S, T, M codes, dwell, plane, units,
     /// compensation, coordinate system, path control, distance and retract modes.
     fn modes_before_motion(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
-        if w.g(970).is_some() {
-            // G97: RPM mode, the only one.
+        self.feed_speed_tool(w)?;
+        self.m_codes(w, params)?;
+        if let Some(column) = w.g(40) {
+            if w.g(20).is_some() || w.g(30).is_some() {
+                return fault(column, "G4 alone: G2/G3 on its line use P too");
+            }
+            let Some(p) = w.take(b'p').filter(|p| *p != -1.0) else {
+                return fault(column, "G4 needs P, the dwell time in seconds");
+            };
+            self.dwell(p, w.column(b'p'))?;
         }
+        self.modes(w, params)
+    }
+
+    /// Feed mode (`G93`-`G95`: per minute and per revolution reset F), `F`, `S`, `T`.
+    fn feed_speed_tool(&mut self, w: &mut Words) -> Result<(), Fault> {
         if w.g(930).is_some() {
             self.feed_mode = FeedMode::InverseTime;
         } else if w.g(940).is_some() {
@@ -358,6 +356,12 @@ impl Machine {
         if let Some(t) = w.take(b't') {
             self.selected = tool_number(t, w.column(b't'), "T")?;
         }
+        Ok(())
+    }
+
+    /// The M codes before the motion, in LinuxCNC's order: I/O, tool change, spindle and
+    /// modal state, coolant, overrides.
+    fn m_codes(&mut self, w: &mut Words, params: &Params) -> Result<(), Fault> {
         self.io_codes(w)?;
         if w.m(6).is_some() {
             self.tool = self.selected;
@@ -393,16 +397,12 @@ impl Machine {
                 }
             }
         }
-        if let Some(column) = w.g(40) {
-            if w.first_of(b"ijk").is_some() && !w.has(b'g') {
-                return fault(column, "G4 takes P only");
-            }
-            let p = w.take(b'p').filter(|p| *p != -1.0);
-            let Some(p) = p else {
-                return fault(column, "G4 needs P, the dwell time in seconds");
-            };
-            self.dwell(p, w.column(b'p'))?;
-        }
+        Ok(())
+    }
+
+    /// Plane, units, tool length offsets (recorded), coordinate system, path control,
+    /// distance modes, retract mode.
+    fn modes(&mut self, w: &mut Words, params: &Params) -> Result<(), Fault> {
         for (code, plane) in [(170, Plane::Xy), (180, Plane::Zx), (190, Plane::Yz)] {
             if w.g(code).is_some() {
                 self.plane = plane;
@@ -413,30 +413,7 @@ impl Machine {
         } else if w.g(210).is_some() {
             self.units = 1.0e-3;
         }
-        if w.g(430).is_some() || w.g(432).is_some() {
-            // Recorded: the TCP carries the tool length. H names the tool (0: the one in
-            // the spindle).
-            if let Some(h) = w.take(b'h') {
-                tool_number(h, w.column(b'h'), "H")?;
-            }
-            if w.g(432).is_some() && w.peek(b'h').is_none() && w.first_of(b"xyz").is_none() {
-                return fault(w.g(432).unwrap_or(1), "G43.2 needs H or axis words");
-            }
-        } else if w.g(431).is_some() {
-            // G43.1 reads every axis word as an offset; they move the tool only with a motion
-            // code on the same line (LinuxCNC).
-            let motion_here =
-                w.g.iter()
-                    .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
-            for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
-                let v = if motion_here { w.peek(l) } else { w.take(l) };
-                if let (Some(v), Some(o)) = (v, self.tool_offset.get_mut(k)) {
-                    *o = v * self.units;
-                }
-            }
-        } else if w.g(490).is_some() {
-            self.tool_offset = Vector3::zeros();
-        }
+        self.tool_length(w)?;
         let systems = [540, 550, 560, 570, 580, 590, 591, 592, 593];
         if let Some(n) = systems.iter().position(|&g| w.g(g).is_some())
             && n + 1 != self.system
@@ -455,20 +432,48 @@ impl Machine {
                 naive_tolerance: q,
             };
         }
-        if w.g(900).is_some() {
-            self.absolute = true;
-        } else if w.g(910).is_some() {
-            self.absolute = false;
+        for (on, off, flag) in [
+            (900, 910, &mut self.absolute),
+            (901, 911, &mut self.ijk_absolute),
+            (980, 990, &mut self.retract_old_z),
+        ] {
+            if w.g(on).is_some() {
+                *flag = true;
+            } else if w.g(off).is_some() {
+                *flag = false;
+            }
         }
-        if w.g(901).is_some() {
-            self.ijk_absolute = true;
-        } else if w.g(911).is_some() {
-            self.ijk_absolute = false;
-        }
-        if w.g(980).is_some() {
-            self.retract_old_z = true;
-        } else if w.g(990).is_some() {
-            self.retract_old_z = false;
+        Ok(())
+    }
+
+    /// `G43 H`, `G43.1`, `G43.2`, `G49`: recorded (the TCP carries the tool length); their
+    /// words are read and checked.
+    fn tool_length(&mut self, w: &mut Words) -> Result<(), Fault> {
+        if w.g(430).is_some() || w.g(432).is_some() {
+            // H names the tool (0: the one in the spindle).
+            if let Some(h) = w.take(b'h') {
+                tool_number(h, w.column(b'h'), "H")?;
+            }
+            if let Some(column) = w.g(432)
+                && w.peek(b'h').is_none()
+                && w.first_of(b"xyz").is_none()
+            {
+                return fault(column, "G43.2 needs H or axis words");
+            }
+        } else if w.g(431).is_some() {
+            // G43.1 reads every axis word as an offset; they move the tool only with a motion
+            // code on the same line (LinuxCNC).
+            let motion_here =
+                w.g.iter()
+                    .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
+            for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
+                let v = if motion_here { w.peek(l) } else { w.take(l) };
+                if let (Some(v), Some(o)) = (v, self.tool_offset.get_mut(k)) {
+                    *o = v * self.units;
+                }
+            }
+        } else if w.g(490).is_some() {
+            self.tool_offset = Vector3::zeros();
         }
         Ok(())
     }
@@ -533,190 +538,6 @@ impl Machine {
         Ok(())
     }
 
-    /// Group 0 and 16: G10, G28/G30 (and .1), G52, G92 (and .1-.3). Returns whether the
-    /// axis words were used here (they then move nothing else).
-    fn non_modal(&mut self, w: &mut Words, params: &mut Params) -> Result<bool, Fault> {
-        let axis_users = [100, 280, 300, 520, 920];
-        let user = axis_users.iter().find_map(|&g| w.g(g).map(|c| (g, c)));
-        if let Some((g, column)) = user
-            && let Some(&(m, _)) =
-                w.g.iter()
-                    .find(|x| super::words_group(x.0) == Some(1) && x.0 != 800)
-        {
-            return fault(
-                column,
-                std::format!(
-                    "{} and {}: two codes that both use the axis words",
-                    g_name(g),
-                    g_name(m)
-                ),
-            );
-        }
-        if w.g(281).is_some() || w.g(301).is_some() {
-            let base = if w.g(281).is_some() { 5161 } else { 5181 };
-            let m = self.to_machine(&self.pos);
-            for (k, v) in m.iter().enumerate() {
-                params.set(base + k, v * 1e3);
-            }
-        }
-        match user {
-            Some((100, column)) => self.g10(w, params, column).map(|()| true),
-            Some((280 | 300, column)) => {
-                let base = if w.g(280).is_some() { 5161 } else { 5181 };
-                self.home(w, params, base, column).map(|()| true)
-            }
-            Some((520 | 920, column)) => self.g92(w, params, column).map(|()| true),
-            _ => {
-                for (g, keep_params) in [(921, false), (922, true)] {
-                    if w.g(g).is_some() {
-                        self.pos += self.g92;
-                        self.g92 = Vector3::zeros();
-                        params.set(5210, 0.0);
-                        if !keep_params {
-                            for k in 5211..=5219 {
-                                params.set(k, 0.0);
-                            }
-                        }
-                    }
-                }
-                if w.g(923).is_some() {
-                    let stored =
-                        Vector3::new(params.get(5211), params.get(5212), params.get(5213)) * 1e-3;
-                    self.pos += self.g92 - stored;
-                    self.g92 = stored;
-                    params.set(5210, 1.0);
-                }
-                Ok(false)
-            }
-        }
-    }
-
-    /// G92 (set the axis offset so the current point has the given coordinates) and G52 (set
-    /// the axis offset itself).
-    fn g92(&mut self, w: &mut Words, params: &mut Params, column: usize) -> Result<(), Fault> {
-        let local = w.g(520).is_some();
-        if w.first_of(b"xyz").is_none() {
-            return fault(column, "G92/G52 need at least one axis word (X, Y, Z)");
-        }
-        for (k, l) in [b'x', b'y', b'z'].into_iter().enumerate() {
-            if let Some(v) = w.take(l) {
-                let v = v * self.units;
-                let (Some(p), Some(o)) = (self.pos.get_mut(k), self.g92.get_mut(k)) else {
-                    continue;
-                };
-                if local {
-                    *p += *o - v;
-                    *o = v;
-                } else {
-                    *o += *p - v;
-                    *p = v;
-                }
-            }
-        }
-        params.set(5210, 1.0);
-        for k in 0..3 {
-            params.set(5211 + k, self.g92.get(k).copied().unwrap_or(0.0) * 1e3);
-        }
-        Ok(())
-    }
-
-    /// G10 L2 / L20 (work offsets); L1, L10, L11 (tool table entries) and L0 (reload) are
-    /// read and recorded: deflect takes the tools from its own table.
-    fn g10(&mut self, w: &mut Words, params: &mut Params, column: usize) -> Result<(), Fault> {
-        let l = w.take(b'l').map(|l| l.round() as i64);
-        let p = w.take(b'p');
-        match l {
-            Some(2 | 20) => {}
-            Some(0 | 1 | 10 | 11) => {
-                for letter in *b"xyzrijq" {
-                    w.take(letter);
-                }
-                return Ok(());
-            }
-            _ => {
-                return fault(
-                    column,
-                    "G10 needs L2 or L20 (work offsets), or L0, L1, L10, L11",
-                );
-            }
-        }
-        let Some(p) = p else {
-            return fault(
-                column,
-                "G10 L2/L20 needs P, the coordinate system (0: the active one, 1-9)",
-            );
-        };
-        if p + 0.0001 - p.round() > 0.0002 || !(-0.0001..9.0001).contains(&p) {
-            return fault(
-                w.column(b'p'),
-                std::format!("a coordinate system P in 0..=9 with G10, got P{p}"),
-            );
-        }
-        let n = match (p + 0.0001) as usize {
-            0 => self.system,
-            n => n,
-        };
-        let l20 = l == Some(20);
-        if w.has(b'i') || w.has(b'j') {
-            return fault(
-                w.first_of(b"ij").unwrap_or(column),
-                "no I or J with G10 L2/L20",
-            );
-        }
-        let base = 5200 + 20 * n;
-        let r = match w.take(b'r') {
-            Some(_) if l20 => return fault(w.column(b'r'), "no R with G10 L20"),
-            Some(r) => {
-                params.set(base + 10, r);
-                r
-            }
-            None => params.get(base + 10),
-        };
-        let old = Vector3::new(
-            params.get(base + 1),
-            params.get(base + 2),
-            params.get(base + 3),
-        ) * 1e-3;
-        let mut new = old;
-        let (x, y, z) = (w.take(b'x'), w.take(b'y'), w.take(b'z'));
-        if l20 {
-            let m = self.to_machine(&self.pos);
-            // The current point in system n, then the offset that gives it the words.
-            let cur = rotate(m.xy() - old.xy(), -r) - self.g92.xy();
-            let want = Vector2::new(
-                x.map_or(cur.x, |v| v * self.units),
-                y.map_or(cur.y, |v| v * self.units),
-            );
-            if x.is_some() || y.is_some() {
-                let o = m.xy() - rotate(want + self.g92.xy(), r);
-                new.x = o.x;
-                new.y = o.y;
-            }
-            if let Some(z) = z {
-                new.z = m.z - self.g92.z - z * self.units;
-            }
-        } else {
-            for (k, v) in [x, y, z].into_iter().enumerate() {
-                if let (Some(v), Some(o)) = (v, new.get_mut(k)) {
-                    *o = v * self.units;
-                }
-            }
-        }
-        for k in 0..3 {
-            params.set(base + 1 + k, new.get(k).copied().unwrap_or(0.0) * 1e3);
-        }
-        if n == self.system {
-            // The tool stays where it is: its program coordinates change. (LinuxCNC leaves G92
-            // out of this, so with G92 set and a new rotation its tool would jump without a
-            // move; a robot's path is continuous, so the machine position is kept.)
-            let m = self.to_machine(&self.pos);
-            self.g5x = new;
-            self.rotation = r;
-            self.pos = self.to_program(&m);
-        }
-        Ok(())
-    }
-
     fn stops(&mut self, w: &Words) {
         if w.m(2).is_some() || w.m(30).is_some() {
             self.ended = Some(self.line);
@@ -733,79 +554,6 @@ fn tool_number(v: f64, column: usize, what: &str) -> Result<u32, Fault> {
             std::format!("a tool number {what} in 0..={MAX_TOOL_NUMBER} (an integer), got {v}"),
         ),
     }
-}
-
-/// The G and M codes of a block grouped as LinuxCNC groups them: one per group (G80 may
-/// join another motion code and is then dropped; M7 and M8 share group 8 but LinuxCNC
-/// refuses them together too), at most 4 M codes.
-fn check_groups(w: &mut Words, dialect: Dialect) -> Result<(), Fault> {
-    let has_other_motion =
-        w.g.iter()
-            .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
-    if has_other_motion {
-        w.g.retain(|g| g.0 != 800);
-    }
-    let _ = dialect;
-    for (i, &(a, ca)) in w.g.iter().enumerate() {
-        let ga = super::words_group(a);
-        if let Some(&(b, _)) =
-            w.g.iter()
-                .skip(i + 1)
-                .find(|&&(b, _)| super::words_group(b) == ga)
-        {
-            return fault(
-                ca,
-                std::format!(
-                    "one G code of each modal group per line, got {} and {}",
-                    g_name(a),
-                    g_name(b)
-                ),
-            );
-        }
-    }
-    if w.m.len() > 4 {
-        return fault(w.m.get(4).map_or(1, |m| m.1), "at most 4 M codes on a line");
-    }
-    for (i, &(a, ca)) in w.m.iter().enumerate() {
-        let ga = super::m_group(a);
-        if let Some(&(b, _)) =
-            w.m.iter()
-                .skip(i + 1)
-                .find(|&&(b, _)| super::m_group(b) == ga)
-        {
-            return fault(
-                ca,
-                std::format!("one M code of each modal group per line, got M{a} and M{b}"),
-            );
-        }
-    }
-    Ok(())
-}
-
-/// Why a word nothing used is on the line.
-fn unused_message(letter: char, w: &Words) -> String {
-    let motion = w.g.iter().find(|g| super::words_group(g.0) == Some(1));
-    let users = match letter {
-        'X' | 'Y' | 'Z' | '@' | '^' => {
-            return std::format!(
-                "{letter}: axis words with no motion mode to use them (G0, G1, G2, G3 or a \
-                 cycle; after G80 or at the start, the line needs one)"
-            );
-        }
-        'I' | 'J' | 'K' => "G2, G3, G5, G5.1 or G87",
-        'R' => "G2, G3, a canned cycle or G10 L2",
-        'P' => "G2, G3, G4, G5, G10, G64, G82, G86, G88, G89, M50-M53, M62-M66 or M98",
-        'Q' => "G5, G10, G64, G73, G83, M61, M66-M68 or M19",
-        'L' => "G10, a canned cycle or M98",
-        'H' => "G43 or G43.2",
-        'D' => "G41 or G42 (not modelled)",
-        'E' => "M66, M67 or M68",
-        _ => "any code",
-    };
-    let context = motion.map_or(String::new(), |m| {
-        std::format!(" (this line's is {})", g_name(m.0))
-    });
-    std::format!("{letter}: a word nothing on the line uses; only {users} use it{context}")
 }
 
 impl Machine {

@@ -62,6 +62,7 @@ mod flow;
 mod interp;
 pub mod lex;
 mod motion;
+mod offsets;
 pub mod params;
 mod read;
 pub mod report;

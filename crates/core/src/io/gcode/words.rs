@@ -5,6 +5,8 @@
 use std::string::String;
 use std::vec::Vec;
 
+use super::interp::{Fault, fault};
+
 /// Letters `a`-`z`, then `@` (polar radius), `^` (polar angle), `$` (spindle).
 const SLOTS: usize = 29;
 
@@ -126,4 +128,76 @@ pub(super) fn g_name(code: u16) -> String {
     } else {
         std::format!("G{}.{}", code / 10, code % 10)
     }
+}
+
+/// The G and M codes of a block grouped as LinuxCNC groups them: one per group (G80 may
+/// join another motion code and is then dropped; M7 and M8 share group 8 but LinuxCNC
+/// refuses them together too), at most 4 M codes.
+pub(super) fn check_groups(w: &mut Words) -> Result<(), Fault> {
+    let has_other_motion =
+        w.g.iter()
+            .any(|g| super::words_group(g.0) == Some(1) && g.0 != 800);
+    if has_other_motion {
+        w.g.retain(|g| g.0 != 800);
+    }
+    for (i, &(a, ca)) in w.g.iter().enumerate() {
+        let ga = super::words_group(a);
+        if let Some(&(b, _)) =
+            w.g.iter()
+                .skip(i + 1)
+                .find(|&&(b, _)| super::words_group(b) == ga)
+        {
+            return fault(
+                ca,
+                std::format!(
+                    "one G code of each modal group per line, got {} and {}",
+                    g_name(a),
+                    g_name(b)
+                ),
+            );
+        }
+    }
+    if w.m.len() > 4 {
+        return fault(w.m.get(4).map_or(1, |m| m.1), "at most 4 M codes on a line");
+    }
+    for (i, &(a, ca)) in w.m.iter().enumerate() {
+        let ga = super::m_group(a);
+        if let Some(&(b, _)) =
+            w.m.iter()
+                .skip(i + 1)
+                .find(|&&(b, _)| super::m_group(b) == ga)
+        {
+            return fault(
+                ca,
+                std::format!("one M code of each modal group per line, got M{a} and M{b}"),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Why a word nothing used is on the line.
+pub(super) fn unused_message(letter: char, w: &Words) -> String {
+    let motion = w.g.iter().find(|g| super::words_group(g.0) == Some(1));
+    let users = match letter {
+        'X' | 'Y' | 'Z' | '@' | '^' => {
+            return std::format!(
+                "{letter}: axis words with no motion mode to use them (G0, G1, G2, G3 or a \
+                 cycle; after G80 or at the start, the line needs one)"
+            );
+        }
+        'I' | 'J' | 'K' => "G2, G3, G5, G5.1 or G87",
+        'R' => "G2, G3, a canned cycle or G10 L2",
+        'P' => "G2, G3, G4, G5, G10, G64, G82, G86, G88, G89, M50-M53, M62-M66 or M98",
+        'Q' => "G5, G10, G64, G73, G83, M61, M66-M68 or M19",
+        'L' => "G10, a canned cycle or M98",
+        'H' => "G43 or G43.2",
+        'D' => "G41 or G42 (not modelled)",
+        'E' => "M66, M67 or M68",
+        _ => "any code",
+    };
+    let context = motion.map_or(String::new(), |m| {
+        std::format!(" (this line's is {})", g_name(m.0))
+    });
+    std::format!("{letter}: a word nothing on the line uses; only {users} use it{context}")
 }
