@@ -5,6 +5,8 @@
 //! any plane (the drilling axis is the plane's normal). Arithmetic is in the program's unit,
 //! as LinuxCNC's, so the number of pecks is the same.
 
+use std::string::String;
+
 use nalgebra::Vector3;
 
 use super::interp::{Fault, FeedMode, Machine, fault};
@@ -72,22 +74,11 @@ impl Machine {
             );
         }
         let same = self.motion == Some(code);
-        let repeats = match w.take(b'l') {
-            None => 1,
-            Some(l) => match super::expr::integer(l) {
-                Some(l) if (1..=100_000).contains(&l) => l as u32,
-                _ => {
-                    return fault(
-                        w.column(b'l'),
-                        std::format!("{name}: repeats L in 1..=100000, got L{l}"),
-                    );
-                }
-            },
-        };
-        let (axes, depth_letter, a_letter, b_letter) = match self.plane {
-            Plane::Xy => ((0, 1, 2), b'z', b'x', b'y'),
-            Plane::Zx => ((2, 0, 1), b'y', b'z', b'x'),
-            Plane::Yz => ((1, 2, 0), b'x', b'y', b'z'),
+        let repeats = repeats(w, &name)?;
+        let (axes, depth_letter) = match self.plane {
+            Plane::Xy => ((0, 1, 2), b'z'),
+            Plane::Zx => ((2, 0, 1), b'y'),
+            Plane::Yz => ((1, 2, 0), b'x'),
         };
         let axis_name = char::from(depth_letter.to_ascii_uppercase());
         let Some(r_word) = w.take(b'r').or(if same { self.cycle.r } else { None }) else {
@@ -107,9 +98,8 @@ impl Machine {
                 ),
             );
         };
-        let u = self.units;
         let (ia, ib, ic) = axes;
-        let coord = |p: &Vector3<f64>, k: usize| p.get(k).copied().unwrap_or(0.0) / u;
+        let here = |m: &Self, k: usize| m.pos.get(k).copied().unwrap_or(0.0) / m.units;
         let initial = match self.cycle.initial {
             Some(v) => v,
             None => {
@@ -118,35 +108,12 @@ impl Machine {
                 v
             }
         };
-        let mut old_c = initial / u;
-        let (aw, bw) = (w.take(a_letter), w.take(b_letter));
-        let (radius, theta) = (w.take(b'@'), w.take(b'^').map(f64::to_radians));
-        let polar = radius.is_some() || theta.is_some();
-        if polar && (self.plane != Plane::Xy || aw.is_some() || bw.is_some()) {
-            return fault(
-                w.first_of(b"@^").unwrap_or(column),
-                std::format!("{name}: polar coordinates (@, ^) in G17 only, without X and Y"),
-            );
-        }
-        let (mut a, mut b) = (coord(&self.pos, ia), coord(&self.pos, ib));
-        let mut polar_step = (0.0, 0.0);
-        let (r, bottom, step) = if self.absolute {
-            if polar {
-                let rad = radius.unwrap_or(a.hypot(b));
-                let th = theta.unwrap_or(b.atan2(a));
-                (a, b) = (rad * th.cos(), rad * th.sin());
-            } else {
-                a = aw.unwrap_or(a);
-                b = bw.unwrap_or(b);
-            }
-            (r_word, depth_word, (0.0, 0.0))
+        let mut old_c = initial / self.units;
+        let mut holes = self.holes(w, axes, &name, column)?;
+        let (r, bottom) = if self.absolute {
+            (r_word, depth_word)
         } else {
-            polar_step = (radius.unwrap_or(0.0), theta.unwrap_or(0.0));
-            (
-                r_word + old_c,
-                r_word + old_c + depth_word,
-                (aw.unwrap_or(0.0), bw.unwrap_or(0.0)),
-            )
+            (r_word + old_c, r_word + old_c + depth_word)
         };
         if r < bottom {
             return fault(
@@ -163,35 +130,16 @@ impl Machine {
             clear: r,
         };
         if old_c < r {
-            let here = (coord(&self.pos, ia), coord(&self.pos, ib));
-            self.rapid_to(&g, here.0, here.1, r, column)?;
+            self.rapid_to(&g, here(self, ia), here(self, ib), r, column)?;
             old_c = r;
         }
         g.clear = if self.retract_old_z { old_c } else { r };
         let body = self.cycle_words(w, code, same, &name, column)?;
         for rep in 0..repeats {
-            a += step.0;
-            b += step.1;
-            for (k, inc) in [polar_step.0, polar_step.1].into_iter().enumerate() {
-                if inc != 0.0 {
-                    if a == 0.0 && b == 0.0 {
-                        return fault(
-                            column,
-                            std::format!(
-                                "{name}: incremental polar coordinates away from the origin (the angle is undefined there)"
-                            ),
-                        );
-                    }
-                    let (mut rad, mut th) = (a.hypot(b), b.atan2(a));
-                    if k == 0 {
-                        rad += inc;
-                    } else {
-                        th += inc;
-                    }
-                    (a, b) = (rad * th.cos(), rad * th.sin());
-                }
-            }
-            let c = coord(&self.pos, ic);
+            let (a, b) = holes
+                .next()
+                .map_err(|e| (column, std::format!("{name}: {e}")))?;
+            let c = here(self, ic);
             if rep == 0 && c > r {
                 let p = self.cycle_point(&g, a, b, c);
                 self.emit(Motion::Rapid, p, 0.0, column)?;
@@ -207,6 +155,50 @@ impl Machine {
         self.cycle.r = Some(r_word);
         self.cycle.depth = Some(depth_word);
         Ok(())
+    }
+
+    /// Where the block's holes are, in the plane's axes (program units): its words, or polar
+    /// `@ ^` (G17); in `G91`, steps from the current point per repeat.
+    fn holes(
+        &self,
+        w: &mut Words,
+        (ia, ib, _): (usize, usize, usize),
+        name: &str,
+        column: usize,
+    ) -> Result<Holes, Fault> {
+        let letter = |k: usize| [b'x', b'y', b'z'].get(k).copied().unwrap_or(b'x');
+        let (aw, bw) = (w.take(letter(ia)), w.take(letter(ib)));
+        let (radius, theta) = (w.take(b'@'), w.take(b'^').map(f64::to_radians));
+        let polar = radius.is_some() || theta.is_some();
+        if polar && (self.plane != Plane::Xy || aw.is_some() || bw.is_some()) {
+            return fault(
+                w.first_of(b"@^").unwrap_or(column),
+                std::format!("{name}: polar coordinates (@, ^) in G17 only, without X and Y"),
+            );
+        }
+        let here = |k: usize| self.pos.get(k).copied().unwrap_or(0.0) / self.units;
+        let (mut a, mut b) = (here(ia), here(ib));
+        if !self.absolute {
+            return Ok(Holes {
+                a,
+                b,
+                step: (aw.unwrap_or(0.0), bw.unwrap_or(0.0)),
+                polar: (radius.unwrap_or(0.0), theta.unwrap_or(0.0)),
+            });
+        }
+        if polar {
+            let rad = radius.unwrap_or(a.hypot(b));
+            let th = theta.unwrap_or(b.atan2(a));
+            (a, b) = (rad * th.cos(), rad * th.sin());
+        } else {
+            (a, b) = (aw.unwrap_or(a), bw.unwrap_or(b));
+        }
+        Ok(Holes {
+            a,
+            b,
+            step: (0.0, 0.0),
+            polar: (0.0, 0.0),
+        })
     }
 
     /// The P, Q and I/J/K a cycle needs, checked and remembered.
@@ -394,6 +386,56 @@ impl Machine {
             _ => return fault(column, std::format!("{}: not a canned cycle", g_name(code))),
         }
         Ok(())
+    }
+}
+
+/// The holes of a block: the first at (`a`, `b`) plus one `step` (`G91`), each next one a step
+/// further, the polar steps (radius, angle in radians) turning it about the origin after.
+struct Holes {
+    a: f64,
+    b: f64,
+    step: (f64, f64),
+    polar: (f64, f64),
+}
+
+impl Holes {
+    fn next(&mut self) -> Result<(f64, f64), String> {
+        self.a += self.step.0;
+        self.b += self.step.1;
+        for (k, inc) in [self.polar.0, self.polar.1].into_iter().enumerate() {
+            if inc == 0.0 {
+                continue;
+            }
+            if self.a == 0.0 && self.b == 0.0 {
+                return Err(
+                    "incremental polar coordinates away from the origin (the angle is undefined \
+                     there)"
+                        .into(),
+                );
+            }
+            let (mut rad, mut th) = (self.a.hypot(self.b), self.b.atan2(self.a));
+            if k == 0 {
+                rad += inc;
+            } else {
+                th += inc;
+            }
+            (self.a, self.b) = (rad * th.cos(), rad * th.sin());
+        }
+        Ok((self.a, self.b))
+    }
+}
+
+/// `L`, the repeats of a cycle block: an integer in 1..=100,000, 1 without it (not modal).
+fn repeats(w: &mut Words, name: &str) -> Result<u32, Fault> {
+    let Some(l) = w.take(b'l') else {
+        return Ok(1);
+    };
+    match super::expr::integer(l) {
+        Some(l) if (1..=100_000).contains(&l) => Ok(l as u32),
+        _ => fault(
+            w.column(b'l'),
+            std::format!("{name}: repeats L in 1..=100000, got L{l}"),
+        ),
     }
 }
 
