@@ -60,138 +60,119 @@ pub fn words(text: &str, options: &GcodeOptions) -> Result<Vec<WordUse>, LoadErr
             got: lines,
         });
     }
-    let mut out: Vec<WordUse> = Vec::new();
-    let mut index: HashMap<String, usize> = HashMap::new();
-    let mut add = |word: String, line: usize, (status, meaning): (WordStatus, String)| match index
-        .get(&word)
-    {
-        Some(&k) => {
-            if let Some(u) = out.get_mut(k) {
-                u.count += 1;
-            }
-        }
-        None => {
-            index.insert(word.clone(), out.len());
-            out.push(WordUse {
-                word,
-                status,
-                count: 1,
-                first_line: line,
-                meaning,
-            });
-        }
-    };
+    let mut tally = Tally::default();
     let mut block = Block::default();
     for (i, raw) in text.lines().enumerate() {
         let line = i + 1;
-        let trimmed = raw.trim();
-        if trimmed.starts_with('%') {
-            add(
+        if raw.trim().starts_with('%') {
+            tally.add(
                 "%".into(),
                 line,
-                (
-                    WordStatus::Honoured,
-                    "program start and end marker (tape)".into(),
-                ),
+                honoured("program start and end marker (tape)"),
             );
             continue;
         }
         if let Err((_, message)) = lex::lex(raw, options.dialect, &mut block) {
-            add(
-                "(a line that does not read)".into(),
-                line,
-                (WordStatus::Refused, std::format!("expected {message}")),
-            );
+            let why = (WordStatus::Refused, std::format!("expected {message}"));
+            tally.add("(a line that does not read)".into(), line, why);
             continue;
         }
         if block.delete {
-            add(
-                "/".into(),
-                line,
-                (
-                    WordStatus::Honoured,
-                    "block delete (the line runs unless block delete is on)".into(),
-                ),
-            );
+            let what = honoured("block delete (the line runs unless block delete is on)");
+            tally.add("/".into(), line, what);
         }
         if let Some(o) = &block.o_word {
-            let word = std::format!("O {}", o.keyword.name());
             let meaning = match o.keyword {
                 Keyword::Header => "a program number: M98's target, or nothing",
                 Keyword::Sub | Keyword::Endsub | Keyword::Call | Keyword::Return => "subroutine",
                 _ => "control flow",
             };
-            add(word, line, (WordStatus::Honoured, meaning.into()));
+            tally.add(
+                std::format!("O {}", o.keyword.name()),
+                line,
+                honoured(meaning),
+            );
         }
         for item in &block.items {
-            match *item {
-                Item::Set { .. } => add(
-                    "#".into(),
-                    line,
-                    (WordStatus::Honoured, "parameter setting".into()),
-                ),
-                Item::Word { letter, value, .. } => {
-                    let literal = match block.nodes.get(value as usize) {
-                        Some(Node::Num(v)) => Some(*v),
-                        _ => None,
-                    };
-                    let (word, class) = match (letter, literal) {
-                        (b'g', Some(v)) => {
-                            let code = (v * 10.0).round() as u16;
-                            (g_name(code), g_class(code))
-                        }
-                        (b'm', Some(v)) => {
-                            let code = v.round() as u16;
-                            (std::format!("M{code}"), m_class(code))
-                        }
-                        (b'g' | b'm', None) => (
-                            std::format!("{}[...]", char::from(letter.to_ascii_uppercase())),
-                            (WordStatus::Honoured, "a code given by an expression".into()),
-                        ),
-                        (b'a' | b'b' | b'c', Some(v)) if v != 0.0 => (
-                            char::from(letter.to_ascii_uppercase()).to_string(),
-                            refused("rotary axis turning: not modelled"),
-                        ),
-                        _ => (
-                            char::from(letter.to_ascii_uppercase()).to_string(),
-                            letter_class(letter),
-                        ),
-                    };
-                    add(word, line, class);
-                }
-            }
+            let (word, class) = item_class(&block, item);
+            tally.add(word, line, class);
         }
         if let Some(c) = &block.comment {
-            let (word, class) = match c.kind {
-                CommentKind::Plain => ("( )", (WordStatus::Recorded, "comment")),
-                CommentKind::Msg => (
-                    "(MSG,...)",
-                    (WordStatus::Recorded, "operator message: no motion"),
-                ),
-                CommentKind::Debug => (
-                    "(DEBUG,...)",
-                    (WordStatus::Recorded, "debug message: no motion"),
-                ),
-                CommentKind::Print => (
-                    "(PRINT,...)",
-                    (WordStatus::Recorded, "printed message: no motion"),
-                ),
-                CommentKind::Log => (
-                    "(LOG,...)",
-                    (WordStatus::Recorded, "log message: no motion"),
-                ),
-                CommentKind::Abort => (
-                    "(ABORT,...)",
-                    (
-                        WordStatus::Honoured,
-                        "stops the reading with its text as the error",
-                    ),
-                ),
-            };
-            add(word.into(), line, (class.0, class.1.into()));
+            let (word, class) = comment_class(c.kind);
+            tally.add(word.into(), line, class);
         }
     }
-    Ok(out)
+    Ok(tally.words)
+}
+
+/// The words met so far, by first use.
+#[derive(Default)]
+struct Tally {
+    words: Vec<WordUse>,
+    index: HashMap<String, usize>,
+}
+
+impl Tally {
+    fn add(&mut self, word: String, line: usize, (status, meaning): (WordStatus, String)) {
+        if let Some(u) = self.index.get(&word).and_then(|&k| self.words.get_mut(k)) {
+            u.count += 1;
+            return;
+        }
+        self.index.insert(word.clone(), self.words.len());
+        self.words.push(WordUse {
+            word,
+            status,
+            count: 1,
+            first_line: line,
+            meaning,
+        });
+    }
+}
+
+/// A word or a parameter setting as the report names and classes it.
+fn item_class(block: &Block, item: &Item) -> (String, (WordStatus, String)) {
+    let &Item::Word { letter, value, .. } = item else {
+        return ("#".into(), honoured("parameter setting"));
+    };
+    let literal = match block.nodes.get(value as usize) {
+        Some(Node::Num(v)) => Some(*v),
+        _ => None,
+    };
+    let upper = char::from(letter.to_ascii_uppercase());
+    match (letter, literal) {
+        (b'g', Some(v)) => {
+            let code = (v * 10.0).round() as u16;
+            (g_name(code), g_class(code))
+        }
+        (b'm', Some(v)) => {
+            let code = v.round() as u16;
+            (std::format!("M{code}"), m_class(code))
+        }
+        (b'g' | b'm', None) => (
+            std::format!("{upper}[...]"),
+            honoured("a code given by an expression"),
+        ),
+        (b'a' | b'b' | b'c', Some(v)) if v != 0.0 => (
+            upper.to_string(),
+            refused("rotary axis turning: not modelled"),
+        ),
+        _ => (upper.to_string(), letter_class(letter)),
+    }
+}
+
+/// A paren comment as the report names and classes it.
+fn comment_class(kind: CommentKind) -> (&'static str, (WordStatus, String)) {
+    match kind {
+        CommentKind::Plain => ("( )", recorded("comment")),
+        CommentKind::Msg => ("(MSG,...)", recorded("operator message: no motion")),
+        CommentKind::Debug => ("(DEBUG,...)", recorded("debug message: no motion")),
+        CommentKind::Print => ("(PRINT,...)", recorded("printed message: no motion")),
+        CommentKind::Log => ("(LOG,...)", recorded("log message: no motion")),
+        CommentKind::Abort => (
+            "(ABORT,...)",
+            honoured("stops the reading with its text as the error"),
+        ),
+    }
 }
 
 fn honoured(s: &str) -> (WordStatus, String) {
