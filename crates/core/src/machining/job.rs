@@ -41,7 +41,7 @@ use super::cutting::{self, Coefficients, Engagement, Tool};
 use super::engagement::{self, Contact};
 use super::path::{self, PathOptions, PathSample};
 pub use super::report::{ErrorStats, JobSample, LineForce, RapidContact, Report, SurfaceError};
-use super::stock::{Cutter, ZMap};
+use super::stock::{Cutter, Removal, ZMap};
 use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
 use crate::mechanism::{PoseIkOptions, pose_ik};
@@ -352,7 +352,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         to_base,
         to_work,
     };
-    let mut tool_in_spindle: Option<(u32, Option<(Tool, Cutter)>)> = None;
+    let mut spindle_tool = SpindleTool::default();
     let mut rapid_contact: Option<RapidContact> = None;
     for s in &path {
         let at = |error: TickError| JobError::AtLine {
@@ -362,21 +362,7 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         };
         let p = s.position;
         let from = prev_nom.unwrap_or(p);
-        let looked_up = match tool_in_spindle {
-            Some((t, found)) if t == s.tool => found,
-            _ => {
-                let found = job.tool(s.tool);
-                tool_in_spindle = Some((s.tool, found));
-                found
-            }
-        };
-        let known = looked_up.is_some();
-        let (tool, cutter) = looked_up.unwrap_or((
-            setup.tool,
-            Cutter::Flat {
-                radius: 0.5 * setup.tool.diameter,
-            },
-        ));
+        let (tool, cutter, known) = spindle_tool.at(job, s.tool);
         let spindle = match (s.spindle, setup.hand_spindle) {
             (0.0, Some(hand)) => hand,
             (v, _) => v,
@@ -385,35 +371,13 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         // 2. The nominal contact, checked before the cut lowers the stock.
         let contact = engagement::contact_turning(&nominal, cutter.radius(), &p, &s.direction, ccw);
         let removed = nominal.cut(&cutter, &from, &p).map_err(at)?;
-        if !known && (contact != Contact::Air || removed.cells > 0) {
-            return Err(JobError::UnknownTool {
-                line: s.line,
-                time: s.time,
-                tool: s.tool,
-            });
-        }
-        if !s.feed_move && removed.deepest > engagement::MIN_DEPTH {
-            if rapid_contact.is_none_or(|c: RapidContact| removed.deepest > c.depth) {
-                rapid_contact = Some(RapidContact {
-                    line: s.line,
-                    time: s.time,
-                    depth: removed.deepest,
-                });
-            }
-            if removed.deepest > setup.rapid_skim {
-                return Err(JobError::RapidInStock {
-                    line: s.line,
-                    time: s.time,
-                    depth: removed.deepest,
-                });
-            }
-        }
-        if contact != Contact::Air && spindle == 0.0 {
-            return Err(JobError::SpindleOff {
-                line: s.line,
-                time: s.time,
-            });
-        }
+        let cut = NominalCut {
+            contact: &contact,
+            removed: &removed,
+            known,
+            spindle,
+        };
+        cut.check(setup, s, &mut rapid_contact)?;
         if matches!(contact, Contact::Plunge { .. }) {
             plunge_samples += 1;
         }
@@ -503,6 +467,75 @@ pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobErro
         dof,
         top: st.top,
     })
+}
+
+/// The tool in the spindle, looked up once per change: its cutter, and whether the job
+/// knows it (else the setup's tool stands in, and cutting with it is an error).
+#[derive(Default)]
+struct SpindleTool {
+    last: Option<(u32, Option<(Tool, Cutter)>)>,
+}
+
+impl SpindleTool {
+    fn at(&mut self, job: &Job, t: u32) -> (Tool, Cutter, bool) {
+        let found = match self.last {
+            Some((n, found)) if n == t => found,
+            _ => {
+                let found = job.tool(t);
+                self.last = Some((t, found));
+                found
+            }
+        };
+        let stand_in = job.setup.tool;
+        let (tool, cutter) = found.unwrap_or((
+            stand_in,
+            Cutter::Flat {
+                radius: 0.5 * stand_in.diameter,
+            },
+        ));
+        (tool, cutter, found.is_some())
+    }
+}
+
+/// The nominal cut of one sample, checked: a tool the job lacks must not cut, a rapid may
+/// skim the stock by `rapid_skim` (the deepest skim kept), the spindle must turn in a cut.
+struct NominalCut<'a> {
+    contact: &'a Contact,
+    removed: &'a Removal,
+    known: bool,
+    spindle: f64,
+}
+
+impl NominalCut<'_> {
+    fn check(
+        &self,
+        setup: &Setup,
+        s: &PathSample,
+        rapid_contact: &mut Option<RapidContact>,
+    ) -> Result<(), JobError> {
+        let (line, time) = (s.line, s.time);
+        let cuts = *self.contact != Contact::Air;
+        if !self.known && (cuts || self.removed.cells > 0) {
+            return Err(JobError::UnknownTool {
+                line,
+                time,
+                tool: s.tool,
+            });
+        }
+        let depth = self.removed.deepest;
+        if !s.feed_move && depth > engagement::MIN_DEPTH {
+            if rapid_contact.is_none_or(|c| depth > c.depth) {
+                *rapid_contact = Some(RapidContact { line, time, depth });
+            }
+            if depth > setup.rapid_skim {
+                return Err(JobError::RapidInStock { line, time, depth });
+            }
+        }
+        if cuts && self.spindle == 0.0 {
+            return Err(JobError::SpindleOff { line, time });
+        }
+        Ok(())
+    }
 }
 
 /// What every prediction shares: the job and the frames.
