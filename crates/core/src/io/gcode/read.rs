@@ -241,67 +241,8 @@ impl Reader<'_> {
         self.numbered.clear();
         self.named.clear();
         for k in 0..self.block.items.len() {
-            let Some(item) = self.block.items.get(k).copied() else {
-                break;
-            };
-            match item {
-                Item::Word {
-                    letter,
-                    value,
-                    column,
-                } => {
-                    let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
-                    match letter {
-                        b'g' => {
-                            let code = g_code(v).map_err(|e| (column, e))?;
-                            self.words.g.push((code, column));
-                        }
-                        b'm' => {
-                            let code = m_code(v).map_err(|e| (column, e))?;
-                            self.words.m.push((code, column));
-                        }
-                        _ => self.words.set(letter, v, column),
-                    }
-                }
-                Item::Set {
-                    target,
-                    value,
-                    column,
-                } => match target {
-                    Param::Named(s, e) => {
-                        let name = self.block.name(s, e).to_string();
-                        if self.m.predefined(&name).is_some() {
-                            return Err((
-                                column,
-                                std::format!(
-                                    "a parameter that may be set, got #<{name}> (read-only)"
-                                ),
-                            ));
-                        }
-                        // LinuxCNC: the name exists (as 0) from its `=` on.
-                        if self.params.named(&name).is_none() {
-                            self.params.set_named(&name, 0.0).map_err(|e| (column, e))?;
-                        }
-                        let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
-                        self.named.push((name, v));
-                    }
-                    Param::Numbered(i) => {
-                        let i = expr::eval(&self.block, i, self)
-                            .and_then(check_index)
-                            .map_err(|e| (column, e))?;
-                        if (5400..=5413).contains(&i) || (5420..=5428).contains(&i) {
-                            return Err((
-                                column,
-                                std::format!(
-                                    "a parameter that may be set, got #{i} (read-only: the tool \
-                                     and the position)"
-                                ),
-                            ));
-                        }
-                        let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
-                        self.numbered.push((i, v));
-                    }
-                },
+            if let Some(item) = self.block.items.get(k).copied() {
+                self.evaluate(item)?;
             }
         }
         for &(i, v) in &self.numbered {
@@ -333,6 +274,73 @@ impl Reader<'_> {
             Some(FanucCall::Return) => Ok(self.m99()),
             None => Ok(None),
         }
+    }
+}
+
+impl Reader<'_> {
+    /// One word or setting of the line, with the parameters as they were before the line: a
+    /// word's value into the words, a setting's into the pending settings.
+    fn evaluate(&mut self, item: Item) -> Result<(), (usize, String)> {
+        match item {
+            Item::Word {
+                letter,
+                value,
+                column,
+            } => {
+                let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
+                match letter {
+                    b'g' => {
+                        let code = g_code(v).map_err(|e| (column, e))?;
+                        self.words.g.push((code, column));
+                    }
+                    b'm' => {
+                        let code = m_code(v).map_err(|e| (column, e))?;
+                        self.words.m.push((code, column));
+                    }
+                    _ => self.words.set(letter, v, column),
+                }
+            }
+            Item::Set {
+                target: Param::Named(s, e),
+                value,
+                column,
+            } => {
+                let name = self.block.name(s, e).to_string();
+                if self.m.predefined(&name).is_some() {
+                    return Err((
+                        column,
+                        std::format!("a parameter that may be set, got #<{name}> (read-only)"),
+                    ));
+                }
+                // LinuxCNC: the name exists (as 0) from its `=` on.
+                if self.params.named(&name).is_none() {
+                    self.params.set_named(&name, 0.0).map_err(|e| (column, e))?;
+                }
+                let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
+                self.named.push((name, v));
+            }
+            Item::Set {
+                target: Param::Numbered(i),
+                value,
+                column,
+            } => {
+                let i = expr::eval(&self.block, i, self)
+                    .and_then(check_index)
+                    .map_err(|e| (column, e))?;
+                if (5400..=5413).contains(&i) || (5420..=5428).contains(&i) {
+                    return Err((
+                        column,
+                        std::format!(
+                            "a parameter that may be set, got #{i} (read-only: the tool and the \
+                             position)"
+                        ),
+                    ));
+                }
+                let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
+                self.numbered.push((i, v));
+            }
+        }
+        Ok(())
     }
 }
 
