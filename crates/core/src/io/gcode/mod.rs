@@ -47,7 +47,7 @@
 //! `return`, values in `#<_value>`), Fanuc-style `M98 P L` / `M99`, and `if`/`elseif`/`else`,
 //! `while`, `do`, `repeat`, `break`, `continue`. Subroutines are looked for in the program,
 //! not in files. Budgets: [`MAX_CALL_DEPTH`], [`MAX_BLOCKS`] (a loop that never ends is a
-//! budget error), [`lex::MAX_EXPRESSION_DEPTH`], [`params::MAX_NAMED_PARAMETERS`].
+//! budget error), [`MAX_EXPRESSION_DEPTH`], [`MAX_NAMED_PARAMETERS`].
 //!
 //! # Dialects
 //! Some programs LinuxCNC refuses run on the control their post targets; [`Dialect`] reads
@@ -60,10 +60,10 @@ mod cycles;
 mod expr;
 mod flow;
 mod interp;
-pub mod lex;
+mod lex;
 mod motion;
 mod offsets;
-pub mod params;
+mod params;
 mod read;
 pub mod report;
 mod words;
