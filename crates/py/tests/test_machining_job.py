@@ -181,6 +181,9 @@ def test_each_tool_cuts_with_its_own_cutter_and_m4_mirrors_the_force(kr300, tmp_
         expected = slot_force(flutes, v / (rev * flutes)) * [1.0, mirror, 1.0]
         np.testing.assert_allclose(r.force[mid], expected, rtol=1e-9)
     assert set(r.tool.tolist()) == {1, 2} and r.spindle.min() == -rev
+    # The compensated program changes tools and turns the spindle as the program does.
+    back = deflect.GcodeProgram.from_text(r.compensated_gcode(1e-6), start=r.commanded[0, :3, 3])
+    assert back.tools == [1, 2] and back.spindle.min() == -rev and back.spindle.max() == rev
     # The 10 mm slot is 10 mm wide: the nominal part's floor at y = 15 +- 4 mm, stock at 6 mm.
     z = r.nominal_surface
     j = lambda y: int(round((y + 0.03) / 5e-4 - 0.5))  # noqa: E731

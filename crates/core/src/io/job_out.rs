@@ -9,7 +9,9 @@
 //! stays within `tolerance` of every dropped one (the correction varies along a move, so
 //! arcs come out as lines). Every block says in a comment which program line it comes from.
 //! Only the position is corrected in G-code (a 3-axis program has no orientation); the
-//! orientation part of the correction is in the CSV's commanded quaternion and joints.
+//! orientation part of the correction is in the CSV's commanded quaternion and joints. The
+//! program's tool changes (`T M6`), spindle directions (`M3`, `M4`, `M5`) and dwells (`G4`)
+//! are written where they happen.
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -18,8 +20,8 @@ use std::vec::Vec;
 
 use crate::contour::shape::distance_to_segment;
 use crate::error::LoadError;
-use crate::machining::Program;
 use crate::machining::job::Report;
+use crate::machining::{Motion, Program};
 
 /// Most samples one dropped run may hold before a block is written anyway (bounds the
 /// decimation's time to `O(n x 256)`).
@@ -70,23 +72,38 @@ pub fn compensated_gcode(report: &Report, program: &Program, tolerance: f64) -> 
         }
     }
     keep.dedup();
-    let (mut line, mut feed, mut spindle) = (0usize, f64::NAN, f64::NAN);
+    let (mut line, mut feed, mut spindle, mut tool) = (0usize, f64::NAN, f64::NAN, 0u32);
     let mut first = true;
+    let mut dwelt = usize::MAX;
     for &k in &keep {
         let Some(s) = samples.get(k) else { continue };
         let p = s.commanded.translation.vector * 1e3;
         let mv = program.moves.get(s.path.move_index);
+        if s.path.tool != tool {
+            tool = s.path.tool;
+            let _ = writeln!(out, "T{tool} M6");
+            // M6 stops the spindle: it is started again below.
+            spindle = f64::NAN;
+        }
         if s.path.spindle != spindle {
             spindle = s.path.spindle;
-            if spindle > 0.0 {
-                let _ = writeln!(out, "S{:.0} M3", spindle * 60.0);
-            } else {
-                let _ = writeln!(out, "M5");
-            }
+            let rpm = spindle.abs() * 60.0;
+            let _ = match spindle {
+                v if v > 0.0 => writeln!(out, "S{rpm:.0} M3"),
+                v if v < 0.0 => writeln!(out, "S{rpm:.0} M4"),
+                _ => writeln!(out, "M5"),
+            };
         }
         if s.path.line != line {
             line = s.path.line;
             let _ = writeln!(out, "(program line {line})");
+        }
+        if let Some(Motion::Dwell { seconds }) = mv.map(|m| m.motion) {
+            if dwelt != s.path.move_index {
+                dwelt = s.path.move_index;
+                let _ = writeln!(out, "G4 P{seconds:.4}");
+            }
+            continue;
         }
         let word = if first || !s.path.feed_move {
             "G0"
