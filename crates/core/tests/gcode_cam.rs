@@ -143,6 +143,13 @@ M2
     );
     let p = read_with(&haas, Dialect::Fanuc).unwrap();
     assert_eq!(trace(&p).last().unwrap(), &('R', [5.0, 5.0, 1.0]));
+    // Haas's settings, %-lines with text, nested comments: fanuc only.
+    let haas = "%O1000 (FUSION)\nG187 P3 E0.05 (FINISH (SMOOTH))\nG103 P0\nG0 X1\n%\n";
+    assert!(read_with(haas, Dialect::LinuxCnc).is_err());
+    assert_eq!(
+        trace(&read_with(haas, Dialect::Fanuc).unwrap()),
+        [('R', [1.0, 0.0, 0.0])]
+    );
 }
 
 #[test]

@@ -47,7 +47,7 @@ pub struct JobArgs {
     pub explain: Option<PathBuf>,
     /// The control the program is written for: linuxcnc (default), grbl (ignores an arc's
     /// off-plane centre word, as FreeCAD's grbl post writes it), fanuc (Fanuc, Haas, Mach3:
-    /// axis words after G80 move in the last G0-G3 mode; '%' lines anywhere).
+    /// axis words after G80 move in the last G0-G3 mode; '%' lines anywhere; G187/G103).
     #[arg(long, value_enum, default_value_t = DialectArg::Linuxcnc)]
     pub dialect: DialectArg,
     /// Tool table: LinuxCNC's .tbl (`T1 P1 D6 Z0 ;comment`, mm; flutes and helix from

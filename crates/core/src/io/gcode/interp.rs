@@ -311,6 +311,11 @@ impl Machine {
     /// compensation, coordinate system, path control, distance and retract modes.
     fn modes_before_motion(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
         self.feed_speed_tool(w)?;
+        if w.g(1030).is_some() || w.g(1870).is_some() {
+            // Haas's look-ahead and smoothness settings (fanuc dialect): recorded.
+            w.take(b'p');
+            w.take(b'e');
+        }
         self.m_codes(w, params)?;
         if let Some(column) = w.g(40) {
             if w.g(20).is_some() || w.g(30).is_some() {

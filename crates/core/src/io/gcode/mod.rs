@@ -109,7 +109,8 @@ pub enum Dialect {
     Grbl,
     /// Fanuc-style controls (Fanuc, Haas, Mach3): axis words after `G80` with no motion code
     /// move in the last `G0`-`G3` mode; `%` lines are tape markers wherever they are, and text
-    /// after a `%` (`%O1000`) is a comment; comments may nest.
+    /// after a `%` (`%O1000`) is a comment; comments may nest; Haas's smoothness and
+    /// look-ahead settings (`G187 P E`, `G103 P`) are read without motion.
     Fanuc,
 }
 
@@ -147,6 +148,10 @@ impl Dialect {
 
     pub(crate) fn percent_anywhere(self) -> bool {
         self != Self::LinuxCnc
+    }
+
+    pub(crate) fn haas_settings(self) -> bool {
+        self == Self::Fanuc
     }
 }
 
@@ -244,6 +249,7 @@ pub(crate) fn words_group(code: u16) -> Option<u8> {
         960 | 970 => 14,
         70 | 80 => 15,
         921..=923 => 16,
+        1030 | 1870 => 17,
         _ => return None,
     })
 }

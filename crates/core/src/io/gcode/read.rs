@@ -290,7 +290,7 @@ impl Reader<'_> {
                 let v = expr::eval(&self.block, value, self).map_err(|e| (column, e))?;
                 match letter {
                     b'g' => {
-                        let code = g_code(v).map_err(|e| (column, e))?;
+                        let code = g_code(v, self.options.dialect).map_err(|e| (column, e))?;
                         self.words.g.push((code, column));
                     }
                     b'm' => {
@@ -346,8 +346,12 @@ impl Reader<'_> {
 
 /// A G code's value as ten times its number (G91.1 -> 911): within 0.001 of a tenth,
 /// 0..=99.9, one LinuxCNC knows.
-fn g_code(v: f64) -> Result<u16, String> {
+fn g_code(v: f64, dialect: super::Dialect) -> Result<u16, String> {
     let tenth = (v * 10.0).round();
+    // Haas's smoothness (G187) and look-ahead (G103) settings: no motion.
+    if dialect.haas_settings() && (tenth == 1870.0 || tenth == 1030.0) {
+        return Ok(tenth as u16);
+    }
     if v < 0.0 || (v * 10.0 - tenth).abs() > 1.0e-3 || tenth > 999.0 {
         return Err(std::format!(
             "a G code (a number 0-99.9 with at most one decimal), got G{v}"

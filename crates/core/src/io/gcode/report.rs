@@ -232,6 +232,9 @@ fn g_class(code: u16) -> (WordStatus, String) {
         }
         70 | 700..=722 | 960 => refused("lathe mode or cycle"),
         80 => recorded("lathe radius mode (the default)"),
+        1030 | 1870 => {
+            recorded("Haas look-ahead, smoothness: no motion (fanuc dialect; LinuxCNC refuses it)")
+        }
         52 | 53 => refused("NURBS: not modelled"),
         171 | 181 | 191 => refused("UVW planes"),
         _ => refused("a G code LinuxCNC does not know"),
