@@ -394,3 +394,15 @@ fn tool_tables_read_linuxcncs_tbl_and_the_toml_form() {
         "{e}"
     );
 }
+
+#[test]
+fn a_latin1_comment_does_not_refuse_the_program() {
+    // A European post's comment in ISO-8859-1 ("Fräser"): not UTF-8, read as LinuxCNC reads
+    // bytes.
+    let dir = std::env::temp_dir().join(format!("deflect-latin1-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let f = dir.join("fraeser.nc");
+    std::fs::write(&f, b"(Fr\xe4ser 6 mm)\nG0 X1\nM30\n").unwrap();
+    let p = gcode::from_path(&f, &GcodeOptions::default()).unwrap();
+    assert_eq!(trace(&p), [('R', [1.0, 0.0, 0.0])]);
+}

@@ -144,7 +144,7 @@ impl GcodeProgram {
     ) -> PyResult<Self> {
         let o = options(start, units, dialect, block_delete)?;
         let text = py
-            .detach(|| deflect_core::io::read_text_file(&path))
+            .detach(|| deflect_core::io::read_text_lossy(&path))
             .map_err(load_err)?;
         Self::read(py, &text, &o)
     }

@@ -61,9 +61,27 @@ pub fn read_text_file(path: &Path) -> Result<String, LoadError> {
     read_text(path)
 }
 
+/// [`read_text_file`] for a G-code program: bytes that are not UTF-8 (a Latin-1 comment of a
+/// European post) become U+FFFD instead of refusing the file, as LinuxCNC reads bytes.
+pub fn read_text_lossy(path: &Path) -> Result<String, LoadError> {
+    match read_bytes(path) {
+        Ok(bytes) => Ok(String::from_utf8_lossy(&bytes).into_owned()),
+        Err(e) => Err(e),
+    }
+}
+
 /// Reads a whole text file, naming it in the error; reads at most [`MAX_FILE_BYTES`] + 1
 /// bytes, so a huge file or an endless one (`/dev/zero`) is refused, not read.
 pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
+    let bytes = read_bytes(path)?;
+    String::from_utf8(bytes).map_err(|e| LoadError::Io {
+        path: path.display().to_string(),
+        message: std::format!("not UTF-8 text: {e}"),
+    })
+}
+
+/// The bytes of a file of at most [`MAX_FILE_BYTES`] (a larger or endless one refused).
+fn read_bytes(path: &Path) -> Result<std::vec::Vec<u8>, LoadError> {
     use std::io::Read;
     let io = |e: std::io::Error| LoadError::Io {
         path: path.display().to_string(),
@@ -84,8 +102,5 @@ pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
             got: bytes.len(),
         });
     }
-    String::from_utf8(bytes).map_err(|e| LoadError::Io {
-        path: path.display().to_string(),
-        message: std::format!("not UTF-8 text: {e}"),
-    })
+    Ok(bytes)
 }

@@ -20,7 +20,7 @@ use deflect_sim::SimError;
 use deflect_sim::scenes::milling::part_map;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::serial::{load_robot, read_text};
+use super::serial::{load_robot, read_program, read_text};
 use super::stdout;
 use crate::cli::{CliError, JobArgs, ToolArgs};
 
@@ -69,7 +69,7 @@ pub(crate) fn default_stock(
 
 /// `job --explain FILE`: the program's word report and whether it reads, on stdout.
 pub fn explain(a: &JobArgs, path: &Path) -> Result<(), CliError> {
-    let text = read_text("--explain", path, "G-code program")?;
+    let text = read_program("--explain", path)?;
     let options = GcodeOptions {
         dialect: a.dialect.dialect(),
         ..GcodeOptions::default()
@@ -128,7 +128,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     };
     let (program, program_name) = match (&a.program, &a.points) {
         (Some(p), _) => {
-            let text = read_text("--program", p, "G-code program")?;
+            let text = read_program("--program", p)?;
             let program = gcode::from_str(&text, &options)
                 .map_err(|e| CliError::Failure(format!("--program {}: {e}", p.display())))?;
             (program, p.display().to_string())

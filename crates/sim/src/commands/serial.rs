@@ -37,6 +37,24 @@ pub struct SerialInput {
 /// Reads a text file of `flag` (regular, at most 16 MiB): a usage error naming the flag and
 /// the file otherwise.
 pub(crate) fn read_text(flag: &str, path: &Path, expected: &str) -> Result<String, CliError> {
+    let bytes = read_bytes(flag, path, expected)?;
+    String::from_utf8(bytes).map_err(|e| {
+        CliError::Failure(format!(
+            "{flag} {}: cannot read the {expected}: not UTF-8 text: {e}",
+            path.display()
+        ))
+    })
+}
+
+/// [`read_text`] for a G-code program: bytes that are not UTF-8 (a Latin-1 comment of a
+/// European post) become U+FFFD, as LinuxCNC reads bytes.
+pub(crate) fn read_program(flag: &str, path: &Path) -> Result<String, CliError> {
+    let bytes = read_bytes(flag, path, "G-code program")?;
+    Ok(String::from_utf8_lossy(&bytes).into_owned())
+}
+
+/// The bytes of an input file of at most `MAX_FILE` bytes, every error naming the flag.
+fn read_bytes(flag: &str, path: &Path, expected: &str) -> Result<Vec<u8>, CliError> {
     input_file(flag, path, expected)?;
     let len = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
     if len > MAX_FILE {
@@ -45,7 +63,7 @@ pub(crate) fn read_text(flag: &str, path: &Path, expected: &str) -> Result<Strin
             path.display()
         )));
     }
-    std::fs::read_to_string(path).map_err(|e| {
+    std::fs::read(path).map_err(|e| {
         CliError::Failure(format!(
             "{flag} {}: cannot read the {expected}: {e}",
             path.display()

@@ -181,9 +181,10 @@ impl Default for GcodeOptions {
     }
 }
 
-/// Reads a G-code file (at most [`super::MAX_FILE_BYTES`]).
+/// Reads a G-code file (at most [`super::MAX_FILE_BYTES`]; bytes that are not UTF-8 become
+/// U+FFFD, [`super::read_text_lossy`]).
 pub fn from_path(path: &Path, options: &GcodeOptions) -> Result<Program, LoadError> {
-    let text = super::read_text(path)?;
+    let text = super::read_text_lossy(path)?;
     from_str(&text, options)
 }
 
