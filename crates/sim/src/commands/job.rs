@@ -310,7 +310,11 @@ fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
             )
         }
         None => {
-            let names: Vec<String> = used.iter().map(|n| format!("T{n}")).collect();
+            let names: Vec<String> = used
+                .iter()
+                .filter(|&&n| n > 0)
+                .map(|n| format!("T{n}"))
+                .collect();
             json.push(serde_json::json!({
                 "tool": "every", "diameter_m": setup.tool.diameter, "shape": "flat",
                 "flutes": setup.tool.flutes, "helix_rad": setup.tool.helix,
@@ -321,7 +325,7 @@ fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
                 setup.tool.diameter * 1e3,
                 setup.tool.flutes,
                 if names.is_empty() {
-                    "none".to_string()
+                    "it names none".to_string()
                 } else {
                     names.join(", ")
                 }
