@@ -142,18 +142,18 @@ fn a_slot_engages_zero_to_pi_at_its_depth_and_half_immersion_a_quarter() {
     else {
         panic!("{c:?}")
     };
-    // One cell at the rim is ~sqrt(2 cell / R) = 0.22 rad at the thin end of the chip.
+    // The probe of angle phi reads the rim's lateral offset R cos(phi) ahead of the tool:
+    // the first slot's wall lies at lateral R from this pass, i.e. at phi = pi/2, where the
+    // interpolation between the cut row (centre 0.1 mm inside) and the uncut one reads half
+    // the depth. So the arc ends at pi/2 and its mean depth is (90 a + a/2) / 91.
     assert_eq!(entry2, 0.0);
-    assert!(
-        (exit2 - PI / 2.0).abs() < (2.0 * 1.75 * cell / r).sqrt(),
-        "{exit2}"
-    );
-    assert!((depth2 - a).abs() < 1e-12);
+    assert!((exit2 - PI / 2.0).abs() < 1e-12, "{exit2}");
+    assert!((depth2 - a * 90.5 / 91.0).abs() < 1e-12, "{depth2}");
     // Back along the groove already cut: only the walls beside the rim are seen, as two thin
-    // arcs at the ends (the probe circle lies 0.75 cell outside the cutter), no wider than
-    // acos(R / (R + 0.75 cell)) + one probe step each.
+    // arcs at the ends where R cos(phi) passes the last cut row's centre (R - cell/2), no
+    // wider than acos(1 - cell / R) + one probe step each.
     let c = engagement::contact(&z, r, &Vector3::new(0.02, 0.0, -a), &Vector3::x());
-    let sliver = (r / (r + 0.75 * cell)).acos() + PI / 180.0;
+    let sliver = (1.0 - cell / r).acos() + PI / 180.0;
     assert_eq!(c.arcs().len(), 2, "{c:?}");
     assert_eq!(c.arcs()[0].entry, 0.0);
     assert!(c.arcs()[0].exit <= sliver && c.arcs()[1].entry >= PI - sliver);

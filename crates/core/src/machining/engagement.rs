@@ -1,28 +1,115 @@
-//! Where a flat end mill meets the stock: the immersion (entry and exit angles) and the axial
-//! depth read from the z-map ([`super::stock::ZMap`]) at the tool's position, so the force
-//! model ([`super::cutting`]) never asks the user for them.
+//! Where a flat end mill meets the stock: the material in front of the cutter at each of
+//! [`ANGLES`] immersion angles (the [`Chip`]), read from the z-map ([`super::stock::ZMap`]) at
+//! the tool's position, so the force model ([`super::chip`]) never asks the user for an
+//! engagement.
 //!
-//! The front half of the cutter circle (`phi` in `[0, pi]`, clockwise from the tool frame's
-//! +y, feed along +x; the conventions of [`super::cutting`]) is probed at [`ANGLES`] angles on
-//! a circle of radius `R + 0.75 cell`: three quarters of a cell outside the cutter, so a cell
-//! the tool has just cut (its centre within `R` of the path) is never read as material, and a
-//! cell it is about to cut is. An angle is engaged where the stock stands more than
-//! [`MIN_DEPTH`] above the tip; the entry and exit are the first and last engaged angles and
-//! the depth is the mean height above the tip over the engaged angles (the depth that gives
-//! the per-revolution force of a varying depth when the force is linear in it). Resolution:
-//! one cell at the cutter's rim, i.e. about `sqrt(2 cell / R)` rad at the ends of a slot,
-//! where the chip is thin and the force small.
+//! The front half of the cutter (`phi` in `[0, pi]`, clockwise from the tool frame's +y, feed
+//! along +x; the conventions of [`super::cutting`]) is probed 1 degree apart. The probe of
+//! angle `phi` lies at the rim's lateral offset `R cos(phi)` and ahead of the tool on the
+//! circle of radius `R + PROBE_CLEARANCE cell` around the tip: what the edge at `phi` meets as
+//! the tool advances, read where the tool has not cut yet. The clearance of 1.5 cells keeps
+//! the four cell centres the probe interpolates outside the cutter's swept path for any feed
+//! direction (they lie within `sqrt(2)` cells of the probe), so the engagement never reads the
+//! material the tool itself has just removed; a wall parallel to the feed (the previous pass
+//! of a side cut) is read at its exact lateral offset, so the radial width of cut is not
+//! biased by the clearance.
+//!
+//! The depth at a probe is the stock's clipped depth above the tip, interpolated between cell
+//! centres ([`super::stock::ZMap::depth_at`]): no threshold switches a probe on, and a change
+//! `d` of the tool's position changes every probe's depth by at most `|d_z| + sqrt(2) D / cell
+//! |d_xy|` (`D` the largest depth read), which [`super::chip`] turns into the bound on the
+//! force. Resolution: a wall met head-on (an entry into the stock) is felt up to
+//! `PROBE_CLEARANCE` cells early at the front (`phi = pi / 2`) and up to
+//! `sqrt(2 R PROBE_CLEARANCE cell)` early at the sides, where the chip is thinnest.
+//!
+//! [`Contact`] summarises a chip for reports: the arcs where the depth exceeds [`MIN_DEPTH`].
 
 use nalgebra::{ComplexField, Vector2, Vector3};
 
 use super::stock::ZMap;
 
-/// Angles probed over the front half of the cutter (1 degree apart).
+/// Angles probed over the front half of the cutter (1 degree apart): `phi_k = k pi / 180`.
 pub const ANGLES: usize = 181;
-/// Least height of stock above the tip \[m\] that counts as material (1 um).
+/// How far outside the cutter the probes lie, in cells of the z-map (see the module docs).
+pub const PROBE_CLEARANCE: f64 = 1.5;
+/// Least depth \[m\] a report counts as an engaged arc (1 um); the force has no threshold.
 pub const MIN_DEPTH: f64 = 1.0e-6;
 /// Most separate engaged arcs one contact keeps; further arcs are merged into the last.
 pub const MAX_ARCS: usize = 8;
+
+/// The probe angle `phi_k` \[rad\].
+#[inline]
+pub fn angle(k: usize) -> f64 {
+    k as f64 * (core::f64::consts::PI / (ANGLES - 1) as f64)
+}
+
+/// Where the probes lie around a cutter of one radius on a z-map of one cell: per angle, the
+/// offset ahead of the tip along the feed and to its side (+y of the tool frame) \[m\].
+/// Computed once per tool; reading a chip then costs no trigonometry.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Probes {
+    radius: f64,
+    ahead: [f64; ANGLES],
+    side: [f64; ANGLES],
+}
+
+impl Probes {
+    /// The probes of a cutter of `radius` \[m\] on a z-map of cells of `cell` \[m\] (both
+    /// finite and > 0, as a validated job's are; other values give probes that read no
+    /// material).
+    pub fn new(radius: f64, cell: f64) -> Self {
+        let rho = radius + PROBE_CLEARANCE * cell;
+        let mut ahead = [0.0; ANGLES];
+        let mut side = [0.0; ANGLES];
+        for (k, (a, s)) in ahead.iter_mut().zip(side.iter_mut()).enumerate() {
+            let lateral = radius * ComplexField::cos(angle(k));
+            *s = lateral;
+            *a = ComplexField::sqrt((rho * rho - lateral * lateral).max(0.0));
+        }
+        Self {
+            radius,
+            ahead,
+            side,
+        }
+    }
+
+    /// The cutter radius \[m\].
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+}
+
+/// What the cutter meets.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ChipKind {
+    /// Side or slot milling (or air: every depth 0).
+    #[default]
+    Side,
+    /// The tool moves along its axis (or too steeply to have a feed direction): a plunge,
+    /// which the side-milling model does not cover; the depths are 0.
+    Plunge,
+}
+
+/// The material in front of the cutter: its depth above the tip at each probe angle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Chip {
+    /// Depth of stock above the tip at `phi_k` ([`angle`]) \[m\], `>= 0`.
+    pub depth: [f64; ANGLES],
+    /// Side milling or a plunge.
+    pub kind: ChipKind,
+    /// For a plunge: the stock above the tip at the tool's axis \[m\].
+    pub plunge_depth: f64,
+}
+
+impl Default for Chip {
+    fn default() -> Self {
+        Self {
+            depth: [0.0; ANGLES],
+            kind: ChipKind::Side,
+            plunge_depth: 0.0,
+        }
+    }
+}
 
 /// One contiguous engaged arc of the cutter.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -35,13 +122,12 @@ pub struct Arc {
     pub depth: f64,
 }
 
-/// Where the cutter meets the stock.
+/// A chip summarised for reports: the arcs deeper than [`MIN_DEPTH`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Contact {
-    /// No material in front of the cutter.
+    /// No probe deeper than [`MIN_DEPTH`].
     Air,
-    /// The tool moves along its axis (or too steeply to have a feed direction) with
-    /// material under it \[m\]: a plunge, which the side-milling model does not cover.
+    /// A plunge with material under the tip \[m\] ([`ChipKind::Plunge`]).
     Plunge {
         /// Stock above the tip at the tool's axis \[m\].
         depth: f64,
@@ -87,45 +173,28 @@ impl Contact {
     }
 }
 
-/// The contact of a vertical flat end mill of `radius` \[m\] with its tip at `tip` \[m\],
-/// moving along `feed` (any length; only its horizontal part counts), workpiece frame, its
-/// spindle turning clockwise seen from above (`M3`). A feed whose horizontal part is below
-/// 1e-9 of its length is a plunge (or air).
-pub fn contact(stock: &ZMap, radius: f64, tip: &Vector3<f64>, feed: &Vector3<f64>) -> Contact {
-    contact_turning(stock, radius, tip, feed, false)
-}
-
-/// [`contact`] for either spindle direction: `counter_clockwise` (`M4`, a left-hand cutter)
-/// mirrors the cutter's angles about the feed direction (`phi` clockwise from the tool frame's
-/// -y), so [`super::cutting`]'s model of a clockwise cutter applies to the mirror image.
-pub fn contact_turning(
-    stock: &ZMap,
-    radius: f64,
-    tip: &Vector3<f64>,
-    feed: &Vector3<f64>,
-    counter_clockwise: bool,
-) -> Contact {
-    let horizontal = feed.xy();
-    let n = horizontal.norm();
-    if n.is_nan() || n <= 1.0e-9 * feed.norm() {
-        return match stock.height_at(&tip.xy()) {
-            Some(h) if h - tip.z > MIN_DEPTH => Contact::Plunge { depth: h - tip.z },
-            _ => Contact::Air,
-        };
-    }
-    let x = horizontal / n;
-    let left = Vector2::new(-x.y, x.x);
-    let y = if counter_clockwise { -left } else { left };
-    let rho = radius + 0.75 * stock.cell();
-    let step = core::f64::consts::PI / (ANGLES - 1) as f64;
-    let mut arcs = [Arc::default(); MAX_ARCS];
-    let (mut count, mut open, mut probes) = (0usize, false, 0usize);
-    for k in 0..ANGLES {
-        let phi = k as f64 * step;
-        let (sin, cos) = ComplexField::sin_cos(phi);
-        let p = tip.xy() + (x * sin + y * cos) * rho;
-        let depth = stock.height_at(&p).map_or(0.0, |h| h - tip.z);
-        if depth > MIN_DEPTH {
+impl Chip {
+    /// The chip summarised: arcs of consecutive probes deeper than [`MIN_DEPTH`] (a single
+    /// probe spans one probe step), each with its probes' mean depth.
+    pub fn contact(&self) -> Contact {
+        if self.kind == ChipKind::Plunge {
+            return if self.plunge_depth > MIN_DEPTH {
+                Contact::Plunge {
+                    depth: self.plunge_depth,
+                }
+            } else {
+                Contact::Air
+            };
+        }
+        let step = angle(1);
+        let mut arcs = [Arc::default(); MAX_ARCS];
+        let (mut count, mut open, mut probes) = (0usize, false, 0usize);
+        for (k, &depth) in self.depth.iter().enumerate() {
+            if depth <= MIN_DEPTH {
+                open = false;
+                continue;
+            }
+            let phi = angle(k);
             if !open {
                 if count < MAX_ARCS {
                     count += 1;
@@ -141,24 +210,88 @@ pub fn contact_turning(
                 open = true;
             }
             if let Some(a) = arcs.get_mut(count.saturating_sub(1)) {
-                // Running mean over the arc's probes.
                 probes += 1;
                 a.depth += (depth - a.depth) / probes as f64;
                 a.exit = phi;
             }
-        } else {
-            open = false;
         }
-    }
-    if count == 0 {
-        return Contact::Air;
-    }
-    for a in arcs.iter_mut().take(count) {
-        // A single engaged probe still spans one probe step.
-        if a.exit <= a.entry {
-            a.exit = (a.entry + step).min(core::f64::consts::PI);
-            a.entry = a.exit - step;
+        if count == 0 {
+            return Contact::Air;
         }
+        for a in arcs.iter_mut().take(count) {
+            if a.exit <= a.entry {
+                a.exit = (a.entry + step).min(core::f64::consts::PI);
+                a.entry = a.exit - step;
+            }
+        }
+        Contact::Cutting { arcs, count }
     }
-    Contact::Cutting { arcs, count }
+
+    /// The largest depth over the probes \[m\].
+    pub fn deepest(&self) -> f64 {
+        self.depth.iter().fold(0.0, |m, &d| m.max(d))
+    }
+}
+
+/// Reads the chip of a vertical cutter with its tip at `tip` \[m\], moving along `feed` (any
+/// length; only its horizontal part counts), workpiece frame, into `chip`: allocation-free.
+/// `counter_clockwise` (`M4`, a left-hand cutter) mirrors the angles about the feed
+/// direction (`phi` clockwise from the tool frame's -y), so [`super::cutting`]'s model of a
+/// clockwise cutter applies to the mirror image. A feed whose horizontal part is below 1e-9 of
+/// its length is a plunge.
+pub fn read(
+    stock: &ZMap,
+    probes: &Probes,
+    tip: &Vector3<f64>,
+    feed: &Vector3<f64>,
+    counter_clockwise: bool,
+    chip: &mut Chip,
+) {
+    let horizontal = feed.xy();
+    let n = horizontal.norm();
+    if n.is_nan() || n <= 1.0e-9 * feed.norm() {
+        chip.kind = ChipKind::Plunge;
+        chip.depth = [0.0; ANGLES];
+        chip.plunge_depth = stock.depth_at(&tip.xy(), tip.z);
+        return;
+    }
+    chip.kind = ChipKind::Side;
+    chip.plunge_depth = 0.0;
+    let x = horizontal / n;
+    let left = Vector2::new(-x.y, x.x);
+    let y = if counter_clockwise { -left } else { left };
+    // Fractional cell coordinates: the tip's, and per metre along x and y.
+    let cell = stock.cell();
+    let base = (tip.xy() - stock.origin()) / cell - Vector2::repeat(0.5);
+    let (xs, ys) = (x / cell, y / cell);
+    for ((d, &a), &s) in chip
+        .depth
+        .iter_mut()
+        .zip(probes.ahead.iter())
+        .zip(probes.side.iter())
+    {
+        let u = base + xs * a + ys * s;
+        *d = stock.depth_at_index(u.x, u.y, tip.z);
+    }
+}
+
+/// The contact of a vertical flat end mill of `radius` \[m\] with its tip at `tip` \[m\],
+/// moving along `feed`, its spindle turning clockwise seen from above (`M3`): [`read`] with
+/// probes built for this call, summarised.
+pub fn contact(stock: &ZMap, radius: f64, tip: &Vector3<f64>, feed: &Vector3<f64>) -> Contact {
+    contact_turning(stock, radius, tip, feed, false)
+}
+
+/// [`contact`] for either spindle direction (see [`read`]).
+pub fn contact_turning(
+    stock: &ZMap,
+    radius: f64,
+    tip: &Vector3<f64>,
+    feed: &Vector3<f64>,
+    counter_clockwise: bool,
+) -> Contact {
+    let probes = Probes::new(radius, stock.cell());
+    let mut chip = Chip::default();
+    read(stock, &probes, tip, feed, counter_clockwise, &mut chip);
+    chip.contact()
 }

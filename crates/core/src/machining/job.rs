@@ -1,26 +1,38 @@
 //! The offline pass of the hybrid compensation of Hähn and Weigold (2020, sec. 2.3-2.4) over a
 //! user's program: the program driven at its feeds ([`super::path`]), the stock cut along it
-//! ([`super::stock`]) with the engagement read at every sample ([`super::engagement`]), the
-//! mechanistic per-revolution force ([`super::cutting::average`]) turned into the TCP wrench,
+//! ([`super::stock`]) with the chip read at every sample ([`super::engagement`]), the
+//! mechanistic per-revolution force of that chip ([`super::chip`]) turned into the TCP wrench,
 //! the exact virtual-joint deflection (Eq. 2-9 of the paper) at the rigid pose-IK joints, and
 //! the compensated joints at which the *loaded* arm lands on the programmed pose.
 //!
 //! Per sample (workpiece frame `W`, placed at [`Setup::placement`] in the base frame):
 //!
-//! 1. the programmed tool tip `p`, its target pose `placement * (p, tool_orientation)`, and
-//!    the rigid joints `q` by pose IK from the previous sample's (the first from the seed);
-//! 2. the contact of the nominal tool with the nominal stock, the force `F` on the tool and
-//!    the wrench about the tip: `F` acting at half the depth up the tool axis and the cutting
-//!    torque about the axis ([`super::cutting::average_torque`]);
-//! 3. the deflection of the tip under that wrench at `q` (exact VJM), and the compensated
-//!    joints `q_c` at which the loaded tip reaches the target (pose IK of the loaded chain);
-//!    the Cartesian command is the rigid pose at `q_c`, the axis-specific one `q_c - q`;
-//! 4. the part, predicted three ways on three z-maps: nominal (the tool on the program),
-//!    uncompensated (at `q`) and compensated (at `q_c`). The two predictions feel the force of
-//!    the tool where it is, not where it was programmed: the engagement is read on their own
-//!    stock at the tip position of the previous sample plus this sample's programmed step
-//!    (one sample of lag at 250 Hz-2 kHz), so a deflected tool cuts shallower and feels
-//!    less force, as on the robot.
+//! 1. the programmed tool tip `p` and the chip of the nominal tool on the nominal stock, the
+//!    force `F` on the tool and the wrench about the tip (each angle's force halfway up its
+//!    depth, the cutting torque about the axis); then the nominal stock is cut to `p`;
+//! 2. the target pose `placement * (p, tool_orientation)`, the rigid joints `q` by pose IK
+//!    warm-started from the previous samples, the deflection of the tip under the wrench at
+//!    `q` (exact VJM), and the compensated joints `q_c` at which the loaded tip reaches the
+//!    target (pose IK of the loaded chain); the Cartesian command is the rigid pose at `q_c`,
+//!    the axis-specific one `q_c - q`;
+//! 3. the part, predicted three ways on three z-maps: nominal (the tool on the program),
+//!    uncompensated (at `q`) and compensated (at `q_c`). Each prediction's tool feels the force
+//!    of its own chip where it is: its tip `t` solves `t = tip(q, F(t))` on its own stock, by
+//!    fixed-point iteration from the previous sample's tip plus the programmed step, to
+//!    [`COUPLING_TOLERANCE`] within [`MAX_COUPLING_ITERATIONS`] (the last step is reported per
+//!    sample, [`JobSample::coupling_residual`]); then its stock is cut to `t`.
+//!
+//! # How close the compensated prediction stays to the program
+//! The compensated joints put the loaded tip on `p` to the IK's position tolerance `e_ik`
+//! under the nominal force. The compensated tool feels `F(t)` instead, on a stock its own
+//! past cut, so `|t - p| <= e_ik + |C| |F(t) - F(p)|` with `|C|` the arm's compliance. The
+//! force is continuous in the tool's position ([`super::chip`]: `|F(t) - F(p)| <= W (|d_z| +
+//! sqrt(2) D / cell |d_xy|)`) and the stocks agree to the earlier deviations, so where `|C| W`
+//! stays below 1 the deviation stays within `e_ik / (1 - |C| W)` plus the coupling residual:
+//! 1e-8 m on the KR 300 (`|C| W` about 0.1-0.5 in aluminium). [`PREDICTION_TOLERANCE`] (1 um)
+//! is what the report holds it to; lines past it are named with the reason
+//! ([`super::report::Deviation`]). A sample the arm cannot reach or the IK cannot solve is an
+//! error naming its line.
 //!
 //! The tool axis is the workpiece's z (a 2.5-D program); the deflected tool's tilt
 //! (milliradians) is not carried into the z-maps.
@@ -31,21 +43,35 @@
 //! spindle (`M4`) cuts as the mirror image of a clockwise one about the feed direction. A
 //! program that never starts its spindle (posts for hand-started spindles) cuts at
 //! [`Setup::hand_spindle`].
+//!
+//! # Long programs
+//! [`run`] keeps every sample (up to [`path::MAX_PATH_SAMPLES`]); [`run_streaming`] hands
+//! them to a sink chunk by chunk ([`RunOptions::chunk`]) and keeps only the z-maps, the plan
+//! and the per-line figures ([`Summary`]): its memory does not grow with the program's
+//! duration. With the `std` feature and [`RunOptions::threads`] above 1, the two predictions
+//! of a chunk run on two threads once the nominal cut of the chunk is done.
 
 use alloc::vec::Vec;
 
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use super::Program;
-use super::cutting::{self, Coefficients, Engagement, Tool};
-use super::engagement::{self, Contact};
+use super::chip::ChipModel;
+use super::cutting::{self, Coefficients, Tool};
+use super::engagement::{self, Chip};
 use super::path::{self, PathOptions, PathSample};
-pub use super::report::{ErrorStats, JobSample, LineForce, RapidContact, Report, SurfaceError};
-use super::stock::{Cutter, Removal, ZMap};
+pub use super::report::{
+    Deviation, ErrorStats, JobSample, LineForce, LineSummary, RapidContact, Report, Summary,
+    SurfaceError,
+};
+use super::stock::{Cutter, ZMap};
 use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
-use crate::mechanism::{PoseIkOptions, pose_ik};
-use crate::vjm::{self, Data, Load, MAX_DOF, Model, Vector6};
+use crate::mechanism::PoseIkOptions;
+use crate::vjm::{Model, Vector6};
+
+mod nominal;
+mod predict;
 
 pub use crate::mechanism::JOINT_LIMIT_TOLERANCE;
 
@@ -230,37 +256,31 @@ impl Job {
     }
 }
 
-/// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece
-/// frame) of a contact of `setup`'s tool, turning clockwise, moving along `feed` (workpiece
-/// frame, any length): [`tool_wrench`] with the setup's tool and material. What a simulation
-/// calls with the contact where its tool really is.
-pub fn contact_wrench(
-    setup: &Setup,
-    contact: &Contact,
-    feed: &Vector3<f64>,
-    feed_per_tooth: f64,
-) -> Result<(Vector3<f64>, Vector6), TickError> {
-    tool_wrench(
-        &setup.coefficients,
-        &setup.tool,
-        contact,
-        feed,
-        feed_per_tooth,
-        false,
-    )
-}
+/// How close the fixed point of the force-deflection coupling gets \[m\]: 1e-8 m, the pose
+/// IK's default position tolerance (the predicted tip is known no better than the joints
+/// that put it there).
+pub const COUPLING_TOLERANCE: f64 = 1.0e-8;
+/// Most evaluations of the coupling per prediction and sample; the residual is reported
+/// when they run out.
+pub const MAX_COUPLING_ITERATIONS: usize = 20;
+/// How far the compensated prediction may leave the program \[m\] before the report names
+/// the line and why ([`Deviation`]): 1 um.
+pub const PREDICTION_TOLERANCE: f64 = 1.0e-6;
+/// Samples per chunk of a streamed run by default: 4096 (16 s of program at 250 Hz, about
+/// 2.5 MB of samples).
+pub const DEFAULT_CHUNK: usize = 4096;
+/// Most samples per chunk: 2^20.
+pub const MAX_CHUNK: usize = 1 << 20;
 
-/// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece
-/// frame) of `tool` in `contact`, moving along `feed` (workpiece frame, any length): each
-/// engaged arc's per-revolution force acting at half its depth up the axis, plus the cutting
-/// torque about the axis; zero in air, for plunges and without a horizontal feed. A
-/// `counter_clockwise` spindle (`M4`; its contact read by [`engagement::contact_turning`])
-/// gives the mirror image about the feed direction: the lateral force and the torques turn
-/// sign.
-pub fn tool_wrench(
-    coefficients: &Coefficients,
-    tool: &Tool,
-    contact: &Contact,
+/// The force on the tool \[N\] and the wrench about the tip \[N, N m\] (both workpiece frame)
+/// of `chip` for the tool of `model`, moving along `feed` (workpiece frame, any length) at
+/// `feed_per_tooth` \[m\]: zero for plunges and without a horizontal feed. A
+/// `counter_clockwise` spindle (`M4`, its chip read mirrored by [`engagement::read`]) gives
+/// the mirror image about the feed direction: the lateral force and the torques turn sign.
+/// [`TickError::NonFiniteOutput`] for depths that overflow.
+pub fn chip_wrench(
+    model: &ChipModel,
+    chip: &Chip,
     feed: &Vector3<f64>,
     feed_per_tooth: f64,
     counter_clockwise: bool,
@@ -268,19 +288,7 @@ pub fn tool_wrench(
     let Some(frame) = cutting::tool_frame(&Vector3::z(), feed) else {
         return Ok((Vector3::zeros(), Vector6::zeros()));
     };
-    let (mut f_tool, mut m_tool) = (Vector3::zeros(), Vector3::zeros());
-    for arc in contact.arcs() {
-        let e = Engagement {
-            entry: arc.entry,
-            exit: arc.exit,
-            depth: arc.depth,
-            feed_per_tooth,
-        };
-        let f = cutting::average(coefficients, tool, &e)?;
-        let torque = cutting::average_torque(coefficients, tool, &e)?;
-        m_tool += Vector3::new(0.0, 0.0, 0.5 * arc.depth).cross(&f) + Vector3::z() * torque;
-        f_tool += f;
-    }
+    let (mut f_tool, mut m_tool) = model.wrench(chip, feed_per_tooth);
     if counter_clockwise {
         // The mirror about the tool frame's xz plane: a force's y and a moment's x and z
         // (a pseudovector) turn sign.
@@ -289,7 +297,9 @@ pub fn tool_wrench(
         m_tool.z = -m_tool.z;
     }
     let (f, m) = (frame * f_tool, frame * m_tool);
-    Ok((f, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)))
+    let w = Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z);
+    crate::error::check_output("cutting wrench", w.as_slice())?;
+    Ok((f, w))
 }
 
 /// Feed per tooth \[m\] of `setup`'s tool at a path sample: horizontal speed over spindle
@@ -305,308 +315,64 @@ fn tooth_feed(tool: &Tool, s: &PathSample, spindle: f64) -> f64 {
     if teeth > 0.0 { v / teeth } else { 0.0 }
 }
 
-fn in_limits(q: &[f64], limits: &[(f64, f64)]) -> Result<(), TickError> {
-    crate::mechanism::check_limits(q, limits, JOINT_LIMIT_TOLERANCE)
-}
-
-/// Runs the offline pass (see the module docs) from the joints `seed` near the first pose
-/// (they choose the IK branch). Errors name the program line.
-pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobError> {
-    let setup = &job.setup;
-    let model = &job.model;
-    let dof = model.dof();
-    let st = &setup.stock;
-    let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
-    let mut nominal = zmap()?;
-    let (mut unc, mut comp) = (Predicted::new(zmap()?), Predicted::new(zmap()?));
-    let path = path::sample(program, &setup.path)?;
-    let mut samples = Vec::new();
-    samples
-        .try_reserve_exact(path.len())
-        .map_err(|_| BuildError::Budget {
-            what: "job samples (the allocation was refused)",
-            budget: "MAX_PATH_SAMPLES",
-            limit: path::MAX_PATH_SAMPLES,
-            requested: path.len(),
-        })?;
-    let mut data = Data::new(model);
-    let mut q = [0.0; MAX_DOF];
-    match q.get_mut(..dof) {
-        Some(head) if seed.len() == dof => head.copy_from_slice(seed),
-        _ => {
-            return Err(BuildError::WrongLength {
-                what: "seed joints",
-                expected: dof,
-                got: seed.len(),
-            }
-            .into());
-        }
-    }
-    let mut qc = q;
-    let to_base = setup.placement;
-    let to_work = to_base.inverse();
-    let (mut plunge_samples, mut cell_updates) = (0, 0);
-    let mut prev_nom: Option<Vector3<f64>> = None;
-    let frame = Frame {
-        job,
-        to_base,
-        to_work,
-    };
-    let mut spindle_tool = SpindleTool::default();
-    let mut rapid_contact: Option<RapidContact> = None;
-    for s in &path {
-        let at = |error: TickError| JobError::AtLine {
-            line: s.line,
-            time: s.time,
-            error,
-        };
-        let p = s.position;
-        let from = prev_nom.unwrap_or(p);
-        let (tool, cutter, known) = spindle_tool.at(job, s.tool);
-        let spindle = match (s.spindle, setup.hand_spindle) {
-            (0.0, Some(hand)) => hand,
-            (v, _) => v,
-        };
-        let ccw = spindle < 0.0;
-        // 2. The nominal contact, checked before the cut lowers the stock.
-        let contact = engagement::contact_turning(&nominal, cutter.radius(), &p, &s.direction, ccw);
-        let removed = nominal.cut(&cutter, &from, &p).map_err(at)?;
-        let cut = NominalCut {
-            contact: &contact,
-            removed: &removed,
-            known,
-            spindle,
-        };
-        cut.check(setup, s, &mut rapid_contact)?;
-        if matches!(contact, Contact::Plunge { .. }) {
-            plunge_samples += 1;
-        }
-        let fz = tooth_feed(&tool, s, spindle);
-        let (force, wrench_w) =
-            tool_wrench(&setup.coefficients, &tool, &contact, &s.direction, fz, ccw).map_err(at)?;
-        let wrench = rotate(&to_base, &wrench_w);
-        // 1. The programmed pose and its rigid joints.
-        let target = to_base * Isometry3::from_parts(Translation3::from(p), setup.tool_orientation);
-        let zero = Vector6::zeros();
-        let rigid = pose_ik(
-            model,
-            &mut data,
-            &target,
-            q.get(..dof).unwrap_or(&[]),
-            &zero,
-            Load::Rigid,
-            &setup.ik,
-        )
-        .map_err(at)?;
-        q = rigid.q;
-        in_limits(q.get(..dof).unwrap_or(&[]), &job.limits).map_err(at)?;
-        // 3. The deflection and the compensated joints.
-        let deflection = vjm::deflection(
-            model,
-            &mut data,
-            q.get(..dof).unwrap_or(&[]),
-            &wrench,
-            Load::Exact,
-        )
-        .map_err(at)?;
-        let loaded = pose_ik(
-            model,
-            &mut data,
-            &target,
-            qc.get(..dof).unwrap_or(&[]),
-            &wrench,
-            Load::Exact,
-            &setup.ik,
-        )
-        .map_err(at)?;
-        qc = loaded.q;
-        in_limits(qc.get(..dof).unwrap_or(&[]), &job.limits).map_err(at)?;
-        let commanded = to_work * data.tcp;
-        // 4. The predictions: the force where each tool is (lagged one sample), its
-        // deflection, its cut.
-        let tick = Tick {
-            sample: s,
-            step: p - from,
-            feed_per_tooth: fz,
-            tool,
-            cutter,
-            counter_clockwise: ccw,
-        };
-        let q_rigid = q.get(..dof).unwrap_or(&[]);
-        let (force_unc, actual_unc, r_unc) =
-            unc.advance(&frame, &mut data, q_rigid, &tick).map_err(at)?;
-        let q_comp = qc.get(..dof).unwrap_or(&[]);
-        let (_, actual_comp, r_comp) =
-            comp.advance(&frame, &mut data, q_comp, &tick).map_err(at)?;
-        cell_updates += removed.cells + r_unc + r_comp;
-        prev_nom = Some(p);
-        samples.push(JobSample {
-            path: *s,
-            contact,
-            feed_per_tooth: fz,
-            force,
-            wrench,
-            q,
-            deflection,
-            q_commanded: qc,
-            commanded,
-            actual_uncompensated: actual_unc,
-            force_uncompensated: force_unc,
-            actual_compensated: actual_comp,
-        });
-    }
-    Ok(Report {
-        samples,
-        rapid_contact,
-        nominal,
-        uncompensated: unc.stock,
-        compensated: comp.stock,
-        plunge_samples,
-        cell_updates,
-        rate_hz: setup.path.rate_hz,
-        dof,
-        top: st.top,
-    })
-}
-
-/// The tool in the spindle, looked up once per change: its cutter, and whether the job
-/// knows it (else the setup's tool stands in, and cutting with it is an error).
-#[derive(Default)]
-struct SpindleTool {
-    last: Option<(u32, Option<(Tool, Cutter)>)>,
-}
-
-impl SpindleTool {
-    fn at(&mut self, job: &Job, t: u32) -> (Tool, Cutter, bool) {
-        let found = match self.last {
-            Some((n, found)) if n == t => found,
-            _ => {
-                let found = job.tool(t);
-                self.last = Some((t, found));
-                found
-            }
-        };
-        let stand_in = job.setup.tool;
-        let (tool, cutter) = found.unwrap_or((
-            stand_in,
-            Cutter::Flat {
-                radius: 0.5 * stand_in.diameter,
-            },
-        ));
-        (tool, cutter, found.is_some())
-    }
-}
-
-/// The nominal cut of one sample, checked: a tool the job lacks must not cut, a rapid may
-/// skim the stock by `rapid_skim` (the deepest skim kept), the spindle must turn in a cut.
-struct NominalCut<'a> {
-    contact: &'a Contact,
-    removed: &'a Removal,
-    known: bool,
-    spindle: f64,
-}
-
-impl NominalCut<'_> {
-    fn check(
-        &self,
-        setup: &Setup,
-        s: &PathSample,
-        rapid_contact: &mut Option<RapidContact>,
-    ) -> Result<(), JobError> {
-        let (line, time) = (s.line, s.time);
-        let cuts = *self.contact != Contact::Air;
-        if !self.known && (cuts || self.removed.cells > 0) {
-            return Err(JobError::UnknownTool {
-                line,
-                time,
-                tool: s.tool,
-            });
-        }
-        let depth = self.removed.deepest;
-        if !s.feed_move && depth > engagement::MIN_DEPTH {
-            if rapid_contact.is_none_or(|c| depth > c.depth) {
-                *rapid_contact = Some(RapidContact { line, time, depth });
-            }
-            if depth > setup.rapid_skim {
-                return Err(JobError::RapidInStock { line, time, depth });
-            }
-        }
-        if cuts && self.spindle == 0.0 {
-            return Err(JobError::SpindleOff { line, time });
-        }
-        Ok(())
-    }
-}
-
-/// What every prediction shares: the job and the frames.
-struct Frame<'a> {
-    job: &'a Job,
-    to_base: Isometry3<f64>,
-    to_work: Isometry3<f64>,
-}
-
-/// One sample as a prediction sees it: the programmed sample, the programmed step since the
-/// last one \[m\], the feed per tooth \[m\], the tool in the spindle and its direction.
-struct Tick<'a> {
-    sample: &'a PathSample,
-    step: Vector3<f64>,
-    feed_per_tooth: f64,
+/// One tool of the program as the pass uses it: its cutter, probes and force weights, built
+/// once per run, and whether the job knows it (else the setup's tool stands in, and cutting
+/// with it is an error).
+#[derive(Debug, Clone)]
+struct ToolModel {
+    number: u32,
     tool: Tool,
     cutter: Cutter,
-    counter_clockwise: bool,
+    probes: engagement::Probes,
+    chip: ChipModel,
+    known: bool,
 }
 
-/// One predicted arm (uncompensated or compensated): its own stock and where its tool is.
-struct Predicted {
-    stock: ZMap,
-    tip: Option<Vector3<f64>>,
+/// The tools a program uses, in the order of their numbers.
+#[derive(Debug, Clone)]
+struct ToolModels {
+    list: Vec<ToolModel>,
 }
 
-impl Predicted {
-    fn new(stock: ZMap) -> Self {
-        Self { stock, tip: None }
+impl ToolModels {
+    fn new(job: &Job, program: &Program) -> Self {
+        let setup = &job.setup;
+        let mut list: Vec<ToolModel> = Vec::new();
+        for number in program.tools() {
+            let found = job.tool(number);
+            let (tool, cutter) = found.unwrap_or((
+                setup.tool,
+                Cutter::Flat {
+                    radius: 0.5 * setup.tool.diameter,
+                },
+            ));
+            list.push(ToolModel {
+                number,
+                tool,
+                cutter,
+                probes: engagement::Probes::new(cutter.radius(), setup.stock.cell),
+                chip: ChipModel::new(&setup.coefficients, &tool),
+                known: found.is_some(),
+            });
+        }
+        Self { list }
     }
 
-    /// The arm at joints `q` for one sample: the force where its tool is (its last tip plus
-    /// the programmed step), the deflected tip under that force, the cut to it. Returns the
-    /// force \[N\] and the tip \[m\] (workpiece frame) and the cells lowered.
-    fn advance(
-        &mut self,
-        f: &Frame<'_>,
-        data: &mut Data,
-        q: &[f64],
-        t: &Tick<'_>,
-    ) -> Result<(Vector3<f64>, Vector3<f64>, usize), TickError> {
-        let s = t.sample;
-        let probe = self.tip.map_or(s.position, |tip| tip + t.step);
-        let radius = t.cutter.radius();
-        let contact = engagement::contact_turning(
-            &self.stock,
-            radius,
-            &probe,
-            &s.direction,
-            t.counter_clockwise,
-        );
-        let (force, wrench) = tool_wrench(
-            &f.job.setup.coefficients,
-            &t.tool,
-            &contact,
-            &s.direction,
-            t.feed_per_tooth,
-            t.counter_clockwise,
-        )?;
-        vjm::deflection(
-            &f.job.model,
-            data,
-            q,
-            &rotate(&f.to_base, &wrench),
-            Load::Exact,
-        )?;
-        let tip = (f.to_work * Point3::from(data.tcp_deflected.translation.vector)).coords;
-        let removed = self.stock.cut(&t.cutter, &self.tip.unwrap_or(tip), &tip)?;
-        self.tip = Some(tip);
-        Ok((force, tip, removed.cells))
+    /// The index of tool `number` (the program's tools are all listed; 0 otherwise).
+    fn find(&self, number: u32) -> usize {
+        self.list
+            .iter()
+            .position(|t| t.number == number)
+            .unwrap_or(0)
     }
+
+    fn get(&self, index: usize) -> Option<&ToolModel> {
+        self.list.get(index)
+    }
+}
+
+fn in_limits(q: &[f64], limits: &[(f64, f64)]) -> Result<(), TickError> {
+    crate::mechanism::check_limits(q, limits, JOINT_LIMIT_TOLERANCE)
 }
 
 /// A wrench `[f; m]` turned by the rotation of `t` (the moment point moves with it).
@@ -614,4 +380,241 @@ fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
     let f = t.rotation * w.fixed_rows::<3>(0).into_owned();
     let m = t.rotation * w.fixed_rows::<3>(3).into_owned();
     Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+}
+
+/// How a run is cut into chunks and spread over threads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RunOptions {
+    /// Samples per chunk, 1..=[`MAX_CHUNK`]: the sink gets them together, and the memory of
+    /// a streamed run grows with it (about 0.6 KB per sample).
+    pub chunk: usize,
+    /// Threads: 1 runs everything on the caller's; 2 or more (with the `std` feature) run the
+    /// two predictions of each chunk side by side (the results do not depend on it).
+    pub threads: usize,
+}
+
+impl Default for RunOptions {
+    /// [`DEFAULT_CHUNK`] samples; two threads with `std`, one without.
+    fn default() -> Self {
+        Self {
+            chunk: DEFAULT_CHUNK,
+            threads: if cfg!(feature = "std") { 2 } else { 1 },
+        }
+    }
+}
+
+impl RunOptions {
+    /// Checks the chunk size and the thread count.
+    pub fn validate(&self) -> Result<(), BuildError> {
+        crate::error::param(
+            "chunk (samples)",
+            self.chunk as f64,
+            (1..=MAX_CHUNK).contains(&self.chunk),
+            "1..=MAX_CHUNK (1048576) samples",
+        )?;
+        crate::error::param("threads", self.threads as f64, self.threads >= 1, ">= 1")?;
+        Ok(())
+    }
+}
+
+/// Where a streamed run's samples go, a chunk at a time, in time order.
+pub trait Sink {
+    /// What a failed write says.
+    type Error;
+    /// The next chunk of finished samples.
+    fn samples(&mut self, chunk: &[JobSample]) -> Result<(), Self::Error>;
+}
+
+impl<E, F: FnMut(&[JobSample]) -> Result<(), E>> Sink for F {
+    type Error = E;
+    fn samples(&mut self, chunk: &[JobSample]) -> Result<(), E> {
+        self(chunk)
+    }
+}
+
+/// Why a streamed run stopped: the job failed, or the sink did.
+#[derive(Debug, Clone, PartialEq)]
+pub enum RunError<E> {
+    /// The job (setup, a sample) failed.
+    Job(JobError),
+    /// The sink refused a chunk.
+    Sink(E),
+}
+
+impl<E> From<JobError> for RunError<E> {
+    fn from(e: JobError) -> Self {
+        Self::Job(e)
+    }
+}
+
+impl<E> From<BuildError> for RunError<E> {
+    fn from(e: BuildError) -> Self {
+        Self::Job(e.into())
+    }
+}
+
+impl<E: core::fmt::Display> core::fmt::Display for RunError<E> {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            Self::Job(e) => write!(f, "{e}"),
+            Self::Sink(e) => write!(f, "writing the samples: {e}"),
+        }
+    }
+}
+
+/// Runs the offline pass (see the module docs) from the joints `seed` near the first pose
+/// (they choose the IK branch), keeping every sample in [`Report::samples`]: at most
+/// [`path::MAX_PATH_SAMPLES`] ([`BuildError::Budget`] past it; [`run_streaming`] takes
+/// longer programs). Errors name the program line.
+pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobError> {
+    let count = path::Sampler::new(program, &job.setup.path)?.len();
+    if count > path::MAX_PATH_SAMPLES {
+        return Err(BuildError::Budget {
+            what: "job samples (duration x rate + 1)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        }
+        .into());
+    }
+    let mut samples = Vec::new();
+    samples
+        .try_reserve_exact(count)
+        .map_err(|_| BuildError::Budget {
+            what: "job samples (the allocation was refused)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        })?;
+    let mut keep = |chunk: &[JobSample]| -> Result<(), core::convert::Infallible> {
+        samples.extend_from_slice(chunk);
+        Ok(())
+    };
+    let mut report = match run_streaming(job, program, seed, &RunOptions::default(), &mut keep) {
+        Ok(r) => r,
+        Err(RunError::Job(e)) => return Err(e),
+        Err(RunError::Sink(never)) => match never {},
+    };
+    report.samples = samples;
+    Ok(report)
+}
+
+/// Runs the offline pass as [`run`] does, handing the samples to `sink` chunk by chunk
+/// instead of keeping them: memory bounded by the z-maps, the program's plan and per-line
+/// figures and one chunk, whatever the duration (up to [`path::MAX_STREAM_SAMPLES`]). The
+/// returned report's `samples` is empty; its [`Report::summary`] holds the figures.
+pub fn run_streaming<S: Sink + ?Sized>(
+    job: &Job,
+    program: &Program,
+    seed: &[f64],
+    options: &RunOptions,
+    sink: &mut S,
+) -> Result<Report, RunError<S::Error>> {
+    options.validate()?;
+    let setup = &job.setup;
+    let dof = job.model.dof();
+    if seed.len() != dof {
+        return Err(BuildError::WrongLength {
+            what: "seed joints",
+            expected: dof,
+            got: seed.len(),
+        }
+        .into());
+    }
+    let mut sampler = path::Sampler::new(program, &setup.path)?;
+    let tools = ToolModels::new(job, program);
+    let st = &setup.stock;
+    let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
+    let mut nominal = nominal::Stage::new(job, &tools, zmap()?);
+    let mut unc = predict::Arm::new(job, &tools, zmap()?, seed, false);
+    let mut comp = predict::Arm::new(job, &tools, zmap()?, seed, true);
+    let chunk = options.chunk.min(sampler.len().max(1));
+    let reserve = |what: &'static str| -> Result<(), BuildError> {
+        Err(BuildError::Budget {
+            what,
+            budget: "MAX_CHUNK",
+            limit: MAX_CHUNK,
+            requested: chunk,
+        })
+    };
+    let mut noms = Vec::new();
+    let mut out_u = Vec::new();
+    let mut out_c = Vec::new();
+    let mut done: Vec<JobSample> = Vec::new();
+    if noms.try_reserve_exact(chunk).is_err()
+        || out_u.try_reserve_exact(chunk).is_err()
+        || out_c.try_reserve_exact(chunk).is_err()
+        || done.try_reserve_exact(chunk).is_err()
+    {
+        reserve("job chunk (the allocation was refused)")?;
+    }
+    let mut summary = Summary::default();
+    loop {
+        noms.clear();
+        let mut failed: Option<(usize, JobError)> = None;
+        for s in sampler.by_ref().take(chunk) {
+            match nominal.advance(&s) {
+                Ok(n) => noms.push(n),
+                Err(e) => {
+                    failed = Some((noms.len(), e));
+                    break;
+                }
+            }
+        }
+        if noms.is_empty() && failed.is_none() {
+            break;
+        }
+        out_u.clear();
+        out_c.clear();
+        let (ru, rc) = predict::both(&mut unc, &mut comp, &noms, &mut out_u, &mut out_c, options);
+        // The earliest failure wins (a nominal failure comes after every sample before it).
+        for r in [ru, rc] {
+            if let Err((k, e)) = r
+                && failed.as_ref().is_none_or(|(f, _)| k < *f)
+            {
+                failed = Some((k, e));
+            }
+        }
+        done.clear();
+        for ((n, u), c) in noms.iter().zip(&out_u).zip(&out_c) {
+            let s = JobSample {
+                path: n.path,
+                contact: n.contact,
+                feed_per_tooth: n.fz,
+                force: n.force,
+                wrench: n.wrench,
+                q: u.q,
+                deflection: u.deflection,
+                q_commanded: c.q,
+                commanded: c.commanded,
+                actual_uncompensated: u.tip,
+                force_uncompensated: u.force,
+                actual_compensated: c.tip,
+                force_compensated: c.force,
+                coupling_residual: [u.residual, c.residual],
+            };
+            summary.add(&s);
+            done.push(s);
+        }
+        if !done.is_empty() {
+            sink.samples(&done).map_err(RunError::Sink)?;
+        }
+        if let Some((_, e)) = failed {
+            return Err(RunError::Job(e));
+        }
+    }
+    let cell_updates = nominal.cell_updates + unc.cell_updates + comp.cell_updates;
+    Ok(Report {
+        samples: Vec::new(),
+        summary,
+        rapid_contact: nominal.rapid_contact,
+        plunge_samples: nominal.plunge_samples,
+        nominal: nominal.stock,
+        uncompensated: unc.stock,
+        compensated: comp.stock,
+        cell_updates,
+        rate_hz: setup.path.rate_hz,
+        dof,
+        top: st.top,
+    })
 }

@@ -8,6 +8,8 @@
 //! "the motion commands stored in the robot program are combined with roughly estimated
 //! cutting forces prior to the machining process".
 
+#[cfg(feature = "alloc")]
+pub mod chip;
 pub mod cutting;
 #[cfg(feature = "alloc")]
 pub mod engagement;

@@ -31,8 +31,10 @@ use crate::motion::{Limits, Profile};
 
 /// Highest sampling rate \[Hz\] (10 kHz; servo loops run at 1-8 kHz).
 pub const MAX_RATE_HZ: f64 = 1.0e4;
-/// Most samples of one sampled program: 1,000,000 (67 min at the 4 ms cycle, 8 min at
-/// 2 kHz; an offline pass keeps about 0.4 KB per sample). Longer programs go in pieces.
+/// Most samples of one program sampled into memory ([`sample`], and the offline pass that
+/// keeps every sample, [`super::job::run`]): 1,000,000 (67 min at the 4 ms cycle, 8 min at
+/// 2 kHz; the pass keeps about 0.6 KB per sample). Longer programs stream
+/// ([`Sampler`], [`super::job::run_streaming`]) up to [`MAX_STREAM_SAMPLES`].
 pub const MAX_PATH_SAMPLES: usize = 1_000_000;
 /// Moves shorter than this \[m\] carry no motion and are skipped.
 pub const MIN_MOVE_LENGTH: f64 = 1.0e-12;
@@ -246,18 +248,16 @@ pub fn duration(program: &Program, options: &PathOptions) -> Result<f64, BuildEr
 /// [`MAX_PATH_SAMPLES`], [`BuildError::TooFew`] for a program without motion,
 /// [`BuildError::InvalidEntry`] for a feed move before any `F`.
 pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample>, BuildError> {
-    let plan = plan(program, options)?;
-    let total = plan.duration();
-    let ticks = ComplexField::ceil(total * options.rate_hz - 1.0e-9).max(0.0);
-    if ticks.is_nan() || ticks >= MAX_PATH_SAMPLES as f64 {
+    let sampler = Sampler::new(program, options)?;
+    let count = sampler.len();
+    if count > MAX_PATH_SAMPLES {
         return Err(BuildError::Budget {
             what: "path samples (duration x rate + 1)",
             budget: "MAX_PATH_SAMPLES",
             limit: MAX_PATH_SAMPLES,
-            requested: (ticks + 1.0).min(usize::MAX as f64) as usize,
+            requested: count,
         });
     }
-    let count = ticks as usize + 1;
     let mut out = Vec::new();
     out.try_reserve_exact(count)
         .map_err(|_| BuildError::Budget {
@@ -266,37 +266,106 @@ pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample
             limit: MAX_PATH_SAMPLES,
             requested: count,
         })?;
-    let (mut r, mut k) = (0usize, 0usize);
-    for tick in 0..count {
-        let t = (tick as f64 / options.rate_hz).min(total);
-        while r + 1 < plan.runs.len()
+    out.extend(sampler);
+    Ok(out)
+}
+
+/// Most samples a streamed program may have ([`Sampler`]): 2^30 (1193 hours at the 4 ms
+/// cycle, 149 hours at 2 kHz). The samples are made one at a time; only the plan (a few
+/// words per move) is held.
+pub const MAX_STREAM_SAMPLES: usize = 1 << 30;
+
+/// The samples of [`sample`] one at a time, in bounded memory: the program is planned once
+/// (memory grows with its moves, not its duration) and each sample is made when asked for.
+#[derive(Debug, Clone)]
+pub struct Sampler<'a> {
+    program: &'a Program,
+    plan: Plan,
+    rate_hz: f64,
+    total: f64,
+    count: usize,
+    tick: usize,
+    run: usize,
+    seg: usize,
+}
+
+impl<'a> Sampler<'a> {
+    /// Plans `program`. [`BuildError::Budget`] past [`MAX_STREAM_SAMPLES`], the errors of
+    /// [`sample`] otherwise.
+    pub fn new(program: &'a Program, options: &PathOptions) -> Result<Self, BuildError> {
+        let plan = plan(program, options)?;
+        let total = plan.duration();
+        let ticks = ComplexField::ceil(total * options.rate_hz - 1.0e-9).max(0.0);
+        if ticks.is_nan() || ticks >= MAX_STREAM_SAMPLES as f64 {
+            return Err(BuildError::Budget {
+                what: "path samples (duration x rate + 1)",
+                budget: "MAX_STREAM_SAMPLES",
+                limit: MAX_STREAM_SAMPLES,
+                requested: (ticks + 1.0).min(usize::MAX as f64) as usize,
+            });
+        }
+        Ok(Self {
+            program,
+            plan,
+            rate_hz: options.rate_hz,
+            total,
+            count: ticks as usize + 1,
+            tick: 0,
+            run: 0,
+            seg: 0,
+        })
+    }
+
+    /// Samples in all (made or not).
+    pub fn len(&self) -> usize {
+        self.count
+    }
+
+    /// Whether the program has no samples (never: a planned program has at least one).
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// The program's duration \[s\].
+    pub fn duration(&self) -> f64 {
+        self.total
+    }
+}
+
+impl Iterator for Sampler<'_> {
+    type Item = PathSample;
+
+    fn next(&mut self) -> Option<PathSample> {
+        if self.tick >= self.count {
+            return None;
+        }
+        let plan = &self.plan;
+        let t = (self.tick as f64 / self.rate_hz).min(self.total);
+        self.tick += 1;
+        while self.run + 1 < plan.runs.len()
             && plan
                 .runs
-                .get(r)
+                .get(self.run)
                 .is_some_and(|run| t > run.t0 + run.duration())
         {
-            r += 1;
+            self.run += 1;
         }
-        let Some(run) = plan.runs.get(r) else { break };
+        let run = plan.runs.get(self.run)?;
         let state = run.profile.sample(t - run.t0);
         // The move holding arc length `s`: the last one of the run starting at or before it.
-        k = k.max(run.first);
-        while k < run.last && plan.s0.get(k + 1).is_some_and(|&s| state.s >= s) {
-            k += 1;
+        self.seg = self.seg.max(run.first);
+        while self.seg < run.last && plan.s0.get(self.seg + 1).is_some_and(|&s| state.s >= s) {
+            self.seg += 1;
         }
-        let (Some(&m), Some(&s)) = (plan.segs.get(k), plan.s0.get(k)) else {
-            break;
-        };
-        let Some(mv) = program.moves.get(m) else {
-            break;
-        };
+        let (&m, &s) = (plan.segs.get(self.seg)?, plan.s0.get(self.seg)?);
+        let mv = self.program.moves.get(m)?;
         let length = mv.length();
         let fraction = if length > 0.0 {
             (state.s - s) / length
         } else {
             0.0
         };
-        out.push(PathSample {
+        Some(PathSample {
             time: t,
             move_index: m,
             line: mv.line,
@@ -307,7 +376,11 @@ pub fn sample(program: &Program, options: &PathOptions) -> Result<Vec<PathSample
             feed_move: mv.is_feed(),
             spindle: mv.spindle,
             tool: mv.tool,
-        });
+        })
     }
-    Ok(out)
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        let left = self.count - self.tick;
+        (left, Some(left))
+    }
 }

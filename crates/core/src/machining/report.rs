@@ -2,6 +2,7 @@
 //! part three ways, and the figures a machining engineer judges them by (path error, floors
 //! and walls of the part, force per program line, the pilot-control signal).
 
+use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
 
 use nalgebra::{Isometry3, Vector3};
@@ -39,6 +40,12 @@ pub struct JobSample {
     pub force_uncompensated: Vector3<f64>,
     /// Predicted tip with compensation \[m\].
     pub actual_compensated: Vector3<f64>,
+    /// Force the compensated tool feels where it is \[N\].
+    pub force_compensated: Vector3<f64>,
+    /// How far the last step of the force-deflection coupling moved each predicted tip
+    /// (uncompensated, compensated) \[m\]: the residual of the fixed point (see
+    /// [`super::job`]); at most [`super::job::COUPLING_TOLERANCE`] where it converged.
+    pub coupling_residual: [f64; 2],
 }
 
 /// Largest and root-mean-square values of a deviation \[m\].
@@ -54,20 +61,40 @@ pub struct ErrorStats {
 
 impl ErrorStats {
     fn of(values: impl Iterator<Item = f64>) -> Self {
-        let (mut s, mut n, mut m) = (0.0, 0usize, 0.0f64);
+        let mut acc = ErrorAccumulator::default();
         for v in values {
-            s += v * v;
-            n += 1;
-            m = m.max(v.abs());
+            acc.add(v);
         }
-        Self {
-            max: m,
-            rms: if n > 0 {
-                nalgebra::ComplexField::sqrt(s / n as f64)
+        acc.stats()
+    }
+}
+
+/// Largest and RMS of a stream of values, in constant memory.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ErrorAccumulator {
+    sum_squares: f64,
+    count: usize,
+    max: f64,
+}
+
+impl ErrorAccumulator {
+    /// One more value.
+    pub fn add(&mut self, v: f64) {
+        self.sum_squares += v * v;
+        self.count += 1;
+        self.max = self.max.max(v.abs());
+    }
+
+    /// The values so far.
+    pub fn stats(&self) -> ErrorStats {
+        ErrorStats {
+            max: self.max,
+            rms: if self.count > 0 {
+                nalgebra::ComplexField::sqrt(self.sum_squares / self.count as f64)
             } else {
                 0.0
             },
-            count: n,
+            count: self.count,
         }
     }
 }
@@ -83,10 +110,34 @@ pub struct SurfaceError {
     pub overcut: f64,
 }
 
-/// Force statistics of one program line.
+/// Why the compensated prediction leaves the program by more than
+/// [`super::job::PREDICTION_TOLERANCE`] on a line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Deviation {
+    /// The force-deflection coupling did not converge within
+    /// [`super::job::MAX_COUPLING_ITERATIONS`]: the force changes faster with the tool's
+    /// position than the arm's stiffness holds the tool (beyond the model's offline
+    /// compensation).
+    Coupling,
+    /// The compensated tool meets a stock the nominal tool did not: an earlier deviation
+    /// left material the compensation, computed on the nominal stock, does not know of.
+    Stock,
+}
+
+impl Deviation {
+    /// A short name for reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Coupling => "coupling",
+            Self::Stock => "stock",
+        }
+    }
+}
+
+/// What one program line did: its force and how far the predictions left it.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LineForce {
-    /// Program line.
+pub struct LineSummary {
+    /// Program line (1-based).
     pub line: usize,
     /// Samples on it.
     pub samples: usize,
@@ -94,13 +145,174 @@ pub struct LineForce {
     pub mean: Vector3<f64>,
     /// Largest force magnitude \[N\].
     pub max: f64,
+    /// Largest distance of the uncompensated prediction from the program \[m\] (feed
+    /// moves).
+    pub error_uncompensated: f64,
+    /// Largest distance of the compensated prediction from the program \[m\] (feed moves).
+    pub error_compensated: f64,
+    /// Largest coupling residual of the compensated prediction \[m\].
+    pub residual: f64,
+    /// Why the compensated prediction leaves the program by more than
+    /// [`super::job::PREDICTION_TOLERANCE`] here (`None` where it does not).
+    pub deviation: Option<Deviation>,
+}
+
+/// The force per program line: [`LineSummary`] by its old name.
+pub type LineForce = LineSummary;
+
+impl LineSummary {
+    fn new(line: usize) -> Self {
+        Self {
+            line,
+            samples: 0,
+            mean: Vector3::zeros(),
+            max: 0.0,
+            error_uncompensated: 0.0,
+            error_compensated: 0.0,
+            residual: 0.0,
+            deviation: None,
+        }
+    }
+
+    fn add(&mut self, s: &JobSample) {
+        self.samples += 1;
+        // A running sum; `Summary::lines` divides.
+        self.mean += s.force;
+        self.max = self.max.max(s.force.norm());
+        let [_, residual] = s.coupling_residual;
+        self.residual = self.residual.max(residual);
+        if s.path.feed_move {
+            let p = s.path.position;
+            let (eu, ec) = (
+                (s.actual_uncompensated - p).norm(),
+                (s.actual_compensated - p).norm(),
+            );
+            self.error_uncompensated = self.error_uncompensated.max(eu);
+            self.error_compensated = self.error_compensated.max(ec);
+            if ec > super::job::PREDICTION_TOLERANCE {
+                let why = if residual > super::job::COUPLING_TOLERANCE {
+                    Deviation::Coupling
+                } else {
+                    Deviation::Stock
+                };
+                // Coupling failures name the line before stock differences do.
+                if self.deviation != Some(Deviation::Coupling) {
+                    self.deviation = Some(why);
+                }
+            }
+        }
+    }
+}
+
+/// The figures of a run, accumulated sample by sample in memory that grows with the
+/// program's lines, not its samples: what a streamed run ([`super::job::run_streaming`])
+/// reports.
+#[derive(Debug, Clone, Default)]
+pub struct Summary {
+    samples: usize,
+    duration: f64,
+    path: [ErrorAccumulator; 2],
+    max_force: f64,
+    residual: [f64; 2],
+    deviating: usize,
+    current: Option<LineSummary>,
+    lines: BTreeMap<usize, LineSummary>,
+}
+
+impl Summary {
+    /// One more sample (in time order).
+    pub fn add(&mut self, s: &JobSample) {
+        self.samples += 1;
+        self.duration = s.path.time;
+        self.max_force = self.max_force.max(s.force.norm());
+        for (r, v) in self.residual.iter_mut().zip(s.coupling_residual) {
+            *r = r.max(v);
+        }
+        if s.path.feed_move {
+            let p = s.path.position;
+            let ec = (s.actual_compensated - p).norm();
+            let [u, c] = &mut self.path;
+            u.add((s.actual_uncompensated - p).norm());
+            c.add(ec);
+            if ec > super::job::PREDICTION_TOLERANCE {
+                self.deviating += 1;
+            }
+        }
+        match &mut self.current {
+            Some(l) if l.line == s.path.line => l.add(s),
+            _ => {
+                self.flush();
+                let mut l = self
+                    .lines
+                    .remove(&s.path.line)
+                    .unwrap_or_else(|| LineSummary::new(s.path.line));
+                l.add(s);
+                self.current = Some(l);
+            }
+        }
+    }
+
+    fn flush(&mut self) {
+        if let Some(l) = self.current.take() {
+            self.lines.insert(l.line, l);
+        }
+    }
+
+    /// Samples counted.
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// Time of the last sample \[s\].
+    pub fn duration(&self) -> f64 {
+        self.duration
+    }
+
+    /// Distance of a predicted tip from the programmed one over the feed moves \[m\]
+    /// (`compensated` false for the uncompensated arm).
+    pub fn path_error(&self, compensated: bool) -> ErrorStats {
+        let [u, c] = &self.path;
+        if compensated { c.stats() } else { u.stats() }
+    }
+
+    /// The largest force on the tool \[N\].
+    pub fn max_force(&self) -> f64 {
+        self.max_force
+    }
+
+    /// The largest coupling residual of each prediction (uncompensated, compensated) \[m\].
+    pub fn max_residual(&self) -> [f64; 2] {
+        self.residual
+    }
+
+    /// Feed samples whose compensated prediction is further than
+    /// [`super::job::PREDICTION_TOLERANCE`] from the program.
+    pub fn deviating_samples(&self) -> usize {
+        self.deviating
+    }
+
+    /// Every program line with samples, in line order, the mean force divided out.
+    pub fn lines(&self) -> Vec<LineSummary> {
+        let mut out: Vec<LineSummary> = self.lines.values().copied().collect();
+        if let Some(c) = self.current {
+            let at = out.partition_point(|l| l.line < c.line);
+            out.insert(at, c);
+        }
+        for l in &mut out {
+            l.mean /= l.samples.max(1) as f64;
+        }
+        out
+    }
 }
 
 /// What the offline pass predicts.
 #[derive(Debug, Clone)]
 pub struct Report {
-    /// Every sample, in time order.
+    /// Every sample, in time order ([`super::job::run`]; empty after a streamed run, whose
+    /// samples went to its sink).
     pub samples: Vec<JobSample>,
+    /// The figures over every sample.
+    pub summary: Summary,
     /// The deepest a rapid move ran into the stock within [`super::job::Setup::rapid_skim`]
     /// (none if no rapid touched it).
     pub rapid_contact: Option<RapidContact>,
@@ -137,14 +349,7 @@ impl Report {
     /// Distance of the predicted tip from the programmed one over the feed moves \[m\]:
     /// `compensated` false for the uncompensated arm.
     pub fn path_error(&self, compensated: bool) -> ErrorStats {
-        ErrorStats::of(self.samples.iter().filter(|s| s.path.feed_move).map(|s| {
-            let a = if compensated {
-                s.actual_compensated
-            } else {
-                s.actual_uncompensated
-            };
-            (a - s.path.position).norm()
-        }))
+        self.summary.path_error(compensated)
     }
 
     /// A predicted part against the nominal one: the floors (cells both cut, by more than
@@ -200,27 +405,8 @@ impl Report {
             .collect()
     }
 
-    /// The force per program line (lines with samples, in program order of first sample).
-    pub fn line_forces(&self) -> Vec<LineForce> {
-        let mut out: Vec<LineForce> = Vec::new();
-        for s in &self.samples {
-            match out.last_mut() {
-                Some(l) if l.line == s.path.line => {
-                    l.samples += 1;
-                    l.mean += s.force;
-                    l.max = l.max.max(s.force.norm());
-                }
-                _ => out.push(LineForce {
-                    line: s.path.line,
-                    samples: 1,
-                    mean: s.force,
-                    max: s.force.norm(),
-                }),
-            }
-        }
-        for l in &mut out {
-            l.mean /= l.samples as f64;
-        }
-        out
+    /// The force and the predictions' errors per program line, in line order.
+    pub fn line_forces(&self) -> Vec<LineSummary> {
+        self.summary.lines()
     }
 }

@@ -8,7 +8,12 @@
 //! (the tip height at the ends of the interval of the move during which the centre is under
 //! the tool; the tip height is linear along the move); for a ball end mill the height
 //! `z(t) + R - sqrt(R^2 - d(t)^2)` is convex in the move's parameter and is minimised by a
-//! golden-section search to 1e-12 of the move.
+//! safeguarded Newton search on its derivative to 1e-12 of the move.
+//!
+//! The engagement ([`super::engagement`]) reads the stock between cell centres as the
+//! bilinear interpolation of the clipped depths `max(0, h - z)` of the four centres around a
+//! point ([`ZMap::depth_at`]; outside the grid a centre counts as no material), a surface
+//! continuous in the point and in `z`: what makes the force continuous in the tool's position.
 
 use alloc::vec::Vec;
 
@@ -203,6 +208,47 @@ impl ZMap {
         self.height(u.x as usize, u.y as usize)
     }
 
+    /// Material above the height `z` at the point (x, y) \[m\]: the bilinear interpolation
+    /// of the clipped depths `max(0, h - z)` of the four cell centres around it, a centre
+    /// outside the grid counting 0 (so the depth falls to 0 over the half cell past the
+    /// stock's edge). Continuous in the point and in `z`: it changes by at most `|dz|` for a
+    /// change `dz` of `z`, and by at most `sqrt(2) D / cell` per metre of the point, `D` the
+    /// largest clipped depth of the four centres. 0 for a non-finite point.
+    #[inline]
+    pub fn depth_at(&self, p: &Vector2<f64>, z: f64) -> f64 {
+        let u = (p - self.origin) / self.cell - Vector2::repeat(0.5);
+        self.depth_at_index(u.x, u.y, z)
+    }
+
+    /// [`Self::depth_at`] at the point of fractional cell coordinates (u, v) (cell (i, j)'s
+    /// centre at (i, j)).
+    #[inline]
+    pub(crate) fn depth_at_index(&self, u: f64, v: f64, z: f64) -> f64 {
+        // Far outside (or NaN): no material. The bounds keep the casts below exact.
+        if !(u > -1.0 && v > -1.0 && u < self.nx as f64 && v < self.ny as f64) {
+            return 0.0;
+        }
+        let (fu, fv) = (ComplexField::floor(u), ComplexField::floor(v));
+        let (a, b) = (u - fu, v - fv);
+        // fu, fv in [-1, n - 1]: i0 = -1 is the virtual column left of the grid.
+        let (i0, j0) = (fu as isize, fv as isize);
+        let depth = |i: isize, j: isize| -> f64 {
+            if i < 0 || j < 0 {
+                return 0.0;
+            }
+            let (i, j) = (i as usize, j as usize);
+            match self.height(i, j) {
+                Some(h) if h > z => h - z,
+                _ => 0.0,
+            }
+        };
+        let (d00, d10) = (depth(i0, j0), depth(i0 + 1, j0));
+        let (d01, d11) = (depth(i0, j0 + 1), depth(i0 + 1, j0 + 1));
+        let low = d00 + (d10 - d00) * a;
+        let high = d01 + (d11 - d01) * a;
+        low + (high - low) * b
+    }
+
     /// Lower corner (x, y) of cell (0, 0) \[m\].
     pub fn origin(&self) -> Vector2<f64> {
         self.origin
@@ -248,15 +294,25 @@ impl ZMap {
         let (j0, j1) = (index(lo.y, self.ny), index(hi.y, self.ny).saturating_add(2));
         let mut removal = Removal::default();
         let area = self.cell * self.cell;
-        for j in j0..j1.min(self.ny) {
-            for i in i0..i1.min(self.nx) {
-                let c = self.center(i, j);
+        // No point of the cutter's surface lies below the lower end of the move: a cell at or
+        // below it keeps its height, which is most cells under a tool cutting a floor.
+        let floor = from.z.min(to.z);
+        let (nx, cell, origin) = (self.nx, self.cell, self.origin);
+        let (i1, j1) = (i1.min(nx), j1.min(self.ny));
+        for j in j0..j1 {
+            let cy = origin.y + (j as f64 + 0.5) * cell;
+            let Some(row) = self.heights.get_mut(j * nx + i0..j * nx + i1.max(i0)) else {
+                continue;
+            };
+            for (k, h) in row.iter_mut().enumerate() {
+                if *h <= floor {
+                    continue;
+                }
+                let c = Vector2::new(origin.x + ((i0 + k) as f64 + 0.5) * cell, cy);
                 let Some(z) = lowest(cutter, from, to, &c) else {
                     continue;
                 };
-                if let Some(h) = self.heights.get_mut(j * self.nx + i)
-                    && z < *h
-                {
+                if z < *h {
                     removal.cells += 1;
                     removal.volume += (*h - z) * area;
                     removal.deepest = removal.deepest.max(*h - z);
@@ -302,14 +358,62 @@ fn lowest(
     match cutter {
         Cutter::Flat { .. } => Some(z(t0).min(z(t1))),
         Cutter::Ball { radius } => {
+            let r2 = radius * radius;
+            let dz = to.z - from.z;
             let surface = |t: f64| {
                 let d2 = (a + b * t).norm_squared();
-                z(t) + radius - ComplexField::sqrt((radius * radius - d2).max(0.0))
+                z(t) + radius - ComplexField::sqrt((r2 - d2).max(0.0))
             };
-            // Convex on [t0, t1]: golden section, 60 steps take the bracket below 1e-12 of
-            // the move.
-            let inner = crate::golden::minimise(t0, t1, 60, surface, |f| *f);
-            Some(surface(t0).min(surface(t1)).min(inner))
+            // The surface is convex in t: its slope dz + (a + b t).b / sqrt(R^2 - d^2) rises
+            // from t0 to t1. Its root by Newton's method kept inside a shrinking bracket.
+            let slope = |t: f64| {
+                let w = a + b * t;
+                let root = ComplexField::sqrt((r2 - w.norm_squared()).max(0.0));
+                let wb = w.dot(&b);
+                if root > 0.0 {
+                    (
+                        dz + wb / root,
+                        (bb * root * root + wb * wb) / (root * root * root),
+                    )
+                } else if wb < 0.0 {
+                    (f64::NEG_INFINITY, f64::INFINITY)
+                } else {
+                    (f64::INFINITY, f64::INFINITY)
+                }
+            };
+            let (lo_s, _) = slope(t0);
+            let (hi_s, _) = slope(t1);
+            let t = if !(lo_s < 0.0) || t1 - t0 <= 1.0e-12 {
+                t0
+            } else if !(hi_s > 0.0) {
+                t1
+            } else {
+                let (mut lo, mut hi) = (t0, t1);
+                let mut t = 0.5 * (t0 + t1);
+                for _ in 0..100 {
+                    let (g, h) = slope(t);
+                    if g < 0.0 {
+                        lo = t;
+                    } else {
+                        hi = t;
+                    }
+                    if hi - lo <= 1.0e-12 || g == 0.0 {
+                        break;
+                    }
+                    let newton = t - g / h;
+                    if newton > lo && newton < hi && h.is_finite() {
+                        let step = newton - t;
+                        t = newton;
+                        if step.abs() <= 1.0e-13 {
+                            break;
+                        }
+                    } else {
+                        t = 0.5 * (lo + hi);
+                    }
+                }
+                t
+            };
+            Some(surface(t0).min(surface(t1)).min(surface(t)))
         }
     }
 }

@@ -8,6 +8,7 @@
 //! compared with the nominal one.
 
 use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
+use deflect_core::machining::chip::ChipModel;
 use deflect_core::machining::engagement;
 use deflect_core::machining::job::{self, Job, Report, SurfaceError};
 use deflect_core::machining::stock::{Cutter, ZMap};
@@ -226,6 +227,9 @@ pub fn run_program(
     let cutter = Cutter::Flat {
         radius: 0.5 * setup.tool.diameter,
     };
+    let probes = engagement::Probes::new(cutter.radius(), st.cell);
+    let chip_model = ChipModel::new(&setup.coefficients, &setup.tool);
+    let mut chip = engagement::Chip::default();
     let mut noise = Noise::new(opts.seed);
     let dt = opts.dt;
     let cycle = 1.0 / offline.rate_hz;
@@ -329,8 +333,9 @@ pub fn run_program(
             // The force where the tool is: the engagement on this run's stock at the
             // simulated tip, then the cut to it.
             let tip = (to_work * Point3::from(sim.tcp_pose().translation.vector)).coords;
-            let contact = engagement::contact(&part, cutter.radius(), &tip, &s.path.direction);
-            let (f, w) = job::contact_wrench(setup, &contact, &s.path.direction, fz)
+            engagement::read(&part, &probes, &tip, &s.path.direction, false, &mut chip);
+            let contact = chip.contact();
+            let (f, w) = job::chip_wrench(&chip_model, &chip, &s.path.direction, fz, false)
                 .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
             force_w = f;
             engaged = contact

@@ -1,0 +1,162 @@
+//! Stage 1 of the pass: the nominal tool on the nominal stock, sample by sample (each cut
+//! depends on the last): its chip, force and wrench, and the checks of the cut (a tool the
+//! job lacks, a rapid into the stock, a cut with the spindle off).
+
+use nalgebra::{Isometry3, Vector3};
+
+use super::{Job, ToolModels, chip_wrench, engagement, rotate, tooth_feed};
+use crate::error::{JobError, TickError};
+use crate::machining::engagement::{Chip, Contact};
+use crate::machining::path::PathSample;
+use crate::machining::report::RapidContact;
+use crate::machining::stock::{Removal, ZMap};
+use crate::vjm::Vector6;
+
+/// What the nominal stage hands on for one sample.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Sample {
+    pub path: PathSample,
+    /// Index of the tool in [`ToolModels`].
+    pub tool: usize,
+    pub counter_clockwise: bool,
+    /// Feed per tooth \[m\].
+    pub fz: f64,
+    pub contact: Contact,
+    /// Force on the tool \[N\], workpiece frame.
+    pub force: Vector3<f64>,
+    /// The wrench about the tip \[N, N m\], base frame.
+    pub wrench: Vector6,
+    /// The programmed step since the last sample \[m\].
+    pub step: Vector3<f64>,
+}
+
+pub(super) struct Stage<'a> {
+    job: &'a Job,
+    tools: &'a ToolModels,
+    to_base: Isometry3<f64>,
+    pub stock: ZMap,
+    chip: Chip,
+    prev: Option<Vector3<f64>>,
+    last_tool: Option<(u32, usize)>,
+    pub rapid_contact: Option<RapidContact>,
+    pub plunge_samples: usize,
+    pub cell_updates: usize,
+}
+
+impl<'a> Stage<'a> {
+    pub fn new(job: &'a Job, tools: &'a ToolModels, stock: ZMap) -> Self {
+        Self {
+            job,
+            tools,
+            to_base: job.setup.placement,
+            stock,
+            chip: Chip::default(),
+            prev: None,
+            last_tool: None,
+            rapid_contact: None,
+            plunge_samples: 0,
+            cell_updates: 0,
+        }
+    }
+
+    fn tool_index(&mut self, number: u32) -> usize {
+        match self.last_tool {
+            Some((n, i)) if n == number => i,
+            _ => {
+                let i = self.tools.find(number);
+                self.last_tool = Some((number, i));
+                i
+            }
+        }
+    }
+
+    /// The nominal tool at sample `s`: its chip on the stock before the cut, the cut, the
+    /// checks, the force.
+    pub fn advance(&mut self, s: &PathSample) -> Result<Sample, JobError> {
+        let at = |error: TickError| JobError::AtLine {
+            line: s.line,
+            time: s.time,
+            error,
+        };
+        let setup = &self.job.setup;
+        let p = s.position;
+        let from = self.prev.unwrap_or(p);
+        let index = self.tool_index(s.tool);
+        let tools = self.tools;
+        let Some(tm) = tools.get(index) else {
+            return Err(JobError::UnknownTool {
+                line: s.line,
+                time: s.time,
+                tool: s.tool,
+            });
+        };
+        let spindle = match (s.spindle, setup.hand_spindle) {
+            (0.0, Some(hand)) => hand,
+            (v, _) => v,
+        };
+        let ccw = spindle < 0.0;
+        engagement::read(
+            &self.stock,
+            &tm.probes,
+            &p,
+            &s.direction,
+            ccw,
+            &mut self.chip,
+        );
+        let contact = self.chip.contact();
+        let removed = self.stock.cut(&tm.cutter, &from, &p).map_err(at)?;
+        self.check(s, &contact, &removed, tm.known, spindle)?;
+        if matches!(contact, Contact::Plunge { .. }) {
+            self.plunge_samples += 1;
+        }
+        let fz = tooth_feed(&tm.tool, s, spindle);
+        let (force, wrench_w) =
+            chip_wrench(&tm.chip, &self.chip, &s.direction, fz, ccw).map_err(at)?;
+        self.cell_updates += removed.cells;
+        self.prev = Some(p);
+        Ok(Sample {
+            path: *s,
+            tool: index,
+            counter_clockwise: ccw,
+            fz,
+            contact,
+            force,
+            wrench: rotate(&self.to_base, &wrench_w),
+            step: p - from,
+        })
+    }
+
+    /// A tool the job lacks must not cut, a rapid may skim the stock by `rapid_skim` (the
+    /// deepest skim kept), the spindle must turn in a cut.
+    fn check(
+        &mut self,
+        s: &PathSample,
+        contact: &Contact,
+        removed: &Removal,
+        known: bool,
+        spindle: f64,
+    ) -> Result<(), JobError> {
+        let (line, time) = (s.line, s.time);
+        let cuts = *contact != Contact::Air;
+        if !known && (cuts || removed.cells > 0) {
+            return Err(JobError::UnknownTool {
+                line,
+                time,
+                tool: s.tool,
+            });
+        }
+        let depth = removed.deepest;
+        if !s.feed_move && depth > engagement::MIN_DEPTH {
+            if self.rapid_contact.is_none_or(|c| depth > c.depth) {
+                self.rapid_contact = Some(RapidContact { line, time, depth });
+            }
+            if depth > self.job.setup.rapid_skim {
+                return Err(JobError::RapidInStock { line, time, depth });
+            }
+        }
+        if cuts && spindle == 0.0 {
+            return Err(JobError::SpindleOff { line, time });
+        }
+        Ok(())
+    }
+}

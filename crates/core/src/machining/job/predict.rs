@@ -1,0 +1,294 @@
+//! Stages 2 and 3 of the pass, one per arm: the joints (rigid pose IK for the uncompensated
+//! arm, loaded pose IK for the compensated one, each warm-started from the joints of the
+//! last two samples) and the prediction of where that arm's tool goes and what it cuts: the
+//! fixed point of the force-deflection coupling on the arm's own stock (see the parent's
+//! docs). The two arms do not share state: with two threads they run side by side.
+
+use alloc::vec::Vec;
+
+use nalgebra::{Isometry3, Matrix6, Point3, Translation3, Vector3};
+
+use super::nominal::Sample;
+use super::{
+    COUPLING_TOLERANCE, Job, MAX_COUPLING_ITERATIONS, RunOptions, ToolModels, chip_wrench,
+    engagement, in_limits, rotate,
+};
+use crate::error::{JobError, TickError};
+use crate::machining::engagement::Chip;
+use crate::machining::stock::ZMap;
+use crate::mechanism::pose_ik;
+use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
+
+/// A correction of the linear coupling step \[m\] past which the arm's deflection is
+/// evaluated exactly again: the linear model's error is below 1e-3 of the step at the
+/// springs' small angles, so the coupling's steps stay exact to about 1e-8 m.
+const RELINEARISE: f64 = 1.0e-5;
+
+/// What one arm gives for one sample.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Out {
+    /// The arm's joints (rigid IK or compensated) \[rad or m\].
+    pub q: [f64; MAX_DOF],
+    /// Deflection of the tip at the rigid joints under the nominal wrench (uncompensated arm
+    /// only; zero for the other).
+    pub deflection: Vector6,
+    /// The rigid pose at the joints, workpiece frame (the compensated arm's command).
+    pub commanded: Isometry3<f64>,
+    /// The predicted tip \[m\], workpiece frame.
+    pub tip: Vector3<f64>,
+    /// The force the tool feels there \[N\], workpiece frame.
+    pub force: Vector3<f64>,
+    /// The coupling's last step \[m\].
+    pub residual: f64,
+}
+
+pub(super) struct Arm<'a> {
+    job: &'a Job,
+    tools: &'a ToolModels,
+    compensated: bool,
+    data: Data,
+    q: [f64; MAX_DOF],
+    q_before: Option<[f64; MAX_DOF]>,
+    to_base: Isometry3<f64>,
+    to_work: Isometry3<f64>,
+    pub stock: ZMap,
+    tip: Option<Vector3<f64>>,
+    chip: Chip,
+    pub cell_updates: usize,
+}
+
+impl<'a> Arm<'a> {
+    /// `seed` has the model's dof (checked by the caller).
+    pub fn new(
+        job: &'a Job,
+        tools: &'a ToolModels,
+        stock: ZMap,
+        seed: &[f64],
+        compensated: bool,
+    ) -> Self {
+        let mut q = [0.0; MAX_DOF];
+        for (d, s) in q.iter_mut().zip(seed) {
+            *d = *s;
+        }
+        Self {
+            job,
+            tools,
+            compensated,
+            data: Data::new(&job.model),
+            q,
+            q_before: None,
+            to_base: job.setup.placement,
+            to_work: job.setup.placement.inverse(),
+            stock,
+            tip: None,
+            chip: Chip::default(),
+            cell_updates: 0,
+        }
+    }
+
+    /// Every sample of a chunk, into `out`; the index and error of the first that fails.
+    pub fn process(
+        &mut self,
+        noms: &[Sample],
+        out: &mut Vec<Out>,
+    ) -> Result<(), (usize, JobError)> {
+        for (k, n) in noms.iter().enumerate() {
+            match self.advance(n) {
+                Ok(o) => out.push(o),
+                Err(error) => {
+                    return Err((
+                        k,
+                        JobError::AtLine {
+                            line: n.path.line,
+                            time: n.path.time,
+                            error,
+                        },
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The joints at one sample: pose IK from the joints the last two samples extrapolate
+    /// to (from the last one's if that fails).
+    fn joints(&mut self, n: &Sample) -> Result<(), TickError> {
+        let job = self.job;
+        let dof = job.model.dof();
+        let setup = &job.setup;
+        let target = self.to_base
+            * Isometry3::from_parts(Translation3::from(n.path.position), setup.tool_orientation);
+        let (wrench, load) = if self.compensated {
+            (n.wrench, Load::Exact)
+        } else {
+            (Vector6::zeros(), Load::Rigid)
+        };
+        let mut seed = self.q;
+        if let Some(before) = self.q_before {
+            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
+                *s = 2.0 * q - b;
+            }
+        }
+        let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
+            pose_ik(
+                &job.model,
+                data,
+                &target,
+                seed.get(..dof).unwrap_or(&[]),
+                &wrench,
+                load,
+                &setup.ik,
+            )
+        };
+        let sol = match solve(&mut self.data, &seed) {
+            Ok(sol) => sol,
+            Err(_) if self.q_before.is_some() => solve(&mut self.data, &self.q)?,
+            Err(e) => return Err(e),
+        };
+        self.q_before = Some(self.q);
+        self.q = sol.q;
+        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
+    }
+
+    fn advance(&mut self, n: &Sample) -> Result<Out, TickError> {
+        self.joints(n)?;
+        let job = self.job;
+        let model = &job.model;
+        let q = self.q;
+        let qs = q.get(..job.model.dof()).unwrap_or(&[]);
+        // The loaded tip under the nominal wrench: the coupling's first anchor.
+        let (deflection, commanded) = if self.compensated {
+            // The loaded IK's last pass: the rigid pose to command, the loaded one on target.
+            (Vector6::zeros(), self.to_work * self.data.tcp)
+        } else {
+            let d = vjm::deflection(model, &mut self.data, qs, &n.wrench, Load::Exact)?;
+            (d, Isometry3::identity())
+        };
+        let tip_at = |data: &Data, to_work: &Isometry3<f64>| {
+            (to_work * Point3::from(data.tcp_deflected.translation.vector)).coords
+        };
+        let mut anchor = (n.wrench, tip_at(&self.data, &self.to_work));
+        let (tip, force, residual) = self.couple(n, qs, &mut anchor)?;
+        let Some(tm) = self.tools.get(n.tool) else {
+            return Err(TickError::InvalidArgument {
+                what: "tool index",
+                value: n.tool as f64,
+            });
+        };
+        let removed = self.stock.cut(&tm.cutter, &self.tip.unwrap_or(tip), &tip)?;
+        self.cell_updates += removed.cells;
+        self.tip = Some(tip);
+        Ok(Out {
+            q,
+            deflection,
+            commanded,
+            tip,
+            force,
+            residual,
+        })
+    }
+
+    /// The fixed point `t = tip(q, F(t))` from the last tip plus the programmed step: each
+    /// step reads the chip at the current tip on this arm's stock and moves the tip by the
+    /// compliance times the change of the wrench since `anchor` (exact deflection again when
+    /// that change moves it by more than [`RELINEARISE`]). Returns the tip, the force there
+    /// and the last step.
+    fn couple(
+        &mut self,
+        n: &Sample,
+        qs: &[f64],
+        anchor: &mut (Vector6, Vector3<f64>),
+    ) -> Result<(Vector3<f64>, Vector3<f64>, f64), TickError> {
+        let model = &self.job.model;
+        let Some(tm) = self.tools.get(n.tool) else {
+            return Err(TickError::InvalidArgument {
+                what: "tool index",
+                value: n.tool as f64,
+            });
+        };
+        let dir = n.path.direction;
+        let mut guess = self.tip.map_or(n.path.position, |t| t + n.step);
+        let mut compliance: Option<Matrix6<f64>> = None;
+        let (mut force, mut residual) = (Vector3::zeros(), f64::INFINITY);
+        for _ in 0..MAX_COUPLING_ITERATIONS {
+            engagement::read(
+                &self.stock,
+                &tm.probes,
+                &guess,
+                &dir,
+                n.counter_clockwise,
+                &mut self.chip,
+            );
+            let (f, w) = chip_wrench(&tm.chip, &self.chip, &dir, n.fz, n.counter_clockwise)?;
+            let wrench = rotate(&self.to_base, &w);
+            force = f;
+            let change = wrench - anchor.0;
+            let tip = if change.iter().all(|v| *v == 0.0) {
+                anchor.1
+            } else {
+                let c = match compliance {
+                    Some(c) => c,
+                    None => {
+                        let c = vjm::compliance(model, &mut self.data, qs)?;
+                        compliance = Some(c);
+                        c
+                    }
+                };
+                let shift = (c * change).fixed_rows::<3>(0).into_owned();
+                if shift.norm() > RELINEARISE {
+                    vjm::deflection(model, &mut self.data, qs, &wrench, Load::Exact)?;
+                    let t = (self.to_work
+                        * Point3::from(self.data.tcp_deflected.translation.vector))
+                    .coords;
+                    *anchor = (wrench, t);
+                    t
+                } else {
+                    anchor.1 + self.to_work.rotation * shift
+                }
+            };
+            residual = (tip - guess).norm();
+            guess = tip;
+            if residual <= COUPLING_TOLERANCE {
+                break;
+            }
+        }
+        crate::error::check_output("predicted tip", guess.as_slice())?;
+        Ok((guess, force, residual))
+    }
+}
+
+/// Both arms over a chunk: side by side on two threads when `options` allow and `std` is on.
+pub(super) fn both(
+    unc: &mut Arm<'_>,
+    comp: &mut Arm<'_>,
+    noms: &[Sample],
+    out_u: &mut Vec<Out>,
+    out_c: &mut Vec<Out>,
+    options: &RunOptions,
+) -> (Result<(), (usize, JobError)>, Result<(), (usize, JobError)>) {
+    #[cfg(feature = "std")]
+    if options.threads > 1 && noms.len() > 1 {
+        // Two fixed stages of equal weight: a scoped thread for one, the caller's for the
+        // other (no pool needed, and the arms share nothing mutable).
+        return std::thread::scope(|s| {
+            let h = s.spawn(|| unc.process(noms, out_u));
+            let rc = comp.process(noms, out_c);
+            let ru = h.join().unwrap_or_else(|_| {
+                Err((
+                    0,
+                    JobError::AtLine {
+                        line: noms.first().map_or(0, |n| n.path.line),
+                        time: noms.first().map_or(0.0, |n| n.path.time),
+                        error: TickError::InvalidArgument {
+                            what: "prediction thread (it panicked)",
+                            value: 0.0,
+                        },
+                    },
+                ))
+            });
+            (ru, rc)
+        });
+    }
+    let _ = options;
+    (unc.process(noms, out_u), comp.process(noms, out_c))
+}
