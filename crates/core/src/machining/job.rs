@@ -260,9 +260,10 @@ impl Job {
 /// IK's default position tolerance (the predicted tip is known no better than the joints
 /// that put it there).
 pub const COUPLING_TOLERANCE: f64 = 1.0e-8;
-/// Most evaluations of the coupling per prediction and sample; the residual is reported
-/// when they run out.
-pub const MAX_COUPLING_ITERATIONS: usize = 20;
+/// Most evaluations of the coupling per prediction and sample (fixed-point steps while they
+/// contract by half or better, then Newton steps of four evaluations each); the residual is
+/// reported when they run out.
+pub const MAX_COUPLING_ITERATIONS: usize = 40;
 /// How far the compensated prediction may leave the program \[m\] before the report names
 /// the line and why ([`Deviation`]): 1 um.
 pub const PREDICTION_TOLERANCE: f64 = 1.0e-6;

@@ -383,9 +383,9 @@ fn lowest(
             };
             let (lo_s, _) = slope(t0);
             let (hi_s, _) = slope(t1);
-            let t = if !(lo_s < 0.0) || t1 - t0 <= 1.0e-12 {
+            let t = if lo_s >= 0.0 || lo_s.is_nan() || t1 - t0 <= 1.0e-12 {
                 t0
-            } else if !(hi_s > 0.0) {
+            } else if hi_s <= 0.0 || hi_s.is_nan() {
                 t1
             } else {
                 let (mut lo, mut hi) = (t0, t1);

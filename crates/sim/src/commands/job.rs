@@ -390,6 +390,18 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
             l.max
         );
     }
+    let mut off: Vec<_> = lines.iter().filter(|l| l.deviation.is_some()).collect();
+    off.sort_by(|a, b| b.error_compensated.total_cmp(&a.error_compensated));
+    for l in off.iter().take(10) {
+        let _ = writeln!(
+            text,
+            "DEBUG line {} compensated error {:.4} mm residual {:.2e} m ({})",
+            l.line,
+            l.error_compensated * 1e3,
+            l.residual,
+            l.deviation.map_or("", |d| d.name())
+        );
+    }
     for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
         let _ = writeln!(
             text,

@@ -6,7 +6,7 @@
 
 use alloc::vec::Vec;
 
-use nalgebra::{Isometry3, Matrix6, Point3, Translation3, Vector3};
+use nalgebra::{Isometry3, Matrix3, Matrix6, Point3, Translation3, Vector3};
 
 use super::nominal::Sample;
 use super::{
@@ -23,6 +23,9 @@ use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
 /// evaluated exactly again: the linear model's error is below 1e-3 of the step at the
 /// springs' small angles, so the coupling's steps stay exact to about 1e-8 m.
 const RELINEARISE: f64 = 1.0e-5;
+
+/// How an arm's chunk ended: the index and error of the first sample that failed.
+pub(super) type Outcome = Result<(), (usize, JobError)>;
 
 /// What one arm gives for one sample.
 #[derive(Debug, Clone, Copy)]
@@ -167,8 +170,8 @@ impl<'a> Arm<'a> {
         let tip_at = |data: &Data, to_work: &Isometry3<f64>| {
             (to_work * Point3::from(data.tcp_deflected.translation.vector)).coords
         };
-        let mut anchor = (n.wrench, tip_at(&self.data, &self.to_work));
-        let (tip, force, residual) = self.couple(n, qs, &mut anchor)?;
+        let anchor = (n.wrench, tip_at(&self.data, &self.to_work));
+        let (tip, force, residual) = self.couple(n, qs, anchor)?;
         let Some(tm) = self.tools.get(n.tool) else {
             return Err(TickError::InvalidArgument {
                 what: "tool index",
@@ -188,17 +191,94 @@ impl<'a> Arm<'a> {
         })
     }
 
-    /// The fixed point `t = tip(q, F(t))` from the last tip plus the programmed step: each
-    /// step reads the chip at the current tip on this arm's stock and moves the tip by the
-    /// compliance times the change of the wrench since `anchor` (exact deflection again when
-    /// that change moves it by more than [`RELINEARISE`]). Returns the tip, the force there
-    /// and the last step.
+    /// The fixed point `t = tip(q, F(t))` from the last tip plus the programmed step (see
+    /// [`Coupling`]). Returns the tip, the force there and the residual.
     fn couple(
         &mut self,
         n: &Sample,
         qs: &[f64],
-        anchor: &mut (Vector6, Vector3<f64>),
+        anchor: (Vector6, Vector3<f64>),
     ) -> Result<(Vector3<f64>, Vector3<f64>, f64), TickError> {
+        let mut c = Coupling {
+            anchor,
+            compliance: None,
+            evaluations: 0,
+        };
+        let start = self.tip.map_or(n.path.position, |t| t + n.step);
+        // Fixed-point steps while they contract fast; the best point so far is kept.
+        let mut t = start;
+        let mut best: Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>, f64)> = None;
+        loop {
+            let (yt, ft) = self.phi(n, qs, &t, &mut c)?;
+            let r = (yt - t).norm();
+            let last = best.map_or(f64::INFINITY, |b| b.3);
+            if r < last {
+                best = Some((t, yt, ft, r));
+            }
+            if r <= COUPLING_TOLERANCE || c.evaluations >= MAX_COUPLING_ITERATIONS {
+                return Ok((yt, ft, r));
+            }
+            if r > 0.5 * last {
+                break;
+            }
+            t = yt;
+        }
+        let Some((bt, by, bf, _)) = best else {
+            return Err(TickError::NonFiniteOutput {
+                what: "predicted tip",
+                index: 0,
+            });
+        };
+        let (mut t, mut y, mut force) = (bt, by, bf);
+        // Slow or diverging (the force changes faster with the position than the arm holds
+        // the tool): Newton's method on g(t) = phi(t) - t, its Jacobian by differences,
+        // with backtracking on |g|.
+        let mut g = y - t;
+        while c.evaluations + 4 <= MAX_COUPLING_ITERATIONS {
+            let mut jac = Matrix3::identity() * -1.0;
+            for axis in 0..3 {
+                let mut te = t;
+                te[axis] += NEWTON_STEP;
+                let (ye, _) = self.phi(n, qs, &te, &mut c)?;
+                let column = (ye - te - g) / NEWTON_STEP;
+                jac.set_column(axis, &column);
+            }
+            let Some(step) = jac.lu().solve(&-g) else {
+                break;
+            };
+            let mut lambda = 1.0;
+            let mut moved = false;
+            while c.evaluations < MAX_COUPLING_ITERATIONS {
+                let tn = t + step * lambda;
+                let (yn, fnew) = self.phi(n, qs, &tn, &mut c)?;
+                let gn = yn - tn;
+                if gn.norm() < g.norm() {
+                    (t, y, force, g) = (tn, yn, fnew, gn);
+                    moved = true;
+                    break;
+                }
+                lambda *= 0.5;
+                if lambda < 1.0e-3 {
+                    break;
+                }
+            }
+            if !moved || g.norm() <= COUPLING_TOLERANCE {
+                break;
+            }
+        }
+        Ok((y, force, g.norm()))
+    }
+
+    /// One evaluation of the coupling's map: the chip read at `t` on this arm's stock, its
+    /// wrench, and the tip the arm deflects to under it (returned with the force).
+    fn phi(
+        &mut self,
+        n: &Sample,
+        qs: &[f64],
+        t: &Vector3<f64>,
+        c: &mut Coupling,
+    ) -> Result<(Vector3<f64>, Vector3<f64>), TickError> {
+        c.evaluations += 1;
         let model = &self.job.model;
         let Some(tm) = self.tools.get(n.tool) else {
             return Err(TickError::InvalidArgument {
@@ -207,55 +287,45 @@ impl<'a> Arm<'a> {
             });
         };
         let dir = n.path.direction;
-        let mut guess = self.tip.map_or(n.path.position, |t| t + n.step);
-        let mut compliance: Option<Matrix6<f64>> = None;
-        let (mut force, mut residual) = (Vector3::zeros(), f64::INFINITY);
-        for _ in 0..MAX_COUPLING_ITERATIONS {
-            engagement::read(
-                &self.stock,
-                &tm.probes,
-                &guess,
-                &dir,
-                n.counter_clockwise,
-                &mut self.chip,
-            );
-            let (f, w) = chip_wrench(&tm.chip, &self.chip, &dir, n.fz, n.counter_clockwise)?;
-            let wrench = rotate(&self.to_base, &w);
-            force = f;
-            let change = wrench - anchor.0;
-            let tip = if change.iter().all(|v| *v == 0.0) {
-                anchor.1
-            } else {
-                let c = match compliance {
-                    Some(c) => c,
-                    None => {
-                        let c = vjm::compliance(model, &mut self.data, qs)?;
-                        compliance = Some(c);
-                        c
-                    }
-                };
-                let shift = (c * change).fixed_rows::<3>(0).into_owned();
-                if shift.norm() > RELINEARISE {
-                    vjm::deflection(model, &mut self.data, qs, &wrench, Load::Exact)?;
-                    let t = (self.to_work
-                        * Point3::from(self.data.tcp_deflected.translation.vector))
-                    .coords;
-                    *anchor = (wrench, t);
-                    t
-                } else {
-                    anchor.1 + self.to_work.rotation * shift
-                }
-            };
-            residual = (tip - guess).norm();
-            guess = tip;
-            if residual <= COUPLING_TOLERANCE {
-                break;
-            }
+        let ccw = n.counter_clockwise;
+        engagement::read(&self.stock, &tm.probes, t, &dir, ccw, &mut self.chip);
+        let (f, w) = chip_wrench(&tm.chip, &self.chip, &dir, n.fz, ccw)?;
+        let wrench = rotate(&self.to_base, &w);
+        let change = wrench - c.anchor.0;
+        if change.iter().all(|v| *v == 0.0) {
+            return Ok((c.anchor.1, f));
         }
-        crate::error::check_output("predicted tip", guess.as_slice())?;
-        Ok((guess, force, residual))
+        let compliance = match c.compliance {
+            Some(m) => m,
+            None => {
+                let m = vjm::compliance(model, &mut self.data, qs)?;
+                c.compliance = Some(m);
+                m
+            }
+        };
+        let shift = (compliance * change).fixed_rows::<3>(0).into_owned();
+        if shift.norm() <= RELINEARISE {
+            return Ok((c.anchor.1 + self.to_work.rotation * shift, f));
+        }
+        vjm::deflection(model, &mut self.data, qs, &wrench, Load::Exact)?;
+        let tip = (self.to_work * Point3::from(self.data.tcp_deflected.translation.vector)).coords;
+        c.anchor = (wrench, tip);
+        crate::error::check_output("predicted tip", tip.as_slice())?;
+        Ok((tip, f))
     }
 }
+
+/// The state of one sample's coupling: the wrench and tip of the last exact deflection, the
+/// compliance at the joints once needed, and the evaluations so far.
+struct Coupling {
+    anchor: (Vector6, Vector3<f64>),
+    compliance: Option<Matrix6<f64>>,
+    evaluations: usize,
+}
+
+/// The difference step of the coupling's Newton iteration \[m\]: far below a cell, far
+/// above the rounding of the tip.
+const NEWTON_STEP: f64 = 1.0e-7;
 
 /// Both arms over a chunk: side by side on two threads when `options` allow and `std` is on.
 pub(super) fn both(
@@ -265,7 +335,7 @@ pub(super) fn both(
     out_u: &mut Vec<Out>,
     out_c: &mut Vec<Out>,
     options: &RunOptions,
-) -> (Result<(), (usize, JobError)>, Result<(), (usize, JobError)>) {
+) -> (Outcome, Outcome) {
     #[cfg(feature = "std")]
     if options.threads > 1 && noms.len() > 1 {
         // Two fixed stages of equal weight: a scoped thread for one, the caller's for the
