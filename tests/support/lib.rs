@@ -2,6 +2,7 @@
 //! harnesses of its loaders ([`fuzz`]).
 
 pub mod fuzz;
+pub mod programs;
 
 /// Path of a file shipped in the repository, from the workspace root.
 pub fn repo_path(relative: &str) -> String {

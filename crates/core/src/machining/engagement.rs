@@ -49,6 +49,8 @@ pub fn angle(k: usize) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Probes {
     radius: f64,
+    /// The probes' largest distance from the tip \[m\].
+    reach: f64,
     ahead: [f64; ANGLES],
     side: [f64; ANGLES],
 }
@@ -68,6 +70,7 @@ impl Probes {
         }
         Self {
             radius,
+            reach: rho.abs(),
             ahead,
             side,
         }
@@ -264,6 +267,12 @@ pub fn read(
     let cell = stock.cell();
     let base = (tip.xy() - stock.origin()) / cell - Vector2::repeat(0.5);
     let (xs, ys) = (x / cell, y / cell);
+    // A probe whose four cells lie inside the grid is read without the edge cases of
+    // `depth_at_index` (the common case, and the hot loop of the pass).
+    let (nx, ny) = stock.shape();
+    let (umax, vmax) = (nx as f64 - 1.0, ny as f64 - 1.0);
+    let z = tip.z;
+    let heights = stock.heights();
     for ((d, &a), &s) in chip
         .depth
         .iter_mut()
@@ -271,7 +280,24 @@ pub fn read(
         .zip(probes.side.iter())
     {
         let u = base + xs * a + ys * s;
-        *d = stock.depth_at_index(u.x, u.y, tip.z);
+        *d = if u.x >= 0.0 && u.y >= 0.0 && u.x < umax && u.y < vmax {
+            // u, v >= 0: the casts are the floors.
+            let (iu, iv) = (u.x as usize, u.y as usize);
+            let (fa, fb) = (u.x - iu as f64, u.y - iv as f64);
+            let k = iv * nx + iu;
+            match (heights.get(k..k + 2), heights.get(k + nx..k + nx + 2)) {
+                (Some(&[h00, h10]), Some(&[h01, h11])) => {
+                    let (d00, d10) = ((h00 - z).max(0.0), (h10 - z).max(0.0));
+                    let (d01, d11) = ((h01 - z).max(0.0), (h11 - z).max(0.0));
+                    let low = d00 + (d10 - d00) * fa;
+                    let high = d01 + (d11 - d01) * fa;
+                    low + (high - low) * fb
+                }
+                _ => 0.0,
+            }
+        } else {
+            stock.depth_at_index(u.x, u.y, z)
+        };
     }
 }
 

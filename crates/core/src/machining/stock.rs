@@ -228,22 +228,34 @@ impl ZMap {
         if !(u > -1.0 && v > -1.0 && u < self.nx as f64 && v < self.ny as f64) {
             return 0.0;
         }
-        let (fu, fv) = (ComplexField::floor(u), ComplexField::floor(v));
-        let (a, b) = (u - fu, v - fv);
-        // fu, fv in [-1, n - 1]: i0 = -1 is the virtual column left of the grid.
-        let (i0, j0) = (fu as isize, fv as isize);
-        let depth = |i: isize, j: isize| -> f64 {
-            if i < 0 || j < 0 {
-                return 0.0;
+        // u + 1 > 0: truncation is the floor (no libm call on the hot path).
+        let (iu, iv) = ((u + 1.0) as usize, (v + 1.0) as usize);
+        let (a, b) = (u + 1.0 - iu as f64, v + 1.0 - iv as f64);
+        // Cell (iu - 1, iv - 1) is the lower corner; index 0 is the virtual cell before the
+        // grid's first.
+        let nx = self.nx;
+        let clip = |h: f64| (h - z).max(0.0);
+        let row = |j: usize| -> (f64, f64) {
+            if j == 0 || j > self.ny {
+                return (0.0, 0.0);
             }
-            let (i, j) = (i as usize, j as usize);
-            match self.height(i, j) {
-                Some(h) if h > z => h - z,
-                _ => 0.0,
+            let base = (j - 1) * nx;
+            if iu >= 1 && iu < nx {
+                match self.heights.get(base + iu - 1..base + iu + 1) {
+                    Some(&[h0, h1]) => (clip(h0), clip(h1)),
+                    _ => (0.0, 0.0),
+                }
+            } else if iu == 0 {
+                (0.0, self.heights.get(base).map_or(0.0, |&h| clip(h)))
+            } else {
+                (
+                    self.heights.get(base + nx - 1).map_or(0.0, |&h| clip(h)),
+                    0.0,
+                )
             }
         };
-        let (d00, d10) = (depth(i0, j0), depth(i0 + 1, j0));
-        let (d01, d11) = (depth(i0, j0 + 1), depth(i0 + 1, j0 + 1));
+        let (d00, d10) = row(iv);
+        let (d01, d11) = row(iv + 1);
         let low = d00 + (d10 - d00) * a;
         let high = d01 + (d11 - d01) * a;
         low + (high - low) * b
@@ -268,6 +280,21 @@ impl ZMap {
         from: &Vector3<f64>,
         to: &Vector3<f64>,
     ) -> Result<Removal, TickError> {
+        self.sweep(cutter, from, to, false)
+    }
+
+    /// Whether a followed step may visit the crescent only (flat end, shorter than a cell).
+    fn crescent(&self, cutter: &Cutter, from: &Vector3<f64>, to: &Vector3<f64>) -> bool {
+        matches!(cutter, Cutter::Flat { .. }) && (to.xy() - from.xy()).norm() < self.cell
+    }
+
+    fn sweep(
+        &mut self,
+        cutter: &Cutter,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+        after: bool,
+    ) -> Result<Removal, TickError> {
         check_finite("cut start", from.as_slice())?;
         check_finite("cut end", to.as_slice())?;
         let r = cutter.radius();
@@ -277,11 +304,15 @@ impl ZMap {
                 value: r,
             });
         }
+        let cell = self.cell;
+        // A step shorter than a cell: every cell it reaches lies within r + cell of an end.
+        let short = (to.xy() - from.xy()).norm() < cell;
+        let crescent = after && self.crescent(cutter, from, to);
         // The cells whose centres can lie within r of the move.
         let lo = from.xy().inf(&to.xy()) - Vector2::repeat(r) - self.origin;
         let hi = from.xy().sup(&to.xy()) + Vector2::repeat(r) - self.origin;
         let index = |v: f64, n: usize| -> usize {
-            let k = ComplexField::floor(v / self.cell - 0.5);
+            let k = ComplexField::floor(v / cell - 0.5);
             if k <= 0.0 {
                 0
             } else if k >= n as f64 {
@@ -290,37 +321,227 @@ impl ZMap {
                 k as usize
             }
         };
-        let (i0, i1) = (index(lo.x, self.nx), index(hi.x, self.nx).saturating_add(2));
-        let (j0, j1) = (index(lo.y, self.ny), index(hi.y, self.ny).saturating_add(2));
+        let (nx, origin) = (self.nx, self.origin);
+        let i1 = index(hi.x, nx).saturating_add(2).min(nx);
+        let i0 = index(lo.x, nx).min(i1);
+        let (j0, j1) = (
+            index(lo.y, self.ny),
+            index(hi.y, self.ny).saturating_add(2).min(self.ny),
+        );
+        let pass = Pass {
+            cutter,
+            from,
+            to,
+            // No point of the cutter's surface lies below the lower end of the move.
+            floor: from.z.min(to.z),
+            p0: from.xy(),
+            b: to.xy() - from.xy(),
+            r,
+            area: cell * cell,
+        };
         let mut removal = Removal::default();
-        let area = self.cell * self.cell;
-        // No point of the cutter's surface lies below the lower end of the move: a cell at or
-        // below it keeps its height, which is most cells under a tool cutting a floor.
-        let floor = from.z.min(to.z);
-        let (nx, cell, origin) = (self.nx, self.cell, self.origin);
-        let (i1, j1) = (i1.min(nx), j1.min(self.ny));
+        // Centre column of x (m) rounded up / down.
+        let above = |x: f64| -floor_of(-((x - origin.x) / cell - 0.5));
+        let below = |x: f64| floor_of((x - origin.x) / cell - 0.5);
+        let clamp = |k: f64| k.clamp(i0 as f64, i1 as f64) as usize;
         for j in j0..j1 {
             let cy = origin.y + (j as f64 + 0.5) * cell;
-            let Some(row) = self.heights.get_mut(j * nx + i0..j * nx + i1.max(i0)) else {
+            let Some(row) = self.heights.get_mut(j * nx..(j + 1) * nx) else {
                 continue;
             };
-            for (k, h) in row.iter_mut().enumerate() {
-                if *h <= floor {
-                    continue;
+            if !crescent {
+                if short {
+                    // Within r + cell of either end: the hull of the two discs' chords.
+                    let reach = r + cell;
+                    let chord = |p: &Vector3<f64>| {
+                        let dy = cy - p.y;
+                        (dy.abs() <= reach).then(|| {
+                            let w = ComplexField::sqrt(reach * reach - dy * dy);
+                            (p.x - w, p.x + w)
+                        })
+                    };
+                    let (a, b) = match (chord(from), chord(to)) {
+                        (Some(f), Some(t)) => (f.0.min(t.0), f.1.max(t.1)),
+                        (Some(c), None) | (None, Some(c)) => c,
+                        (None, None) => continue,
+                    };
+                    pass.row(
+                        row,
+                        clamp(above(a)),
+                        clamp(below(b) + 1.0),
+                        cy,
+                        origin.x,
+                        cell,
+                        &mut removal,
+                    );
+                } else {
+                    pass.row(row, i0, i1, cy, origin.x, cell, &mut removal);
                 }
-                let c = Vector2::new(origin.x + ((i0 + k) as f64 + 0.5) * cell, cy);
-                let Some(z) = lowest(cutter, from, to, &c) else {
-                    continue;
-                };
-                if z < *h {
-                    removal.cells += 1;
-                    removal.volume += (*h - z) * area;
-                    removal.deepest = removal.deepest.max(*h - z);
-                    *h = z;
-                }
+                continue;
+            }
+            // The disc at `to` grown by a cell (so the sliver of the capsule between the
+            // discs is inside), minus the cells strictly inside the disc at `from`.
+            let reach = r + cell;
+            let dy = cy - to.y;
+            if dy.abs() > reach {
+                continue;
+            }
+            let w = ComplexField::sqrt(reach * reach - dy * dy);
+            let (a, b) = (clamp(above(to.x - w)), clamp(below(to.x + w) + 1.0));
+            let df = cy - from.y;
+            let inner = r * r - df * df;
+            if inner <= 0.0 {
+                pass.row(row, a, b, cy, origin.x, cell, &mut removal);
+                continue;
+            }
+            let wf = ComplexField::sqrt(inner) - 1.0e-9;
+            let (ea, eb) = (clamp(above(from.x - wf)), clamp(below(from.x + wf) + 1.0));
+            if ea >= eb {
+                pass.row(row, a, b, cy, origin.x, cell, &mut removal);
+            } else {
+                pass.row(row, a, ea.max(a).min(b), cy, origin.x, cell, &mut removal);
+                pass.row(row, eb.max(a).min(b), b, cy, origin.x, cell, &mut removal);
             }
         }
         Ok(removal)
+    }
+}
+
+/// How far a [`Follower`] may leave cells above the exact sweep \[m\]: 1e-8 m, the pose
+/// IK's position tolerance.
+pub const FOLLOW_TOLERANCE: f64 = 1.0e-8;
+
+/// A tool followed sample by sample over one z-map: each [`Self::cut_to`] cuts from where
+/// the last one ended. A flat end mill stepping less than a cell visits only the cells its
+/// disc newly reaches (every cell within its radius of the last tip is at or below the last
+/// tip's height), a few per row instead of its whole footprint, as long as the descents it
+/// so skips add up to at most [`FOLLOW_TOLERANCE`] since the last full sweep: the cells are
+/// then within that tolerance of [`ZMap::cut`]'s, and a deflected tool's nanometre wobble
+/// does not lower its whole footprint every sample.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Follower {
+    last: Option<(Cutter, Vector3<f64>)>,
+    slack: f64,
+}
+
+impl Follower {
+    /// A tool not yet on the stock.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The last tip cut to \[m\].
+    pub fn tip(&self) -> Option<Vector3<f64>> {
+        self.last.map(|(_, p)| p)
+    }
+
+    /// Cuts `stock` with `cutter` from the last tip (or at `to` the first time, or after a
+    /// tool change) to `to` \[m\]; the errors of [`ZMap::cut`].
+    pub fn cut_to(
+        &mut self,
+        stock: &mut ZMap,
+        cutter: &Cutter,
+        to: &Vector3<f64>,
+    ) -> Result<Removal, TickError> {
+        let (from, same) = match self.last {
+            Some((c, p)) => (p, c == *cutter),
+            None => (*to, false),
+        };
+        let descent = (from.z - to.z).max(0.0);
+        let crescent = same && self.slack + descent <= FOLLOW_TOLERANCE;
+        let removal = stock.sweep(cutter, &from, to, crescent)?;
+        // `sweep` visits the whole footprint unless the step allows the crescent.
+        self.slack = if crescent && stock.crescent(cutter, &from, to) {
+            self.slack + descent
+        } else {
+            0.0
+        };
+        self.last = Some((*cutter, *to));
+        Ok(removal)
+    }
+}
+
+/// The floor of `x` without a libm call (`x` within +-2^52; else `x`).
+#[inline]
+fn floor_of(x: f64) -> f64 {
+    if x.is_nan() || x.abs() >= 4.0e15 {
+        return x;
+    }
+    let t = x as i64 as f64;
+    if t > x { t - 1.0 } else { t }
+}
+
+/// One sweep of a cutter, cell by cell.
+struct Pass<'a> {
+    cutter: &'a Cutter,
+    from: &'a Vector3<f64>,
+    to: &'a Vector3<f64>,
+    floor: f64,
+    p0: Vector2<f64>,
+    b: Vector2<f64>,
+    r: f64,
+    area: f64,
+}
+
+impl Pass<'_> {
+    /// Lowers the cells `i0..i1` of one row (centre height `cy`), each to the lowest point
+    /// of the cutter above its centre. A cell at or below the lower end of the move keeps
+    /// its height (most cells under a tool cutting a floor), and for a ball one at or below
+    /// `floor + R - sqrt(R^2 - d^2)` at `d` from the move (the cells the last samples left
+    /// on the ball's surface) is passed over without a search.
+    #[allow(clippy::too_many_arguments)]
+    fn row(
+        &self,
+        row: &mut [f64],
+        i0: usize,
+        i1: usize,
+        cy: f64,
+        ox: f64,
+        cell: f64,
+        removal: &mut Removal,
+    ) {
+        let Some(cells) = row.get_mut(i0..i1.max(i0)) else {
+            return;
+        };
+        let bb = self.b.norm_squared();
+        let inv_bb = if bb > 1.0e-30 { 1.0 / bb } else { 0.0 };
+        let ball = matches!(self.cutter, Cutter::Ball { .. });
+        let (r, floor) = (self.r, self.floor);
+        let r2 = r * r;
+        for (k, h) in cells.iter_mut().enumerate() {
+            if *h <= floor {
+                continue;
+            }
+            let c = Vector2::new(ox + ((i0 + k) as f64 + 0.5) * cell, cy);
+            let a = self.p0 - c;
+            let t = (-a.dot(&self.b) * inv_bb).clamp(0.0, 1.0);
+            let d2 = (a + self.b * t).norm_squared();
+            if d2 > r2 {
+                continue;
+            }
+            let z = if ball {
+                let rise = r + floor - *h;
+                if rise >= 0.0 && d2 >= r2 - rise * rise {
+                    continue;
+                }
+                lowest(self.cutter, self.from, self.to, &c)
+            } else if a.norm_squared() <= r2 && (a + self.b).norm_squared() <= r2 {
+                // Under the flat end at both ends of the move (so all along it: the distance
+                // is convex in the move's parameter): its lowest point is the lower end.
+                Some(floor)
+            } else {
+                lowest(self.cutter, self.from, self.to, &c)
+            };
+            let Some(z) = z else {
+                continue;
+            };
+            if z < *h {
+                removal.cells += 1;
+                removal.volume += (*h - z) * self.area;
+                removal.deepest = removal.deepest.max(*h - z);
+                *h = z;
+            }
+        }
     }
 }
 

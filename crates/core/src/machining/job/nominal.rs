@@ -9,7 +9,7 @@ use crate::error::{JobError, TickError};
 use crate::machining::engagement::{Chip, Contact};
 use crate::machining::path::PathSample;
 use crate::machining::report::RapidContact;
-use crate::machining::stock::{Removal, ZMap};
+use crate::machining::stock::{Follower, Removal, ZMap};
 use crate::vjm::Vector6;
 
 /// What the nominal stage hands on for one sample.
@@ -38,6 +38,7 @@ pub(super) struct Stage<'a> {
     chip: Chip,
     prev: Option<Vector3<f64>>,
     last_tool: Option<(u32, usize)>,
+    follower: Follower,
     pub rapid_contact: Option<RapidContact>,
     pub plunge_samples: usize,
     pub cell_updates: usize,
@@ -53,6 +54,7 @@ impl<'a> Stage<'a> {
             chip: Chip::default(),
             prev: None,
             last_tool: None,
+            follower: Follower::new(),
             rapid_contact: None,
             plunge_samples: 0,
             cell_updates: 0,
@@ -104,7 +106,10 @@ impl<'a> Stage<'a> {
             &mut self.chip,
         );
         let contact = self.chip.contact();
-        let removed = self.stock.cut(&tm.cutter, &from, &p).map_err(at)?;
+        let removed = self
+            .follower
+            .cut_to(&mut self.stock, &tm.cutter, &p)
+            .map_err(at)?;
         self.check(s, &contact, &removed, tm.known, spindle)?;
         if matches!(contact, Contact::Plunge { .. }) {
             self.plunge_samples += 1;

@@ -15,7 +15,7 @@ use super::{
 };
 use crate::error::{JobError, TickError};
 use crate::machining::engagement::Chip;
-use crate::machining::stock::ZMap;
+use crate::machining::stock::{Follower, ZMap};
 use crate::mechanism::pose_ik;
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
 
@@ -56,6 +56,7 @@ pub(super) struct Arm<'a> {
     to_work: Isometry3<f64>,
     pub stock: ZMap,
     tip: Option<Vector3<f64>>,
+    follower: Follower,
     chip: Chip,
     pub cell_updates: usize,
 }
@@ -84,6 +85,7 @@ impl<'a> Arm<'a> {
             to_work: job.setup.placement.inverse(),
             stock,
             tip: None,
+            follower: Follower::new(),
             chip: Chip::default(),
             cell_updates: 0,
         }
@@ -178,7 +180,7 @@ impl<'a> Arm<'a> {
                 value: n.tool as f64,
             });
         };
-        let removed = self.stock.cut(&tm.cutter, &self.tip.unwrap_or(tip), &tip)?;
+        let removed = self.follower.cut_to(&mut self.stock, &tm.cutter, &tip)?;
         self.cell_updates += removed.cells;
         self.tip = Some(tip);
         Ok(Out {
@@ -207,7 +209,8 @@ impl<'a> Arm<'a> {
         let start = self.tip.map_or(n.path.position, |t| t + n.step);
         // Fixed-point steps while they contract fast; the best point so far is kept.
         let mut t = start;
-        let mut best: Option<(Vector3<f64>, Vector3<f64>, Vector3<f64>, f64)> = None;
+        // (point, its image, the force there, the residual)
+        let mut best: Option<Trial> = None;
         loop {
             let (yt, ft) = self.phi(n, qs, &t, &mut c)?;
             let r = (yt - t).norm();
@@ -238,7 +241,9 @@ impl<'a> Arm<'a> {
             let mut jac = Matrix3::identity() * -1.0;
             for axis in 0..3 {
                 let mut te = t;
-                te[axis] += NEWTON_STEP;
+                if let Some(v) = te.get_mut(axis) {
+                    *v += NEWTON_STEP;
+                }
                 let (ye, _) = self.phi(n, qs, &te, &mut c)?;
                 let column = (ye - te - g) / NEWTON_STEP;
                 jac.set_column(axis, &column);
@@ -322,6 +327,9 @@ struct Coupling {
     compliance: Option<Matrix6<f64>>,
     evaluations: usize,
 }
+
+/// A point of the coupling, its image, the force there and the residual.
+type Trial = (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64);
 
 /// The difference step of the coupling's Newton iteration \[m\]: far below a cell, far
 /// above the rounding of the tip.
