@@ -208,3 +208,13 @@ impl<const J: usize> deflect_core::dalembert::parallel::DisplacementModel<3, J>
         true
     }
 }
+
+/// Path of a file of the shared references next to the repository (`../shared/`, or the
+/// folder `DEFLECT_SHARED` names): programs written by real CAM systems and the machining
+/// reproducers, which are not ours to commit.
+pub fn shared_path(relative: &str) -> String {
+    match std::env::var("DEFLECT_SHARED") {
+        Ok(dir) => format!("{dir}/{relative}"),
+        Err(_) => format!("{}/../shared/{relative}", env!("CARGO_MANIFEST_DIR")),
+    }
+}

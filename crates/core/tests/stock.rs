@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 
 use deflect_core::BuildError;
 use deflect_core::TickError;
-use deflect_core::machining::stock::{Cutter, MAX_CELLS, ZMap};
+use deflect_core::machining::stock::{Cutter, FOLLOW_TOLERANCE, Follower, MAX_CELLS, ZMap};
 use nalgebra::{Vector2, Vector3};
 
 const CELL: f64 = 1.0e-4;
@@ -168,4 +168,60 @@ fn budgets_and_bad_inputs_are_typed_errors() {
     );
     assert_eq!(far.unwrap().cells, 0);
     assert!(z.height(1000, 0).is_none() && z.height(0, 400).is_none());
+}
+
+/// A followed tool cuts what the plain sweep cuts, within `FOLLOW_TOLERANCE`: random walks
+/// of a flat and a ball end mill (steps up to a cell, nanometre wobble and real descents in
+/// z, turns, stops, tool changes) on two copies of a stock.
+#[test]
+fn a_followed_tool_cuts_what_the_sweep_cuts() {
+    let mut rnd = {
+        let mut state = 0x9e3779b97f4a7c15u64;
+        move |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * (state >> 11) as f64 / (1u64 << 53) as f64
+        }
+    };
+    for cutter in [
+        Cutter::Flat { radius: 0.004 },
+        Cutter::Ball { radius: 0.003 },
+    ] {
+        let mut exact = ZMap::new(Vector2::zeros(), Vector2::new(0.04, 0.04), 0.0, 5.0e-4).unwrap();
+        let mut followed = exact.clone();
+        let mut follower = Follower::new();
+        let mut p = Vector3::new(0.02, 0.02, -0.001);
+        let mut last = p;
+        let mut heading: f64 = 0.0;
+        for k in 0..3000 {
+            heading += rnd(-0.3, 0.3);
+            let step = if k % 97 == 0 { 0.0 } else { rnd(0.0, 6.0e-4) };
+            let dz = match k % 5 {
+                0 => rnd(-3.0e-6, 3.0e-6),
+                1 => rnd(-2.0e-9, 2.0e-9),
+                _ => rnd(-1.0e-10, 1.0e-10),
+            };
+            p += Vector3::new(heading.cos() * step, heading.sin() * step, dz);
+            p.x = p.x.clamp(0.002, 0.038);
+            p.y = p.y.clamp(0.002, 0.038);
+            p.z = p.z.clamp(-0.003, 0.0);
+            // A tool change now and then: the follower sweeps the whole footprint again.
+            let c = if k % 500 == 250 {
+                Cutter::Flat { radius: 0.002 }
+            } else {
+                cutter
+            };
+            let _ = exact.cut(&c, &last, &p).unwrap();
+            let _ = follower.cut_to(&mut followed, &c, &p).unwrap();
+            last = p;
+        }
+        let worst = exact
+            .heights()
+            .iter()
+            .zip(followed.heights())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f64, f64::max);
+        assert!(worst <= FOLLOW_TOLERANCE, "{cutter:?}: {worst:e}");
+    }
 }

@@ -1,8 +1,10 @@
 //! What an offline pass hands back to the shop (`std`): the compensated program as G-code
-//! the user's CAM or controller loads like the original ([`compensated_gcode`]), and every
-//! sample as CSV ([`samples_csv`]: programmed and commanded poses, nominal and compensated
-//! joints for axis-specific correction, the force, the deflection and the pilot wrench of
-//! the annotated program).
+//! the user's CAM or controller loads like the original ([`compensated_gcode`], or
+//! [`GcodeWriter`] as the samples stream), and every sample as CSV ([`samples_csv`],
+//! [`CsvWriter`]: programmed and commanded poses, nominal and compensated joints for
+//! axis-specific correction, the force, the deflection and the pilot wrench of the annotated
+//! program). The writers hold a bounded window of samples (at most [`MAX_DROPPED`] + 2, and
+//! the pilot lead's), whatever the program's length.
 //!
 //! The compensated G-code is in mm (`G21`), absolute (`G90`), one `G1`/`G0` per kept sample
 //! of the commanded tip: samples are dropped while the straight line between the kept ones
@@ -13,14 +15,16 @@
 //! program's tool changes (`T M6`), spindle directions (`M3`, `M4`, `M5`) and dwells (`G4`)
 //! are written where they happen.
 
+use std::collections::VecDeque;
 use std::fmt::Write as _;
+use std::io::Write;
 use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
 use crate::contour::shape::distance_to_segment;
 use crate::error::LoadError;
-use crate::machining::job::Report;
+use crate::machining::job::{JobSample, Report};
 use crate::machining::{Motion, Program};
 
 /// Most samples one dropped run may hold before a block is written anyway (bounds the
@@ -31,81 +35,184 @@ pub const MAX_DROPPED: usize = 256;
 /// compensation to a micrometre). `program` must be the one the report was run on (for the
 /// feeds).
 pub fn compensated_gcode(report: &Report, program: &Program, tolerance: f64) -> String {
-    let tolerance = if tolerance.is_finite() && tolerance > 0.0 {
-        tolerance
-    } else {
-        1.0e-6
-    };
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "%\n(compensated by deflect {}: the commanded tool tip, workpiece frame, mm)\n\
-         G21 G90 G17",
-        env!("CARGO_PKG_VERSION")
-    );
-    let samples = &report.samples;
-    let point = |k: usize| samples.get(k).map(|s| s.commanded.translation.vector);
-    // Keep the first and last sample, every sample where the move changes, and the samples
-    // the tolerance needs.
-    let mut keep = Vec::with_capacity(samples.len() / 8 + 2);
-    let mut anchor = 0usize;
-    keep.push(0usize);
-    for k in 1..samples.len() {
-        let (Some(a), Some(p)) = (point(anchor), point(k)) else {
-            continue;
-        };
-        let changes = samples.get(k + 1).is_none_or(|n| {
-            samples
-                .get(k)
-                .is_some_and(|s| s.path.move_index != n.path.move_index)
-        });
-        let within = k - anchor <= MAX_DROPPED
-            && (anchor + 1..k)
-                .all(|j| point(j).is_some_and(|q| distance_to_segment(&q, &a, &p) <= tolerance));
-        if !within {
-            keep.push(k - 1);
-            anchor = k - 1;
-        }
-        if changes {
-            keep.push(k);
-            anchor = k;
+    let mut w = GcodeWriter::new(Vec::new(), program, tolerance);
+    // Writing to a Vec cannot fail.
+    let _ = w.push(&report.samples);
+    let bytes = w.finish().unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// The compensated program written as the samples come ([`compensated_gcode`] in pieces):
+/// [`Self::push`] each chunk in time order, then [`Self::finish`].
+#[derive(Debug)]
+pub struct GcodeWriter<'p, W: Write> {
+    out: W,
+    program: &'p Program,
+    tolerance: f64,
+    /// The samples from the last kept one (the anchor) to the newest not yet decided.
+    window: VecDeque<JobSample>,
+    /// The newest sample, decided when the next arrives (whether the move changes after it).
+    pending: Option<JobSample>,
+    started: bool,
+    state: BlockState,
+    text: String,
+}
+
+/// What the blocks written so far have set.
+#[derive(Debug, Clone, Copy)]
+struct BlockState {
+    line: usize,
+    feed: f64,
+    spindle: f64,
+    tool: u32,
+    first: bool,
+    dwelt: usize,
+    last_kept: Option<f64>,
+}
+
+impl<'p, W: Write> GcodeWriter<'p, W> {
+    /// A writer of the program run as `program` (for its feeds and dwells), to `out`, the
+    /// path decimated to `tolerance` \[m\] (not finite or <= 0: 1e-6).
+    pub fn new(out: W, program: &'p Program, tolerance: f64) -> Self {
+        Self {
+            out,
+            program,
+            tolerance: if tolerance.is_finite() && tolerance > 0.0 {
+                tolerance
+            } else {
+                1.0e-6
+            },
+            window: VecDeque::new(),
+            pending: None,
+            started: false,
+            state: BlockState {
+                line: 0,
+                feed: f64::NAN,
+                spindle: f64::NAN,
+                tool: 0,
+                first: true,
+                dwelt: usize::MAX,
+                last_kept: None,
+            },
+            text: String::new(),
         }
     }
-    keep.dedup();
-    let (mut line, mut feed, mut spindle, mut tool) = (0usize, f64::NAN, f64::NAN, 0u32);
-    let mut first = true;
-    let mut dwelt = usize::MAX;
-    for &k in &keep {
-        let Some(s) = samples.get(k) else { continue };
-        let p = s.commanded.translation.vector * 1e3;
-        let mv = program.moves.get(s.path.move_index);
-        if s.path.tool != tool {
-            tool = s.path.tool;
-            let _ = writeln!(out, "T{tool} M6");
-            // M6 stops the spindle: it is started again below.
-            spindle = f64::NAN;
+
+    /// The next samples, in time order.
+    pub fn push(&mut self, chunk: &[JobSample]) -> std::io::Result<()> {
+        if !self.started {
+            self.started = true;
+            let _ = writeln!(
+                self.text,
+                "%\n(compensated by deflect {}: the commanded tool tip, workpiece frame, mm)\n\
+                 G21 G90 G17",
+                env!("CARGO_PKG_VERSION")
+            );
         }
-        if s.path.spindle != spindle {
-            spindle = s.path.spindle;
-            let rpm = spindle.abs() * 60.0;
-            let _ = match spindle {
+        for s in chunk {
+            if let Some(prev) = self.pending.replace(*s) {
+                let changes = prev.path.move_index != s.path.move_index;
+                self.decide(prev, changes);
+            }
+            if self.text.len() > 1 << 16 {
+                self.out.write_all(self.text.as_bytes())?;
+                self.text.clear();
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the last sample and the program's end; hands back the output.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        if !self.started {
+            self.push(&[])?;
+        }
+        if let Some(last) = self.pending.take() {
+            self.decide(last, true);
+        }
+        let _ = writeln!(self.text, "M5\nM30\n%");
+        self.out.write_all(self.text.as_bytes())?;
+        self.out.flush()?;
+        Ok(self.out)
+    }
+
+    /// Sample `s` joins the window: kept (with the one before it) where the straight line
+    /// from the anchor no longer holds the dropped samples within the tolerance, and where
+    /// the move `changes` after it.
+    fn decide(&mut self, s: JobSample, changes: bool) {
+        let point = |x: &JobSample| x.commanded.translation.vector;
+        if self.window.is_empty() {
+            // The first sample is kept.
+            self.window.push_back(s);
+            self.keep(s);
+            return;
+        }
+        self.window.push_back(s);
+        let n = self.window.len();
+        let within = n - 1 <= MAX_DROPPED
+            && match (self.window.front(), self.window.back()) {
+                (Some(a), Some(p)) => {
+                    let (a, p) = (point(a), point(p));
+                    self.window
+                        .range(1..n - 1)
+                        .all(|q| distance_to_segment(&point(q), &a, &p) <= self.tolerance)
+                }
+                _ => true,
+            };
+        if !within {
+            // Keep the sample before this one; it anchors the next stretch.
+            self.window.pop_back();
+            if let Some(before) = self.window.pop_back() {
+                self.keep(before);
+                self.window.clear();
+                self.window.push_back(before);
+            }
+            self.window.push_back(s);
+        }
+        if changes {
+            self.keep(s);
+            self.window.clear();
+            self.window.push_back(s);
+        }
+    }
+
+    /// Writes the block of a kept sample (once: a sample kept twice is written once).
+    fn keep(&mut self, s: JobSample) {
+        if self.state.last_kept == Some(s.path.time) {
+            return;
+        }
+        self.state.last_kept = Some(s.path.time);
+        let st = &mut self.state;
+        let out = &mut self.text;
+        let p = s.commanded.translation.vector * 1e3;
+        let mv = self.program.moves.get(s.path.move_index);
+        if s.path.tool != st.tool {
+            st.tool = s.path.tool;
+            let _ = writeln!(out, "T{} M6", st.tool);
+            // M6 stops the spindle: it is started again below.
+            st.spindle = f64::NAN;
+        }
+        if s.path.spindle != st.spindle {
+            st.spindle = s.path.spindle;
+            let rpm = st.spindle.abs() * 60.0;
+            let _ = match st.spindle {
                 v if v > 0.0 => writeln!(out, "S{rpm:.0} M3"),
                 v if v < 0.0 => writeln!(out, "S{rpm:.0} M4"),
                 _ => writeln!(out, "M5"),
             };
         }
-        if s.path.line != line {
-            line = s.path.line;
-            let _ = writeln!(out, "(program line {line})");
+        if s.path.line != st.line {
+            st.line = s.path.line;
+            let _ = writeln!(out, "(program line {})", st.line);
         }
         if let Some(Motion::Dwell { seconds }) = mv.map(|m| m.motion) {
-            if dwelt != s.path.move_index {
-                dwelt = s.path.move_index;
+            if st.dwelt != s.path.move_index {
+                st.dwelt = s.path.move_index;
                 let _ = writeln!(out, "G4 P{seconds:.4}");
             }
-            continue;
+            return;
         }
-        let word = if first || !s.path.feed_move {
+        let word = if st.first || !s.path.feed_move {
             "G0"
         } else {
             "G1"
@@ -113,16 +220,69 @@ pub fn compensated_gcode(report: &Report, program: &Program, tolerance: f64) -> 
         let _ = write!(out, "{word} X{:.4} Y{:.4} Z{:.4}", p.x, p.y, p.z);
         if word == "G1"
             && let Some(f) = mv.map(|m| m.feed)
-            && f != feed
+            && f != st.feed
         {
-            feed = f;
+            st.feed = f;
             let _ = write!(out, " F{:.1}", f * 60e3);
         }
         out.push('\n');
-        first = false;
+        st.first = false;
     }
-    let _ = writeln!(out, "M5\nM30\n%");
+}
+
+/// The CSV's header for an arm of `dof` joints (see [`samples_csv`]).
+fn csv_header(dof: usize) -> String {
+    let mut out = String::from("time_s,line,x_m,y_m,z_m,cx_m,cy_m,cz_m,cqx,cqy,cqz,cqw");
+    for prefix in ["q", "qc"] {
+        for j in 1..=dof {
+            let _ = write!(out, ",{prefix}{j}_rad");
+        }
+    }
+    out.push_str(",fx_n,fy_n,fz_n,dx_m,dy_m,dz_m");
+    out.push_str(",pilot_fx_n,pilot_fy_n,pilot_fz_n,pilot_mx_nm,pilot_my_nm,pilot_mz_nm");
+    out.push_str(",entry_rad,exit_rad,depth_m\n");
     out
+}
+
+/// One CSV row: sample `s` with the pilot wrench `w`.
+fn csv_row(out: &mut String, s: &JobSample, w: &crate::vjm::Vector6, dof: usize) {
+    let c = &s.commanded;
+    let q = c.rotation.coords;
+    let _ = write!(
+        out,
+        "{},{},{},{},{},{},{},{},{},{},{},{}",
+        s.path.time,
+        s.path.line,
+        s.path.position.x,
+        s.path.position.y,
+        s.path.position.z,
+        c.translation.x,
+        c.translation.y,
+        c.translation.z,
+        q.x,
+        q.y,
+        q.z,
+        q.w
+    );
+    for v in s.q.iter().take(dof).chain(s.q_commanded.iter().take(dof)) {
+        let _ = write!(out, ",{v}");
+    }
+    for v in s
+        .force
+        .iter()
+        .chain(s.deflection.fixed_rows::<3>(0).iter())
+        .chain(w.iter())
+    {
+        let _ = write!(out, ",{v}");
+    }
+    let span = s.contact.span();
+    let _ = writeln!(
+        out,
+        ",{},{},{}",
+        span.map_or(0.0, |a| a.entry),
+        span.map_or(0.0, |a| a.exit),
+        span.map_or(0.0, |a| a.depth)
+    );
 }
 
 /// Every sample as CSV, SI: `time_s, line, x_m, y_m, z_m` (programmed tip, workpiece
@@ -132,57 +292,77 @@ pub fn compensated_gcode(report: &Report, program: &Program, tolerance: f64) -> 
 /// `pilot_fx_n .. pilot_mz_nm` (the TCP wrench `lead` \[s\] ahead, base frame: the
 /// annotated program's pilot signal), `entry_rad, exit_rad, depth_m` (engagement span).
 pub fn samples_csv(report: &Report, lead: f64) -> String {
-    let n = report.dof;
-    let mut out = String::from("time_s,line,x_m,y_m,z_m,cx_m,cy_m,cz_m,cqx,cqy,cqz,cqw");
-    for prefix in ["q", "qc"] {
-        for j in 1..=n {
-            let _ = write!(out, ",{prefix}{j}_rad");
+    let mut w = CsvWriter::new(Vec::new(), report.dof, report.rate_hz, lead);
+    let _ = w.push(&report.samples);
+    String::from_utf8(w.finish().unwrap_or_default()).unwrap_or_default()
+}
+
+/// [`samples_csv`] written as the samples come: each row waits for the sample `lead` ahead
+/// (its pilot wrench); the last rows take the last wrench.
+#[derive(Debug)]
+pub struct CsvWriter<W: Write> {
+    out: W,
+    dof: usize,
+    shift: usize,
+    held: VecDeque<JobSample>,
+    started: bool,
+    text: String,
+}
+
+impl<W: Write> CsvWriter<W> {
+    /// A writer to `out` for an arm of `dof` joints sampled at `rate_hz`, the pilot wrench
+    /// `lead` \[s\] ahead (rounded to samples; negative or non-finite: 0).
+    pub fn new(out: W, dof: usize, rate_hz: f64, lead: f64) -> Self {
+        let shift = if lead.is_finite() && lead > 0.0 && rate_hz.is_finite() {
+            (lead * rate_hz).round().min(1.0e6) as usize
+        } else {
+            0
+        };
+        Self {
+            out,
+            dof,
+            shift,
+            held: VecDeque::new(),
+            started: false,
+            text: String::new(),
         }
     }
-    out.push_str(",fx_n,fy_n,fz_n,dx_m,dy_m,dz_m");
-    out.push_str(",pilot_fx_n,pilot_fy_n,pilot_fz_n,pilot_mx_nm,pilot_my_nm,pilot_mz_nm");
-    out.push_str(",entry_rad,exit_rad,depth_m\n");
-    let pilot = report.pilot_wrenches(lead);
-    for (s, w) in report.samples.iter().zip(&pilot) {
-        let c = &s.commanded;
-        let q = c.rotation.coords;
-        let _ = write!(
-            out,
-            "{},{},{},{},{},{},{},{},{},{},{},{}",
-            s.path.time,
-            s.path.line,
-            s.path.position.x,
-            s.path.position.y,
-            s.path.position.z,
-            c.translation.x,
-            c.translation.y,
-            c.translation.z,
-            q.x,
-            q.y,
-            q.z,
-            q.w
-        );
-        for v in s.q.iter().take(n).chain(s.q_commanded.iter().take(n)) {
-            let _ = write!(out, ",{v}");
+
+    /// The next samples, in time order.
+    pub fn push(&mut self, chunk: &[JobSample]) -> std::io::Result<()> {
+        if !self.started {
+            self.started = true;
+            self.text.push_str(&csv_header(self.dof));
         }
-        for v in s
-            .force
-            .iter()
-            .chain(s.deflection.fixed_rows::<3>(0).iter())
-            .chain(w.iter())
-        {
-            let _ = write!(out, ",{v}");
+        for s in chunk {
+            self.held.push_back(*s);
+            if self.held.len() > self.shift
+                && let Some(first) = self.held.pop_front()
+            {
+                let w = self.held.back().map_or(first.wrench, |b| b.wrench);
+                csv_row(&mut self.text, &first, &w, self.dof);
+            }
+            if self.text.len() > 1 << 16 {
+                self.out.write_all(self.text.as_bytes())?;
+                self.text.clear();
+            }
         }
-        let span = s.contact.span();
-        let _ = writeln!(
-            out,
-            ",{},{},{}",
-            span.map_or(0.0, |a| a.entry),
-            span.map_or(0.0, |a| a.exit),
-            span.map_or(0.0, |a| a.depth)
-        );
+        Ok(())
     }
-    out
+
+    /// Writes the rows held for their lead (with the last wrench); hands back the output.
+    pub fn finish(mut self) -> std::io::Result<W> {
+        if !self.started {
+            self.push(&[])?;
+        }
+        let last = self.held.back().map(|s| s.wrench);
+        while let Some(s) = self.held.pop_front() {
+            csv_row(&mut self.text, &s, &last.unwrap_or(s.wrench), self.dof);
+        }
+        self.out.write_all(self.text.as_bytes())?;
+        self.out.flush()?;
+        Ok(self.out)
+    }
 }
 
 /// Writes `text` to `path`, naming the file in the error.

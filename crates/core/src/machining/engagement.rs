@@ -7,10 +7,10 @@
 //! along +x; the conventions of [`super::cutting`]) is probed 1 degree apart. The probe of
 //! angle `phi` lies at the rim's lateral offset `R cos(phi)` and ahead of the tool on the
 //! circle of radius `R + PROBE_CLEARANCE cell` around the tip: what the edge at `phi` meets as
-//! the tool advances, read where the tool has not cut yet. The clearance of 1.5 cells keeps
-//! the four cell centres the probe interpolates outside the cutter's swept path for any feed
-//! direction (they lie within `sqrt(2)` cells of the probe), so the engagement never reads the
-//! material the tool itself has just removed; a wall parallel to the feed (the previous pass
+//! the tool advances, read where the tool has not cut yet. The clearance of 2 cells keeps the
+//! four cell centres the probe interpolates outside the cutter's swept path and its rim's band
+//! of half a cell ([`super::stock`]) for any feed direction (they lie within `sqrt(2)` cells
+//! of the probe), so the engagement never reads the material the tool itself has just removed; a wall parallel to the feed (the previous pass
 //! of a side cut) is read at its exact lateral offset, so the radial width of cut is not
 //! biased by the clearance.
 //!
@@ -31,7 +31,7 @@ use super::stock::ZMap;
 /// Angles probed over the front half of the cutter (1 degree apart): `phi_k = k pi / 180`.
 pub const ANGLES: usize = 181;
 /// How far outside the cutter the probes lie, in cells of the z-map (see the module docs).
-pub const PROBE_CLEARANCE: f64 = 1.5;
+pub const PROBE_CLEARANCE: f64 = 2.0;
 /// Least depth \[m\] a report counts as an engaged arc (1 um); the force has no threshold.
 pub const MIN_DEPTH: f64 = 1.0e-6;
 /// Most separate engaged arcs one contact keeps; further arcs are merged into the last.

@@ -605,13 +605,6 @@ pub fn run_streaming<S: Sink + ?Sized>(
         }
     }
     let cell_updates = nominal.cell_updates + unc.cell_updates + comp.cell_updates;
-    #[cfg(feature = "std")]
-    std::eprintln!(
-        "DEBUG cells {} {} {}",
-        nominal.cell_updates,
-        unc.cell_updates,
-        comp.cell_updates
-    );
     Ok(Report {
         samples: Vec::new(),
         summary,

@@ -355,7 +355,10 @@ impl Report {
     /// A predicted part against the nominal one: the floors (cells both cut, by more than
     /// [`super::engagement::MIN_DEPTH`]: height above the nominal, > 0 where material is
     /// left), and the walls' shift as the areas cut by one and not the other \[m^2\] (a
-    /// height map sees a wall moved sideways as a full-depth step; the areas measure it).
+    /// height map sees a wall moved sideways as a full-depth step; the areas measure it). A
+    /// cell keeps the mean height over its area ([`super::stock`]): a wall moved by less than
+    /// half a cell changes the height of the cells its rim crosses, which the floor figures
+    /// count.
     pub fn surface_error(&self, predicted: &ZMap) -> SurfaceError {
         let cut = |h: f64| h < self.top - super::engagement::MIN_DEPTH;
         let area = self.nominal.cell() * self.nominal.cell();

@@ -10,6 +10,15 @@
 //! `z(t) + R - sqrt(R^2 - d(t)^2)` is convex in the move's parameter and is minimised by a
 //! safeguarded Newton search on its derivative to 1e-12 of the move.
 //!
+//! A height is the mean over its cell: a cell whose centre lies within half a cell of the
+//! cutter's rim (closest approach `d` of the move, `|d - R| < cell / 2`) is cut over the part
+//! of the cell the cutter covers, `f = 1/2 + (R - d) / cell` (exact for a rim parallel to a
+//! cell side), to `z + (top - z)(1 - f)` with `z` the cutter's surface under the rim (its
+//! rim height past it) and `top` the stock's top. So the part, like the engagement, changes
+//! continuously with the tool's position: a wall does not jump by a cell's full depth when
+//! the tool moves a nanometre past a cell centre (the compensated tool, a few nanometres
+//! off the program, cut whole cells the nominal tool did not).
+//!
 //! The engagement ([`super::engagement`]) reads the stock between cell centres as the
 //! bilinear interpolation of the clipped depths `max(0, h - z)` of the four centres around a
 //! point ([`ZMap::depth_at`]; outside the grid a centre counts as no material), a surface
@@ -72,6 +81,8 @@ pub struct ZMap {
     ny: usize,
     /// Row-major heights: cell (i, j) at `j * nx + i` (i along x).
     heights: Vec<f64>,
+    /// The stock's top \[m\]: the height of the part of a cell the cutter's rim leaves.
+    top: f64,
 }
 
 impl ZMap {
@@ -169,6 +180,7 @@ impl ZMap {
             nx,
             ny,
             heights,
+            top,
         })
     }
 
@@ -309,8 +321,8 @@ impl ZMap {
         let short = (to.xy() - from.xy()).norm() < cell;
         let crescent = after && self.crescent(cutter, from, to);
         // The cells whose centres can lie within r of the move.
-        let lo = from.xy().inf(&to.xy()) - Vector2::repeat(r) - self.origin;
-        let hi = from.xy().sup(&to.xy()) + Vector2::repeat(r) - self.origin;
+        let lo = from.xy().inf(&to.xy()) - Vector2::repeat(r + 0.5 * cell) - self.origin;
+        let hi = from.xy().sup(&to.xy()) + Vector2::repeat(r + 0.5 * cell) - self.origin;
         let index = |v: f64, n: usize| -> usize {
             let k = ComplexField::floor(v / cell - 0.5);
             if k <= 0.0 {
@@ -337,6 +349,7 @@ impl ZMap {
             p0: from.xy(),
             b: to.xy() - from.xy(),
             r,
+            top: self.top,
             area: cell * cell,
         };
         let mut removal = Removal::default();
@@ -389,7 +402,9 @@ impl ZMap {
             let w = ComplexField::sqrt(reach * reach - dy * dy);
             let (a, b) = (clamp(above(to.x - w)), clamp(below(to.x + w) + 1.0));
             let df = cy - from.y;
-            let inner = r * r - df * df;
+            // Cells fully under the disc at `from` (inside its rim's band) are at or below it.
+            let core = (r - 0.5 * cell).max(0.0);
+            let inner = core * core - df * df;
             if inner <= 0.0 {
                 pass.row(row, a, b, cy, origin.x, cell, &mut removal);
                 continue;
@@ -480,12 +495,13 @@ struct Pass<'a> {
     p0: Vector2<f64>,
     b: Vector2<f64>,
     r: f64,
+    top: f64,
     area: f64,
 }
 
 impl Pass<'_> {
     /// Lowers the cells `i0..i1` of one row (centre height `cy`), each to the lowest point
-    /// of the cutter above its centre. A cell at or below the lower end of the move keeps
+    /// of the cutter above its centre (see [`ZMap::cut`] for the rim's band). A cell at or below the lower end of the move keeps
     /// its height (most cells under a tool cutting a floor), and for a ball one at or below
     /// `floor + R - sqrt(R^2 - d^2)` at `d` from the move (the cells the last samples left
     /// on the ball's surface) is passed over without a search.
@@ -508,6 +524,10 @@ impl Pass<'_> {
         let ball = matches!(self.cutter, Cutter::Ball { .. });
         let (r, floor) = (self.r, self.floor);
         let r2 = r * r;
+        // The rim's band: cells within half a cell of the rim are cut in proportion to the
+        // part of the cell the cutter covers.
+        let inner = (r - 0.5 * cell).max(0.0);
+        let (inner2, outer2) = (inner * inner, (r + 0.5 * cell) * (r + 0.5 * cell));
         for (k, h) in cells.iter_mut().enumerate() {
             if *h <= floor {
                 continue;
@@ -516,10 +536,27 @@ impl Pass<'_> {
             let a = self.p0 - c;
             let t = (-a.dot(&self.b) * inv_bb).clamp(0.0, 1.0);
             let d2 = (a + self.b * t).norm_squared();
-            if d2 > r2 {
+            if d2 > outer2 {
                 continue;
             }
-            let z = if ball {
+            let z = if d2 > inner2 {
+                // The surface under the rim (or the rim's height at the closest approach,
+                // past it), raised towards the stock's top over the part of the cell the
+                // cutter does not cover: continuous in the tool's position.
+                let d = ComplexField::sqrt(d2);
+                let rim = |t: f64| {
+                    let z = self.from.z + (self.to.z - self.from.z) * t;
+                    if ball { z + r } else { z }
+                };
+                let under = if d2 <= r2 {
+                    lowest(self.cutter, self.from, self.to, &c)
+                } else {
+                    None
+                };
+                let zs = under.unwrap_or_else(|| rim(t));
+                let covered = ((r - d) / cell + 0.5).clamp(0.0, 1.0);
+                Some(zs + (self.top - zs).max(0.0) * (1.0 - covered))
+            } else if ball {
                 let rise = r + floor - *h;
                 if rise >= 0.0 && d2 >= r2 - rise * rise {
                     continue;
