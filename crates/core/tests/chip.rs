@@ -100,8 +100,10 @@ fn one_depth_everywhere_is_the_closed_form() {
     let tool = Tool::new(0.016, 3, 0.3).unwrap();
     let model = ChipModel::new(&C, &tool);
     let (a, fz) = (0.004, 1.2e-4);
-    let mut chip = Chip::default();
-    chip.depth = [a; ANGLES];
+    let chip = Chip {
+        depth: [a; ANGLES],
+        ..Chip::default()
+    };
     let (f, m) = model.wrench(&chip, fz);
     let e = Engagement::slot(a, fz);
     let exact = cutting::average(&C, &tool, &e).unwrap();
@@ -161,7 +163,7 @@ proptest! {
         heights in prop::collection::vec(-1.0e-3..3.0e-3f64, 24 * 24),
         x in 0.0105..0.0135f64, y in 0.0105..0.0135f64, zt in -1.0e-3..1.0e-3f64,
         dx in -2e-6..2e-6f64, dy in -2e-6..2e-6f64, dz in -2e-6..2e-6f64,
-        angle in 0.0..6.28f64, fz in 0.0..2.0e-4f64,
+        angle in 0.0..core::f64::consts::TAU, fz in 0.0..2.0e-4f64,
     ) {
         let cell = 1.0e-3;
         // Every cell at its random height: a fresh map whose top is the highest, each cell
