@@ -26,6 +26,7 @@
 pub mod jobs;
 pub mod mcap_log;
 pub mod noise;
+pub mod npz_stream;
 pub mod plot_style;
 pub mod rapier_util;
 pub mod scenes;

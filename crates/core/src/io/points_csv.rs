@@ -127,7 +127,10 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
         });
         at = end;
     }
-    Ok(Program { moves })
+    Ok(Program {
+        moves,
+        operations: Vec::new(),
+    })
 }
 
 /// Reads a points CSV file (at most [`super::MAX_FILE_BYTES`]).

@@ -7,6 +7,7 @@
 //! program that never sets them leaves at zero). A robot's TCP is the tool tip, so a move's
 //! points are the tool tip's, whatever tool length (`G43`) the program selects.
 
+use alloc::string::String;
 use alloc::vec::Vec;
 
 use nalgebra::{ComplexField, Vector3};
@@ -341,10 +342,26 @@ impl Move {
 pub struct Program {
     /// The moves, in program order.
     pub moves: Vec<Move>,
+    /// The operations the program's moves fall into, in order of their first move (empty:
+    /// one operation). What a CAM system calls a toolpath: the G-code reader starts one at
+    /// each tool change and at each comment line standing alone between moves (the CAM's
+    /// operation name: `(2D Pocket1)`, `( Profile1 )`), named by the last such comment.
+    pub operations: Vec<Operation>,
+}
+
+/// A stretch of a program's moves: one operation of the CAM system.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Operation {
+    /// The name: the comment that started it, trimmed, or `T<n>` after a tool change without
+    /// one.
+    pub name: String,
+    /// Index of its first move in [`Program::moves`].
+    pub first_move: usize,
 }
 
 impl Program {
-    /// Checks a program however it was made (read, built by hand, unpickled): at most
+    /// Checks a program however it was made (read, built by hand, unpickled): operations
+    /// in order of their first moves, each a move of the program; at most
     /// [`MAX_MOVES`] moves, lines >= 1, points finite within [`MAX_COORDINATE`], each move
     /// starting where the one before ends (within [`MAX_GAP`]), feeds in `[0, MAX_FEED]`,
     /// spindle speeds within `MAX_SPINDLE_RPM / 60` rev/s either way, tools up to
@@ -377,6 +394,18 @@ impl Program {
             previous = Some(m.end);
             check_move(i, m)?;
         }
+        let mut last: Option<usize> = None;
+        for (index, o) in self.operations.iter().enumerate() {
+            if o.first_move >= self.moves.len() || last.is_some_and(|l| o.first_move <= l) {
+                return Err(BuildError::InvalidEntry {
+                    what: "program operations (index: the operation)",
+                    index,
+                    value: o.first_move as f64,
+                    expected: "first moves increasing, each an index of the moves",
+                });
+            }
+            last = Some(o.first_move);
+        }
         Ok(())
     }
 
@@ -387,6 +416,14 @@ impl Program {
             .filter(|m| m.is_feed())
             .map(Move::length)
             .sum()
+    }
+
+    /// The index in [`Self::operations`] of the operation move `index` belongs to (0 when
+    /// the program has none listed).
+    pub fn operation_of(&self, index: usize) -> usize {
+        self.operations
+            .partition_point(|o| o.first_move <= index)
+            .saturating_sub(1)
     }
 
     /// The tool numbers the program's moves use, ascending, each once.

@@ -100,10 +100,11 @@ pub struct JobArgs {
         "Stock top in the workpiece frame [mm]", "CAM's usual zero"
     ))]
     pub top: f64,
-    #[arg(long, default_value_t = 0.5, allow_negative_numbers = true, help = CELL_MM.help(
-        "Z-map cell [mm]", "At most 2^24 cells (MAX_CELLS)"
+    #[arg(long, allow_negative_numbers = true, help = CELL_MM.help(
+        "Z-map cell [mm]",
+        "Default: the smallest cutting tool's diameter / 12, within [0.1, 0.5] mm; at most 2^24 cells (MAX_CELLS)"
     ))]
-    pub cell: f64,
+    pub cell: Option<f64>,
     #[command(flatten)]
     pub tool: ToolArgs,
     #[arg(long, default_value_t = 250.0, allow_negative_numbers = true, help = RATE_HZ.help(
@@ -126,6 +127,22 @@ pub struct JobArgs {
         "Lead of the pilot-control forces in the samples CSV [ms]", "The paper used 40 ms"
     ))]
     pub lead_ms: f64,
+    /// Also write every sample as CSV (job_samples.csv; the .npz and the MCAP log are always
+    /// written).
+    #[arg(long)]
+    pub samples_csv: bool,
+    #[arg(long, default_value_t = 25.0, allow_negative_numbers = true, help = LOG_RATE_HZ.help(
+        "Messages per second of program in the MCAP log (job.mcap) [Hz]",
+        "0: every sample; the .npz has every sample"
+    ))]
+    pub log_rate: f64,
+    #[arg(
+        long,
+        default_value_t = 2,
+        help = "Threads: 1 runs the pass on one; 2 or more run \
+        its two predictions side by side (the results do not depend on it) [1..=64]"
+    )]
+    pub threads: usize,
     #[arg(long, default_value_t = 0.001, allow_negative_numbers = true, help = TOLERANCE_MM.help(
         "Largest distance of the compensated G-code from the commanded path [mm]", ""
     ))]
@@ -136,7 +153,16 @@ impl JobArgs {
     /// Checks every numeric flag and the lengths of the lists.
     pub fn check(&self) -> Result<(), CliError> {
         TOP_MM.check(self.top)?;
-        CELL_MM.check(self.cell)?;
+        if let Some(cell) = self.cell {
+            CELL_MM.check(cell)?;
+        }
+        LOG_RATE_HZ.check(self.log_rate)?;
+        if !(1..=64).contains(&self.threads) {
+            return Err(CliError::Usage(format!(
+                "--threads {}: expected 1..=64",
+                self.threads
+            )));
+        }
         self.tool.check()?;
         RATE_HZ.check(self.rate)?;
         PATH_ACCELERATION.check(self.acceleration)?;

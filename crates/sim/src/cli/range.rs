@@ -155,6 +155,8 @@ pub const ATLAS_POINTS: Range = Range::closed("--region", 1.0, 100.0, "points pe
 pub const ANGLE_STEP: Range = Range::closed("--angle-step", 0.1, 90.0, "deg");
 /// `job --cell`: z-map resolution.
 pub const CELL_MM: Range = Range::closed("--cell", 0.01, 10.0, "mm");
+/// `job --log-rate`.
+pub const LOG_RATE_HZ: Range = Range::closed("--log-rate", 0.0, 10000.0, "Hz");
 /// `job --diameter`: end mill diameter.
 pub const DIAMETER_MM: Range = Range::closed("--diameter", 0.1, 200.0, "mm");
 /// `job --flutes`.

@@ -20,6 +20,7 @@ use deflect_sim::SimError;
 use deflect_sim::scenes::milling::part_map;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
+use super::job_files::{FileOptions, JobFiles, OperationFigures};
 use super::serial::{load_robot, read_program, read_text};
 use super::stdout;
 use crate::cli::{CliError, JobArgs, ToolArgs};
@@ -227,6 +228,30 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         }
         None => None,
     };
+    // The z-map resolves the smallest cutting tool: a twelfth of its diameter, within
+    // [0.1, 0.5] mm (finer cells for small tools keep the force's sensitivity to the tool's
+    // position what the cutter, not the grid, makes it).
+    let smallest = match &table {
+        Some(t) => t
+            .tools()
+            .iter()
+            .filter(|spec| {
+                program
+                    .moves
+                    .iter()
+                    .any(|m| m.is_feed() && m.tool == spec.number)
+            })
+            .map(|spec| spec.tool.diameter * 1e3)
+            .fold(f64::INFINITY, f64::min),
+        None => a.tool.diameter,
+    };
+    let cell_mm = a.cell.unwrap_or_else(|| {
+        if smallest.is_finite() {
+            (smallest / 12.0).clamp(0.1, 0.5)
+        } else {
+            0.5
+        }
+    });
     let setup = Setup {
         placement,
         tool_orientation: Setup::tool_down(),
@@ -236,7 +261,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             min,
             max,
             top: a.top * 1e-3,
-            cell: a.cell * 1e-3,
+            cell: cell_mm * 1e-3,
         },
         path: PathOptions {
             rate_hz: a.rate,
@@ -342,26 +367,38 @@ fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
     (text, json)
 }
 
-/// The summary as text lines and JSON.
-fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
+/// The summary as text lines and JSON: the run, the tools, per operation, the ten lines of
+/// largest force, where the compensated prediction leaves the program, and the totals.
+fn summary(
+    t: &JobTask,
+    r: &Report,
+    ops: &[OperationFigures],
+    wall: f64,
+    threads: usize,
+) -> (String, serde_json::Value) {
     let (pu, pc) = (r.path_error(false), r.path_error(true));
     let (su, sc) = (
         r.surface_error(&r.uncompensated),
         r.surface_error(&r.compensated),
     );
-    let duration = r.samples.last().map_or(0.0, |s| s.path.time);
-    let fmax = r.samples.iter().map(|s| s.force.norm()).fold(0.0, f64::max);
+    let sm = &r.summary;
+    let duration = sm.duration();
+    let fmax = sm.max_force();
+    let cell = t.job.setup().stock.cell;
     let mut text = String::new();
     let _ = writeln!(
         text,
         "job: {} on {}: {} samples at {} Hz over {duration:.2} s of program, in {wall:.2} s \
-         ({:.0} samples/s, {:.0} z-map cell updates/s); {} plunge samples (no side force)",
+         on {threads} thread{} ({:.0} samples/s, {:.0} z-map cell updates/s); z-map cells of \
+         {:.3} mm; {} plunge samples (no side force)",
         t.program_name,
         t.robot_name,
-        r.samples.len(),
+        sm.samples(),
         r.rate_hz,
-        r.samples.len() as f64 / wall.max(1e-9),
+        if threads == 1 { "" } else { "s" },
+        sm.samples() as f64 / wall.max(1e-9),
         r.cell_updates as f64 / wall.max(1e-9),
+        cell * 1e3,
         r.plunge_samples
     );
     let (tools, tools_json) = tools_text(t);
@@ -378,30 +415,103 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
         );
     }
     let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
-    let _ = writeln!(text, "line  samples  mean |F| [N]  max |F| [N]");
-    let lines = r.line_forces();
-    for l in lines.iter().filter(|l| l.max > 0.0) {
+    let _ = writeln!(
+        text,
+        "\noperations ({}): path error max [mm] uncompensated -> compensated",
+        ops.len()
+    );
+    let _ = writeln!(
+        text,
+        "{:<32} {:>6} {:>5} {:>10} {:>9} {:>9} {:>14} {:>12}",
+        "operation",
+        "line",
+        "tool",
+        "time [s]",
+        "max |F|",
+        "mean |F|",
+        "uncompensated",
+        "compensated"
+    );
+    let name_width = 32;
+    for o in ops {
+        let name = deflect_sim::scenes::milling::part_map::shorten(&o.name, 32 * 9, 16);
+        let name: String = name.chars().take(name_width).collect();
         let _ = writeln!(
             text,
-            "{:>4}  {:>7}  {:>12.1}  {:>11.1}",
+            "{name:<32} {:>6} {:>5} {:>10.1} {:>9.1} {:>9.1} {:>14.4} {:>12.6}",
+            o.line,
+            format!("T{}", o.tool),
+            o.end - o.start,
+            o.max_force,
+            o.sum_force / o.samples.max(1) as f64,
+            o.error_uncompensated * 1e3,
+            o.error_compensated * 1e3
+        );
+    }
+    let lines = r.line_forces();
+    let mut top: Vec<_> = lines.iter().filter(|l| l.max > 0.0).collect();
+    top.sort_by(|a, b| b.max.total_cmp(&a.max));
+    top.truncate(10);
+    let _ = writeln!(text, "\nthe ten program lines of largest force");
+    let _ = writeln!(
+        text,
+        "{:>6}  {:>7}  {:>12}  {:>11}  {:>22}",
+        "line", "samples", "mean |F| [N]", "max |F| [N]", "path error max [mm] u/c"
+    );
+    for l in &top {
+        let _ = writeln!(
+            text,
+            "{:>6}  {:>7}  {:>12.1}  {:>11.1}  {:>11.4} / {:.6}",
             l.line,
             l.samples,
             l.mean.norm(),
-            l.max
+            l.max,
+            l.error_uncompensated * 1e3,
+            l.error_compensated * 1e3
         );
     }
     let mut off: Vec<_> = lines.iter().filter(|l| l.deviation.is_some()).collect();
     off.sort_by(|a, b| b.error_compensated.total_cmp(&a.error_compensated));
-    for l in off.iter().take(10) {
+    let tol = job::PREDICTION_TOLERANCE;
+    if off.is_empty() {
         let _ = writeln!(
             text,
-            "DEBUG line {} compensated error {:.4} mm residual {:.2e} m ({})",
-            l.line,
-            l.error_compensated * 1e3,
-            l.residual,
-            l.deviation.map_or("", |d| d.name())
+            "\nthe compensated prediction stays within {:.0} um of the program on every line \
+             (largest {:.2e} mm; coupling residual at most {:.1e} m)",
+            tol * 1e6,
+            pc.max * 1e3,
+            sm.max_residual()[1]
         );
+    } else {
+        let _ = writeln!(
+            text,
+            "\nthe compensated prediction leaves the program by more than {:.0} um on {} lines \
+             ({} samples); the worst:",
+            tol * 1e6,
+            off.len(),
+            sm.deviating_samples()
+        );
+        for l in off.iter().take(10) {
+            let why = match l.deviation {
+                Some(job::Deviation::Coupling) => {
+                    "the force-deflection coupling does not converge (the force changes faster \
+                     with the tool's position than the arm holds it; a finer --cell may help)"
+                }
+                _ => {
+                    "the compensated tool meets a stock an earlier deviation left (beyond the \
+                     offline compensation)"
+                }
+            };
+            let _ = writeln!(
+                text,
+                "  line {}: {:.4} mm, residual {:.1e} m: {why}",
+                l.line,
+                l.error_compensated * 1e3,
+                l.residual
+            );
+        }
     }
+    let _ = writeln!(text);
     for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
         let _ = writeln!(
             text,
@@ -422,13 +532,25 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
             "material_left_m2": s.material_left, "overcut_m2": s.overcut,
         })
     };
+    let line_json = |l: &job::LineSummary| {
+        serde_json::json!({
+            "line": l.line, "samples": l.samples,
+            "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
+            "path_error_uncompensated_m": l.error_uncompensated,
+            "path_error_compensated_m": l.error_compensated,
+            "coupling_residual_m": l.residual,
+            "deviation": l.deviation.map(job::Deviation::name),
+        })
+    };
     let json = serde_json::json!({
         "program": t.program_name,
         "robot": t.robot_name,
-        "samples": r.samples.len(),
+        "samples": sm.samples(),
         "rate_hz": r.rate_hz,
         "duration_s": duration,
         "wall_time_s": wall,
+        "threads": threads,
+        "cell_m": cell,
         "cell_updates": r.cell_updates,
         "plunge_samples": r.plunge_samples,
         "max_force_n": fmax,
@@ -437,33 +559,130 @@ fn summary(t: &JobTask, r: &Report, wall: f64) -> (String, serde_json::Value) {
             "line": c.line, "time_s": c.time, "depth_m": c.depth,
         })),
         "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
-        "lines": lines.iter().map(|l| serde_json::json!({
-            "line": l.line, "samples": l.samples,
-            "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
+        "operations": ops.iter().map(|o| serde_json::json!({
+            "name": o.name, "line": o.line, "tool": o.tool, "samples": o.samples,
+            "start_s": o.start, "end_s": o.end, "max_force_n": o.max_force,
+            "mean_force_n": o.sum_force / o.samples.max(1) as f64,
+            "path_error_uncompensated_m": o.error_uncompensated,
+            "path_error_compensated_m": o.error_compensated,
+            "deviating_samples": o.deviating,
         })).collect::<Vec<_>>(),
+        "top_lines": top.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
+        "deviating_lines": off.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
+        "prediction_tolerance_m": tol,
+        "coupling_residual_max_m": sm.max_residual(),
         "uncompensated": stats(pu, su),
         "compensated": stats(pc, sc),
     });
     (text, json)
 }
 
-/// Runs the pass and writes its files.
+/// A progress bar over the program's duration \[s\] with its ETA on stderr: drawn once the
+/// job has run a second, never when stderr is not a terminal or under CI.
+struct Progress {
+    bar: indicatif::ProgressBar,
+    started: Instant,
+    shown: bool,
+    allowed: bool,
+}
+
+impl Progress {
+    fn new(duration: f64) -> Self {
+        use std::io::IsTerminal;
+        let allowed = std::io::stderr().is_terminal()
+            && !std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0");
+        let bar = indicatif::ProgressBar::with_draw_target(
+            Some((duration * 1e3).ceil().max(1.0) as u64),
+            indicatif::ProgressDrawTarget::hidden(),
+        );
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{msg} [{bar:40}] {percent:>3}% of the program, {elapsed_precise} (ETA {eta})",
+        ) {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar.set_message("job");
+        Self {
+            bar,
+            started: Instant::now(),
+            shown: false,
+            allowed,
+        }
+    }
+
+    fn at(&mut self, time: f64) {
+        if self.allowed && !self.shown && self.started.elapsed().as_secs_f64() > 1.0 {
+            self.shown = true;
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        self.bar.set_position((time * 1e3) as u64);
+    }
+
+    fn done(&self) {
+        self.bar.finish_and_clear();
+    }
+}
+
+/// Runs the pass, streaming its samples to the files on a writer thread, then writes the
+/// part map and the summary.
 pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
     let started = Instant::now();
-    let r = job::run(&t.job, &t.program, &t.seed)
+    let setup = t.job.setup();
+    let duration = deflect_core::machining::path::duration(&t.program, &setup.path)
         .map_err(|e| SimError::new(format!("{}: {e}", t.program_name)))?;
-    let wall = started.elapsed().as_secs_f64();
-    let write = |name: &str, text: &str| {
-        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
+    let options = FileOptions {
+        out: out.to_path_buf(),
+        tolerance: a.tolerance * 1e-3,
+        csv: a.samples_csv.then_some(a.lead_ms * 1e-3),
+        log_rate: a.log_rate,
+        rate_hz: setup.path.rate_hz,
+        robot: t.robot_name.clone(),
+        dof: t.job.model().dof(),
+        to_base: setup.placement.rotation,
     };
-    write(
-        "job_compensated.nc",
-        &job_out::compensated_gcode(&r, &t.program, a.tolerance * 1e-3),
-    )?;
-    write(
-        "job_samples.csv",
-        &job_out::samples_csv(&r, a.lead_ms * 1e-3),
-    )?;
+    let files = JobFiles::create(&t.program, &options)?;
+    let mut progress = Progress::new(duration);
+    let run_options = job::RunOptions {
+        threads: a.threads,
+        ..job::RunOptions::default()
+    };
+    let (report, written) = std::thread::scope(|scope| {
+        // Two chunks in flight at most: the writer's memory is bounded too.
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<job::JobSample>>(2);
+        let writer = scope.spawn(move || -> Result<_, SimError> {
+            let mut files = files;
+            for chunk in rx {
+                files.write(&chunk)?;
+            }
+            files.finish()
+        });
+        let mut sink = |chunk: &[job::JobSample]| -> Result<(), SimError> {
+            if let Some(last) = chunk.last() {
+                progress.at(last.path.time);
+            }
+            tx.send(chunk.to_vec())
+                .map_err(|_| SimError::new("the file writer stopped"))
+        };
+        let run = job::run_streaming(&t.job, &t.program, &t.seed, &run_options, &mut sink);
+        drop(sink);
+        drop(tx);
+        let written = writer
+            .join()
+            .map_err(|_| SimError::new("the file writer panicked"))?;
+        match (run, written) {
+            (Ok(r), Ok(w)) => Ok((r, w)),
+            // The writer's own error says more than the run's "writer stopped".
+            (_, Err(e)) => Err(e),
+            (Err(job::RunError::Job(e)), _) => {
+                Err(SimError::new(format!("{}: {e}", t.program_name)))
+            }
+            (Err(job::RunError::Sink(e)), _) => Err(e),
+        }
+    })?;
+    progress.done();
+    let (ops, paths) = written;
+    let wall = started.elapsed().as_secs_f64();
+    let r = report;
     let png = out.join("job_part.png");
     let label = |name: &str, part| {
         let s = r.surface_error(part);
@@ -479,26 +698,38 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         label("uncompensated", &r.uncompensated),
         label("compensated offline", &r.compensated),
     );
+    let short_name = Path::new(&t.program_name).file_name().map_or_else(
+        || t.program_name.clone(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     part_map::plot_part_deviation(
         &png,
         &format!(
-            "{} on {}: the part's height above the nominal one",
-            t.program_name, t.robot_name
+            "{short_name} on {}: the part's height above the nominal one",
+            t.robot_name
         ),
         &r.nominal,
         &[(&lu, &r.uncompensated), (&lc, &r.compensated)],
-        t.job.setup().stock.top,
+        setup.stock.top,
     )?;
-    let (text, json) = summary(t, &r, wall);
+    let (text, json) = summary(t, &r, &ops, wall, a.threads);
+    let write = |name: &str, text: &str| {
+        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
+    };
     write("job_summary.txt", &text)?;
     write(
         "job_summary.json",
         &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
     )?;
+    let names: Vec<String> = paths
+        .iter()
+        .chain([&png])
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
     stdout(format_args!(
-        "{text}outputs: {}/job_compensated.nc, job_samples.csv, job_part.png, \
-         job_summary.{{txt,json}}\n",
-        out.display()
+        "{text}outputs in {}: {}, job_summary.{{txt,json}}\n",
+        out.display(),
+        names.join(", ")
     ))
 }
 

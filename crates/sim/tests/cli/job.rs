@@ -146,20 +146,49 @@ fn job_writes_the_compensated_program_samples_heat_map_and_summary() {
         .unwrap();
     let co = summary["compensated"]["path_error_max_m"].as_f64().unwrap();
     assert!(un > 1e-4 && co < 1e-7, "{un} {co}");
-    // The slot line (file line 4) carries the force.
-    let lines = summary["lines"].as_array().unwrap();
-    assert!(
-        lines
-            .iter()
-            .any(|l| l["line"] == 4 && l["max_force_n"].as_f64().unwrap() > 50.0)
-    );
+    // The slot line (file line 4) carries the largest force; it is the first of the ten.
+    let lines = summary["top_lines"].as_array().unwrap();
+    assert!(lines.len() <= 10);
+    assert!(lines[0]["line"] == 4 && lines[0]["max_force_n"].as_f64().unwrap() > 50.0);
+    assert!(summary["deviating_lines"].as_array().unwrap().is_empty());
+    // One operation (the program has no comments): all its samples.
+    let ops = summary["operations"].as_array().unwrap();
+    assert_eq!(ops.len(), 1);
+    assert_eq!(ops[0]["samples"], summary["samples"]);
     let gcode = std::fs::read_to_string(out.join("job_compensated.nc")).unwrap();
     assert!(
         gcode.contains("(program line 4)") && gcode.contains("G1 X"),
         "{gcode}"
     );
+    // The samples: no CSV unless asked; the archive has every sample.
+    assert!(!out.join("job_samples.csv").exists());
+    let npz = std::fs::read(out.join("job_samples.npz")).unwrap();
+    assert_eq!(&npz[..2], b"PK");
+    let mcap = std::fs::read(out.join("job.mcap")).unwrap();
+    assert_eq!(&mcap[1..5], b"MCAP");
+    let o = sim(&[
+        "job",
+        "--program",
+        program.to_str().unwrap(),
+        "--stock",
+        "0,-20,50,20",
+        "--samples-csv",
+        "--threads",
+        "1",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
     let csv = std::fs::read_to_string(out.join("job_samples.csv")).unwrap();
     assert!(csv.starts_with("time_s,line,x_m"));
+    // One thread or two: the same figures.
+    let again: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("job_summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(again["compensated"], summary["compensated"]);
+    assert_eq!(again["top_lines"], summary["top_lines"]);
+    let rows = csv.lines().count() - 1;
+    assert_eq!(Some(rows as u64), summary["samples"].as_u64());
     let png = std::fs::read(out.join("job_part.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
@@ -232,8 +261,12 @@ fn job_explains_a_programs_words_and_runs_two_tools_on_a_hand_started_spindle() 
             .unwrap();
     assert_eq!(summary["hand_spindle_rpm"].as_f64(), Some(12000.0));
     assert_eq!(summary["tools"][1]["shape"], "ball");
-    // Both lines cut: the 10 mm slot (file line 6) and the 6 mm one (line 11).
-    let lines = summary["lines"].as_array().unwrap();
+    // Both lines cut: the 10 mm slot (file line 6) and the 6 mm one (line 11); each tool
+    // change starts an operation.
+    let ops = summary["operations"].as_array().unwrap();
+    assert_eq!(ops.len(), 2, "{ops:?}");
+    assert_eq!((ops[0]["tool"].as_u64(), ops[1]["tool"].as_u64()), (Some(1), Some(2)));
+    let lines = summary["top_lines"].as_array().unwrap();
     for l in [6, 11] {
         assert!(
             lines

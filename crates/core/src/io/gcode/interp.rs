@@ -115,6 +115,11 @@ pub(super) struct Machine {
     /// M70/M73 saved states.
     pub saved: Option<Modal>,
     pub moves: Vec<Move>,
+    /// The operations so far (see [`crate::machining::Program::operations`]), the name the
+    /// next one takes, and whether the next move starts one.
+    pub operations: Vec<crate::machining::Operation>,
+    pub operation_name: Option<String>,
+    pub operation_next: bool,
     /// The line of M2/M30 (or an M99 at the top level), once read.
     pub ended: Option<usize>,
     /// The physical line being run (1-based).
@@ -135,6 +140,23 @@ pub(super) fn rotate(v: Vector2<f64>, deg: f64) -> Vector2<f64> {
 }
 
 impl Machine {
+    /// A comment line standing alone: after moves it starts the next operation; the last
+    /// one before a move names it.
+    pub(super) fn note_comment(&mut self, text: &str) {
+        let name = text.trim();
+        if name.is_empty() {
+            return;
+        }
+        if self
+            .operations
+            .last()
+            .is_some_and(|o| o.first_move < self.moves.len())
+        {
+            self.operation_next = true;
+        }
+        self.operation_name = Some(name.chars().take(200).collect());
+    }
+
     pub(super) fn new(dialect: Dialect, start: Vector3<f64>, units: f64) -> Self {
         Self {
             dialect,
@@ -166,6 +188,9 @@ impl Machine {
             spline_pq: None,
             saved: None,
             moves: Vec::new(),
+            operations: Vec::new(),
+            operation_name: None,
+            operation_next: false,
             ended: None,
             line: 0,
             value: 0.0,
@@ -371,6 +396,7 @@ impl Machine {
         if w.m(6).is_some() {
             self.tool = self.selected;
             self.spindle_dir = 0;
+            self.operation_next = true;
         } else if let Some(column) = w.m(61) {
             let Some(q) = w.take(b'q').filter(|q| *q >= 0.0) else {
                 return fault(column, "M61 needs Q, the tool number (>= 0)");

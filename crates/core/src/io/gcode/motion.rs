@@ -307,6 +307,22 @@ impl Machine {
                 .to_string(),
             ));
         }
+        if self.operations.is_empty() || self.operation_next {
+            let tool = if self.tool == 0 {
+                self.selected
+            } else {
+                self.tool
+            };
+            let name = self
+                .operation_name
+                .take()
+                .unwrap_or_else(|| std::format!("T{tool}"));
+            self.operations.push(crate::machining::Operation {
+                name,
+                first_move: self.moves.len(),
+            });
+            self.operation_next = false;
+        }
         self.moves.push(Move {
             spindle: self.spindle(),
             // Before the first tool change, the tool the program selected (posts for manual

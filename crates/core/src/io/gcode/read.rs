@@ -84,7 +84,10 @@ pub(super) fn run(text: &str, options: &GcodeOptions) -> Result<Program, LoadErr
     };
     r.scan()?;
     r.main()?;
-    Ok(Program { moves: r.m.moves })
+    Ok(Program {
+        moves: r.m.moves,
+        operations: r.m.operations,
+    })
 }
 
 impl Scope for Reader<'_> {
@@ -261,6 +264,13 @@ impl Reader<'_> {
                     c.text.trim()
                 ),
             ));
+        }
+        if let Some(c) = &self.block.comment
+            && c.kind == CommentKind::Plain
+            && self.block.items.is_empty()
+            && self.block.o_word.is_none()
+        {
+            self.m.note_comment(&c.text);
         }
         let call = self.fanuc_call()?;
         self.m.execute(&mut self.words, &mut self.params)?;

@@ -80,7 +80,9 @@ pub fn plot_part_deviation(
         path,
         ((560 * parts.len().max(1) as u32 + 160).max(900), 600),
     )?;
-    let (plot, side) = figure(&root, title, 18, &[])?;
+    let (width, _) = root.dim_in_pixel();
+    let title = shorten(title, width.saturating_sub(40), 18);
+    let (plot, side) = figure(&root, &title, 18, &[])?;
     let (plot, side) = {
         let (w, _) = plot.dim_in_pixel();
         let _ = side;
@@ -93,7 +95,21 @@ pub fn plot_part_deviation(
     let panels = plot.split_evenly((1, parts.len().max(1)));
     for (area, (label, part)) in panels.iter().zip(parts) {
         let dev = deviations(nominal, part, top);
-        let caption = area.titled(label, ("sans-serif", 16)).map_err(perr)?;
+        // The label in lines that fit the panel (split at "; " and ": "), each shortened in
+        // the middle if it still does not.
+        let (pw, _) = area.dim_in_pixel();
+        let lines = wrap(label, pw.saturating_sub(16), 15);
+        let head_px = 8 + 19 * lines.len() as u32;
+        let (head, caption) = area.split_vertically(head_px);
+        let font = ("sans-serif", 15).into_font().color(&BLACK);
+        for (k, line) in lines.iter().enumerate() {
+            head.draw(&Text::new(
+                line.clone(),
+                (8, 4 + 19 * k as i32),
+                font.clone(),
+            ))
+            .map_err(perr)?;
+        }
         // Equal scales on x and y: the part's shape, not the panel's.
         let (w, h) = caption.dim_in_pixel();
         let pw = f64::from(w.saturating_sub(CHART.label_areas.1 + 24).max(1));
@@ -167,6 +183,52 @@ pub fn plot_part_deviation(
     present(&root, path)
 }
 
+/// About how many characters of a sans-serif font of `px` pixels fit in `width` pixels.
+fn chars_in(width: u32, px: u32) -> usize {
+    (f64::from(width) / (0.55 * f64::from(px.max(1))))
+        .floor()
+        .max(8.0) as usize
+}
+
+/// `text` cut in the middle (with "...") to fit `width` pixels at `px`.
+pub fn shorten(text: &str, width: u32, px: u32) -> String {
+    let max = chars_in(width, px);
+    let chars: Vec<char> = text.chars().collect();
+    if chars.len() <= max {
+        return text.to_string();
+    }
+    let keep = max.saturating_sub(3);
+    let head = keep / 2;
+    let tail = keep - head;
+    let mut out: String = chars.iter().take(head).collect();
+    out.push_str("...");
+    out.extend(chars.iter().skip(chars.len() - tail));
+    out
+}
+
+/// `text` in lines of at most `width` pixels at `px`: broken after "; " or ": " where a line
+/// would not fit, each line still too long shortened in the middle.
+pub fn wrap(text: &str, width: u32, px: u32) -> Vec<String> {
+    let max = chars_in(width, px);
+    let mut pieces: Vec<String> = Vec::new();
+    for part in text.split_inclusive("; ") {
+        for piece in part.split_inclusive(": ") {
+            pieces.push(piece.to_string());
+        }
+    }
+    let mut lines: Vec<String> = Vec::new();
+    for piece in pieces {
+        match lines.last_mut() {
+            Some(l) if l.chars().count() + piece.chars().count() <= max => l.push_str(&piece),
+            _ => lines.push(piece),
+        }
+    }
+    lines
+        .into_iter()
+        .map(|l| shorten(l.trim_end(), width, px))
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -178,5 +240,22 @@ mod tests {
         assert_eq!(deviation_color(-1.0), RGBColor(33, 102, 172));
         assert_eq!(deviation_color(5.0), deviation_color(1.0));
         assert_eq!(deviation_color(f64::NAN), deviation_color(0.0));
+    }
+
+    #[test]
+    fn long_titles_fit_their_width() {
+        let long = "a/very/long/path/to/the/program/of/a/user/who/names/files/at/length/part.nc";
+        let s = shorten(long, 200, 18);
+        assert!(s.chars().count() <= chars_in(200, 18), "{s}");
+        assert!(s.starts_with("a/very") && s.ends_with("part.nc") && s.contains("..."));
+        assert_eq!(shorten("short", 200, 18), "short");
+        let label =
+            "compensated offline: floors max 0.001 mm, RMS 0.000 mm; walls 0 mm^2 left, 0 overcut";
+        let lines = wrap(label, 300, 15);
+        assert!(lines.len() >= 2, "{lines:?}");
+        for l in &lines {
+            assert!(l.chars().count() <= chars_in(300, 15), "{l}");
+        }
+        assert_eq!(lines.concat().replace(' ', ""), label.replace(' ', ""));
     }
 }
