@@ -398,6 +398,7 @@ fn a_hand_built_program_is_checked_like_a_read_one() {
     );
     let ok = Program {
         moves: vec![line(a, b), line(b, c)],
+        ..Program::default()
     };
     ok.validate().unwrap();
     let text = |p: &Program| p.validate().unwrap_err().to_string();

@@ -5,7 +5,7 @@
 use deflect_core::io::gcode::{self, Dialect, GcodeOptions, WordStatus, WordUse};
 use deflect_core::io::points_csv;
 use deflect_core::machining::cutting::{self, Coefficients, Engagement, MAX_DISCS, Tool};
-use deflect_core::machining::{Motion, Move, PathControl, Plane, Program};
+use deflect_core::machining::{Motion, Move, Operation, PathControl, Plane, Program};
 use deflect_core::motion::MAX_SAMPLES;
 use deflect_core::units::LengthUnit;
 use nalgebra::Vector3;
@@ -36,7 +36,7 @@ type MoveState = (
 type WordState = (String, String, usize, usize, String);
 
 /// A program as pickled: its moves and its word report.
-type ProgramState = (Vec<MoveState>, Vec<WordState>);
+type ProgramState = (Vec<MoveState>, Vec<WordState>, Vec<(String, usize)>);
 
 /// A machining program read from RS274/NGC G-code as LinuxCNC reads it (tools, work
 /// offsets, planes, canned cycles, parameters, subroutines, control flow): its moves as
@@ -199,18 +199,36 @@ impl GcodeProgram {
         let rebuild = slf.get_type().getattr("_from_state")?;
         let me = slf.get();
         let state = me.inner.moves.iter().map(move_state).collect();
-        Ok((rebuild, (state, me.words.iter().map(word_state).collect())))
+        let ops = me
+            .inner
+            .operations
+            .iter()
+            .map(|o| (o.name.clone(), o.first_move))
+            .collect();
+        Ok((
+            rebuild,
+            (state, me.words.iter().map(word_state).collect(), ops),
+        ))
     }
 
     /// The program of a pickled state (see `__reduce__`), checked.
     #[staticmethod]
-    fn _from_state(state: Vec<MoveState>, words: Vec<WordState>) -> PyResult<Self> {
+    #[pyo3(signature = (state, words, operations=Vec::new()))]
+    fn _from_state(
+        state: Vec<MoveState>,
+        words: Vec<WordState>,
+        operations: Vec<(String, usize)>,
+    ) -> PyResult<Self> {
         let moves = state
             .into_iter()
             .enumerate()
             .map(|(i, m)| from_move_state(i, m))
             .collect::<PyResult<Vec<_>>>()?;
-        let inner = Program { moves };
+        let operations = operations
+            .into_iter()
+            .map(|(name, first_move)| Operation { name, first_move })
+            .collect();
+        let inner = Program { moves, operations };
         inner.validate().map_err(build_err)?;
         let words = words
             .into_iter()
@@ -251,6 +269,20 @@ impl GcodeProgram {
             self.inner.moves.len(),
             self.inner.cutting_length()
         )
+    }
+
+    /// The program's operations (a CAM toolpath each: a tool change or a comment line
+    /// standing alone between moves starts one): `(name, first_move, first_line)` in order.
+    #[getter]
+    fn operations(&self) -> Vec<(String, usize, usize)> {
+        self.inner
+            .operations
+            .iter()
+            .map(|o| {
+                let line = self.inner.moves.get(o.first_move).map_or(0, |m| m.line);
+                (o.name.clone(), o.first_move, line)
+            })
+            .collect()
     }
 
     /// The program line of each move (1-based), (n,).

@@ -430,6 +430,68 @@ impl MachiningResult {
         })
     }
 
+    /// Force the compensated tool feels where it is (n, 3) [N].
+    #[getter]
+    fn force_compensated<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| {
+            o.copy_from_slice(s.force_compensated.as_slice())
+        })
+    }
+
+    /// The last step of each prediction's force-deflection coupling (n, 2) [m]
+    /// (uncompensated, compensated): at most 1e-8 m where the fixed point converged.
+    #[getter]
+    fn coupling_residual<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 2, |s, o| o.copy_from_slice(&s.coupling_residual))
+    }
+
+    /// Program lines where the compensated prediction leaves the program by more than 1 um:
+    /// `(line, largest distance [m], reason)`, reason "coupling" (the force-deflection
+    /// coupling did not converge) or "stock" (the compensated tool meets a stock an earlier
+    /// deviation left). Empty where the compensation holds.
+    #[getter]
+    fn deviations(&self) -> Vec<(usize, f64, &'static str)> {
+        self.report
+            .line_forces()
+            .iter()
+            .filter_map(|l| l.deviation.map(|d| (l.line, l.error_compensated, d.name())))
+            .collect()
+    }
+
+    /// The program's operations with their figures: per operation `(name, first_line,
+    /// samples, max_force [N], path_error_uncompensated [m], path_error_compensated [m])`.
+    #[getter]
+    fn operations(&self) -> Vec<(String, usize, usize, f64, f64, f64)> {
+        let n = self.program.operations.len().max(1);
+        let mut out: Vec<(String, usize, usize, f64, f64, f64)> = (0..n)
+            .map(|k| {
+                let name = self
+                    .program
+                    .operations
+                    .get(k)
+                    .map_or_else(|| "program".to_string(), |o| o.name.clone());
+                (name, 0, 0, 0.0, 0.0, 0.0)
+            })
+            .collect();
+        for s in &self.report.samples {
+            let k = self.program.operation_of(s.path.move_index);
+            if let Some(o) = out.get_mut(k) {
+                if o.2 == 0 {
+                    o.1 = s.path.line;
+                }
+                o.2 += 1;
+                o.3 = o.3.max(s.force.norm());
+                if s.path.feed_move {
+                    let p = s.path.position;
+                    o.4 = o.4.max((s.actual_uncompensated - p).norm());
+                    o.5 = o.5.max((s.actual_compensated - p).norm());
+                }
+            }
+        }
+        out.retain(|o| o.2 > 0);
+        out
+    }
+
     /// TCP wrench (n, 6) [N, N m], base frame, about the tool tip.
     #[getter]
     fn wrench<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {

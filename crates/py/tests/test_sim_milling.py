@@ -132,11 +132,13 @@ def test_a_users_arm_tool_and_program(ur5_out):
     # One cut from the block's edge at x = 0 to its end at x = 30 mm.
     assert len(s["cuts"]) == 1
     cut = s["cuts"][0]
-    # The phase is the radius over the feed. In the material from the centre at -3.375 mm
-    # (the probes three quarters of a 0.5 mm cell outside the cutter meet x = 0) until it
-    # passes the block's end at 30 mm (the side probes leave the walls): 33.375 mm at 10 mm/s.
+    # The phase is the radius over the feed. In the material from the centre at -4.25 mm
+    # (the front probe, two 0.5 mm cells outside the 3 mm cutter, meets the block's edge,
+    # which the z-map ramps over the half cell from x = -0.25 mm) until the side probes,
+    # sqrt(4^2 - 3^2) = 2.646 mm ahead of the tip, leave the block's end (ramped to
+    # 30.25 mm): tip at 27.604 mm; 31.854 mm at 10 mm/s.
     assert cut["phase"] == pytest.approx(0.003 / 0.010, rel=1e-9)
-    assert cut["exit"] - cut["entry"] == pytest.approx(3.3375, abs=0.01)
+    assert cut["exit"] - cut["entry"] == pytest.approx(3.1854, abs=0.01)
     # The UR5 bends by tenths of a millimetre under the slot's tens of newtons; the offline
     # compensation takes nearly all of it, the online loops most of it.
     assert m["uncompensated"]["max_mm"] > 0.2

@@ -1016,13 +1016,17 @@ class GcodeProgram:
     @staticmethod
     def from_points_text(text: str, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
         """Same as ``from_points_file``, from the CSV text."""
-    def __reduce__(self) -> Tuple[Any, Tuple[Any, Any]]:
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, Any, Any]]:
         """Pickling and copy.deepcopy: the moves and the word report, rebuilt bit for bit."""
     @staticmethod
-    def _from_state(state: Any, words: Any) -> "GcodeProgram": ...
+    def _from_state(state: Any, words: Any, operations: Any = ...) -> "GcodeProgram": ...
     def __eq__(self, value: object, /) -> bool: ...
     __hash__: ClassVar[None]  # type: ignore[assignment]
     def __len__(self) -> int: ...
+    @property
+    def operations(self) -> List[Tuple[str, int, int]]:
+        """The program's operations (a CAM toolpath each: a tool change or a comment line
+        standing alone between moves starts one): `(name, first_move, first_line)` in order."""
     @property
     def line(self) -> npt.NDArray[np.uint64]:
         """The program line of each move (1-based), (n,)."""
@@ -1175,6 +1179,21 @@ class MachiningResult:
     @property
     def force_uncompensated(self) -> _FloatArray:
         """Force the uncompensated tool feels where it is (n, 3) [N]."""
+    @property
+    def force_compensated(self) -> _FloatArray:
+        """Force the compensated tool feels where it is (n, 3) [N]."""
+    @property
+    def coupling_residual(self) -> _FloatArray:
+        """The last step of each prediction's force-deflection coupling (n, 2) [m]
+        (uncompensated, compensated): at most 1e-8 m where the fixed point converged."""
+    @property
+    def deviations(self) -> List[Tuple[int, float, str]]:
+        """Program lines where the compensated prediction leaves the program by more than
+        1 um: `(line, largest distance [m], reason)`, reason "coupling" or "stock"."""
+    @property
+    def operations(self) -> List[Tuple[str, int, int, float, float, float]]:
+        """Per operation `(name, first_line, samples, max_force [N],
+        path_error_uncompensated [m], path_error_compensated [m])`."""
     @property
     def wrench(self) -> _FloatArray:
         """TCP wrench (n, 6) [N, N m], base frame, about the tool tip."""

@@ -664,7 +664,7 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
                 .map_err(|_| SimError::new("the file writer stopped"))
         };
         let run = job::run_streaming(&t.job, &t.program, &t.seed, &run_options, &mut sink);
-        drop(sink);
+        // The last sender gone, the writer's loop ends.
         drop(tx);
         let written = writer
             .join()

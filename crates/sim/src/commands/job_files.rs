@@ -230,7 +230,7 @@ impl<'p> JobFiles<'p> {
         }
         for s in chunk {
             self.arrays(s)?;
-            if self.count % self.log_every == 0 {
+            if self.count.is_multiple_of(self.log_every) {
                 self.log(s)?;
             }
             self.operation(s);

@@ -265,7 +265,10 @@ fn job_explains_a_programs_words_and_runs_two_tools_on_a_hand_started_spindle() 
     // change starts an operation.
     let ops = summary["operations"].as_array().unwrap();
     assert_eq!(ops.len(), 2, "{ops:?}");
-    assert_eq!((ops[0]["tool"].as_u64(), ops[1]["tool"].as_u64()), (Some(1), Some(2)));
+    assert_eq!(
+        (ops[0]["tool"].as_u64(), ops[1]["tool"].as_u64()),
+        (Some(1), Some(2))
+    );
     let lines = summary["top_lines"].as_array().unwrap();
     for l in [6, 11] {
         assert!(
