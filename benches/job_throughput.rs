@@ -12,51 +12,20 @@
 
 use std::time::Instant;
 
-use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::Program;
-use deflect_core::machining::cutting::{Coefficients, Tool};
-use deflect_core::machining::job::{self, Job, JobSample, RunOptions, Setup, Stock};
-use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::cutting::Tool;
+use deflect_core::machining::job::{self, Job, JobSample, RunOptions, Setup};
 use deflect_core::machining::tools::{ToolShape, ToolSpec, ToolTable};
-use deflect_core::mechanism::PoseIkOptions;
-use deflect_core::units::LengthUnit;
-use deflect_tests::{kr300, programs, repo_path};
-use nalgebra::{Isometry3, Vector2, Vector3};
+use deflect_tests::{JOB_SEED as SEED, job_setup, kr300, programs, read_mm as read, repo_path};
+use nalgebra::Vector2;
 
-const SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
-
-fn read(text: &str) -> Program {
-    gcode::from_str(
-        text,
-        &GcodeOptions {
-            start: Vector3::new(0.0, 0.0, 0.02),
-            units: LengthUnit::Millimetre,
-            ..GcodeOptions::default()
-        },
-    )
-    .unwrap()
-}
-
+/// The KR 300 job of `deflect-sim job` over the stock `[min, max]` (mm), 0.5 mm cells.
 fn setup(min: [f64; 2], max: [f64; 2]) -> Setup {
-    Setup {
-        placement: Isometry3::new(
-            Vector3::new(2.45, 0.02, 0.92),
-            Vector3::new(0.0, 0.0, std::f64::consts::PI),
-        ),
-        tool_orientation: Setup::tool_down(),
-        tool: Tool::new(0.016, 3, 0.0).unwrap(),
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
-        stock: Stock {
-            min: Vector2::new(min[0], min[1]) * 1e-3,
-            max: Vector2::new(max[0], max[1]) * 1e-3,
-            top: 0.0,
-            cell: 5.0e-4,
-        },
-        path: PathOptions::default(),
-        ik: PoseIkOptions::default(),
-        hand_spindle: None,
-        rapid_skim: job::RAPID_SKIM,
-    }
+    job_setup(
+        Vector2::new(min[0], min[1]) * 1e-3,
+        Vector2::new(max[0], max[1]) * 1e-3,
+        5.0e-4,
+    )
 }
 
 fn ball_table() -> ToolTable {

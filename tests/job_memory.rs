@@ -8,14 +8,9 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use deflect_core::io::gcode::{self, GcodeOptions};
-use deflect_core::machining::cutting::{Coefficients, Tool};
-use deflect_core::machining::job::{self, Job, JobSample, RunOptions, Setup, Stock};
-use deflect_core::machining::path::PathOptions;
-use deflect_core::mechanism::PoseIkOptions;
-use deflect_core::units::LengthUnit;
-use deflect_tests::{kr300, programs};
-use nalgebra::{Isometry3, Vector2, Vector3};
+use deflect_core::machining::job::{self, Job, JobSample, RunOptions};
+use deflect_tests::{JOB_SEED, job_setup, kr300, programs, read_mm};
+use nalgebra::Vector2;
 
 struct Counting;
 
@@ -52,16 +47,7 @@ static ALLOCATOR: Counting = Counting;
 fn run(job: &Job, feed_scale: f64) -> (usize, usize, usize) {
     let text = programs::sloped_zigzag(4, 6.0, 0.5, 2.0, 0.01)
         .replace("F508", &format!("F{:.1}", 508.0 * feed_scale));
-    let program = gcode::from_str(
-        &text,
-        &GcodeOptions {
-            start: Vector3::new(0.0, 0.0, 0.02),
-            units: LengthUnit::Millimetre,
-            ..GcodeOptions::default()
-        },
-    )
-    .unwrap();
-    let seed = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+    let program = read_mm(&text);
     let options = RunOptions {
         chunk: 256,
         threads: 1,
@@ -74,7 +60,7 @@ fn run(job: &Job, feed_scale: f64) -> (usize, usize, usize) {
     let base = NOW.load(Ordering::SeqCst);
     PEAK.store(base, Ordering::SeqCst);
     let allocations = COUNT.load(Ordering::SeqCst);
-    let r = job::run_streaming(job, &program, &seed, &options, &mut sink).unwrap();
+    let r = job::run_streaming(job, &program, &JOB_SEED, &options, &mut sink).unwrap();
     let peak = PEAK.load(Ordering::SeqCst) - base;
     let allocations = COUNT.load(Ordering::SeqCst) - allocations;
     assert!(r.path_error(true).max < 1e-6);
@@ -85,25 +71,11 @@ fn run(job: &Job, feed_scale: f64) -> (usize, usize, usize) {
 #[test]
 fn a_streamed_job_peaks_at_the_same_memory_for_four_times_the_samples() {
     let robot = kr300();
-    let setup = Setup {
-        placement: Isometry3::new(
-            Vector3::new(2.45, 0.02, 0.92),
-            Vector3::new(0.0, 0.0, std::f64::consts::PI),
-        ),
-        tool_orientation: Setup::tool_down(),
-        tool: Tool::new(0.016, 3, 0.0).unwrap(),
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
-        stock: Stock {
-            min: Vector2::new(-0.01, -0.01),
-            max: Vector2::new(0.016, 0.012),
-            top: 0.0,
-            cell: 5.0e-4,
-        },
-        path: PathOptions::default(),
-        ik: PoseIkOptions::default(),
-        hand_spindle: None,
-        rapid_skim: job::RAPID_SKIM,
-    };
+    let setup = job_setup(
+        Vector2::new(-0.01, -0.01),
+        Vector2::new(0.016, 0.012),
+        5.0e-4,
+    );
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
     let (peak, allocations, n) = run(&job, 1.0);
     let (peak4, allocations4, n4) = run(&job, 0.25);

@@ -5,30 +5,12 @@
 //! named as deviating; the uncompensated tip is not (the tests would notice a compensation
 //! that did nothing).
 
-use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::Program;
-use deflect_core::machining::cutting::{Coefficients, Tool};
-use deflect_core::machining::job::{self, Job, PREDICTION_TOLERANCE, Setup, Stock};
-use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::cutting::Tool;
+use deflect_core::machining::job::{self, Job, PREDICTION_TOLERANCE};
 use deflect_core::machining::tools::{ToolShape, ToolSpec, ToolTable};
-use deflect_core::mechanism::PoseIkOptions;
-use deflect_core::units::LengthUnit;
-use deflect_tests::{kr300, programs};
-use nalgebra::{Isometry3, Vector2, Vector3};
-
-const SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
-
-fn read(text: &str) -> Program {
-    gcode::from_str(
-        text,
-        &GcodeOptions {
-            start: Vector3::new(0.0, 0.0, 0.02),
-            units: LengthUnit::Millimetre,
-            ..GcodeOptions::default()
-        },
-    )
-    .unwrap()
-}
+use deflect_tests::{JOB_SEED, job_setup, kr300, programs, read_mm as read};
+use nalgebra::Vector2;
 
 /// `deflect-sim job`'s defaults: the KR 300, its placement, the stock the feed moves' box
 /// grown by the tool radius, 0.5 mm cells, a 16 mm three-flute end mill in Al7075.
@@ -44,25 +26,11 @@ fn job(program: &Program, tools: Option<ToolTable>) -> Job {
             hi = hi.sup(&p);
         }
     }
-    let setup = Setup {
-        placement: Isometry3::new(
-            Vector3::new(2.45, 0.02, 0.92),
-            Vector3::new(0.0, 0.0, std::f64::consts::PI),
-        ),
-        tool_orientation: Setup::tool_down(),
-        tool: Tool::new(0.016, 3, 0.0).unwrap(),
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
-        stock: Stock {
-            min: lo - Vector2::repeat(radius),
-            max: hi + Vector2::repeat(radius),
-            top: 0.0,
-            cell: 5.0e-4,
-        },
-        path: PathOptions::default(),
-        ik: PoseIkOptions::default(),
-        hand_spindle: None,
-        rapid_skim: job::RAPID_SKIM,
-    };
+    let setup = job_setup(
+        lo - Vector2::repeat(radius),
+        hi + Vector2::repeat(radius),
+        5.0e-4,
+    );
     let robot = kr300();
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
     match tools {
@@ -76,7 +44,7 @@ fn job(program: &Program, tools: Option<ToolTable>) -> Job {
 fn check(name: &str, text: &str, tools: Option<ToolTable>) -> (f64, f64) {
     let program = read(text);
     let job = job(&program, tools);
-    let r = job::run(&job, &program, &SEED).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let r = job::run(&job, &program, &JOB_SEED).unwrap_or_else(|e| panic!("{name}: {e}"));
     let (u, c) = (r.path_error(false).max, r.path_error(true).max);
     let off: Vec<_> = r
         .line_forces()

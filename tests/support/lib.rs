@@ -218,3 +218,56 @@ pub fn shared_path(relative: &str) -> String {
         Err(_) => format!("{}/../shared/{relative}", env!("CARGO_MANIFEST_DIR")),
     }
 }
+
+/// Joints near the start of a program on [`job_setup`]'s placement (`deflect-sim job`'s
+/// seed): the KR 300's tool down over the table.
+pub const JOB_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+
+/// `deflect-sim job`'s setup of the KR 300: the workpiece 2.45 m in front of the base, 0.92 m
+/// up, turned half a turn about z, the tool down; a 16 mm three-flute end mill in Al7075;
+/// the stock over `[min, max]` \[m\] with its top at 0 and cells of `cell` \[m\]; the
+/// default path and IK options.
+pub fn job_setup(
+    min: nalgebra::Vector2<f64>,
+    max: nalgebra::Vector2<f64>,
+    cell: f64,
+) -> deflect_core::machining::job::Setup {
+    use deflect_core::machining::cutting::{Coefficients, Tool};
+    use deflect_core::machining::job::{RAPID_SKIM, Setup, Stock};
+    let tool = match Tool::new(0.016, 3, 0.0) {
+        Ok(t) => t,
+        Err(e) => panic!("the 16 mm tool: {e}"),
+    };
+    Setup {
+        placement: nalgebra::Isometry3::new(
+            nalgebra::Vector3::new(2.45, 0.02, 0.92),
+            nalgebra::Vector3::new(0.0, 0.0, std::f64::consts::PI),
+        ),
+        tool_orientation: Setup::tool_down(),
+        tool,
+        coefficients: Coefficients::AL7075_T6_CARBIDE,
+        stock: Stock {
+            min,
+            max,
+            top: 0.0,
+            cell,
+        },
+        path: deflect_core::machining::path::PathOptions::default(),
+        ik: deflect_core::mechanism::PoseIkOptions::default(),
+        hand_spindle: None,
+        rapid_skim: RAPID_SKIM,
+    }
+}
+
+/// A G-code program in mm, the tool 20 mm above the workpiece origin before it starts.
+pub fn read_mm(text: &str) -> deflect_core::machining::Program {
+    let options = deflect_core::io::gcode::GcodeOptions {
+        start: nalgebra::Vector3::new(0.0, 0.0, 0.02),
+        units: deflect_core::units::LengthUnit::Millimetre,
+        ..deflect_core::io::gcode::GcodeOptions::default()
+    };
+    match deflect_core::io::gcode::from_str(text, &options) {
+        Ok(p) => p,
+        Err(e) => panic!("the program must read: {e}"),
+    }
+}

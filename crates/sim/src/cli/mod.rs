@@ -142,9 +142,11 @@ pub enum Command {
     /// A machining job offline (the offline half of Hähn & Weigold's hybrid compensation): a
     /// G-code program (or tool points CSV) driven at its feeds on an arm (default: the KR 300
     /// R2500 and data/groove_and_pocket.nc, built in), the stock cut along it, the milling
-    /// force from the engagement, the arm's deflection and the compensated joints. Writes
-    /// job_compensated.nc, job_samples.csv, job_part.png (the part's deviation, with and
-    /// without compensation) and job_summary.{txt,json}.
+    /// force from the chip at every sample, the arm's deflection and the compensated joints,
+    /// streamed in bounded memory. Writes job_samples.npz (every sample), job.mcap (Foxglove),
+    /// job_compensated.nc, job_part.png (the part's deviation, with and without
+    /// compensation) and job_summary.{txt,json} (per operation, the ten lines of largest
+    /// force); job_samples.csv with --samples-csv.
     Job(JobArgs),
     /// The D'Alembert correction on a Delta robot (Clavel's parallel robot of pick and
     /// place): a flexible Delta in rapier, static tests on a 3-D grid over the workspace, the
