@@ -237,12 +237,14 @@ fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
         s_un.floor.max > 1e-5 && s_co.floor.max < 1e-6,
         "{s_un:?} {s_co:?}"
     );
-    // Pushed sideways, the uncompensated groove cuts into one wall (cells the nominal one
-    // leaves whole); on the other side the rim stays within the band of the cells the
-    // nominal rim crosses, which keep more of their height (their mean: the floor figures);
-    // the compensated one matches cell for cell.
-    assert!(s_un.overcut > 0.0 && s_un.floor.max > 1e-4, "{s_un:?}");
-    assert_eq!((s_co.material_left, s_co.overcut), (0.0, 0.0));
+    // Pushed sideways, the uncompensated groove leaves a strip of one wall and cuts into the
+    // other: tens of micrometres along its 80 mm, square millimetres; the compensated one
+    // matches it to a few square micrometres (its tool nanometres off).
+    assert!(s_un.material_left > 1e-6 && s_un.overcut > 1e-6, "{s_un:?}");
+    assert!(
+        s_co.material_left < 1e-11 && s_co.overcut < 1e-9,
+        "{s_co:?}"
+    );
     // The nominal groove: depth 2 mm at its middle.
     let (i, j) = ((0.04 / 5e-4) as usize, (0.03 / 5e-4) as usize);
     assert!((r.nominal.height(i, j).unwrap() + 0.002).abs() < 1e-12);

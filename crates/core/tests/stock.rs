@@ -28,14 +28,18 @@ fn a_slot_leaves_a_groove_of_the_tool_width_and_depth() {
     let end = Vector3::new(0.02 + l, 0.0, -a);
     let plunge = z.cut(&flat, &above, &down).unwrap();
     let slot = z.cut(&flat, &down, &end).unwrap();
-    // Across the middle of the slot (x = 50 mm): the cut cells span D within one cell, at
-    // depth a exactly.
+    // Across the middle of the slot (x = 50 mm): the cells cut (by more than a nanometre:
+    // the cells whose centre lies on the rim's band edge are cut by rounding) span D within
+    // one cell, at depth a exactly.
     let i = 500;
     let cut: Vec<usize> = (0..400)
-        .filter(|&j| z.height(i, j).unwrap() < 0.0)
+        .filter(|&j| z.height(i, j).unwrap() < -1e-9)
         .collect();
     let width = cut.len() as f64 * CELL;
-    assert!((width - d).abs() <= CELL, "groove width {width} m");
+    assert!(
+        (width - d).abs() <= CELL * (1.0 + 1e-9),
+        "groove width {width} m"
+    );
     for &j in &cut {
         assert!((z.height(i, j).unwrap() + a).abs() < 1e-9);
     }

@@ -49,7 +49,8 @@
 //! them to a sink chunk by chunk ([`RunOptions::chunk`]) and keeps only the z-maps, the plan
 //! and the per-line figures ([`Summary`]): its memory does not grow with the program's
 //! duration. With the `std` feature and [`RunOptions::threads`] above 1, the two predictions
-//! of a chunk run on two threads once the nominal cut of the chunk is done.
+//! of a chunk run on two threads once the nominal cut of the chunk is done, and the nominal
+//! cut of the next chunk on a third beside them.
 
 use alloc::vec::Vec;
 
@@ -376,6 +377,23 @@ fn in_limits(q: &[f64], limits: &[(f64, f64)]) -> Result<(), TickError> {
     crate::mechanism::check_limits(q, limits, JOINT_LIMIT_TOLERANCE)
 }
 
+/// The nominal stage over the next `chunk` samples into `noms`; the index in it and the error
+/// of a sample that failed (the chunk ends there).
+fn fill(
+    nominal: &mut nominal::Stage<'_>,
+    sampler: &mut path::Sampler<'_>,
+    chunk: usize,
+    noms: &mut Vec<nominal::Sample>,
+) -> Option<(usize, JobError)> {
+    for s in sampler.by_ref().take(chunk) {
+        match nominal.advance(&s) {
+            Ok(n) => noms.push(n),
+            Err(e) => return Some((noms.len(), e)),
+        }
+    }
+    None
+}
+
 /// A wrench `[f; m]` turned by the rotation of `t` (the moment point moves with it).
 fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
     let f = t.rotation * w.fixed_rows::<3>(0).into_owned();
@@ -550,24 +568,38 @@ pub fn run_streaming<S: Sink + ?Sized>(
         reserve("job chunk (the allocation was refused)")?;
     }
     let mut summary = Summary::default();
+    let mut next = Vec::new();
+    if next.try_reserve_exact(chunk).is_err() {
+        reserve("job chunk (the allocation was refused)")?;
+    }
+    let mut next_failed = fill(&mut nominal, &mut sampler, chunk, &mut next);
     loop {
-        noms.clear();
-        let mut failed: Option<(usize, JobError)> = None;
-        for s in sampler.by_ref().take(chunk) {
-            match nominal.advance(&s) {
-                Ok(n) => noms.push(n),
-                Err(e) => {
-                    failed = Some((noms.len(), e));
-                    break;
-                }
-            }
-        }
-        if noms.is_empty() && failed.is_none() {
+        if next.is_empty() && next_failed.is_none() {
             break;
         }
+        core::mem::swap(&mut noms, &mut next);
+        next.clear();
+        let mut failed = next_failed.take();
         out_u.clear();
         out_c.clear();
-        let (ru, rc) = predict::both(&mut unc, &mut comp, &noms, &mut out_u, &mut out_c, options);
+        // The arms on this chunk; beside them the nominal cut of the next (unless this one
+        // failed: the job ends with it).
+        let more = failed.is_none();
+        let (ru, rc, nf) = predict::both(
+            &mut unc,
+            &mut comp,
+            &noms,
+            (&mut out_u, &mut out_c),
+            options,
+            || {
+                if more {
+                    fill(&mut nominal, &mut sampler, chunk, &mut next)
+                } else {
+                    None
+                }
+            },
+        );
+        next_failed = nf;
         // The earliest failure wins (a nominal failure comes after every sample before it).
         for r in [ru, rc] {
             if let Err((k, e)) = r

@@ -59,16 +59,6 @@ pub struct ErrorStats {
     pub count: usize,
 }
 
-impl ErrorStats {
-    fn of(values: impl Iterator<Item = f64>) -> Self {
-        let mut acc = ErrorAccumulator::default();
-        for v in values {
-            acc.add(v);
-        }
-        acc.stats()
-    }
-}
-
 /// Largest and RMS of a stream of values, in constant memory.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ErrorAccumulator {
@@ -352,39 +342,68 @@ impl Report {
         self.summary.path_error(compensated)
     }
 
-    /// A predicted part against the nominal one: the floors (cells both cut, by more than
-    /// [`super::engagement::MIN_DEPTH`]: height above the nominal, > 0 where material is
-    /// left), and the walls' shift as the areas cut by one and not the other \[m^2\] (a
-    /// height map sees a wall moved sideways as a full-depth step; the areas measure it). A
-    /// cell keeps the mean height over its area ([`super::stock`]): a wall moved by less than
-    /// half a cell changes the height of the cells its rim crosses, which the floor figures
-    /// count.
+    /// A predicted part against the nominal one: the floors and the walls.
+    ///
+    /// A cell keeps the mean height over its area ([`super::stock`]), so a wall is a row of
+    /// cells partly cut. Floors: the cells both parts cut (by more than
+    /// [`super::engagement::MIN_DEPTH`]) whose four neighbours both parts cut too, height
+    /// above the nominal (> 0 where material is left). Walls: every other cell either part
+    /// cut counts the part of its area one part cut and the other did not, `(h_p - h_n) /
+    /// (top - z)` of a cell for material left (and the opposite for overcut), `z` the lowest
+    /// height around it (its floor) \[m^2\]: a wall moved sideways by `s` along a length `L`
+    /// counts about `s L`, whether it crosses cells or stays within them.
     pub fn surface_error(&self, predicted: &ZMap) -> SurfaceError {
-        let cut = |h: f64| h < self.top - super::engagement::MIN_DEPTH;
+        let top = self.top;
+        let cut = |h: f64| h < top - super::engagement::MIN_DEPTH;
         let area = self.nominal.cell() * self.nominal.cell();
-        let (mut left, mut over) = (0usize, 0usize);
-        let floor = ErrorStats::of(
-            self.nominal
-                .heights()
-                .iter()
-                .zip(predicted.heights())
-                .filter_map(|(&n, &p)| match (cut(n), cut(p)) {
-                    (true, true) => Some(p - n),
-                    (true, false) => {
-                        left += 1;
-                        None
-                    }
-                    (false, true) => {
-                        over += 1;
-                        None
-                    }
-                    (false, false) => None,
-                }),
-        );
+        let (nx, ny) = self.nominal.shape();
+        let (hn, hp) = (self.nominal.heights(), predicted.heights());
+        let at = |h: &[f64], i: isize, j: isize| -> Option<f64> {
+            if i < 0 || j < 0 || i as usize >= nx || j as usize >= ny {
+                return None;
+            }
+            h.get(j as usize * nx + i as usize).copied()
+        };
+        let (mut left, mut over) = (0.0, 0.0);
+        let mut floor = ErrorAccumulator::default();
+        for j in 0..ny as isize {
+            for i in 0..nx as isize {
+                let (Some(n), Some(p)) = (at(hn, i, j), at(hp, i, j)) else {
+                    continue;
+                };
+                if !cut(n) && !cut(p) {
+                    continue;
+                }
+                let around = [(i - 1, j), (i + 1, j), (i, j - 1), (i, j + 1)];
+                let interior = cut(n)
+                    && cut(p)
+                    && around.iter().all(|&(a, b)| {
+                        at(hn, a, b).is_some_and(cut) && at(hp, a, b).is_some_and(cut)
+                    });
+                if interior {
+                    floor.add(p - n);
+                    continue;
+                }
+                let z = around
+                    .iter()
+                    .filter_map(|&(a, b)| Some(at(hn, a, b)?.min(at(hp, a, b)?)))
+                    .fold(n.min(p), f64::min);
+                let depth = top - z;
+                if depth <= super::engagement::MIN_DEPTH {
+                    continue;
+                }
+                let share = ((p - n) / depth).clamp(-1.0, 1.0);
+                if share > 0.0 {
+                    left += share * area;
+                } else {
+                    over -= share * area;
+                }
+            }
+        }
         SurfaceError {
-            floor,
-            material_left: left as f64 * area,
-            overcut: over as f64 * area,
+            floor: floor.stats(),
+            material_left: left,
+            overcut: over,
         }
     }
 

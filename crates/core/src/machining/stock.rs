@@ -594,11 +594,14 @@ fn lowest(
     let a = from.xy() - c;
     let b = to.xy() - from.xy();
     let (bb, ab, aa) = (b.dot(&b), a.dot(&b), a.dot(&a));
-    // |a + t b|^2 <= r^2 for t in [t0, t1] (within [0, 1]).
+    // |a + t b|^2 <= r^2 for t in [t0, t1] (within [0, 1]); under the cutter at both ends,
+    // all along (the distance is convex in t).
     let (t0, t1) = if bb <= 1.0e-30 {
         if aa > r * r {
             return None;
         }
+        (0.0, 1.0)
+    } else if aa <= r * r && (a + b).norm_squared() <= r * r {
         (0.0, 1.0)
     } else {
         let disc = ab * ab - bb * (aa - r * r);
@@ -639,38 +642,39 @@ fn lowest(
                     (f64::INFINITY, f64::INFINITY)
                 }
             };
+            // Most cells: the slope at t0 is >= 0 and the lowest point is there (one root), or
+            // the slope at t1 is <= 0 and it is at t1 (two).
             let (lo_s, _) = slope(t0);
+            if lo_s >= 0.0 || lo_s.is_nan() || t1 - t0 <= 1.0e-12 {
+                return Some(surface(t0));
+            }
             let (hi_s, _) = slope(t1);
-            let t = if lo_s >= 0.0 || lo_s.is_nan() || t1 - t0 <= 1.0e-12 {
-                t0
-            } else if hi_s <= 0.0 || hi_s.is_nan() {
-                t1
-            } else {
-                let (mut lo, mut hi) = (t0, t1);
-                let mut t = 0.5 * (t0 + t1);
-                for _ in 0..100 {
-                    let (g, h) = slope(t);
-                    if g < 0.0 {
-                        lo = t;
-                    } else {
-                        hi = t;
-                    }
-                    if hi - lo <= 1.0e-12 || g == 0.0 {
+            if hi_s <= 0.0 || hi_s.is_nan() {
+                return Some(surface(t1).min(surface(t0)));
+            }
+            let (mut lo, mut hi) = (t0, t1);
+            let mut t = 0.5 * (t0 + t1);
+            for _ in 0..100 {
+                let (g, h) = slope(t);
+                if g < 0.0 {
+                    lo = t;
+                } else {
+                    hi = t;
+                }
+                if hi - lo <= 1.0e-12 || g == 0.0 {
+                    break;
+                }
+                let newton = t - g / h;
+                if newton > lo && newton < hi && h.is_finite() {
+                    let step = newton - t;
+                    t = newton;
+                    if step.abs() <= 1.0e-13 {
                         break;
                     }
-                    let newton = t - g / h;
-                    if newton > lo && newton < hi && h.is_finite() {
-                        let step = newton - t;
-                        t = newton;
-                        if step.abs() <= 1.0e-13 {
-                            break;
-                        }
-                    } else {
-                        t = 0.5 * (lo + hi);
-                    }
+                } else {
+                    t = 0.5 * (lo + hi);
                 }
-                t
-            };
+            }
             Some(surface(t0).min(surface(t1)).min(surface(t)))
         }
     }

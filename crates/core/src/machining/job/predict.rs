@@ -335,38 +335,46 @@ type Trial = (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64);
 /// above the rounding of the tip.
 const NEWTON_STEP: f64 = 1.0e-7;
 
-/// Both arms over a chunk: side by side on two threads when `options` allow and `std` is on.
+/// Both arms over a chunk, and `beside` (the nominal stage's next chunk): the three side by
+/// side on threads when `options` allow and `std` is on, one after the other otherwise.
 pub(super) fn both(
     unc: &mut Arm<'_>,
     comp: &mut Arm<'_>,
     noms: &[Sample],
-    out_u: &mut Vec<Out>,
-    out_c: &mut Vec<Out>,
+    (out_u, out_c): (&mut Vec<Out>, &mut Vec<Out>),
     options: &RunOptions,
-) -> (Outcome, Outcome) {
+    beside: impl FnOnce() -> Option<(usize, JobError)> + Send,
+) -> (Outcome, Outcome, Option<(usize, JobError)>) {
     #[cfg(feature = "std")]
     if options.threads > 1 && noms.len() > 1 {
-        // Two fixed stages of equal weight: a scoped thread for one, the caller's for the
-        // other (no pool needed, and the arms share nothing mutable).
+        // Three fixed stages: scoped threads for two, the caller's for the third (no pool
+        // needed, and the stages share nothing mutable).
+        let panicked = |what: &'static str| {
+            (
+                0,
+                JobError::AtLine {
+                    line: noms.first().map_or(0, |n| n.path.line),
+                    time: noms.first().map_or(0.0, |n| n.path.time),
+                    error: TickError::InvalidArgument { what, value: 0.0 },
+                },
+            )
+        };
         return std::thread::scope(|s| {
-            let h = s.spawn(|| unc.process(noms, out_u));
+            let u = s.spawn(|| unc.process(noms, out_u));
+            let b = s.spawn(beside);
             let rc = comp.process(noms, out_c);
-            let ru = h.join().unwrap_or_else(|_| {
-                Err((
-                    0,
-                    JobError::AtLine {
-                        line: noms.first().map_or(0, |n| n.path.line),
-                        time: noms.first().map_or(0.0, |n| n.path.time),
-                        error: TickError::InvalidArgument {
-                            what: "prediction thread (it panicked)",
-                            value: 0.0,
-                        },
-                    },
-                ))
-            });
-            (ru, rc)
+            let ru = u
+                .join()
+                .unwrap_or_else(|_| Err(panicked("prediction thread (it panicked)")));
+            // A thread that panicked (no path of the stages panics) ends the job with an
+            // error, never with a chunk silently lost.
+            let rb = b
+                .join()
+                .unwrap_or_else(|_| Some(panicked("nominal thread (it panicked)")));
+            (ru, rc, rb)
         });
     }
     let _ = options;
-    (unc.process(noms, out_u), comp.process(noms, out_c))
+    let (ru, rc) = (unc.process(noms, out_u), comp.process(noms, out_c));
+    (ru, rc, beside())
 }
