@@ -8,6 +8,9 @@
 //! `DEFLECT_BENCH_HOURS=8` adds a raster of that many hours of program (7.2 M samples at
 //! 250 Hz for 8): its wall time and the memory it took, streamed.
 //!
+//! `DEFLECT_BENCH_BUILTIN_ONLY=1` stops after the built-in job; `DEFLECT_BENCH_THREADS=1`
+//! runs one thread count only.
+//!
 //! `cargo bench --bench job_throughput`
 
 use std::time::Instant;
@@ -52,7 +55,14 @@ fn peak_rss_mb() -> f64 {
 }
 
 fn measure(name: &str, job: &Job, program: &Program, repeat: usize) {
+    // `DEFLECT_BENCH_THREADS=1` runs one thread count only (for a profiler).
+    let only: Option<usize> = std::env::var("DEFLECT_BENCH_THREADS")
+        .ok()
+        .and_then(|v| v.parse().ok());
     for threads in [1, 2] {
+        if only.is_some_and(|n| n != threads) {
+            continue;
+        }
         let options = RunOptions {
             threads,
             ..RunOptions::default()

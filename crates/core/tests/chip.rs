@@ -58,7 +58,7 @@ fn a_thin_floor_strip_moves_the_force_by_at_most_the_bound() {
         )
         .unwrap();
     let probes = Probes::new(0.008, cell);
-    let model = ChipModel::new(&C, &tool);
+    let model = ChipModel::new(&C, &tool, probes.count());
     let fz = 1.0e-4;
     let w = w_bound(&tool, fz);
     // W < 210 kN/m: a micrometre of height moves the force by less than 0.21 N, and a
@@ -98,18 +98,33 @@ fn a_thin_floor_strip_moves_the_force_by_at_most_the_bound() {
 #[test]
 fn one_depth_everywhere_is_the_closed_form() {
     let tool = Tool::new(0.016, 3, 0.3).unwrap();
-    let model = ChipModel::new(&C, &tool);
     let (a, fz) = (0.004, 1.2e-4);
+    let e = Engagement::slot(a, fz);
+    let exact = cutting::average(&C, &tool, &e).unwrap();
+    let torque = cutting::average_torque(&C, &tool, &e).unwrap();
+    // With the finest probes, a 10 mm tool's on 0.5 mm cells and the coarsest.
+    let probes = Probes::new(0.005, 5.0e-4);
+    assert_eq!(probes.count(), 64);
+    for count in [ANGLES, probes.count(), engagement::MIN_ANGLES] {
+        let model = ChipModel::new(&C, &tool, count);
+        let chip = Chip {
+            depth: [a; ANGLES],
+            count,
+            ..Chip::default()
+        };
+        let (f, m) = model.wrench(&chip, fz);
+        assert!(
+            (f - exact).norm() <= 1e-9 * exact.norm(),
+            "{count}: {f:?} {exact:?}"
+        );
+        assert!((m.z - torque).abs() <= 1e-9 * torque.abs(), "{count}");
+    }
+    let model = ChipModel::new(&C, &tool, ANGLES);
     let chip = Chip {
         depth: [a; ANGLES],
         ..Chip::default()
     };
-    let (f, m) = model.wrench(&chip, fz);
-    let e = Engagement::slot(a, fz);
-    let exact = cutting::average(&C, &tool, &e).unwrap();
-    let torque = cutting::average_torque(&C, &tool, &e).unwrap();
-    assert!((f - exact).norm() <= 1e-9 * exact.norm(), "{f:?} {exact:?}");
-    assert!((m.z - torque).abs() <= 1e-9 * torque.abs());
+    let (_, m) = model.wrench(&chip, fz);
     // The force acts halfway up the depth: m = (a / 2) z x F.
     let lever = Vector3::new(0.0, 0.0, 0.5 * a).cross(&exact);
     assert!((m.xy() - lever.xy()).norm() <= 1e-9 * lever.norm());
@@ -177,7 +192,7 @@ proptest! {
         }
         let tool = Tool::new(0.01, 2, 0.0).unwrap();
         let probes = Probes::new(0.005, cell);
-        let model = ChipModel::new(&C, &tool);
+        let model = ChipModel::new(&C, &tool, probes.count());
         let feed = Vector3::new(angle.cos(), angle.sin(), 0.0);
         let p = Vector3::new(x, y, zt);
         let d = Vector3::new(dx, dy, dz);

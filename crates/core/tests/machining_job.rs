@@ -239,10 +239,11 @@ fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
     );
     // Pushed sideways, the uncompensated groove leaves a strip of one wall and cuts into the
     // other: tens of micrometres along its 80 mm, square millimetres; the compensated one
-    // matches it to a few square micrometres (its tool nanometres off).
+    // matches it to tens of square micrometres: its tool within the IK's 1e-8 m of the
+    // program, a wall 1e-8 m off along 80 mm would be 800 um^2.
     assert!(s_un.material_left > 1e-6 && s_un.overcut > 1e-6, "{s_un:?}");
     assert!(
-        s_co.material_left < 1e-11 && s_co.overcut < 1e-9,
+        s_co.material_left < 5e-11 && s_co.overcut < 1e-9,
         "{s_co:?}"
     );
     // The nominal groove: depth 2 mm at its middle.

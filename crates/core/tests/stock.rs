@@ -7,7 +7,10 @@ use std::f64::consts::PI;
 
 use deflect_core::BuildError;
 use deflect_core::TickError;
-use deflect_core::machining::stock::{Cutter, FOLLOW_TOLERANCE, Follower, MAX_CELLS, ZMap};
+use deflect_core::machining::engagement::{self, Chip, Probes};
+use deflect_core::machining::stock::{
+    Cutter, FOLLOW_TOLERANCE, Follower, MAX_CELLS, MAX_HELD, Step, ZMap,
+};
 use nalgebra::{Vector2, Vector3};
 
 const CELL: f64 = 1.0e-4;
@@ -228,4 +231,116 @@ fn a_followed_tool_cuts_what_the_sweep_cuts() {
             .fold(0.0f64, f64::max);
         assert!(worst <= FOLLOW_TOLERANCE, "{cutter:?}: {worst:e}");
     }
+}
+
+/// A tool held back along lines: the held stock equals, cell for cell, a stock cut by
+/// `ZMap::cut` along the moves the follower reports (from the last tip cut to the tip of each
+/// `Restart` or `Cut`, and to the last tip at the end); a second follower told the same steps
+/// (`step_to`) cuts a copy exactly the same; holds stay shorter than a cell and at most
+/// `MAX_HELD` tips; and wherever `settle` keeps the move held, the chip read from the held
+/// stock equals the chip read after cutting it (to the bit).
+#[test]
+fn a_held_tool_cuts_its_lines_as_single_moves_and_reads_never_see_the_difference() {
+    let cell = 5.0e-4;
+    for cutter in [
+        Cutter::Flat { radius: 0.004 },
+        Cutter::Ball { radius: 0.003 },
+    ] {
+        let r = cutter.radius();
+        let mut held = ZMap::new(Vector2::zeros(), Vector2::new(0.06, 0.06), 0.0, cell).unwrap();
+        let mut mirror = held.clone();
+        let mut exact = held.clone();
+        let (mut follower, mut other) = (Follower::new(), Follower::new());
+        let probes = Probes::new(r, cell);
+        let (mut chip_held, mut chip_cut) = (Chip::default(), Chip::default());
+        let mut last_cut: Option<Vector3<f64>> = None;
+        let mut tips: Vec<Vector3<f64>> = Vec::new();
+        let (mut holds, mut settled_reads) = (0, 0);
+        // Lines of a square spiral, sloped, sampled at 20-140 um (a cell is 500 um).
+        let mut p = Vector3::new(0.03, 0.03, -0.0005);
+        let mut k = 0usize;
+        for (leg, heading) in [0.0f64, 90.0, 180.0, 270.0, 0.0, 90.0, 180.0, 270.0]
+            .iter()
+            .enumerate()
+        {
+            let dir = Vector3::new(heading.to_radians().cos(), heading.to_radians().sin(), 0.0);
+            let step = 2.0e-5 + 2.0e-5 * (leg % 7) as f64;
+            let length = 0.004 + 0.002 * leg as f64;
+            let dz = if leg % 2 == 0 { -2.0e-6 } else { 1.0e-6 };
+            let n = (length / step) as usize;
+            for _ in 0..n {
+                p += dir * step + Vector3::new(0.0, 0.0, dz);
+                k += 1;
+                // Before the read: settle; if it kept the move held, the read must not see it.
+                let before = follower.held();
+                let _ = follower.settle(&mut held, &p, &dir).unwrap();
+                let _ = other.settle(&mut mirror, &p, &dir).unwrap();
+                if before > 0 && follower.held() == 0 {
+                    cut_held(&mut exact, &cutter, &mut last_cut, &mut tips);
+                } else if before > 0 {
+                    settled_reads += 1;
+                    let mut flushed = held.clone();
+                    let mut f = follower;
+                    let _ = f.flush(&mut flushed).unwrap();
+                    engagement::read(&held, &probes, &p, &dir, false, &mut chip_held);
+                    engagement::read(&flushed, &probes, &p, &dir, false, &mut chip_cut);
+                    assert_eq!(chip_held, chip_cut, "{cutter:?}: sample {k}");
+                }
+                let (_, step_taken) = follower.hold_to(&mut held, &cutter, &p).unwrap();
+                let _ = other.step_to(&mut mirror, &cutter, &p, step_taken).unwrap();
+                match step_taken {
+                    Step::Hold => {
+                        holds += 1;
+                        tips.push(p);
+                    }
+                    Step::Restart => {
+                        cut_held(&mut exact, &cutter, &mut last_cut, &mut tips);
+                        tips.push(p);
+                    }
+                    Step::Cut => {
+                        cut_held(&mut exact, &cutter, &mut last_cut, &mut tips);
+                        let _ = exact.cut(&cutter, &last_cut.unwrap_or(p), &p).unwrap();
+                        last_cut = Some(p);
+                    }
+                }
+                assert_eq!(follower.held(), tips.len());
+                assert!(tips.len() <= MAX_HELD);
+                if let (Some(from), Some(to)) = (last_cut, tips.last()) {
+                    assert!((to.xy() - from.xy()).norm() < cell);
+                }
+            }
+        }
+        cut_held(&mut exact, &cutter, &mut last_cut, &mut tips);
+        let _ = follower.flush(&mut held).unwrap();
+        let _ = other.flush(&mut mirror).unwrap();
+        assert_eq!(held.heights(), mirror.heights(), "{cutter:?}");
+        let worst = exact
+            .heights()
+            .iter()
+            .zip(held.heights())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f64, f64::max);
+        // The flat end mill's crescents leave cells within the follow tolerance.
+        assert!(worst <= FOLLOW_TOLERANCE, "{cutter:?}: {worst:e}");
+        // Most samples are held, and most reads happen with a move held.
+        assert!(holds * 10 > k * 8, "{cutter:?}: {holds} of {k}");
+        assert!(
+            settled_reads * 10 > k * 7,
+            "{cutter:?}: {settled_reads} of {k}"
+        );
+    }
+}
+
+/// Cuts the held tips of the test above as one move from the last tip cut.
+fn cut_held(
+    exact: &mut ZMap,
+    cutter: &Cutter,
+    last_cut: &mut Option<Vector3<f64>>,
+    tips: &mut Vec<Vector3<f64>>,
+) {
+    if let (Some(from), Some(&to)) = (*last_cut, tips.last()) {
+        let _ = exact.cut(cutter, &from, &to).unwrap();
+        *last_cut = Some(to);
+    }
+    tips.clear();
 }

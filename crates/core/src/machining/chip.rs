@@ -34,9 +34,9 @@ use super::engagement::{ANGLES, Chip, ChipKind, angle};
 
 /// The closed-form integrals of one probe's hat function against the model's angular terms:
 /// `[1, sin, cos, sin^2, sin cos]`.
-fn hat_integrals(k: usize) -> [f64; 5] {
-    let step = angle(1);
-    let phi = angle(k);
+fn hat_integrals(k: usize, count: usize) -> [f64; 5] {
+    let step = angle(1, count);
+    let phi = angle(k, count);
     // First and second antiderivatives of sin(w x) and cos(w x).
     let sin_w = |w: f64, x: f64| {
         (
@@ -59,13 +59,13 @@ fn hat_integrals(k: usize) -> [f64; 5] {
             let (_, gga) = g(phi - step);
             total += gb - (ggb - gga) / step;
         }
-        if k + 1 < ANGLES {
+        if k + 1 < count {
             let (_, ggc) = g(phi + step);
             total += -gb + (ggc - ggb) / step;
         }
         total
     };
-    let ends = usize::from(k > 0) + usize::from(k + 1 < ANGLES);
+    let ends = usize::from(k > 0) + usize::from(k + 1 < count);
     let one = 0.5 * step * ends as f64;
     let sin = hat(&|x| sin_w(1.0, x));
     let cos = hat(&|x| cos_w(1.0, x));
@@ -80,6 +80,8 @@ fn hat_integrals(k: usize) -> [f64; 5] {
 /// and the edge part (`edge`, \[N/m\]), tool frame, and the same for the torque about the axis.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ChipModel {
+    /// The probe angles (entries from it on are 0).
+    count: usize,
     /// Per axis (x, y, z of the tool frame), per probe.
     cut: [[f64; ANGLES]; 3],
     edge: [[f64; ANGLES]; 3],
@@ -89,19 +91,22 @@ pub struct ChipModel {
 
 impl ChipModel {
     /// The weights of `tool` in a material of `coefficients` (both validated by their
-    /// owners; a clockwise cutter, as [`super::cutting`]).
-    pub fn new(coefficients: &Coefficients, tool: &Tool) -> Self {
+    /// owners; a clockwise cutter, as [`super::cutting`]) for chips of `count` probe angles
+    /// ([`super::engagement::Probes::count`]; clamped to `2..=ANGLES`).
+    pub fn new(coefficients: &Coefficients, tool: &Tool, count: usize) -> Self {
+        let count = count.clamp(2, ANGLES);
         let c = coefficients;
         let scale = f64::from(tool.flutes.max(1)) / core::f64::consts::TAU;
         let radius = 0.5 * tool.diameter;
         let mut m = Self {
+            count,
             cut: [[0.0; ANGLES]; 3],
             edge: [[0.0; ANGLES]; 3],
             torque_cut: [0.0; ANGLES],
             torque_edge: [0.0; ANGLES],
         };
-        for k in 0..ANGLES {
-            let [one, s, co, ss, sc] = hat_integrals(k);
+        for k in 0..count {
+            let [one, s, co, ss, sc] = hat_integrals(k, count);
             let cut = [
                 -c.k_tc * sc - c.k_rc * ss,
                 c.k_tc * ss - c.k_rc * sc,
@@ -138,7 +143,8 @@ impl ChipModel {
 
     /// The mean force on the tool \[N\] and its moment about the tip \[N m\] (tool frame,
     /// clockwise cutter) of `chip` at feed per tooth `feed_per_tooth` \[m\]; zero for a
-    /// plunge. Allocation-free; finite for finite depths.
+    /// plunge. The chip's probes are this model's (`chip.count` is not read). Allocation-free;
+    /// finite for finite depths.
     pub fn wrench(&self, chip: &Chip, feed_per_tooth: f64) -> (Vector3<f64>, Vector3<f64>) {
         if chip.kind == ChipKind::Plunge {
             return (Vector3::zeros(), Vector3::zeros());
@@ -152,7 +158,8 @@ impl ChipModel {
                 continue;
             };
             let (mut f, mut l) = (0.0, 0.0);
-            for ((&a, &c), &e) in chip.depth.iter().zip(cut).zip(edge) {
+            let n = self.count;
+            for ((&a, &c), &e) in chip.depth.iter().zip(cut).zip(edge).take(n) {
                 let w = c * fz + e;
                 f += w * a;
                 l += w * (0.5 * a * a);
@@ -168,6 +175,7 @@ impl ChipModel {
             .iter()
             .zip(&self.torque_cut)
             .zip(&self.torque_edge)
+            .take(self.count)
         {
             torque += (c * fz + e) * a;
         }
@@ -184,7 +192,7 @@ impl ChipModel {
         let [cx, cy, cz] = &self.cut;
         let [ex, ey, ez] = &self.edge;
         let mut sum = 0.0;
-        for k in 0..ANGLES {
+        for k in 0..self.count {
             let w = |c: &[f64; ANGLES], e: &[f64; ANGLES]| {
                 c.get(k).copied().unwrap_or(0.0) * feed_per_tooth + e.get(k).copied().unwrap_or(0.0)
             };
@@ -205,16 +213,25 @@ mod tests {
         // sum_k int hat_k g = int_0^pi g: pi, 2, 0, pi/2, 0.
         let mut sum = [0.0; 5];
         for k in 0..ANGLES {
-            for (s, v) in sum.iter_mut().zip(hat_integrals(k)) {
+            for (s, v) in sum.iter_mut().zip(hat_integrals(k, ANGLES)) {
+                *s += v;
+            }
+        }
+        // The same for a coarser set of probes.
+        let mut coarse = [0.0; 5];
+        for k in 0..40 {
+            for (s, v) in coarse.iter_mut().zip(hat_integrals(k, 40)) {
                 *s += v;
             }
         }
         let expected = [PI, 2.0, 0.0, PI / 2.0, 0.0];
-        for (s, e) in sum.iter().zip(expected) {
+        for ((s, c), e) in sum.iter().zip(coarse).zip(expected) {
             assert!((s - e).abs() < 1e-12, "{sum:?}");
+            assert!((c - e).abs() < 1e-12, "{coarse:?}");
         }
         // One interior hat against the midpoint rule on 20,000 steps.
         let k = 37;
+        let angle = |k: usize| angle(k, ANGLES);
         let (a, c) = (angle(k - 1), angle(k + 1));
         let n = 20_000;
         let mut q = [0.0; 5];
@@ -226,7 +243,7 @@ mod tests {
                 *qq += hat * g * (c - a) / n as f64;
             }
         }
-        for (h, qq) in hat_integrals(k).iter().zip(q) {
+        for (h, qq) in hat_integrals(k, ANGLES).iter().zip(q) {
             assert!((h - qq).abs() < 1e-10, "{h} {qq}");
         }
     }

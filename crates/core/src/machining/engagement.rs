@@ -1,10 +1,12 @@
-//! Where a flat end mill meets the stock: the material in front of the cutter at each of
+//! Where a flat end mill meets the stock: the material in front of the cutter at up to
 //! [`ANGLES`] immersion angles (the [`Chip`]), read from the z-map ([`super::stock::ZMap`]) at
 //! the tool's position, so the force model ([`super::chip`]) never asks the user for an
 //! engagement.
 //!
 //! The front half of the cutter (`phi` in `[0, pi]`, clockwise from the tool frame's +y, feed
-//! along +x; the conventions of [`super::cutting`]) is probed 1 degree apart. The probe of
+//! along +x; the conventions of [`super::cutting`]) is probed at [`probe_count`] angles, at
+//! most half a cell apart along the rim and at most 1 degree apart: the interpolated
+//! stock has its kinks a cell apart, so finer probes only repeat its lines. The probe of
 //! angle `phi` lies at the rim's lateral offset `R cos(phi)` and ahead of the tool on the
 //! circle of radius `R + PROBE_CLEARANCE cell` around the tip: what the edge at `phi` meets as
 //! the tool advances, read where the tool has not cut yet. The clearance of 2 cells keeps the
@@ -28,8 +30,10 @@ use nalgebra::{ComplexField, Vector2, Vector3};
 
 use super::stock::ZMap;
 
-/// Angles probed over the front half of the cutter (1 degree apart): `phi_k = k pi / 180`.
+/// Most angles probed over the front half of the cutter (1 degree apart).
 pub const ANGLES: usize = 181;
+/// Fewest angles probed (10 degrees apart).
+pub const MIN_ANGLES: usize = 19;
 /// How far outside the cutter the probes lie, in cells of the z-map (see the module docs).
 pub const PROBE_CLEARANCE: f64 = 2.0;
 /// Least depth \[m\] a report counts as an engaged arc (1 um); the force has no threshold.
@@ -37,10 +41,22 @@ pub const MIN_DEPTH: f64 = 1.0e-6;
 /// Most separate engaged arcs one contact keeps; further arcs are merged into the last.
 pub const MAX_ARCS: usize = 8;
 
-/// The probe angle `phi_k` \[rad\].
+/// The probe angle `phi_k = k pi / (count - 1)` of `count` probes \[rad\].
 #[inline]
-pub fn angle(k: usize) -> f64 {
-    k as f64 * (core::f64::consts::PI / (ANGLES - 1) as f64)
+pub fn angle(k: usize, count: usize) -> f64 {
+    k as f64 * (core::f64::consts::PI / (count.max(2) - 1) as f64)
+}
+
+/// How many angles a cutter of `radius` \[m\] on cells of `cell` \[m\] is probed at: the
+/// fewest that put them at most half a cell apart along the rim, within [`MIN_ANGLES`] and
+/// [`ANGLES`] (a 16 mm end mill on 0.5 mm cells: 102; a 2 mm one on 0.17 mm cells: 39).
+pub fn probe_count(radius: f64, cell: f64) -> usize {
+    let gaps = core::f64::consts::PI * radius / (0.5 * cell);
+    if gaps.is_finite() && gaps > 0.0 {
+        (ComplexField::ceil(gaps.min(ANGLES as f64)) as usize + 1).clamp(MIN_ANGLES, ANGLES)
+    } else {
+        ANGLES
+    }
 }
 
 /// Where the probes lie around a cutter of one radius on a z-map of one cell: per angle, the
@@ -49,6 +65,7 @@ pub fn angle(k: usize) -> f64 {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Probes {
     radius: f64,
+    count: usize,
     /// The probes' largest distance from the tip \[m\].
     reach: f64,
     ahead: [f64; ANGLES],
@@ -61,15 +78,22 @@ impl Probes {
     /// material).
     pub fn new(radius: f64, cell: f64) -> Self {
         let rho = radius + PROBE_CLEARANCE * cell;
+        let count = probe_count(radius, cell);
         let mut ahead = [0.0; ANGLES];
         let mut side = [0.0; ANGLES];
-        for (k, (a, s)) in ahead.iter_mut().zip(side.iter_mut()).enumerate() {
-            let lateral = radius * ComplexField::cos(angle(k));
+        for (k, (a, s)) in ahead
+            .iter_mut()
+            .zip(side.iter_mut())
+            .enumerate()
+            .take(count)
+        {
+            let lateral = radius * ComplexField::cos(angle(k, count));
             *s = lateral;
             *a = ComplexField::sqrt((rho * rho - lateral * lateral).max(0.0));
         }
         Self {
             radius,
+            count,
             reach: rho.abs(),
             ahead,
             side,
@@ -79,6 +103,11 @@ impl Probes {
     /// The cutter radius \[m\].
     pub fn radius(&self) -> f64 {
         self.radius
+    }
+
+    /// The angles probed ([`probe_count`]).
+    pub fn count(&self) -> usize {
+        self.count
     }
 }
 
@@ -96,8 +125,11 @@ pub enum ChipKind {
 /// The material in front of the cutter: its depth above the tip at each probe angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chip {
-    /// Depth of stock above the tip at `phi_k` ([`angle`]) \[m\], `>= 0`.
+    /// Depth of stock above the tip at `phi_k` ([`angle`]) \[m\], `>= 0`; entries from
+    /// `count` on are unused.
     pub depth: [f64; ANGLES],
+    /// The angles probed, [`MIN_ANGLES`]..=[`ANGLES`] (`phi_k = k pi / (count - 1)`).
+    pub count: usize,
     /// Side milling or a plunge.
     pub kind: ChipKind,
     /// For a plunge: the stock above the tip at the tool's axis \[m\].
@@ -108,6 +140,7 @@ impl Default for Chip {
     fn default() -> Self {
         Self {
             depth: [0.0; ANGLES],
+            count: ANGLES,
             kind: ChipKind::Side,
             plunge_depth: 0.0,
         }
@@ -189,15 +222,16 @@ impl Chip {
                 Contact::Air
             };
         }
-        let step = angle(1);
+        let n = self.count.clamp(2, ANGLES);
+        let step = angle(1, n);
         let mut arcs = [Arc::default(); MAX_ARCS];
         let (mut count, mut open, mut probes) = (0usize, false, 0usize);
-        for (k, &depth) in self.depth.iter().enumerate() {
+        for (k, &depth) in self.depth.iter().enumerate().take(n) {
             if depth <= MIN_DEPTH {
                 open = false;
                 continue;
             }
-            let phi = angle(k);
+            let phi = angle(k, n);
             if !open {
                 if count < MAX_ARCS {
                     count += 1;
@@ -232,7 +266,10 @@ impl Chip {
 
     /// The largest depth over the probes \[m\].
     pub fn deepest(&self) -> f64 {
-        self.depth.iter().fold(0.0, |m, &d| m.max(d))
+        self.depth
+            .iter()
+            .take(self.count)
+            .fold(0.0, |m, &d| m.max(d))
     }
 }
 
@@ -254,12 +291,14 @@ pub fn read(
     let n = horizontal.norm();
     if n.is_nan() || n <= 1.0e-9 * feed.norm() {
         chip.kind = ChipKind::Plunge;
+        chip.count = probes.count;
         chip.depth = [0.0; ANGLES];
         chip.plunge_depth = stock.depth_at(&tip.xy(), tip.z);
         return;
     }
     chip.kind = ChipKind::Side;
     chip.plunge_depth = 0.0;
+    chip.count = probes.count;
     let x = horizontal / n;
     let left = Vector2::new(-x.y, x.x);
     let y = if counter_clockwise { -left } else { left };
@@ -278,6 +317,7 @@ pub fn read(
         .iter_mut()
         .zip(probes.ahead.iter())
         .zip(probes.side.iter())
+        .take(probes.count)
     {
         let u = base + xs * a + ys * s;
         *d = if u.x >= 0.0 && u.y >= 0.0 && u.x < umax && u.y < vmax {

@@ -348,12 +348,14 @@ impl ToolModels {
                     radius: 0.5 * setup.tool.diameter,
                 },
             ));
+            let probes = engagement::Probes::new(cutter.radius(), setup.stock.cell);
+            let count = probes.count();
             list.push(ToolModel {
                 number,
                 tool,
                 cutter,
-                probes: engagement::Probes::new(cutter.radius(), setup.stock.cell),
-                chip: ChipModel::new(&setup.coefficients, &tool),
+                probes,
+                chip: ChipModel::new(&setup.coefficients, &tool, count),
                 known: found.is_some(),
             });
         }
@@ -573,12 +575,17 @@ pub fn run_streaming<S: Sink + ?Sized>(
         reserve("job chunk (the allocation was refused)")?;
     }
     let mut next_failed = fill(&mut nominal, &mut sampler, chunk, &mut next);
+    // The program line and time of the last sample (for an error after the last chunk).
+    let mut last_at = (0, 0.0);
     loop {
         if next.is_empty() && next_failed.is_none() {
             break;
         }
         core::mem::swap(&mut noms, &mut next);
         next.clear();
+        if let Some(n) = noms.last() {
+            last_at = (n.path.line, n.path.time);
+        }
         let mut failed = next_failed.take();
         out_u.clear();
         out_c.clear();
@@ -635,6 +642,18 @@ pub fn run_streaming<S: Sink + ?Sized>(
         if let Some((_, e)) = failed {
             return Err(RunError::Job(e));
         }
+    }
+    // The moves the followers still hold back, cut before the stocks are handed on.
+    let flushed = nominal
+        .flush()
+        .and_then(|()| unc.flush())
+        .and_then(|()| comp.flush());
+    if let Err(error) = flushed {
+        return Err(RunError::Job(JobError::AtLine {
+            line: last_at.0,
+            time: last_at.1,
+            error,
+        }));
     }
     let cell_updates = nominal.cell_updates + unc.cell_updates + comp.cell_updates;
     Ok(Report {

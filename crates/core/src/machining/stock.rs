@@ -30,6 +30,9 @@ use nalgebra::{ComplexField, Vector2, Vector3};
 
 use crate::error::{BuildError, TickError, check_finite};
 
+mod follower;
+pub use follower::{FOLLOW_TOLERANCE, Follower, MAX_HELD, Step};
+
 /// Most cells of one z-map: 2^24 (16.8 million, 134 MB of heights; a 1 m x 1 m stock at
 /// 0.25 mm). [`BuildError::Budget`] past it.
 pub const MAX_CELLS: usize = 1 << 24;
@@ -308,6 +311,7 @@ impl ZMap {
         after: bool,
     ) -> Result<Removal, TickError> {
         check_finite("cut start", from.as_slice())?;
+
         check_finite("cut end", to.as_slice())?;
         let r = cutter.radius();
         if !(r.is_finite() && r > 0.0) {
@@ -422,60 +426,6 @@ impl ZMap {
     }
 }
 
-/// How far a [`Follower`] may leave cells above the exact sweep \[m\]: 1e-8 m, the pose
-/// IK's position tolerance.
-pub const FOLLOW_TOLERANCE: f64 = 1.0e-8;
-
-/// A tool followed sample by sample over one z-map: each [`Self::cut_to`] cuts from where
-/// the last one ended. A flat end mill stepping less than a cell visits only the cells its
-/// disc newly reaches (every cell within its radius of the last tip is at or below the last
-/// tip's height), a few per row instead of its whole footprint, as long as the descents it
-/// so skips add up to at most [`FOLLOW_TOLERANCE`] since the last full sweep: the cells are
-/// then within that tolerance of [`ZMap::cut`]'s, and a deflected tool's nanometre wobble
-/// does not lower its whole footprint every sample.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Follower {
-    last: Option<(Cutter, Vector3<f64>)>,
-    slack: f64,
-}
-
-impl Follower {
-    /// A tool not yet on the stock.
-    pub fn new() -> Self {
-        Self::default()
-    }
-
-    /// The last tip cut to \[m\].
-    pub fn tip(&self) -> Option<Vector3<f64>> {
-        self.last.map(|(_, p)| p)
-    }
-
-    /// Cuts `stock` with `cutter` from the last tip (or at `to` the first time, or after a
-    /// tool change) to `to` \[m\]; the errors of [`ZMap::cut`].
-    pub fn cut_to(
-        &mut self,
-        stock: &mut ZMap,
-        cutter: &Cutter,
-        to: &Vector3<f64>,
-    ) -> Result<Removal, TickError> {
-        let (from, same) = match self.last {
-            Some((c, p)) => (p, c == *cutter),
-            None => (*to, false),
-        };
-        let descent = (from.z - to.z).max(0.0);
-        let crescent = same && self.slack + descent <= FOLLOW_TOLERANCE;
-        let removal = stock.sweep(cutter, &from, to, crescent)?;
-        // `sweep` visits the whole footprint unless the step allows the crescent.
-        self.slack = if crescent && stock.crescent(cutter, &from, to) {
-            self.slack + descent
-        } else {
-            0.0
-        };
-        self.last = Some((*cutter, *to));
-        Ok(removal)
-    }
-}
-
 /// The floor of `x` without a libm call (`x` within +-2^52; else `x`).
 #[inline]
 fn floor_of(x: f64) -> f64 {
@@ -519,6 +469,7 @@ impl Pass<'_> {
         let Some(cells) = row.get_mut(i0..i1.max(i0)) else {
             return;
         };
+
         let bb = self.b.norm_squared();
         let inv_bb = if bb > 1.0e-30 { 1.0 / bb } else { 0.0 };
         let ball = matches!(self.cutter, Cutter::Ball { .. });

@@ -9,7 +9,7 @@ use crate::error::{JobError, TickError};
 use crate::machining::engagement::{Chip, Contact};
 use crate::machining::path::PathSample;
 use crate::machining::report::RapidContact;
-use crate::machining::stock::{Follower, Removal, ZMap};
+use crate::machining::stock::{Follower, Removal, Step, ZMap};
 use crate::vjm::Vector6;
 
 /// What the nominal stage hands on for one sample.
@@ -28,6 +28,11 @@ pub(super) struct Sample {
     pub wrench: Vector6,
     /// The programmed step since the last sample \[m\].
     pub step: Vector3<f64>,
+    /// The nominal stock's held move was cut before this sample's chip was read.
+    pub settled: bool,
+    /// What the nominal cut did with this sample's tip: the arms cut their stocks along
+    /// moves that end at the same samples (see [`Follower::step_to`]).
+    pub cut: Step,
 }
 
 pub(super) struct Stage<'a> {
@@ -59,6 +64,12 @@ impl<'a> Stage<'a> {
             plunge_samples: 0,
             cell_updates: 0,
         }
+    }
+
+    /// Cuts what the follower holds back (before the stock is handed on).
+    pub fn flush(&mut self) -> Result<(), TickError> {
+        self.cell_updates += self.follower.flush(&mut self.stock)?.cells;
+        Ok(())
     }
 
     fn tool_index(&mut self, number: u32) -> usize {
@@ -97,6 +108,13 @@ impl<'a> Stage<'a> {
             (v, _) => v,
         };
         let ccw = spindle < 0.0;
+        let held = self.follower.held();
+        let settled = self
+            .follower
+            .settle(&mut self.stock, &p, &s.direction)
+            .map_err(at)?;
+        self.cell_updates += settled.cells;
+        let settled = held > 0 && self.follower.held() == 0;
         engagement::read(
             &self.stock,
             &tm.probes,
@@ -106,10 +124,15 @@ impl<'a> Stage<'a> {
             &mut self.chip,
         );
         let contact = self.chip.contact();
-        let removed = self
-            .follower
-            .cut_to(&mut self.stock, &tm.cutter, &p)
-            .map_err(at)?;
+        // A rapid's removal is checked at once, and a tool the job lacks must cut nothing:
+        // those are cut now, moves along a line held back (see `Follower::hold_to`).
+        let (removed, cut) = if s.feed_move && tm.known {
+            self.follower.hold_to(&mut self.stock, &tm.cutter, &p)
+        } else {
+            self.flush().map_err(at)?;
+            (self.follower.cut_to(&mut self.stock, &tm.cutter, &p)).map(|r| (r, Step::Cut))
+        }
+        .map_err(at)?;
         self.check(s, &contact, &removed, tm.known, spindle)?;
         if matches!(contact, Contact::Plunge { .. }) {
             self.plunge_samples += 1;
@@ -128,6 +151,8 @@ impl<'a> Stage<'a> {
             force,
             wrench: rotate(&self.to_base, &wrench_w),
             step: p - from,
+            settled,
+            cut,
         })
     }
 

@@ -56,6 +56,9 @@ pub(super) struct Arm<'a> {
     to_work: Isometry3<f64>,
     pub stock: ZMap,
     tip: Option<Vector3<f64>>,
+    /// How far the last tip moved beyond the programmed step \[m\] (the change of the
+    /// deflection): the next sample's first guess repeats it.
+    drift: Vector3<f64>,
     follower: Follower,
     chip: Chip,
     pub cell_updates: usize,
@@ -85,6 +88,7 @@ impl<'a> Arm<'a> {
             to_work: job.setup.placement.inverse(),
             stock,
             tip: None,
+            drift: Vector3::zeros(),
             follower: Follower::new(),
             chip: Chip::default(),
             cell_updates: 0,
@@ -112,6 +116,12 @@ impl<'a> Arm<'a> {
                 }
             }
         }
+        Ok(())
+    }
+
+    /// Cuts what the follower holds back (before the stock is handed on).
+    pub fn flush(&mut self) -> Result<(), TickError> {
+        self.cell_updates += self.follower.flush(&mut self.stock)?.cells;
         Ok(())
     }
 
@@ -157,6 +167,9 @@ impl<'a> Arm<'a> {
 
     fn advance(&mut self, n: &Sample) -> Result<Out, TickError> {
         self.joints(n)?;
+        if n.settled {
+            self.flush()?;
+        }
         let job = self.job;
         let model = &job.model;
         let q = self.q;
@@ -180,8 +193,18 @@ impl<'a> Arm<'a> {
                 value: n.tool as f64,
             });
         };
-        let removed = self.follower.cut_to(&mut self.stock, &tm.cutter, &tip)?;
+        let removed = self
+            .follower
+            .step_to(&mut self.stock, &tm.cutter, &tip, n.cut)?;
         self.cell_updates += removed.cells;
+        // A tool change or a jump restarts the guess from the program's step.
+        self.drift = match self.tip {
+            Some(t) if n.step.norm() > 0.0 => tip - t - n.step,
+            _ => Vector3::zeros(),
+        };
+        if self.drift.norm() > DRIFT_LIMIT || self.drift.iter().any(|v| !v.is_finite()) {
+            self.drift = Vector3::zeros();
+        }
         self.tip = Some(tip);
         Ok(Out {
             q,
@@ -206,7 +229,9 @@ impl<'a> Arm<'a> {
             compliance: None,
             evaluations: 0,
         };
-        let start = self.tip.map_or(n.path.position, |t| t + n.step);
+        let start = self
+            .tip
+            .map_or(n.path.position, |t| t + n.step + self.drift);
         // Fixed-point steps while they contract fast; the best point so far is kept.
         let mut t = start;
         // (point, its image, the force there, the residual)
@@ -293,6 +318,7 @@ impl<'a> Arm<'a> {
         };
         let dir = n.path.direction;
         let ccw = n.counter_clockwise;
+        self.cell_updates += self.follower.settle(&mut self.stock, t, &dir)?.cells;
         engagement::read(&self.stock, &tm.probes, t, &dir, ccw, &mut self.chip);
         let (f, w) = chip_wrench(&tm.chip, &self.chip, &dir, n.fz, ccw)?;
         let wrench = rotate(&self.to_base, &w);
@@ -330,6 +356,10 @@ struct Coupling {
 
 /// A point of the coupling, its image, the force there and the residual.
 type Trial = (Vector3<f64>, Vector3<f64>, Vector3<f64>, f64);
+
+/// Largest drift of the tip between samples the next first guess repeats \[m\]: past it
+/// (the tool entering or leaving the stock) the guess is the programmed step alone.
+const DRIFT_LIMIT: f64 = 1.0e-5;
 
 /// The difference step of the coupling's Newton iteration \[m\]: far below a cell, far
 /// above the rounding of the tip.

@@ -228,7 +228,7 @@ pub fn run_program(
         radius: 0.5 * setup.tool.diameter,
     };
     let probes = engagement::Probes::new(cutter.radius(), st.cell);
-    let chip_model = ChipModel::new(&setup.coefficients, &setup.tool);
+    let chip_model = ChipModel::new(&setup.coefficients, &setup.tool, probes.count());
     let mut chip = engagement::Chip::default();
     let mut noise = Noise::new(opts.seed);
     let dt = opts.dt;
