@@ -320,6 +320,10 @@ impl ZMap {
                 value: r,
             });
         }
+        // No cell rises above the top: a move above it (a rapid, air) cuts nothing.
+        if from.z.min(to.z) >= self.top {
+            return Ok(Removal::default());
+        }
         let cell = self.cell;
         // A step shorter than a cell: every cell it reaches lies within r + cell of an end.
         let short = (to.xy() - from.xy()).norm() < cell;
@@ -370,6 +374,16 @@ impl ZMap {
                 if short {
                     // Within r + cell of either end: the hull of the two discs' chords.
                     let reach = r + cell;
+                    let core = (r - 0.5 * cell).max(0.0);
+                    let core_chord = |p: &Vector3<f64>| {
+                        let dy = cy - p.y;
+                        let inner = core * core - dy * dy;
+                        // 1e-9 m inside, as the crescent's exclusion: rounding stays out.
+                        (inner > 0.0).then(|| {
+                            let w = ComplexField::sqrt(inner) - 1.0e-9;
+                            (p.x - w, p.x + w)
+                        })
+                    };
                     let chord = |p: &Vector3<f64>| {
                         let dy = cy - p.y;
                         (dy.abs() <= reach).then(|| {
@@ -382,15 +396,24 @@ impl ZMap {
                         (Some(c), None) | (None, Some(c)) => c,
                         (None, None) => continue,
                     };
-                    pass.row(
-                        row,
-                        clamp(above(a)),
-                        clamp(below(b) + 1.0),
-                        cy,
-                        origin.x,
-                        cell,
-                        &mut removal,
-                    );
+                    let (a, b) = (clamp(above(a)), clamp(below(b) + 1.0));
+                    // A flat end's cells within `R - cell / 2` of both ends (inside its
+                    // rim's band all along the move) go to the lower end: one comparison
+                    // each instead of the cell's search.
+                    let (ca, cb) = match (cutter, core_chord(from), core_chord(to)) {
+                        (Cutter::Flat { .. }, Some(f), Some(t)) => (
+                            clamp(above(f.0.max(t.0))).max(a).min(b),
+                            clamp(below(f.1.min(t.1)) + 1.0).max(a).min(b),
+                        ),
+                        _ => (b, b),
+                    };
+                    if ca >= cb {
+                        pass.row(row, a, b, cy, origin.x, cell, &mut removal);
+                    } else {
+                        pass.row(row, a, ca, cy, origin.x, cell, &mut removal);
+                        pass.floor(row, ca, cb, &mut removal);
+                        pass.row(row, cb, b, cy, origin.x, cell, &mut removal);
+                    }
                 } else {
                     pass.row(row, i0, i1, cy, origin.x, cell, &mut removal);
                 }
@@ -406,6 +429,23 @@ impl ZMap {
             let w = ComplexField::sqrt(reach * reach - dy * dy);
             let (a, b) = (clamp(above(to.x - w)), clamp(below(to.x + w) + 1.0));
             let df = cy - from.y;
+            // Only cells ahead of `from` along the move: one behind it has `from` for its
+            // closest point, as it had at the end of the last move, and keeps its height to
+            // the descent the follower allows.
+            let (bx, by) = (to.x - from.x, to.y - from.y);
+            let (ha, hb) = if bx > 0.0 {
+                (clamp(above(from.x - df * by / bx)), i1)
+            } else if bx < 0.0 {
+                (i0, clamp(below(from.x - df * by / bx) + 1.0))
+            } else if df * by > 0.0 {
+                (i0, i1)
+            } else {
+                continue;
+            };
+            let (a, b) = (a.max(ha), b.min(hb));
+            if a >= b {
+                continue;
+            }
             // Cells fully under the disc at `from` (inside its rim's band) are at or below it.
             let core = (r - 0.5 * cell).max(0.0);
             let inner = core * core - df * df;
@@ -528,6 +568,25 @@ impl Pass<'_> {
                 removal.volume += (*h - z) * self.area;
                 removal.deepest = removal.deepest.max(*h - z);
                 *h = z;
+            }
+        }
+    }
+}
+
+impl Pass<'_> {
+    /// Lowers the cells `i0..i1` of one row to the move's lower end (cells a flat end covers
+    /// all along the move).
+    fn floor(&self, row: &mut [f64], i0: usize, i1: usize, removal: &mut Removal) {
+        let Some(cells) = row.get_mut(i0..i1.max(i0)) else {
+            return;
+        };
+        let floor = self.floor;
+        for h in cells {
+            if *h > floor {
+                removal.cells += 1;
+                removal.volume += (*h - floor) * self.area;
+                removal.deepest = removal.deepest.max(*h - floor);
+                *h = floor;
             }
         }
     }
