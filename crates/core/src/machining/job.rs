@@ -9,7 +9,8 @@
 //!
 //! 1. the programmed tool tip `p` and the chip of the nominal tool on the nominal stock, the
 //!    force `F` on the tool and the wrench about the tip (each angle's force halfway up its
-//!    depth, the cutting torque about the axis); then the nominal stock is cut to `p`;
+//!    depth, the cutting torque about the axis); then the nominal stock is cut to `p` (a
+//!    straight run of samples held back and cut as one move, [`super::stock::Follower`]);
 //! 2. the target pose `placement * (p, tool_orientation)`, the rigid joints `q` by pose IK
 //!    warm-started from the previous samples, the deflection of the tip under the wrench at
 //!    `q` (exact VJM), and the compensated joints `q_c` at which the loaded tip reaches the
@@ -18,9 +19,11 @@
 //! 3. the part, predicted three ways on three z-maps: nominal (the tool on the program),
 //!    uncompensated (at `q`) and compensated (at `q_c`). Each prediction's tool feels the force
 //!    of its own chip where it is: its tip `t` solves `t = tip(q, F(t))` on its own stock, by
-//!    fixed-point iteration from the previous sample's tip plus the programmed step, to
-//!    [`COUPLING_TOLERANCE`] within [`MAX_COUPLING_ITERATIONS`] (the last step is reported per
-//!    sample, [`JobSample::coupling_residual`]); then its stock is cut to `t`.
+//!    fixed-point iteration from the previous sample's tip plus the programmed step (and, for
+//!    the uncompensated tool, its last drift), to [`COUPLING_TOLERANCE`] within
+//!    [`MAX_COUPLING_ITERATIONS`] (the last step is reported per sample,
+//!    [`JobSample::coupling_residual`]); then its stock is cut to `t`, in moves that end at
+//!    the samples the nominal stock's moves end at (so the three stocks are cut alike).
 //!
 //! # How close the compensated prediction stays to the program
 //! The compensated joints put the loaded tip on `p` to the IK's position tolerance `e_ik`

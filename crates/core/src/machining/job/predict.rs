@@ -229,9 +229,14 @@ impl<'a> Arm<'a> {
             compliance: None,
             evaluations: 0,
         };
-        let start = self
-            .tip
-            .map_or(n.path.position, |t| t + n.step + self.drift);
+        // The compensated tool's guess is the program's step (its tip belongs on the
+        // program); the uncompensated one's repeats its last drift as well.
+        let drift = if self.compensated {
+            Vector3::zeros()
+        } else {
+            self.drift
+        };
+        let start = self.tip.map_or(n.path.position, |t| t + n.step + drift);
         // Fixed-point steps while they contract fast; the best point so far is kept.
         let mut t = start;
         // (point, its image, the force there, the residual)
