@@ -16,7 +16,7 @@ pub const MAX_HELD: usize = 16;
 
 /// How far behind the tip, in cells, a held move may reach sideways or ahead of it and still
 /// leave every cell the engagement reads untouched ([`Follower::settle`]): the probes lie
-/// `R + 2` cells from the tip ([`super::engagement`]) and read centres within `sqrt(2)`
+/// `R + 2` cells from the tip ([`crate::machining::engagement`]) and read centres within `sqrt(2)`
 /// cells of themselves; a cut changes centres within `R + 1/2` cell of the move. With both
 /// ends of the move within `h` of the ray behind the tip, its points lie `R + 2 - sqrt(2) h`
 /// cells from every probe or more, which clears `R + 1/2 + sqrt(2)` for `h < 0.06`.
@@ -146,8 +146,8 @@ impl Follower {
     }
 
     /// Cuts the held move if a read of the stock around `tip` \[m\] moving along `feed`
-    /// (the engagement's probes, [`super::engagement::read`]) could see a cell it changes:
-    /// unless both its ends lie within [`HELD_CLEARANCE`] cells of the ray behind the tip
+    /// (the engagement's probes, [`crate::machining::engagement::read`]) could see a cell it changes:
+    /// unless both its ends lie within 0.05 cell of the ray behind the tip
     /// (and always for a plunge, read under the tip). What was cut.
     pub fn settle(
         &mut self,
