@@ -70,3 +70,9 @@ extractors!(
     /// Optional triples of reals ([`crate::scalars::opt_triple`]).
     opt_triple: crate::scalars::opt_triple => Option<[f64; 3]> { gravity }
 );
+
+extractors!(
+    /// Texts ([`crate::scalars::text`]): a lone surrogate is an `InputError`, not a
+    /// `UnicodeEncodeError`.
+    text: crate::scalars::text => String { text }
+);

@@ -141,14 +141,14 @@ impl ComplianceMap {
     #[staticmethod]
     #[pyo3(signature = (text, force_unit="N", length_unit="mm", interpolation="bilinear", out_of_grid="error"))]
     fn from_csv_text(
-        text: &str,
+        #[pyo3(from_py_with = crate::args::text::text)] text: String,
         force_unit: &str,
         length_unit: &str,
         interpolation: &str,
         out_of_grid: &str,
     ) -> PyResult<Self> {
         let (f, l) = units(force_unit, length_unit)?;
-        let inner = map_csv::from_str(text, f, l).map_err(load_err)?;
+        let inner = map_csv::from_str(&text, f, l).map_err(load_err)?;
         Self::wrap(inner, interpolation, out_of_grid)
     }
 

@@ -130,9 +130,12 @@ impl GridMap {
                 cm::MAX_GRID_NODES * 36,
                 "MAX_GRID_NODES x 36",
             )?;
-            if a.len() != n * n_force * n_displacement {
-                let mut want: Vec<String> = nodes.iter().map(|v| v.len().to_string()).collect();
-                want.extend([n_displacement.to_string(), n_force.to_string()]);
+            // The exact shape, not only the count: a transposed array has the same count
+            // and would be read in the wrong order.
+            let mut want: Vec<usize> = nodes.iter().map(Vec::len).collect();
+            want.extend([n_displacement, n_force]);
+            if a.len() != n * n_force * n_displacement || a.shape() != want.as_slice() {
+                let want: Vec<String> = want.iter().map(usize::to_string).collect();
                 return Err(shape_error(
                     what,
                     &format!("({})", want.join(", ")),

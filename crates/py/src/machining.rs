@@ -14,6 +14,7 @@ use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 
 use crate::InputError;
+use crate::args;
 use crate::arrays::{try_rows, vector, vector_upto};
 use crate::errors::{build_err, load_err, tick_err};
 use crate::scalars::{count, real};
@@ -103,12 +104,16 @@ fn word_state(w: &WordUse) -> WordState {
 /// "refused"; also for a program the reader refuses.
 #[pyfunction]
 #[pyo3(signature = (text, *, dialect="linuxcnc"))]
-fn gcode_words(py: Python<'_>, text: &str, dialect: &str) -> PyResult<Vec<WordState>> {
+fn gcode_words(
+    py: Python<'_>,
+    #[pyo3(from_py_with = args::text::text)] text: String,
+    dialect: &str,
+) -> PyResult<Vec<WordState>> {
     let o = GcodeOptions {
         dialect: self::dialect(dialect)?,
         ..GcodeOptions::default()
     };
-    let words = py.detach(|| gcode::words(text, &o)).map_err(load_err)?;
+    let words = py.detach(|| gcode::words(&text, &o)).map_err(load_err)?;
     Ok(words.iter().map(word_state).collect())
 }
 
@@ -154,14 +159,14 @@ impl GcodeProgram {
     #[pyo3(signature = (text, *, start=None, units="mm", dialect="linuxcnc", block_delete=false))]
     fn from_text(
         py: Python<'_>,
-        text: &str,
+        #[pyo3(from_py_with = args::text::text)] text: String,
         start: Option<&Bound<'_, PyAny>>,
         units: &str,
         dialect: &str,
         block_delete: bool,
     ) -> PyResult<Self> {
         let o = options(start, units, dialect, block_delete)?;
-        Self::read(py, text, &o)
+        Self::read(py, &text, &o)
     }
 
     /// Reads a tool points CSV file: one straight move per row from the previous point (the
@@ -184,9 +189,12 @@ impl GcodeProgram {
     /// Same as `from_points_file`, from the CSV text.
     #[staticmethod]
     #[pyo3(signature = (text, *, start=None))]
-    fn from_points_text(text: &str, start: Option<&Bound<'_, PyAny>>) -> PyResult<Self> {
+    fn from_points_text(
+        #[pyo3(from_py_with = args::text::text)] text: String,
+        start: Option<&Bound<'_, PyAny>>,
+    ) -> PyResult<Self> {
         let o = options(start, "mm", "linuxcnc", false)?;
-        let inner = points_csv::from_str(text, &o).map_err(load_err)?;
+        let inner = points_csv::from_str(&text, &o).map_err(load_err)?;
         Ok(Self {
             inner,
             words: Vec::new(),

@@ -9,6 +9,23 @@ use pyo3::types::{PyFloat, PyInt};
 use crate::arrays::{asarray, is_real_kind, vector};
 use crate::errors::{InputError, shape_error, shape_text, short, type_name};
 
+/// A text argument as UTF-8: a `str` (`InputError` naming `what` for a string no UTF-8
+/// encodes, as a lone surrogate; `TypeError` for anything else, as pyo3 raises).
+pub fn text(o: &Bound<'_, PyAny>, what: &str) -> PyResult<String> {
+    let s = o.cast::<pyo3::types::PyString>().map_err(|_| {
+        pyo3::exceptions::PyTypeError::new_err(format!(
+            "{what}: expected str, got {}",
+            type_name(o)
+        ))
+    })?;
+    match s.to_str() {
+        Ok(t) => Ok(t.to_owned()),
+        Err(e) => Err(InputError::new_err(format!(
+            "{what}: not encodable as UTF-8 ({e})"
+        ))),
+    }
+}
+
 /// A real scalar: a Python int or float, a numpy real scalar or 0-d array, or an object with
 /// `__float__`. Complex numbers, strings, arrays and integers too large for a float are an
 /// `InputError` naming `what`. NaN and infinities pass (the core call names them).

@@ -118,7 +118,14 @@ impl ToolTable {
     /// Same as `from_file`, from the text: `format` "tbl" (LinuxCNC's) or "toml".
     #[staticmethod]
     #[pyo3(signature = (text, *, format="tbl", units="mm", flutes=3, helix=0.0))]
-    fn from_text(text: &str, format: &str, units: &str, flutes: u32, helix: f64) -> PyResult<Self> {
+    fn from_text(
+        #[pyo3(from_py_with = crate::args::text::text)] text: String,
+        format: &str,
+        units: &str,
+        flutes: u32,
+        helix: f64,
+    ) -> PyResult<Self> {
+        let text = text.as_str();
         let inner = match format {
             "tbl" => tool_table::tbl_from_str(text, &tbl_options(units, flutes, helix)?),
             "toml" => tool_table::toml_from_str(text),

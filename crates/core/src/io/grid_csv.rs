@@ -61,6 +61,12 @@ pub fn fit_static_str(
             continue;
         }
         match axis_column(h) {
+            // `x_mm` and `x_m` are one axis given twice.
+            Some((name, _)) if axes.iter().any(|a| a.1.eq_ignore_ascii_case(&name)) => {
+                return Err(LoadError::UnknownColumn {
+                    column: std::format!("{h} (grid axis {name} a second time)"),
+                });
+            }
             Some((name, scale)) => axes.push((c, name, scale)),
             None => {
                 return Err(LoadError::UnknownColumn {

@@ -74,6 +74,14 @@ pub(super) fn read_csv(
         .comment(Some(b'#'))
         .from_reader(text.as_bytes());
     let header = rdr.headers().map_err(|e| csv_err(&e))?.clone();
+    // A column given twice would be read once and the other copy dropped.
+    for (k, h) in header.iter().enumerate() {
+        if header.iter().take(k).any(|p| p.eq_ignore_ascii_case(h)) {
+            return Err(LoadError::UnknownColumn {
+                column: std::format!("{h} (a second time: each column once)"),
+            });
+        }
+    }
     let records = rdr
         .records()
         .collect::<Result<Vec<_>, _>>()

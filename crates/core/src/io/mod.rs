@@ -71,7 +71,8 @@ pub fn read_text_lossy(path: &Path) -> Result<String, LoadError> {
 }
 
 /// Reads a whole text file, naming it in the error; reads at most [`MAX_FILE_BYTES`] + 1
-/// bytes, so a huge file or an endless one (`/dev/zero`) is refused, not read.
+/// bytes, so a huge file is refused, not read, and only a regular file (a FIFO, device or
+/// directory is refused before it is opened).
 pub(crate) fn read_text(path: &Path) -> Result<String, LoadError> {
     let bytes = read_bytes(path)?;
     String::from_utf8(bytes).map_err(|e| LoadError::Io {
@@ -87,6 +88,15 @@ fn read_bytes(path: &Path) -> Result<std::vec::Vec<u8>, LoadError> {
         path: path.display().to_string(),
         message: e.to_string(),
     };
+    // Only a regular file: opening a FIFO blocks until a writer comes (forever, holding
+    // Python's GIL), and a device or directory never reads as a file.
+    let meta = std::fs::metadata(path).map_err(io)?;
+    if !meta.is_file() {
+        return Err(LoadError::Io {
+            path: path.display().to_string(),
+            message: "not a regular file (a directory, FIFO, socket or device)".into(),
+        });
+    }
     let file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = std::vec::Vec::new();
     file.take(MAX_FILE_BYTES as u64 + 1)

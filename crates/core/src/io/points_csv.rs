@@ -56,6 +56,7 @@ fn either(
 /// Reads the points from CSV text (see the module docs); `options.start` is where the tool
 /// is before the first row (`options.units` is unused: the columns name their units).
 pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError> {
+    super::gcode::check_start(&options.start)?;
     let (header, records) = read_csv(text)?;
     check_columns(&header, &COLUMNS)?;
     let x = either(&header, "x_mm", "x_m", 1e-3)?;

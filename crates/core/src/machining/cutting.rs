@@ -31,6 +31,13 @@ pub const MAX_FLUTES: u32 = 16;
 pub const MAX_DISCS: usize = 256;
 /// Largest helix angle \[rad\] (60 degrees; end mills have 0-50).
 pub const MAX_HELIX: f64 = core::f64::consts::FRAC_PI_3;
+/// Smallest tool diameter \[m\] (10 um; micro end mills start at about 50 um).
+pub const MIN_TOOL_DIAMETER: f64 = 1.0e-5;
+/// Largest cutting coefficient `k_*c` \[N/m^2\]: 1e11 (100,000 N/mm^2; hardened steels are
+/// a few thousand): past it a set is in the wrong unit.
+pub const MAX_CUTTING_COEFFICIENT: f64 = 1.0e11;
+/// Largest edge coefficient `k_*e` \[N/m\]: 1e7 (10,000 N/mm).
+pub const MAX_EDGE_COEFFICIENT: f64 = 1.0e7;
 
 /// Cutting (`k_*c`, \[N/m^2\]) and edge (`k_*e`, \[N/m\]) coefficients of a material with a
 /// tool, tangential, radial and axial.
@@ -67,7 +74,9 @@ impl Coefficients {
     };
 
     /// Checked coefficients: every one finite and >= 0 (a negative coefficient has no
-    /// physical reading in this model); [`BuildError::InvalidParameter`] naming it otherwise.
+    /// physical reading in this model), cutting ones at most [`MAX_CUTTING_COEFFICIENT`],
+    /// edge ones at most [`MAX_EDGE_COEFFICIENT`]; [`BuildError::InvalidParameter`] naming it
+    /// otherwise.
     pub fn new(
         k_tc: f64,
         k_rc: f64,
@@ -90,19 +99,23 @@ impl Coefficients {
 
     /// Checks a set built field by field (as [`Self::new`]).
     pub fn validate(&self) -> Result<(), BuildError> {
-        for (what, v) in [
-            ("k_tc", self.k_tc),
-            ("k_rc", self.k_rc),
-            ("k_ac", self.k_ac),
-            ("k_te", self.k_te),
-            ("k_re", self.k_re),
-            ("k_ae", self.k_ae),
+        let (cut, edge) = (
+            "within 0..=MAX_CUTTING_COEFFICIENT (1e11 N/m^2)",
+            "within 0..=MAX_EDGE_COEFFICIENT (1e7 N/m)",
+        );
+        for (what, v, max, expected) in [
+            ("k_tc", self.k_tc, MAX_CUTTING_COEFFICIENT, cut),
+            ("k_rc", self.k_rc, MAX_CUTTING_COEFFICIENT, cut),
+            ("k_ac", self.k_ac, MAX_CUTTING_COEFFICIENT, cut),
+            ("k_te", self.k_te, MAX_EDGE_COEFFICIENT, edge),
+            ("k_re", self.k_re, MAX_EDGE_COEFFICIENT, edge),
+            ("k_ae", self.k_ae, MAX_EDGE_COEFFICIENT, edge),
         ] {
-            if !(v.is_finite() && v >= 0.0) {
+            if !(v.is_finite() && (0.0..=max).contains(&v)) {
                 return Err(BuildError::InvalidParameter {
                     what,
                     value: v,
-                    expected: "finite and >= 0 (N/m^2 or N/m)",
+                    expected,
                 });
             }
         }
@@ -122,8 +135,8 @@ pub struct Tool {
 }
 
 impl Tool {
-    /// A checked tool: diameter finite and in (0, 1 m], flutes in 1..=[`MAX_FLUTES`], helix
-    /// in \[0, [`MAX_HELIX`]).
+    /// A checked tool: diameter in [[`MIN_TOOL_DIAMETER`], 1 m], flutes in
+    /// 1..=[`MAX_FLUTES`], helix in \[0, [`MAX_HELIX`]).
     pub fn new(diameter: f64, flutes: u32, helix: f64) -> Result<Self, BuildError> {
         let t = Self {
             diameter,
@@ -136,11 +149,11 @@ impl Tool {
 
     /// Checks a tool built field by field (as [`Self::new`]).
     pub fn validate(&self) -> Result<(), BuildError> {
-        if !(self.diameter.is_finite() && self.diameter > 0.0 && self.diameter <= 1.0) {
+        if !(self.diameter.is_finite() && (MIN_TOOL_DIAMETER..=1.0).contains(&self.diameter)) {
             return Err(BuildError::InvalidParameter {
                 what: "tool diameter",
                 value: self.diameter,
-                expected: "finite, in (0, 1] m",
+                expected: "finite, in [1e-5, 1] m (MIN_TOOL_DIAMETER)",
             });
         }
         if !(1..=MAX_FLUTES).contains(&self.flutes) {

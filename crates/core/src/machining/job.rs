@@ -548,6 +548,24 @@ pub fn run_streaming<S: Sink + ?Sized>(
     let mut sampler = path::Sampler::new(program, &setup.path)?;
     let tools = ToolModels::new(job, program);
     let st = &setup.stock;
+    // A cell as wide as a tool's radius cannot resolve its cut (a stock of one cell reads
+    // every error as 0): at most half the radius of every tool the program uses.
+    if let Some(t) = tools
+        .list
+        .iter()
+        .find(|t| st.cell > 0.5 * t.cutter.radius())
+    {
+        return Err(BuildError::InvalidParameter {
+            what: "stock cell (m), at most half the radius of every tool the program uses",
+            value: st.cell,
+            expected: if t.known {
+                "<= the radius / 2 of the program's smallest tool"
+            } else {
+                "<= the job's tool radius / 2"
+            },
+        }
+        .into());
+    }
     let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
     let mut nominal = nominal::Stage::new(job, &tools, zmap()?);
     let mut unc = predict::Arm::new(job, &tools, zmap()?, seed, false);

@@ -31,6 +31,9 @@ use crate::motion::{Limits, Profile};
 
 /// Highest sampling rate \[Hz\] (10 kHz; servo loops run at 1-8 kHz).
 pub const MAX_RATE_HZ: f64 = 1.0e4;
+/// Lowest sampling rate \[Hz\] (1 Hz: slower, a program is two samples and its errors
+/// read 0).
+pub const MIN_RATE_HZ: f64 = 1.0;
 /// Most samples of one program sampled into memory ([`sample`], and the offline pass that
 /// keeps every sample, [`super::job::run`]): 1,000,000 (67 min at the 4 ms cycle, 8 min at
 /// 2 kHz; the pass keeps about 0.6 KB per sample). Longer programs stream
@@ -73,8 +76,8 @@ impl PathOptions {
         param(
             "rate_hz",
             self.rate_hz,
-            self.rate_hz.is_normal() && self.rate_hz > 0.0 && self.rate_hz <= MAX_RATE_HZ,
-            "in (0, 10000] Hz",
+            (MIN_RATE_HZ..=MAX_RATE_HZ).contains(&self.rate_hz),
+            "in [MIN_RATE_HZ, MAX_RATE_HZ] = [1, 10000] Hz",
         )?;
         Limits::new(self.rapid_speed, self.acceleration, self.jerk)?;
         param(

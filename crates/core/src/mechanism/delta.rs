@@ -42,6 +42,12 @@ use crate::error::{BuildError, TickError};
 /// millimetres (the paper's five-bar uses 20 mm/rad).
 pub const DELTA_MIN_SIGMA: f64 = 0.010;
 
+/// Shortest length of a [`Delta`] \[m\] (a micrometre: below it a length is a units mistake,
+/// and 5e-324 m would square to 0).
+pub const DELTA_MIN_LENGTH: f64 = 1.0e-6;
+/// Longest length of a [`Delta`] \[m\].
+pub const DELTA_MAX_LENGTH: f64 = 100.0;
+
 /// A Delta robot's dimensions (see the module docs) and singularity threshold.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Delta {
@@ -61,8 +67,8 @@ fn azimuths() -> [(f64, f64); 3] {
 
 impl Delta {
     /// A Delta of base joint circle radius `base_radius`, platform joint circle radius
-    /// `platform_radius`, arm length `arm` and forearm length `forearm` \[m\], all finite and
-    /// positive, with [`DELTA_MIN_SIGMA`]. The forearm must be longer than the arm is offset,
+    /// `platform_radius`, arm length `arm` and forearm length `forearm` \[m\], each within
+    /// [`DELTA_MIN_LENGTH`]..=[`DELTA_MAX_LENGTH`], with [`DELTA_MIN_SIGMA`]. The forearm must be longer than the arm is offset,
     /// `|base_radius - platform_radius|`, else no pose closes.
     pub fn new(
         base_radius: f64,
@@ -70,11 +76,19 @@ impl Delta {
         arm: f64,
         forearm: f64,
     ) -> Result<Self, BuildError> {
+        let length = |what: &'static str, v: f64| {
+            crate::error::param(
+                what,
+                v,
+                (DELTA_MIN_LENGTH..=DELTA_MAX_LENGTH).contains(&v),
+                "within DELTA_MIN_LENGTH..=DELTA_MAX_LENGTH (1e-6..=100 m)",
+            )
+        };
         let d = Self {
-            base_radius: positive("base_radius", base_radius)?,
-            platform_radius: positive("platform_radius", platform_radius)?,
-            arm: positive("arm", arm)?,
-            forearm: positive("forearm", forearm)?,
+            base_radius: length("base_radius", base_radius)?,
+            platform_radius: length("platform_radius", platform_radius)?,
+            arm: length("arm", arm)?,
+            forearm: length("forearm", forearm)?,
             min_sigma: DELTA_MIN_SIGMA,
         };
         if forearm <= (base_radius - platform_radius).abs() {
@@ -171,6 +185,28 @@ impl Delta {
                 *slot = wrap(theta);
             }
         }
+        // Each arm reaches `p`, but the three spheres also meet at `p`'s mirror image in the
+        // plane of their centres: the working mode (and `fk`) has the platform below that
+        // plane; a point above it is the other assembly, refused rather than returned as
+        // joints whose platform sits elsewhere.
+        let mut centres = [Vector3::zeros(); 3];
+        for ((centre, az), theta) in centres.iter_mut().zip(azimuths()).zip(q.iter()) {
+            let (e, _) = self.elbow(az, *theta);
+            *centre = e - Vector3::new(az.0, az.1, 0.0) * r;
+        }
+        let [c0, c1, c2] = centres;
+        let mut normal = (c1 - c0).cross(&(c2 - c0));
+        if normal.z > 0.0 {
+            normal = -normal;
+        }
+        let below = (p - c0).dot(&normal);
+        if !(below >= -1e-12 * normal.norm() * (l_arm + l)) {
+            return Err(TickError::InvalidArgument {
+                what: "position (above the plane of the elbows: the Delta's working mode has \
+                       the platform below its elbows)",
+                value: p.z,
+            });
+        }
         Ok(q)
     }
 
@@ -179,6 +215,7 @@ impl Delta {
     /// be assembled), [`TickError::Singular`] when their centres are collinear.
     pub fn fk(&self, q: &Vector3<f64>) -> Result<Vector3<f64>, TickError> {
         check_finite("joints", q)?;
+        crate::vjm::check_joint_range(q.as_slice())?;
         let r = self.platform_radius;
         let mut centres = [Vector3::zeros(); 3];
         for ((centre, az), theta) in centres.iter_mut().zip(azimuths()).zip(q.iter()) {
@@ -230,6 +267,9 @@ impl Delta {
         q: &Vector3<f64>,
         p: &Vector3<f64>,
     ) -> Result<Matrix3<f64>, TickError> {
+        check_finite("joints", q)?;
+        crate::vjm::check_joint_range(q.as_slice())?;
+        check_finite("position", p)?;
         let r = self.platform_radius;
         let mut s = Matrix3::zeros();
         let mut d = Matrix3::zeros();

@@ -23,7 +23,7 @@ mod parallel;
 pub mod pose_ik;
 mod serial;
 
-pub use delta::{DELTA_MIN_SIGMA, Delta};
+pub use delta::{DELTA_MAX_LENGTH, DELTA_MIN_LENGTH, DELTA_MIN_SIGMA, Delta};
 pub use limits::{JOINT_LIMIT_TOLERANCE, check_limits};
 pub use parallel::{DEFAULT_MIN_SIGMA, PAPER_HALF_WIDTH, PAPER_LINK, ParallelRobot2};
 pub use pose_ik::{PoseIkOptions, PoseIkSolution, Task, largest_task, pose_ik};

@@ -19,7 +19,7 @@ pub struct ContourArgs {
     ))]
     pub noise: f64,
     /// Seed of the sensor noise.
-    #[arg(long, default_value_t = 7)]
+    #[arg(long, default_value_t = 7, allow_negative_numbers = true)]
     pub seed: u64,
     #[arg(long, default_value_t = 2, help = JOBS.help(
         "Worker threads (one object each; results do not depend on it)",

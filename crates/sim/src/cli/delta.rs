@@ -14,7 +14,7 @@ pub struct DeltaArgs {
         "Payload on the platform [kg]", ""
     ))]
     pub payload_mass: f64,
-    #[arg(long, default_value_t = 3, help = DELTA_NODES.help(
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, help = DELTA_NODES.help(
         "Static-test grid nodes per axis (x, y, z over the move's workspace)",
         "Each node takes 6 static tests"
     ))]

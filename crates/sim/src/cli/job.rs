@@ -190,6 +190,32 @@ impl JobArgs {
             6,
             "x,y,z [m], roll,pitch,yaw [rad]",
         )?;
+        if let Some(p) = &self.placement
+            && let [x, y, z, angles @ ..] = p.as_slice()
+        {
+            let far = [x, y, z].into_iter().find(|v| v.abs() > 1.0e3);
+            let turned = angles.iter().find(|a| a.abs() > std::f64::consts::TAU);
+            if let Some(v) = far {
+                return Err(CliError::Usage(format!(
+                    "--placement: {v:e} m; expected x,y,z within +-1000 m"
+                )));
+            }
+            if let Some(a) = turned {
+                return Err(CliError::Usage(format!(
+                    "--placement: {a:e} rad; expected roll,pitch,yaw within +-2 pi rad (radians, \
+                     not degrees)"
+                )));
+            }
+        }
+        if let Some(seed) = &self.seed
+            && let Some(v) = seed
+                .iter()
+                .find(|v| !(v.is_finite() && v.abs() <= deflect_core::vjm::MAX_JOINT_POSITION))
+        {
+            return Err(CliError::Usage(format!(
+                "--seed: {v}; expected finite joint values (rad or m) within +-1e6"
+            )));
+        }
         list("--stock", &self.stock, 4, "XMIN,YMIN,XMAX,YMAX [mm]")?;
         if let Some(s) = &self.stock
             && let [x0, y0, x1, y1] = s.as_slice()

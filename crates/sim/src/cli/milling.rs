@@ -57,7 +57,7 @@ pub struct MillingArgs {
     pub jobs: usize,
     #[arg(long, default_value_t = 25.0, help = FEED.help("Feed speed [mm/s] (paper: 25)", ""))]
     pub feed: f64,
-    #[arg(long, default_value_t = 550.0, help = FORCE.help(
+    #[arg(long, default_value_t = 550.0, allow_negative_numbers = true, help = FORCE.help(
         "Magnitude of the process force [N] (direction as the default [-386, 386, -60] N)",
         ""
     ))]
@@ -85,9 +85,9 @@ pub struct MillingArgs {
     ))]
     pub estimate_error: f64,
     /// Seed of the sensor and measurement noise.
-    #[arg(long, default_value_t = 6)]
+    #[arg(long, default_value_t = 6, allow_negative_numbers = true)]
     pub seed: u64,
-    #[arg(long, default_value_t = 3, help = ID_POSES.help(
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, help = ID_POSES.help(
         "Poses of the stiffness identification's static tests (each about 3.4 s simulated)",
         "Fewer poses: a faster run, fewer identifiable axes"
     ))]

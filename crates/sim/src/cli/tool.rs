@@ -11,7 +11,7 @@ pub struct ToolArgs {
         "Flat end mill diameter [mm]", "Default: the 16 mm tool of Hähn and Weigold"
     ))]
     pub diameter: f64,
-    #[arg(long, default_value_t = 3, help = FLUTES.help("Flutes", ""))]
+    #[arg(long, default_value_t = 3, allow_negative_numbers = true, help = FLUTES.help("Flutes", ""))]
     pub flutes: u32,
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, help = HELIX_DEG.help(
         "Helix angle [deg]", "The per-revolution force does not depend on it"

@@ -27,6 +27,31 @@ fn job_refuses_bad_flags_and_files_before_any_work() {
         &["--stock", "XMIN < XMAX"],
     );
     refused(&d, &["job", "--seed", "0,0"], 2, &["--seed", "expected 6"]);
+    // A negative count names its flag (not "unexpected argument '-1'").
+    for (cmd, flag) in [
+        ("job", "--flutes"),
+        ("milling", "--id-poses"),
+        ("milling", "--seed"),
+        ("milling", "--force"),
+        ("delta", "--nodes"),
+        ("contour", "--seed"),
+    ] {
+        let err = refused(&d, &[cmd, flag, "-1"], 2, &[flag]);
+        assert!(!err.contains("unexpected argument"), "{err}");
+    }
+    // A yaw of 1e300 rad (degrees meant, or an overflow) and a NaN seed are usage errors.
+    refused(
+        &d,
+        &["job", "--placement", "2.45,0.02,0.92,0,0,1e300"],
+        2,
+        &["--placement", "1e300", "2 pi"],
+    );
+    refused(
+        &d,
+        &["job", "--seed", "0,-0.9,1.4,0,-0.5,nan"],
+        2,
+        &["--seed", "NaN"],
+    );
     refused(
         &d,
         &["job", "--coefficients", "1,2,3,4,5,nan"],

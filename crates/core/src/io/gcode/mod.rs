@@ -65,6 +65,7 @@ mod motion;
 mod offsets;
 mod params;
 mod read;
+pub(crate) use read::check_start;
 pub mod report;
 mod words;
 

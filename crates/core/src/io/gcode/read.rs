@@ -53,20 +53,27 @@ pub(super) fn at(line: usize, (column, message): (usize, String)) -> LoadError {
     }
 }
 
-/// Reads `text` (size checked by the caller).
-pub(super) fn run(text: &str, options: &GcodeOptions) -> Result<Program, LoadError> {
-    let start = options.start;
-    if !start
+/// The tool's point before the first move \[m\]: finite, within
+/// [`crate::machining::MAX_COORDINATE`].
+pub(crate) fn check_start(start: &nalgebra::Vector3<f64>) -> Result<(), LoadError> {
+    if start
         .iter()
         .all(|v| v.is_finite() && v.abs() <= crate::machining::MAX_COORDINATE)
     {
-        return Err(LoadError::InvalidValue {
-            element: "G-code options".to_string(),
-            field: "start (m)",
-            expected: std::format!("finite, within +-{} m", crate::machining::MAX_COORDINATE),
-            got: std::format!("{:?}", start.as_slice()),
-        });
+        return Ok(());
     }
+    Err(LoadError::InvalidValue {
+        element: "program options".to_string(),
+        field: "start (m)",
+        expected: std::format!("finite, within +-{} m", crate::machining::MAX_COORDINATE),
+        got: std::format!("{:?}", start.as_slice()),
+    })
+}
+
+/// Reads `text` (size checked by the caller).
+pub(super) fn run(text: &str, options: &GcodeOptions) -> Result<Program, LoadError> {
+    let start = options.start;
+    check_start(&start)?;
     let mut r = Reader {
         lines: text.lines().collect(),
         options: *options,
