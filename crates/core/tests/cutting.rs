@@ -212,3 +212,33 @@ fn the_tool_frame_has_x_along_the_feed_and_z_along_the_axis() {
     assert!(cutting::tool_frame(&Vector3::z(), &Vector3::z()).is_none());
     assert!(cutting::tool_frame(&Vector3::zeros(), &Vector3::x()).is_none());
 }
+
+/// The mean cutting torque by hand: each edge's tangential force `(K_tc c sin(phi) + K_te) a`
+/// acts at the radius, so over a revolution `N / (2 pi) int R (K_tc c sin + K_te) a dphi`:
+/// for a slot `N R a (K_tc c / pi + K_te / 2)`, for the down-milling quarter (pi/2..pi)
+/// `N R a (K_tc c + K_te pi / 2) / (2 pi)`. Numbers typed from the coefficients, not from
+/// the code.
+#[test]
+fn the_mean_cutting_torque_is_the_hand_integral() {
+    let c = Coefficients::AL7075_T6_CARBIDE;
+    let tool = Tool::new(0.016, 3, 0.0).unwrap();
+    let (a, fz) = (0.002, 1.0e-4);
+    // 4.8e-5 m^2 * (76,701 / pi + 13,850) N/m = 4.8e-5 * 38,264.9 = 1.8367 N m
+    let slot = 3.0 * 0.008 * 0.002 * (767.01e6 * 1.0e-4 / std::f64::consts::PI + 27.7e3 / 2.0);
+    let got = cutting::average_torque(&c, &tool, &Engagement::slot(a, fz)).unwrap();
+    assert!((got - slot).abs() <= 1e-12 * slot, "{got} vs {slot}");
+    assert!((slot - 1.8367).abs() < 1e-4, "{slot}");
+    let quarter = 3.0 * 0.008 * 0.002 * (767.01e6 * 1.0e-4 + 27.7e3 * std::f64::consts::FRAC_PI_2)
+        / (2.0 * std::f64::consts::PI);
+    let e = Engagement {
+        entry: std::f64::consts::FRAC_PI_2,
+        exit: std::f64::consts::PI,
+        depth: a,
+        feed_per_tooth: fz,
+    };
+    let got = cutting::average_torque(&c, &tool, &e).unwrap();
+    assert!(
+        (got - quarter).abs() <= 1e-12 * quarter,
+        "{got} vs {quarter}"
+    );
+}

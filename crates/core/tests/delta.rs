@@ -42,8 +42,46 @@ fn ik_and_fk_are_inverse_over_the_workspace_and_close_every_loop() {
             let elbow = u * (0.2 + 0.35 * theta.cos()) - Vector3::z() * 0.35 * theta.sin();
             let joint = p + u * 0.045;
             assert!(((joint - elbow).norm() - 0.8).abs() < 1e-12);
-            // Elbows out: the elbow lies outside the base joint circle's radius less the arm.
-            assert!(elbow.xy().norm() > 0.2 - 0.35 + 1e-3);
+            // Elbows out: of the two arm angles that close this forearm (found by scanning
+            // the arm's circle for the sign changes of |joint - elbow|^2 - l^2 and bisecting,
+            // not by the IK's formula), the IK took the one with the larger radial reach.
+            let g = |t: f64| {
+                let e = u * (0.2 + 0.35 * t.cos()) - Vector3::z() * 0.35 * t.sin();
+                (joint - e).norm_squared() - 0.64
+            };
+            let mut roots = Vec::new();
+            let steps = 720;
+            for k in 0..steps {
+                let tau = 2.0 * std::f64::consts::PI;
+                let (mut a, mut b) = (
+                    -std::f64::consts::PI + tau * k as f64 / steps as f64,
+                    -std::f64::consts::PI + tau * (k + 1) as f64 / steps as f64,
+                );
+                if g(a).signum() == g(b).signum() {
+                    continue;
+                }
+                for _ in 0..60 {
+                    let m = 0.5 * (a + b);
+                    if g(a).signum() == g(m).signum() {
+                        a = m
+                    } else {
+                        b = m
+                    }
+                }
+                roots.push(0.5 * (a + b));
+            }
+            assert_eq!(roots.len(), 2, "{p:?} arm {i}: {roots:?}");
+            let out = roots.iter().copied().fold(f64::NAN, |best, t| {
+                if best.is_nan() || t.cos() > best.cos() {
+                    t
+                } else {
+                    best
+                }
+            });
+            assert!(
+                (theta - out).abs() < 1e-9,
+                "{p:?} arm {i}: ik {theta}, elbow-out root {out}"
+            );
         }
     }
     assert!(n > 500, "{n} of 600 workspace points reachable");

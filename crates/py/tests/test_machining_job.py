@@ -39,7 +39,7 @@ def slot_run(kr300):
     return job.run(program, KR300_POSE)
 
 
-def test_the_slot_force_is_the_closed_form_and_the_deflection_the_numpy_chain(slot_run, kr300_ref):
+def test_the_slot_force_is_the_closed_form_and_the_deflection_the_numpy_chain(slot_run, kr300, kr300_ref):
     r = slot_run
     ktc, krc, kac, kte, kre, kae = deflect.AL7075_T6_CARBIDE
     n, a = 3, 0.002
@@ -54,6 +54,18 @@ def test_the_slot_force_is_the_closed_form_and_the_deflection_the_numpy_chain(sl
     mid = np.flatnonzero((r.line == 4) & (r.position[:, 0] > 0.035))[0]
     np.testing.assert_allclose(r.force[mid], expected, rtol=1e-9)
     np.testing.assert_allclose(r.engagement[mid], [0.0, math.pi, 0.002], rtol=1e-12)
+    # The TCP wrench by hand (workpiece frame = tool frame for this +x feed, then rotated
+    # into the base frame by the placement): the force acts halfway up the 2 mm depth, so its
+    # moment about the tip is (0, 0, a/2) x F; the cutting torque about the axis is the mean
+    # over a revolution of R (K_tc c sin(phi) + K_te) a per edge over the engaged half turn,
+    # N R a (K_tc c / pi + K_te / 2), on the tool along +z (it resists the M3 spindle's turn,
+    # clockwise seen from above).
+    radius = 0.008
+    torque = n * radius * a * (ktc * c / math.pi + kte / 2)
+    moment = np.array([-a / 2 * expected[1], a / 2 * expected[0], torque])
+    rot = placement_under_tcp(kr300)[:3, :3]
+    np.testing.assert_allclose(r.wrench[mid][:3], rot @ expected, rtol=1e-9)
+    np.testing.assert_allclose(r.wrench[mid][3:], rot @ moment, rtol=1e-9, atol=1e-12)
     # The deflection under the job's wrench at the job's joints, by the numpy chain.
     ref = kr300_ref.deflection(r.q[mid], r.wrench[mid])
     np.testing.assert_allclose(r.deflection[mid], ref, rtol=1e-9, atol=1e-15)
