@@ -607,6 +607,7 @@ fn milling_force<'py>(
             "discs: expected 1..={MAX_DISCS}, got {discs}"
         )));
     }
+    cutting::check_force_evaluations(angles.len(), discs, &tool).map_err(tick_err)?;
     let mut out = try_rows(angles.len(), 3, "the forces")?;
     py.detach(|| {
         for (o, &angle) in out.chunks_mut(3).zip(&angles) {

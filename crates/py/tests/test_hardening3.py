@@ -122,3 +122,12 @@ def test_a_cell_too_coarse_for_the_tool_and_a_rate_below_one_hertz_are_refused(k
             job.run(program, KR300_POSE)
     with pytest.raises(deflect.InputError, match="rate_hz"):
         deflect.MachiningJob(kr300, np.eye(4), stock_min=(0, 0), stock_max=(0.1, 0.1), rate_hz=1e-3)
+
+
+def test_a_force_batch_past_its_budget_is_refused_at_once():
+    angles = np.zeros(deflect.MAX_SAMPLES)
+    with pytest.raises(deflect.InputError, match="MAX_FORCE_EVALUATIONS"):
+        deflect.milling_force(0.016, 3, 0.004, 1e-4, angles=angles, discs=256)
+    # Within the budget: computed.
+    f = deflect.milling_force(0.016, 3, 0.004, 1e-4, angles=np.zeros(1000), discs=256)
+    assert f.shape == (1000, 3) and np.isfinite(f).all()

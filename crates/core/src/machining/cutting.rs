@@ -31,6 +31,28 @@ pub const MAX_FLUTES: u32 = 16;
 pub const MAX_DISCS: usize = 256;
 /// Largest helix angle \[rad\] (60 degrees; end mills have 0-50).
 pub const MAX_HELIX: f64 = core::f64::consts::FRAC_PI_3;
+/// Most edge-force evaluations one batch of instantaneous forces may ask for (angles x discs
+/// x flutes): 2^26, about 2 s at the 35 million per second of one core; past it
+/// [`check_force_evaluations`] refuses the batch instead of running for minutes.
+pub const MAX_FORCE_EVALUATIONS: usize = 1 << 26;
+
+/// [`TickError::Budget`] when `angles` instantaneous forces of `discs` discs with `tool`
+/// would take more than [`MAX_FORCE_EVALUATIONS`] edge evaluations.
+pub fn check_force_evaluations(angles: usize, discs: usize, tool: &Tool) -> Result<(), TickError> {
+    let n = angles
+        .saturating_mul(discs)
+        .saturating_mul(tool.flutes.max(1) as usize);
+    if n > MAX_FORCE_EVALUATIONS {
+        return Err(TickError::Budget {
+            what: "edge-force evaluations (angles x discs x flutes; 35 M/s on one core)",
+            budget: "MAX_FORCE_EVALUATIONS",
+            limit: MAX_FORCE_EVALUATIONS as f64,
+            requested: n as f64,
+        });
+    }
+    Ok(())
+}
+
 /// Smallest tool diameter \[m\] (10 um; micro end mills start at about 50 um).
 pub const MIN_TOOL_DIAMETER: f64 = 1.0e-5;
 /// Largest cutting coefficient `k_*c` \[N/m^2\]: 1e11 (100,000 N/mm^2; hardened steels are

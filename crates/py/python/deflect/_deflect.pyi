@@ -466,7 +466,11 @@ class Trajectory:
 class LinePlanner:
     """One straight-line plan in ``dim`` coordinates (1..=8) re-planned in place per move
     (ruckig's ``calculate(input, trajectory)`` habit); path limits validated once. Set
-    ``start`` / ``end`` and call ``plan()``, or pass the points to ``plan(start, end)``."""
+    ``start`` / ``end`` and call ``plan()``, or pass the points to ``plan(start, end)``.
+
+    A planner is mutable state, as a numpy ``Generator`` is: give each thread its own (or
+    hold a lock around each call); a call while another thread's call on the same planner
+    runs raises ``RuntimeError("Already borrowed")``."""
     def __new__(cls, dim: int, v_max: float, a_max: float, j_max: float) -> "LinePlanner": ...
     def plan(self, start: Optional[_ArrayLike] = None, end: Optional[_ArrayLike] = None) -> float:
         """Re-plans from ``start`` to ``end`` in place (bit for bit ``plan_line``) and returns

@@ -24,6 +24,10 @@ use crate::errors::build_err;
 /// duration [s]; or set `start` / `end` (ruckig's `InputParameter`) and call `plan()`.
 /// `at(t)` evaluates the plan and `trajectory()` copies it out as a `Trajectory`. Until the
 /// first `plan` it rests at the origin. Per-coordinate limits: `plan_line`.
+///
+/// A planner is mutable state, as a numpy `Generator` is: give each thread its own (or hold
+/// a lock around each call); a call while another thread's call on the same planner runs
+/// raises `RuntimeError("Already borrowed")` and leaves the plan as the other call leaves it.
 #[pyclass(module = "deflect")]
 #[derive(Debug)]
 pub struct LinePlanner {
