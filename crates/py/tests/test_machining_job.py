@@ -69,6 +69,15 @@ def test_the_slot_force_is_the_closed_form_and_the_deflection_the_numpy_chain(sl
     # The deflection under the job's wrench at the job's joints, by the numpy chain.
     ref = kr300_ref.deflection(r.q[mid], r.wrench[mid])
     np.testing.assert_allclose(r.deflection[mid], ref, rtol=1e-9, atol=1e-15)
+    # The compensated joints land the loaded tip on the program by the numpy chain too (not
+    # the vjm::deflection that computed them): its rigid TCP at q_c plus its deflection there
+    # under the same wrench is the programmed point, placed in the base frame.
+    place = placement_under_tcp(kr300)
+    for k in (mid, mid // 2, len(r) - 3):
+        qc = r.q_commanded[k]
+        loaded = kr300_ref.forward(qc)[:3, 3] + kr300_ref.deflection(qc, r.wrench[k])[:3]
+        target = place[:3, :3] @ r.position[k] + place[:3, 3]
+        assert np.linalg.norm(loaded - target) < 1e-7, (k, loaded - target)
     # The compensated arm lands on the program; the uncompensated one is off by tenths.
     un_max, _ = r.path_error("uncompensated")
     co_max, _ = r.path_error("compensated")
