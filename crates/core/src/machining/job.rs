@@ -567,9 +567,9 @@ pub fn run_streaming<S: Sink + ?Sized>(
         .into());
     }
     let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
-    let mut nominal = nominal::Stage::new(job, &tools, zmap()?);
-    let mut unc = predict::Arm::new(job, &tools, zmap()?, seed, false);
-    let mut comp = predict::Arm::new(job, &tools, zmap()?, seed, true);
+    let mut nominal = nominal::Stage::new(job, program, &tools, zmap()?);
+    let mut unc = predict::Arm::new(job, program, &tools, zmap()?, seed, false);
+    let mut comp = predict::Arm::new(job, program, &tools, zmap()?, seed, true);
     let chunk = options.chunk.min(sampler.len().max(1));
     let reserve = |what: &'static str| -> Result<(), BuildError> {
         Err(BuildError::Budget {

@@ -189,6 +189,25 @@ fn job_writes_the_compensated_program_samples_heat_map_and_summary() {
     assert!(!out.join("job_samples.csv").exists());
     let npz = std::fs::read(out.join("job_samples.npz")).unwrap();
     assert_eq!(&npz[..2], b"PK");
+    // The archive's values: one time per sample, 4 ms apart; the largest force the summary's.
+    let time = npy(&npz, "time");
+    let samples = summary["samples"].as_u64().unwrap() as usize;
+    assert_eq!(time.len(), samples);
+    assert!(
+        time.windows(2)
+            .all(|w| (w[1] - w[0] - 0.004).abs() < 1e-9 || w[1] == time[samples - 1])
+    );
+    let force = npy(&npz, "force");
+    assert_eq!(force.len(), 3 * samples);
+    let largest = force
+        .chunks(3)
+        .map(|f| (f[0] * f[0] + f[1] * f[1] + f[2] * f[2]).sqrt())
+        .fold(0.0f64, f64::max);
+    let reported = summary["max_force_n"].as_f64().unwrap();
+    assert!(
+        (largest - reported).abs() <= 1e-9 * reported,
+        "{largest} vs {reported}"
+    );
     let mcap = std::fs::read(out.join("job.mcap")).unwrap();
     assert_eq!(&mcap[1..5], b"MCAP");
     let o = sim(&[
@@ -302,5 +321,43 @@ fn job_explains_a_programs_words_and_runs_two_tools_on_a_hand_started_spindle() 
                 .any(|x| x["line"] == l && x["max_force_n"].as_f64().unwrap() > 20.0),
             "{l}"
         );
+    }
+}
+
+/// The float64 data of array `name` in an `.npz` archive (stored, little-endian, C order).
+fn npy(npz: &[u8], name: &str) -> Vec<f64> {
+    let mut zip = zip::ZipArchive::new(std::io::Cursor::new(npz)).unwrap();
+    let mut file = zip.by_name(&format!("{name}.npy")).unwrap();
+    let mut bytes = Vec::new();
+    std::io::Read::read_to_end(&mut file, &mut bytes).unwrap();
+    assert_eq!(&bytes[..6], b"\x93NUMPY");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(
+        header.contains("'descr': '<f8'") && header.contains("'fortran_order': False"),
+        "{header}"
+    );
+    bytes[10 + header_len..]
+        .chunks(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect()
+}
+
+#[test]
+fn job_runs_at_one_sample_per_second_and_with_sharp_limits() {
+    // At 1 Hz the chord between samples crossed material the program never enters (exit 1,
+    // "a rapid move runs 2.629 mm into the stock"); the stock now follows the path.
+    let d = scratch("job-rates");
+    for args in [
+        &["job", "--rate", "1"][..],
+        &["job", "--rate", "2"],
+        &["job", "--rate", "10"],
+        &["job", "--acceleration", "100", "--jerk", "10000"],
+    ] {
+        let out = d.join("out");
+        let mut all = args.to_vec();
+        all.extend(["--out", out.to_str().unwrap()]);
+        let o = sim(&all);
+        assert_eq!(o.code, 0, "{args:?}: {}", o.stderr);
     }
 }

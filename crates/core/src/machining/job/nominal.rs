@@ -6,10 +6,12 @@ use nalgebra::{Isometry3, Vector3};
 
 use super::{Job, ToolModels, chip_wrench, engagement, rotate, tooth_feed};
 use crate::error::{JobError, TickError};
+use crate::machining::Program;
 use crate::machining::engagement::{Chip, Contact};
+use crate::machining::path;
 use crate::machining::path::PathSample;
 use crate::machining::report::RapidContact;
-use crate::machining::stock::{Follower, Removal, Step, ZMap};
+use crate::machining::stock::{Follower, Step, ZMap};
 use crate::vjm::Vector6;
 
 /// What the nominal stage hands on for one sample.
@@ -33,10 +35,16 @@ pub(super) struct Sample {
     /// What the nominal cut did with this sample's tip: the arms cut their stocks along
     /// moves that end at the same samples (see [`Follower::step_to`]).
     pub cut: Step,
+    /// The programmed path bends between the last sample and this one
+    /// ([`path::between`]): the stocks were cut through its points, not along the chord.
+    pub via: bool,
 }
 
 pub(super) struct Stage<'a> {
     job: &'a Job,
+    program: &'a Program,
+    /// The last sample's move and fraction on it.
+    prev_at: Option<(usize, f64)>,
     tools: &'a ToolModels,
     to_base: Isometry3<f64>,
     pub stock: ZMap,
@@ -50,9 +58,11 @@ pub(super) struct Stage<'a> {
 }
 
 impl<'a> Stage<'a> {
-    pub fn new(job: &'a Job, tools: &'a ToolModels, stock: ZMap) -> Self {
+    pub fn new(job: &'a Job, program: &'a Program, tools: &'a ToolModels, stock: ZMap) -> Self {
         Self {
             job,
+            program,
+            prev_at: None,
             tools,
             to_base: job.setup.placement,
             stock,
@@ -126,14 +136,23 @@ impl<'a> Stage<'a> {
         let contact = self.chip.contact();
         // A rapid's removal is checked at once, and a tool the job lacks must cut nothing:
         // those are cut now, moves along a line held back (see `Follower::hold_to`).
-        let (removed, cut) = if s.feed_move && tm.known {
+        // Where the path bends between the samples (a corner, an arc at a low rate), the
+        // stock is cut through its points: a chord would cut material the program never
+        // enters (a rapid's corner into a feed move).
+        let (via, via_rapid) = self.cut_between(s).map_err(at)?;
+        let (removed, cut) = if s.feed_move && tm.known && !via {
             self.follower.hold_to(&mut self.stock, &tm.cutter, &p)
         } else {
             self.flush().map_err(at)?;
             (self.follower.cut_to(&mut self.stock, &tm.cutter, &p)).map(|r| (r, Step::Cut))
         }
         .map_err(at)?;
-        self.check(s, &contact, &removed, tm.known, spindle)?;
+        let rapid_depth = if s.feed_move {
+            via_rapid
+        } else {
+            via_rapid.max(removed.deepest)
+        };
+        self.check(s, &contact, removed.cells, rapid_depth, tm.known, spindle)?;
         if matches!(contact, Contact::Plunge { .. }) {
             self.plunge_samples += 1;
         }
@@ -153,30 +172,75 @@ impl<'a> Stage<'a> {
             step: p - from,
             settled,
             cut,
+            via,
         })
     }
 
-    /// A tool the job lacks must not cut, a rapid may skim the stock by `rapid_skim` (the
-    /// deepest skim kept), the spindle must turn in a cut.
+    /// Cuts the stock through the points where the path bends since the last sample
+    /// ([`path::between`]), each stretch with the tool of its move. Whether there were any,
+    /// and the deepest cut of a stretch on a rapid move \[m\].
+    fn cut_between(&mut self, s: &PathSample) -> Result<(bool, f64), TickError> {
+        let here = (s.move_index, s.fraction);
+        let Some(from) = self.prev_at.replace(here) else {
+            return Ok((false, 0.0));
+        };
+        let program = self.program;
+        if path::between(program, from, here, |_, _, _| {}) == 0 {
+            return Ok((false, 0.0));
+        }
+        self.flush()?;
+        let tools = self.tools;
+        let (mut rapid, mut failed, mut cells) = (0.0f64, None, 0usize);
+        let (stock, follower) = (&mut self.stock, &mut self.follower);
+        path::between(program, from, here, |w, m, _| {
+            let Some(mv) = program.moves.get(m) else {
+                return;
+            };
+            let Some(tm) = tools.get(tools.find(mv.tool)) else {
+                return;
+            };
+            if failed.is_some() {
+                return;
+            }
+            match follower.cut_to(stock, &tm.cutter, &w) {
+                Ok(r) => {
+                    cells += r.cells;
+                    if !mv.is_feed() {
+                        rapid = rapid.max(r.deepest);
+                    }
+                }
+                Err(e) => failed = Some(e),
+            }
+        });
+        self.cell_updates += cells;
+        match failed {
+            Some(e) => Err(e),
+            None => Ok((true, rapid)),
+        }
+    }
+
+    /// A tool the job lacks must not cut (`cells` the cells this sample lowered), a rapid
+    /// may skim the stock by `rapid_skim` (`depth` the deepest cut on a rapid move since the
+    /// last sample; the deepest skim kept), the spindle must turn in a cut.
     fn check(
         &mut self,
         s: &PathSample,
         contact: &Contact,
-        removed: &Removal,
+        cells: usize,
+        depth: f64,
         known: bool,
         spindle: f64,
     ) -> Result<(), JobError> {
         let (line, time) = (s.line, s.time);
         let cuts = *contact != Contact::Air;
-        if !known && (cuts || removed.cells > 0) {
+        if !known && (cuts || cells > 0) {
             return Err(JobError::UnknownTool {
                 line,
                 time,
                 tool: s.tool,
             });
         }
-        let depth = removed.deepest;
-        if !s.feed_move && depth > engagement::MIN_DEPTH {
+        if depth > engagement::MIN_DEPTH {
             if self.rapid_contact.is_none_or(|c| depth > c.depth) {
                 self.rapid_contact = Some(RapidContact { line, time, depth });
             }

@@ -14,7 +14,9 @@ use super::{
     engagement, in_limits, rotate,
 };
 use crate::error::{JobError, TickError};
+use crate::machining::Program;
 use crate::machining::engagement::Chip;
+use crate::machining::path;
 use crate::machining::stock::{Follower, ZMap};
 use crate::mechanism::pose_ik;
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
@@ -47,6 +49,9 @@ pub(super) struct Out {
 
 pub(super) struct Arm<'a> {
     job: &'a Job,
+    program: &'a Program,
+    /// The last sample's move, fraction on it and programmed point \[m\].
+    prev_at: Option<(usize, f64, Vector3<f64>)>,
     tools: &'a ToolModels,
     compensated: bool,
     data: Data,
@@ -68,6 +73,7 @@ impl<'a> Arm<'a> {
     /// `seed` has the model's dof (checked by the caller).
     pub fn new(
         job: &'a Job,
+        program: &'a Program,
         tools: &'a ToolModels,
         stock: ZMap,
         seed: &[f64],
@@ -79,6 +85,8 @@ impl<'a> Arm<'a> {
         }
         Self {
             job,
+            program,
+            prev_at: None,
             tools,
             compensated,
             data: Data::new(&job.model),
@@ -193,10 +201,14 @@ impl<'a> Arm<'a> {
                 value: n.tool as f64,
             });
         };
+        if n.via {
+            self.cut_between(n, &tip)?;
+        }
         let removed = self
             .follower
             .step_to(&mut self.stock, &tm.cutter, &tip, n.cut)?;
         self.cell_updates += removed.cells;
+        self.prev_at = Some((n.path.move_index, n.path.fraction, n.path.position));
         // A tool change or a jump restarts the guess from the program's step.
         self.drift = match self.tip {
             Some(t) if n.step.norm() > 0.0 => tip - t - n.step,
@@ -214,6 +226,40 @@ impl<'a> Arm<'a> {
             force,
             residual,
         })
+    }
+
+    /// Cuts this arm's stock through the points where the program bends between the last
+    /// sample and `n` (as the nominal stock was, [`path::between`]), each moved by this
+    /// arm's offset from the program, interpolated along the path from the last tip's to
+    /// `tip`'s.
+    fn cut_between(&mut self, n: &Sample, tip: &Vector3<f64>) -> Result<(), TickError> {
+        let (Some((m0, f0, p0)), Some(t0)) = (self.prev_at, self.follower.tip()) else {
+            return Ok(());
+        };
+        self.flush()?;
+        let (off0, off1) = (t0 - p0, tip - n.path.position);
+        let (program, tools) = (self.program, self.tools);
+        let (stock, follower) = (&mut self.stock, &mut self.follower);
+        let (mut failed, mut cells) = (None, 0usize);
+        let here = (n.path.move_index, n.path.fraction);
+        path::between(program, (m0, f0), here, |w, m, share| {
+            let Some(tm) = program
+                .moves
+                .get(m)
+                .and_then(|mv| tools.get(tools.find(mv.tool)))
+            else {
+                return;
+            };
+            if failed.is_some() {
+                return;
+            }
+            match follower.cut_to(stock, &tm.cutter, &(w + off0 + (off1 - off0) * share)) {
+                Ok(r) => cells += r.cells,
+                Err(e) => failed = Some(e),
+            }
+        });
+        self.cell_updates += cells;
+        failed.map_or(Ok(()), Err)
     }
 
     /// The fixed point `t = tip(q, F(t))` from the last tip plus the programmed step (see
