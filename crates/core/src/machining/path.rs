@@ -430,7 +430,7 @@ pub fn between(
         match mv.motion {
             super::Motion::Arc { sweep, .. } => {
                 let r = mv.radius().max(mv.end_radius());
-                if !(r > WAYPOINT_TOLERANCE) {
+                if r.is_nan() || r <= WAYPOINT_TOLERANCE {
                     return 1;
                 }
                 let step = 2.0 * ComplexField::acos(1.0 - WAYPOINT_TOLERANCE / r);

@@ -200,7 +200,7 @@ impl Delta {
             normal = -normal;
         }
         let below = (p - c0).dot(&normal);
-        if !(below >= -1e-12 * normal.norm() * (l_arm + l)) {
+        if below.is_nan() || below < -1e-12 * normal.norm() * (l_arm + l) {
             return Err(TickError::InvalidArgument {
                 what: "position (above the plane of the elbows: the Delta's working mode has \
                        the platform below its elbows)",
