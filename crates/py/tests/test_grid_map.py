@@ -155,3 +155,43 @@ def test_a_csv_names_the_axes(tmp_path):
     (tmp_path / "gap.csv").write_text("\n".join(r for r in rows if not r.startswith("-50,-50,-400,x")) + "\n")
     with pytest.raises(deflect.LoadError, match=r"\(-0.05, -0.05, -0.4\), force axis 0"):
         deflect.GridMap.fit_csv(tmp_path / "gap.csv")
+
+
+@pytest.mark.parametrize("dims", [3, 4])
+def test_out_of_grid_in_3d_and_4d_by_value(dims):
+    """A map whose node values are a linear function of the coordinates (so multilinear
+    interpolation and extrapolation are exact): outside the grid, "extrapolate" gives the
+    linear function there, "clamp" its value at the nearest grid point, "error" refuses
+    naming the axis. Values by hand from the function, not from the map."""
+    axes = [np.linspace(0.1 * k, 0.1 * k + 0.3, 4 + (k % 2)) for k in range(dims)]
+    grad = np.array([2e-6, -1e-6, 3e-6, 5e-7][:dims])  # m/N per m of each coordinate, row 0
+
+    def slope(p):
+        base = 1e-6 + grad @ p
+        return np.array([[base, 0.5 * base], [0.0, base], [2 * base, 0.0]])  # (3, 2)
+
+    shape = tuple(len(a) for a in axes)
+    slopes = np.empty(shape + (3, 2))
+    for idx in np.ndindex(*shape):
+        slopes[idx] = slope(np.array([a[i] for a, i in zip(axes, idx)]))
+    offsets = np.zeros(shape + (3, 2))
+    m = deflect.GridMap(axes, 2, 3, slopes, offsets)
+    force = np.array([100.0, -40.0])
+    outside = np.array([a[-1] + 0.05 * (k + 1) for k, a in enumerate(axes)])
+    outside[0] = axes[0][0] - 0.07  # below on the first axis, above on the others
+    np.testing.assert_allclose(
+        m.displacement(outside, force, out_of_grid="extrapolate"), slope(outside) @ force, rtol=1e-12
+    )
+    clamped = np.array([np.clip(v, a[0], a[-1]) for v, a in zip(outside, axes)])
+    np.testing.assert_allclose(
+        m.displacement(outside, force, out_of_grid="clamp"), slope(clamped) @ force, rtol=1e-12
+    )
+    with pytest.raises(deflect.InputError, match=r"axis 0"):
+        m.displacement(outside, force)
+    # Batches answer as single queries, out of the grid too.
+    P = np.array([outside, clamped, (outside + clamped) / 2])
+    np.testing.assert_allclose(
+        m.displacement_batch(P, force, out_of_grid="extrapolate"),
+        np.array([slope(p) @ force for p in P]),
+        rtol=1e-12,
+    )
