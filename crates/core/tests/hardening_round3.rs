@@ -194,3 +194,45 @@ fn a_rate_below_one_hertz_is_refused() {
     ));
     assert!(o(1.0).validate().is_ok());
 }
+
+/// An inch program's arcs (I/J and R) are the millimetre program's scaled by 25.4: the same
+/// centres, sweeps and ends.
+#[test]
+fn inch_arcs_are_the_millimetre_arcs() {
+    let read = |text: &str| gcode::from_str(text, &GcodeOptions::default()).unwrap();
+    let inch = read("G20 G90 G17\nG1 X1 Y0 F10\nG2 X2 Y1 I0 J1\nG3 X1 Y2 R1\n");
+    let mm = read("G21 G90 G17\nG1 X25.4 Y0 F254\nG2 X50.8 Y25.4 I0 J25.4\nG3 X25.4 Y50.8 R25.4\n");
+    assert_eq!(inch.moves.len(), mm.moves.len());
+    for (i, m) in inch.moves.iter().zip(&mm.moves) {
+        assert!((i.end - m.end).norm() < 1e-12, "{:?} vs {:?}", i.end, m.end);
+        assert!((i.feed - m.feed).abs() < 1e-12 * m.feed.max(1e-9));
+        assert!((i.length() - m.length()).abs() < 1e-12);
+        match (i.motion, m.motion) {
+            (
+                deflect_core::machining::Motion::Arc {
+                    center: ci,
+                    sweep: si,
+                    ..
+                },
+                deflect_core::machining::Motion::Arc {
+                    center: cm,
+                    sweep: sm,
+                    ..
+                },
+            ) => {
+                assert!((ci - cm).norm() < 1e-12 && (si - sm).abs() < 1e-12);
+            }
+            (a, b) => assert_eq!(a, b),
+        }
+    }
+    // The first arc by hand: about (25.4, 25.4) mm from below the centre to its right,
+    // clockwise: three quarters of a turn.
+    let three_quarters = 1.5 * std::f64::consts::PI;
+    match mm.moves.get(1).unwrap().motion {
+        deflect_core::machining::Motion::Arc { center, sweep, .. } => {
+            assert!((center - Vector3::new(0.0254, 0.0254, 0.0)).norm() < 1e-15);
+            assert!((sweep + three_quarters).abs() < 1e-12, "{sweep}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -258,6 +258,60 @@ fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
     assert!(slot.max >= expected.norm() * (1.0 - 1e-9));
 }
 
+/// A slot fed at 30 degrees feels the +x slot's closed form turned by 30 degrees about z
+/// (the workpiece frame's force), and one along an arc of 100 mm radius the same closed form
+/// along its tangent at the arc's top, within the 8 mm tool's curvature effect (the chip of a
+/// curved groove is not a straight one's: 8 / 100 of the width, bounded here by 3 %).
+#[test]
+fn diagonal_and_arc_slots_feel_the_closed_form_along_their_feed() {
+    let (job, q0) = kr300_job();
+    let k = Coefficients::AL7075_T6_CARBIDE;
+    let (n, a) = (3.0, 0.002);
+    let c = 0.025 / (13000.0 / 60.0 * 3.0);
+    let slot = Vector3::new(
+        -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
+        n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
+        n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
+    );
+    // 70 tan(30 deg) = 40.4145 mm.
+    let diagonal = "G0 X-10 Y-20 Z5\nS13000 M3\nG1 Z-2 F1500\nX60 Y20.41452\nG0 Z5\n";
+    let r = job::run(&job, &program(diagonal), &q0).unwrap();
+    let mid = r
+        .samples
+        .iter()
+        .find(|s| s.path.line == 4 && s.path.position.x > 0.03)
+        .unwrap();
+    let turn = nalgebra::Rotation3::from_axis_angle(&Vector3::z_axis(), PI / 6.0);
+    let want = turn * slot;
+    assert!(
+        (mid.force - want).norm() < 1e-6 * want.norm(),
+        "{} vs {want}",
+        mid.force
+    );
+    // Clockwise over the top of a 100 mm arc from (-10, -25) to (70, -25) mm: its top at
+    // x = 30 mm, feed along +x there.
+    let arc = "G0 X-10 Y-25 Z5\nS13000 M3\nG1 Z-2 F1500\nG2 X70 Y-25 R100\nG0 Z5\n";
+    let r = job::run(&job, &program(arc), &q0).unwrap();
+    let top = r
+        .samples
+        .iter()
+        .filter(|s| s.path.line == 4)
+        .min_by(|p, q| {
+            (p.path.position.x - 0.03)
+                .abs()
+                .total_cmp(&(q.path.position.x - 0.03).abs())
+        })
+        .unwrap();
+    assert!(top.path.direction.x > 0.9999, "{:?}", top.path.direction);
+    assert!(
+        (top.force - slot).norm() < 0.03 * slot.norm(),
+        "{} vs {slot}",
+        top.force
+    );
+    // The arc turns the force: its x and y parts keep their signs, not mirrored.
+    assert!(top.force.x.signum() == slot.x.signum() && top.force.y.signum() == slot.y.signum());
+}
+
 #[test]
 fn faults_name_their_program_line() {
     let (job, q0) = kr300_job();
