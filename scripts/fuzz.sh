@@ -28,7 +28,7 @@ shift
 if [ $# -gt 0 ]; then
   targets=("$@")
 else
-  targets=(urdf_stiffness map_csv static_csv map_json drive_toml gcode)
+  targets=(urdf_stiffness map_csv static_csv map_json drive_toml gcode tool_table)
 fi
 
 cargo +nightly fuzz build || exit 1

@@ -17,13 +17,14 @@ use deflect_core::{SerialRobot, TickError, drivetrain};
 /// The fuzz targets, each with its harness: the names of `fuzz/fuzz_targets/*.rs` and of
 /// the directories of `fuzz/corpus/` and `fuzz/regressions/`. A harness returns whether a
 /// model loaded (the replay test wants each seed corpus to load at least one).
-pub const TARGETS: [(&str, Harness); 6] = [
+pub const TARGETS: [(&str, Harness); 7] = [
     ("urdf_stiffness", urdf_stiffness),
     ("map_csv", map_csv),
     ("static_csv", static_csv),
     ("map_json", map_json),
     ("drive_toml", drive_toml),
     ("gcode", gcode),
+    ("tool_table", tool_table),
 ];
 
 /// A harness: arbitrary bytes in, whether a model loaded out.
@@ -421,6 +422,56 @@ pub fn gcode(data: &[u8]) -> bool {
             panic!("the reader's program fails Program::validate: {e}");
         }
         loaded |= !program.moves.is_empty();
+    }
+    loaded
+}
+
+/// Target `tool_table`: the bytes as a LinuxCNC tool table (mm and inch), as a TOML tool
+/// table and as a tool-points CSV. Whatever loads is sane: every tool passes its own check
+/// (number, diameter within the tool's bounds, flutes, helix, a corner radius within the
+/// radius), the table is sorted by number without repeats, a point program is a continuous
+/// chain of finite moves within `MAX_COORDINATE`. No input panics or hangs.
+pub fn tool_table(data: &[u8]) -> bool {
+    use deflect_core::io::{points_csv, tool_table as tt};
+    let text = String::from_utf8_lossy(data);
+    let mut loaded = false;
+    let mut check = |t: deflect_core::machining::tools::ToolTable| {
+        let tools = t.tools();
+        for spec in tools {
+            assert!(spec.validate().is_ok(), "{spec:?}");
+            assert!(spec.cutter().radius().is_finite() && spec.cutter().radius() > 0.0);
+        }
+        assert!(tools.windows(2).all(|w| w[0].number < w[1].number));
+        loaded = true;
+    };
+    for units in [LengthUnit::Millimetre, LengthUnit::Inch] {
+        let o = tt::TblOptions {
+            units,
+            ..tt::TblOptions::default()
+        };
+        if let Ok(t) = tt::tbl_from_str(&text, &o) {
+            check(t);
+        }
+    }
+    if let Ok(t) = tt::toml_from_str(&text) {
+        check(t);
+    }
+    if let Ok(p) = points_csv::from_str(&text, &gcode::GcodeOptions::default()) {
+        let mut at = nalgebra::Vector3::zeros();
+        for m in &p.moves {
+            assert!((m.start - at).norm() == 0.0, "row {}", m.line);
+            assert!(
+                m.end
+                    .iter()
+                    .all(|v| v.abs() <= deflect_core::machining::MAX_COORDINATE),
+                "row {}",
+                m.line
+            );
+            assert!(m.feed.is_finite() && m.feed >= 0.0 && m.spindle.is_finite());
+            at = m.end;
+        }
+        assert!(p.validate().is_ok());
+        loaded = true;
     }
     loaded
 }
