@@ -222,3 +222,54 @@ def test_batches_of_huge_broadcast_inputs_raise_memory_error_and_the_process_sur
         calls[kind]()
     # Still alive and still right: the same call on one row.
     assert np.all(np.isfinite(ROBOT.deflection_batch(q[None, :], w)))
+
+
+# Tool tables: any set of valid tools written as LinuxCNC .tbl or TOML reads back with its
+# numbers, diameters (to the printed digits) and shapes; any text is a table or a LoadError.
+tool_specs = st.lists(
+    st.tuples(
+        st.integers(1, 99999),
+        floats(0.01, 1000.0),  # diameter [mm]
+        st.integers(1, 16),
+        st.sampled_from(["flat", "ball", "bull-nose"]),
+    ),
+    min_size=1,
+    max_size=12,
+    unique_by=lambda t: t[0],
+)
+
+
+@FAST
+@given(tool_specs)
+def test_tool_tables_read_back_what_was_written(specs):
+    tbl = "".join(f"T{n} P{n} D{d:.9g} Z+0 ;tool {n}\n" for n, d, _, _ in specs)
+    toml = 'units = "mm"\n' + "".join(
+        f"[[tool]]\nnumber = {n}\ndiameter = {d:.17g}\nflutes = {f}\nshape = \"{s}\"\n"
+        + (f"corner_radius = {d / 4:.17g}\n" if s == "bull-nose" else "")
+        for n, d, f, s in specs
+    )
+    want = sorted(specs)
+    from_tbl = deflect.ToolTable.from_text(tbl)
+    assert from_tbl.numbers == [n for n, _, _, _ in want]
+    for (n, d, _, _), got in zip(want, from_tbl.tools):
+        assert got[0] == n and got[4] == "flat"
+        assert got[1] == pytest.approx(float(f"{d:.9g}") * 1e-3, rel=1e-12)
+    from_toml = deflect.ToolTable.from_text(toml, format="toml")
+    for (n, d, f, s), got in zip(want, from_toml.tools):
+        assert (got[0], got[2], got[4]) == (n, f, s)
+        assert got[1] == pytest.approx(d * 1e-3, rel=1e-15)
+
+
+TOKENS = "T P D Z ; 0 1 2 . - + e \n [[tool]] number diameter = \" units mm flat ball".split(" ") + [" "]
+
+
+@FAST
+@given(st.lists(st.sampled_from(TOKENS), max_size=60).map("".join))
+def test_any_tool_table_text_reads_or_raises_load_error(text):
+    for fmt in ("tbl", "toml"):
+        try:
+            t = deflect.ToolTable.from_text(text, format=fmt)
+        except deflect.LoadError:
+            continue
+        assert all(0 < tool[1] <= 1.0 and math.isfinite(tool[1]) for tool in t.tools)
+        assert t.numbers == sorted(set(t.numbers))
