@@ -207,3 +207,70 @@ proptest! {
             "|dF| {} > {bound}", (f1 - f0).norm());
     }
 }
+
+/// Reports: a front crossed by twelve channels parallel to the feed is thirteen engaged arcs,
+/// of which a contact keeps `MAX_ARCS`, the last running to the last engaged probe (the rest
+/// merged into it, not dropped); and a stock half a micrometre above the tip reads as air in
+/// the report (`MIN_DEPTH`, 1 um) while the force still feels it (no threshold in the force),
+/// 1.5 um as contact.
+#[test]
+fn arcs_past_max_arcs_merge_into_the_last_and_min_depth_only_names_arcs() {
+    use deflect_core::machining::engagement::{Contact, MAX_ARCS, MIN_DEPTH};
+    let cell = 1.0e-4;
+    let mut z = ZMap::new(
+        Vector2::new(0.0, -0.012),
+        Vector2::new(0.08, 0.012),
+        0.002,
+        cell,
+    )
+    .unwrap();
+    let channel = Cutter::Flat { radius: 3.0e-4 };
+    for k in 0..12 {
+        let y = -0.0066 + 0.0012 * f64::from(k);
+        let _ = z
+            .cut(
+                &channel,
+                &Vector3::new(0.0, y, 0.0),
+                &Vector3::new(0.08, y, 0.0),
+            )
+            .unwrap();
+    }
+    let c = engagement::contact(&z, 0.008, &Vector3::new(0.03, 0.0, 0.0), &Vector3::x());
+    let Contact::Cutting { arcs, count } = c else {
+        panic!("{c:?}")
+    };
+    assert_eq!(count, MAX_ARCS);
+    for w in arcs.windows(2) {
+        assert!(w[0].exit < w[1].entry, "{arcs:?}");
+    }
+    // The last arc runs to the front's last engaged probe: past the twelfth channel, at pi.
+    assert!((arcs[MAX_ARCS - 1].exit - PI).abs() < 1e-12, "{arcs:?}");
+    assert!(arcs[MAX_ARCS - 1].exit - arcs[MAX_ARCS - 1].entry > 0.5);
+
+    let tool = Tool::new(0.016, 3, 0.0).unwrap();
+    let probes = Probes::new(0.008, 5.0e-4);
+    let model = ChipModel::new(&C, &tool, probes.count());
+    for (top, engaged) in [(0.5 * MIN_DEPTH, false), (1.5 * MIN_DEPTH, true)] {
+        let flat = ZMap::new(
+            Vector2::new(0.0, -0.02),
+            Vector2::new(0.08, 0.02),
+            top,
+            5.0e-4,
+        )
+        .unwrap();
+        let mut chip = Chip::default();
+        engagement::read(
+            &flat,
+            &probes,
+            &Vector3::new(0.04, 0.0, 0.0),
+            &Vector3::x(),
+            false,
+            &mut chip,
+        );
+        assert_eq!(chip.contact() != Contact::Air, engaged, "{top}");
+        // The force of a slot `top` deep: linear in the depth, so the closed form scaled.
+        let f = model.wrench(&chip, 1.0e-4).0;
+        let full = cutting::average(&C, &tool, &Engagement::slot(top, 1.0e-4)).unwrap();
+        assert!((f - full).norm() <= 1e-9 * full.norm(), "{f} vs {full}");
+    }
+}

@@ -242,3 +242,40 @@ fn the_mean_cutting_torque_is_the_hand_integral() {
         "{got} vs {quarter}"
     );
 }
+
+/// The helix lag by hand: with a 30 degree helix, the edge at height z trails its tip by
+/// `2 tan(30 deg) z / D`; cut into two discs, the force is the straight-flute edge force of
+/// each disc's depth at its own lagged immersion, summed (one flute, so that one edge is in
+/// contact: no pitch to add).
+#[test]
+fn a_helical_edge_trails_its_tip_by_the_lag_of_each_disc() {
+    let helical = Tool::new(0.016, 1, 30f64.to_radians()).unwrap();
+    let (a, c) = (0.004, 0.1e-3);
+    let e = Engagement::slot(a, c);
+    let dz = a / 2.0;
+    for angle in [0.9, 1.6, 2.8] {
+        let mut want = Vector3::zeros();
+        for k in 0..2 {
+            let z = (f64::from(k) + 0.5) * dz;
+            // tan(30 deg) = 1 / sqrt(3); D = 16 mm.
+            let lag = 2.0 * z / (3f64.sqrt() * 0.016);
+            let phi = angle - lag;
+            if (0.0..=PI).contains(&phi) {
+                let h = c * phi.sin();
+                let ft = (K.k_tc * h + K.k_te) * dz;
+                let fr = (K.k_rc * h + K.k_re) * dz;
+                let fa = (K.k_ac * h + K.k_ae) * dz;
+                want += Vector3::new(
+                    -ft * phi.cos() - fr * phi.sin(),
+                    ft * phi.sin() - fr * phi.cos(),
+                    fa,
+                );
+            }
+        }
+        let got = cutting::force(&K, &helical, &e, angle, 2).unwrap();
+        assert!(
+            (got - want).norm() <= 1e-12 * want.norm(),
+            "{angle}: {got} vs {want}"
+        );
+    }
+}
