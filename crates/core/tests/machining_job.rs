@@ -312,6 +312,44 @@ fn diagonal_and_arc_slots_feel_the_closed_form_along_their_feed() {
     assert!(top.force.x.signum() == slot.x.signum() && top.force.y.signum() == slot.y.signum());
 }
 
+/// A ramp into the stock: at each sample the probes ahead read the uncut top, so the chip is
+/// a slot as deep as the tip is below the top there, and the force that slot's closed form
+/// at the sample's own depth and feed per tooth (the path speed's horizontal part: 25 mm/s
+/// along a ramp of 3 mm over 80 mm is 25 x 80 / sqrt(80^2 + 3^2) mm/s across the stock).
+#[test]
+fn a_ramp_feels_the_slot_of_its_current_depth() {
+    let (job, q0) = kr300_job();
+    let k = Coefficients::AL7075_T6_CARBIDE;
+    let ramp = "G0 X-10 Y0 Z5\nS13000 M3\nG1 Z0 F1500\nX70 Z-3\nG0 Z5\n";
+    let r = job::run(&job, &program(ramp), &q0).unwrap();
+    let c = 0.025 * 80.0 / 6409f64.sqrt() / (13000.0 / 60.0 * 3.0);
+    let mut checked = 0;
+    for s in r
+        .samples
+        .iter()
+        .filter(|s| s.path.line == 4 && (0.02..0.06).contains(&s.path.position.x))
+    {
+        let (n, a) = (3.0, -s.path.position.z);
+        // At full feed between the ramp's ends (the jerk-limited start and stop elsewhere).
+        if (s.feed_per_tooth - c).abs() > 1e-12 * c {
+            continue;
+        }
+        let slot = Vector3::new(
+            -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
+            n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
+            n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
+        );
+        assert!(
+            (s.force - slot).norm() < 1e-9 * slot.norm(),
+            "x = {}: {} vs {slot}",
+            s.path.position.x,
+            s.force
+        );
+        checked += 1;
+    }
+    assert!(checked > 50, "{checked}");
+}
+
 #[test]
 fn faults_name_their_program_line() {
     let (job, q0) = kr300_job();
