@@ -233,6 +233,19 @@ fn job_writes_the_compensated_program_samples_heat_map_and_summary() {
     assert_eq!(again["top_lines"], summary["top_lines"]);
     let rows = csv.lines().count() - 1;
     assert_eq!(Some(rows as u64), summary["samples"].as_u64());
+    // The CSV's values are the archive's: time, position and force of every row (the CSV
+    // prints them to 17 significant digits or so; 1e-12 relative).
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (ct, cx, cfx, cfz) = (col("time_s"), col("x_m"), col("fx_n"), col("fz_n"));
+    let (time, position, force) = (npy(&npz, "time"), npy(&npz, "position"), npy(&npz, "force"));
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
+    for (k, line) in csv.lines().skip(1).enumerate() {
+        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
+        assert!(close(v[ct], time[k]), "row {k}: time {} vs {}", v[ct], time[k]);
+        assert!(close(v[cx], position[3 * k]), "row {k}: x");
+        assert!(close(v[cfx], force[3 * k]) && close(v[cfz], force[3 * k + 2]), "row {k}: force");
+    }
     let png = std::fs::read(out.join("job_part.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
 }
