@@ -19,6 +19,16 @@ if ! command -v rs274 >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && command -v apt-ge
     echo "linuxcnc-uspace could not be installed (target/apt-linuxcnc.log)"
   fi
 fi
+# strace lists a batch's mappings: the proof that no batch copies its input block by block
+# (crates/py/tests/test_numpy.py) needs it, and is skipped without it.
+if ! command -v strace >/dev/null 2>&1 && [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+  echo "== installing strace (the no-copy proof's mapping list) =="
+  mkdir -p target
+  if ! (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+          --no-install-recommends strace) > target/apt-strace.log 2>&1; then
+    echo "strace could not be installed (target/apt-strace.log)"
+  fi
+fi
 if command -v rs274 >/dev/null 2>&1; then
   echo "rs274 found: the G-code reader is compared with LinuxCNC's interpreter"
 else
