@@ -241,10 +241,21 @@ fn job_writes_the_compensated_program_samples_heat_map_and_summary() {
     let (time, position, force) = (npy(&npz, "time"), npy(&npz, "position"), npy(&npz, "force"));
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(b.abs()).max(1e-300);
     for (k, line) in csv.lines().skip(1).enumerate() {
-        let v: Vec<f64> = line.split(',').map(|x| x.parse().unwrap_or(f64::NAN)).collect();
-        assert!(close(v[ct], time[k]), "row {k}: time {} vs {}", v[ct], time[k]);
+        let v: Vec<f64> = line
+            .split(',')
+            .map(|x| x.parse().unwrap_or(f64::NAN))
+            .collect();
+        assert!(
+            close(v[ct], time[k]),
+            "row {k}: time {} vs {}",
+            v[ct],
+            time[k]
+        );
         assert!(close(v[cx], position[3 * k]), "row {k}: x");
-        assert!(close(v[cfx], force[3 * k]) && close(v[cfz], force[3 * k + 2]), "row {k}: force");
+        assert!(
+            close(v[cfx], force[3 * k]) && close(v[cfz], force[3 * k + 2]),
+            "row {k}: force"
+        );
     }
     let png = std::fs::read(out.join("job_part.png")).unwrap();
     assert_eq!(&png[1..4], b"PNG");
