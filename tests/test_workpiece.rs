@@ -1,7 +1,9 @@
 //! The shipped test workpiece (`data/test_workpiece.nc`, the milling scenario's program) on
 //! the KR 300 job of `deflect-sim job`: mid-groove and mid-ramp forces against the slotting
 //! closed form by hand (Altintas, "Manufacturing Automation", 2nd ed., eq. 2.14-2.16) at each
-//! groove's depth and feed direction, and the compensated prediction on the program.
+//! groove's depth and feed direction, the pocket its helical entry and last turn leave (a
+//! floor at the last turn's depth within 16 mm of its centre, the top past it), and the
+//! compensated prediction on the program.
 
 use std::f64::consts::PI;
 
@@ -62,6 +64,26 @@ fn the_test_workpieces_grooves_and_ramp_feel_the_slot_closed_form() {
     assert!(a > 0.004 && a < 0.006, "{a}");
     let horizontal = 100.0 / (100.0f64.powi(2) + 6.0f64.powi(2)).sqrt();
     close(ramp.force, slot(a, c * horizontal), "ramp");
+    // The pocket after its helical entry: every point within 16 mm of (70, 110) mm lies
+    // within the 8 mm tool of the 8 mm circle its last turn runs at 6 mm, so the floor there
+    // is at -6 mm; past 16 mm and the rim's half-cell band the stock keeps its top.
+    let z = &r.nominal;
+    let (mut floor, mut top) = (0, 0);
+    for i in 0..280 {
+        for j in 0..260 {
+            let c = z.center(i, j) - Vector2::new(0.07, 0.11);
+            let rho = c.norm();
+            let h = z.height(i, j).unwrap();
+            if rho < 0.016 - 3.6e-4 {
+                assert!((h + 0.006).abs() < 1e-12, "({i}, {j}) at {rho}: {h}");
+                floor += 1;
+            } else if rho > 0.016 + 3.6e-4 && rho < 0.019 {
+                assert_eq!(h, 0.0, "({i}, {j}) at {rho}");
+                top += 1;
+            }
+        }
+    }
+    assert!(floor > 3000 && top > 900, "{floor} {top}");
     // The whole program compensated onto the program.
     assert!(
         r.path_error(true).max < PREDICTION_TOLERANCE,
