@@ -279,3 +279,30 @@ fn a_helical_edge_trails_its_tip_by_the_lag_of_each_disc() {
         );
     }
 }
+
+/// Quarter immersion by hand: a radial width of D/4 engages up milling over
+/// `0 .. acos(1/2) = pi/3` and down milling over `2 pi/3 .. pi`; the mean force is the force
+/// law's antiderivative (`int sin cos = sin^2/2`, `int sin^2 = phi/2 - sin(2 phi)/4`) between
+/// those angles, times `N a / (2 pi)`, written out here from the law, not from the code.
+#[test]
+fn quarter_immersion_up_and_down_are_the_antiderivative_between_their_angles() {
+    let (n, a, c, d) = (3.0, 0.003, 0.08e-3, 0.016);
+    let antiderivative = |p: f64| {
+        let (s, co) = p.sin_cos();
+        let s2 = p / 2.0 - (2.0 * p).sin() / 4.0;
+        Vector3::new(
+            -K.k_tc * c * s * s / 2.0 - K.k_te * s - K.k_rc * c * s2 + K.k_re * co,
+            K.k_tc * c * s2 - K.k_te * co - K.k_rc * c * s * s / 2.0 - K.k_re * s,
+            -K.k_ac * c * co + K.k_ae * p,
+        ) * (n * a / TAU)
+    };
+    let up = Engagement::up_milling(d / 4.0, d, a, c);
+    let down = Engagement::down_milling(d / 4.0, d, a, c);
+    assert!(up.entry == 0.0 && (up.exit - PI / 3.0).abs() < 1e-15);
+    assert!((down.entry - 2.0 * PI / 3.0).abs() < 1e-15 && down.exit == PI);
+    for (e, from, to) in [(up, 0.0, PI / 3.0), (down, 2.0 * PI / 3.0, PI)] {
+        let want = antiderivative(to) - antiderivative(from);
+        let got = cutting::average(&K, &tool(), &e).unwrap();
+        assert!(rel(&got, &want) < 1e-12, "{got} vs {want}");
+    }
+}
