@@ -194,6 +194,18 @@ fn kr300_job() -> (Job, Vec<f64>) {
     )
 }
 
+/// The slotting average of the 16 mm three-flute mill in Al7075 at depth `a` and feed per
+/// tooth `c`, tool frame: Altintas' closed forms (2.14-2.16 of Manufacturing Automation).
+fn slot_force(a: f64, c: f64) -> Vector3<f64> {
+    let k = Coefficients::AL7075_T6_CARBIDE;
+    let n = 3.0;
+    Vector3::new(
+        -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
+        n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
+        n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
+    )
+}
+
 const SLOT: &str = "G0 X-10 Y0 Z5\nS13000 M3\nG1 Z-2 F1500\nX70\nG0 Z5\n";
 
 #[test]
@@ -203,14 +215,8 @@ fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
     let r = job::run(&job, &p, &q0).unwrap();
     // Mid-slot, at the feed: Altintas' slotting averages (2.14-2.16 of Manufacturing
     // Automation), N = 3, a = 2 mm, c = 25 mm/s / (13000/60 rev/s x 3).
-    let k = Coefficients::AL7075_T6_CARBIDE;
-    let (n, a) = (3.0, 0.002);
     let c = 0.025 / (13000.0 / 60.0 * 3.0);
-    let expected = Vector3::new(
-        -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
-        n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
-        n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
-    );
+    let expected = slot_force(0.002, c);
     let mid = r
         .samples
         .iter()
@@ -265,14 +271,8 @@ fn a_slot_on_the_kr300_has_the_closed_form_force_and_is_compensated() {
 #[test]
 fn diagonal_and_arc_slots_feel_the_closed_form_along_their_feed() {
     let (job, q0) = kr300_job();
-    let k = Coefficients::AL7075_T6_CARBIDE;
-    let (n, a) = (3.0, 0.002);
     let c = 0.025 / (13000.0 / 60.0 * 3.0);
-    let slot = Vector3::new(
-        -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
-        n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
-        n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
-    );
+    let slot = slot_force(0.002, c);
     // 70 tan(30 deg) = 40.4145 mm.
     let diagonal = "G0 X-10 Y-20 Z5\nS13000 M3\nG1 Z-2 F1500\nX60 Y20.41452\nG0 Z5\n";
     let r = job::run(&job, &program(diagonal), &q0).unwrap();
@@ -319,7 +319,6 @@ fn diagonal_and_arc_slots_feel_the_closed_form_along_their_feed() {
 #[test]
 fn a_ramp_feels_the_slot_of_its_current_depth() {
     let (job, q0) = kr300_job();
-    let k = Coefficients::AL7075_T6_CARBIDE;
     let ramp = "G0 X-10 Y0 Z5\nS13000 M3\nG1 Z0 F1500\nX70 Z-3\nG0 Z5\n";
     let r = job::run(&job, &program(ramp), &q0).unwrap();
     let c = 0.025 * 80.0 / 6409f64.sqrt() / (13000.0 / 60.0 * 3.0);
@@ -329,16 +328,11 @@ fn a_ramp_feels_the_slot_of_its_current_depth() {
         .iter()
         .filter(|s| s.path.line == 4 && (0.02..0.06).contains(&s.path.position.x))
     {
-        let (n, a) = (3.0, -s.path.position.z);
         // At full feed between the ramp's ends (the jerk-limited start and stop elsewhere).
         if (s.feed_per_tooth - c).abs() > 1e-12 * c {
             continue;
         }
-        let slot = Vector3::new(
-            -n * a * k.k_rc * c / 4.0 - n * a * k.k_re / PI,
-            n * a * k.k_tc * c / 4.0 + n * a * k.k_te / PI,
-            n * a * k.k_ac * c / PI + n * a * k.k_ae / 2.0,
-        );
+        let slot = slot_force(-s.path.position.z, c);
         assert!(
             (s.force - slot).norm() < 1e-9 * slot.norm(),
             "x = {}: {} vs {slot}",

@@ -4,6 +4,7 @@
 use nalgebra::Vector3;
 
 use super::{Cutter, Removal, ZMap};
+use crate::contour::shape::distance_to_segment;
 use crate::error::{TickError, check_finite};
 
 /// How far a [`Follower`] may leave cells above the exact sweep \[m\]: 1e-8 m, the pose
@@ -104,7 +105,7 @@ impl Follower {
             && (to.xy() - a.xy()).norm() < stock.cell
             && held
                 .iter()
-                .all(|p| segment_distance(p, &a, to) <= FOLLOW_TOLERANCE)
+                .all(|p| distance_to_segment(p, &a, to) <= FOLLOW_TOLERANCE)
         {
             return Ok((self.step_to(stock, cutter, to, Step::Hold)?, Step::Hold));
         }
@@ -231,16 +232,4 @@ pub enum Step {
     Restart,
     /// Cut at once (the first tip, another cutter).
     Cut,
-}
-
-/// Distance from `p` to the segment `[a, b]` \[m\].
-fn segment_distance(p: &Vector3<f64>, a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
-    let ab = b - a;
-    let l2 = ab.norm_squared();
-    let t = if l2 > 0.0 {
-        ((p - a).dot(&ab) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p - (a + ab * t)).norm()
 }
