@@ -238,6 +238,18 @@ print(json.dumps(res))
 """
 
 
+def _mapping_env(threshold):
+    """A child's environment where every allocation of `threshold` bytes or more is its own
+    mmap (glibc's threshold fixed) in one malloc arena, BLAS on one thread."""
+    return dict(
+        os.environ,
+        OPENBLAS_NUM_THREADS="1",
+        OMP_NUM_THREADS="1",
+        MALLOC_MMAP_THRESHOLD_=str(threshold),
+        MALLOC_ARENA_MAX="1",
+    )
+
+
 def test_no_copy_is_proven_under_an_address_space_limit():
     """float64 C-contiguous batch input is read in place: with the process's address space
     capped at its size plus 24 MB, a batch over a 64 MB (48 MB) input still runs, while the
@@ -247,13 +259,7 @@ def test_no_copy_is_proven_under_an_address_space_limit():
     # one malloc arena (worker threads otherwise reserve 64 MB arenas, where a refused
     # mapping is retried): no memory already counted by the cap is left for a copy to reuse.
     # A copy in Rust would abort the child (infallible allocation), one in numpy raise.
-    env = dict(
-        os.environ,
-        OPENBLAS_NUM_THREADS="1",
-        OMP_NUM_THREADS="1",
-        MALLOC_MMAP_THRESHOLD_="131072",
-        MALLOC_ARENA_MAX="1",
-    )
+    env = _mapping_env(131072)
     repo = str(REPO)
     proc = subprocess.run(
         [sys.executable, "-c", _NO_COPY_CHILD, repo], capture_output=True, text=True, timeout=120, env=env
@@ -314,13 +320,7 @@ def test_no_copy_block_by_block_either():
 
     if shutil.which("strace") is None:
         pytest.skip("strace is not installed (scripts/test-all.sh installs it as root)")
-    env = dict(
-        os.environ,
-        OPENBLAS_NUM_THREADS="1",
-        OMP_NUM_THREADS="1",
-        MALLOC_MMAP_THRESHOLD_="65536",
-        MALLOC_ARENA_MAX="1",
-    )
+    env = _mapping_env(65536)
     trace = REPO / "target" / "strace-batch.txt"
     trace.parent.mkdir(exist_ok=True)
     proc = subprocess.run(
