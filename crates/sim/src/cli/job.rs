@@ -102,7 +102,7 @@ pub struct JobArgs {
     pub top: f64,
     #[arg(long, allow_negative_numbers = true, help = CELL_MM.help(
         "Z-map cell [mm]",
-        "Default: the smallest cutting tool's diameter / 12, within [0.1, 0.5] mm; at most 2^24 cells (MAX_CELLS)"
+        "Default: the smallest cutting tool's diameter / 12, within [0.1, 0.5] mm (at most its radius / 2, which a job requires); at most 2^24 cells (MAX_CELLS)"
     ))]
     pub cell: Option<f64>,
     #[command(flatten)]

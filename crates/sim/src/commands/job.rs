@@ -247,7 +247,9 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     };
     let cell_mm = a.cell.unwrap_or_else(|| {
         if smallest.is_finite() {
-            (smallest / 12.0).clamp(0.1, 0.5)
+            // At least 0.1 mm, but never past half the smallest radius (a tool below 0.4 mm),
+            // which the job refuses.
+            (smallest / 12.0).clamp((smallest / 4.0).min(0.1), 0.5)
         } else {
             0.5
         }

@@ -384,4 +384,21 @@ fn job_runs_at_one_sample_per_second_and_with_sharp_limits() {
         let o = sim(&all);
         assert_eq!(o.code, 0, "{args:?}: {}", o.stderr);
     }
+    // A 0.3 mm tool: the default cell goes below 0.1 mm to half its radius (the job refuses
+    // coarser), and the job runs.
+    let tiny = d.join("tiny.nc");
+    std::fs::write(&tiny, "G0 X0 Y0 Z5\nS20000 M3\nG1 Z-0.1 F300\nX5\nG0 Z5\n").unwrap();
+    let o = sim(&[
+        "job",
+        "--program",
+        tiny.to_str().unwrap(),
+        "--diameter",
+        "0.3",
+        "--flutes",
+        "2",
+        "--out",
+        d.join("tiny").to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("z-map cells of 0.075 mm"), "{}", o.stdout);
 }
