@@ -356,15 +356,25 @@ impl ZMap {
             floor: from.z.min(to.z),
             p0: from.xy(),
             b: to.xy() - from.xy(),
+            inv_bb: {
+                let bb = (to.xy() - from.xy()).norm_squared();
+                if bb > 1.0e-30 { 1.0 / bb } else { 0.0 }
+            },
             r,
             top: self.top,
             area: cell * cell,
         };
         let mut removal = Removal::default();
         // Centre column of x (m) rounded up / down.
-        let above = |x: f64| -floor_of(-((x - origin.x) / cell - 0.5));
-        let below = |x: f64| floor_of((x - origin.x) / cell - 0.5);
+        // Per row a few of these: a product, not a division (the row's set-up is a third of a
+        // small step's sweep).
+        let inv_cell = 1.0 / cell;
+        let above = |x: f64| -floor_of(-((x - origin.x) * inv_cell - 0.5));
+        let below = |x: f64| floor_of((x - origin.x) * inv_cell - 0.5);
         let clamp = |k: f64| k.clamp(i0 as f64, i1 as f64) as usize;
+        // The crescent's half-plane ahead of `from`: x > from.x - (y - from.y) by / bx.
+        let (bx, by) = (to.x - from.x, to.y - from.y);
+        let slope = if bx != 0.0 { by / bx } else { 0.0 };
         for j in j0..j1 {
             let cy = origin.y + (j as f64 + 0.5) * cell;
             let Some(row) = self.heights.get_mut(j * nx..(j + 1) * nx) else {
@@ -432,11 +442,10 @@ impl ZMap {
             // Only cells ahead of `from` along the move: one behind it has `from` for its
             // closest point, as it had at the end of the last move, and keeps its height to
             // the descent the follower allows.
-            let (bx, by) = (to.x - from.x, to.y - from.y);
             let (ha, hb) = if bx > 0.0 {
-                (clamp(above(from.x - df * by / bx)), i1)
+                (clamp(above(from.x - df * slope)), i1)
             } else if bx < 0.0 {
-                (i0, clamp(below(from.x - df * by / bx) + 1.0))
+                (i0, clamp(below(from.x - df * slope) + 1.0))
             } else if df * by > 0.0 {
                 (i0, i1)
             } else {
@@ -484,6 +493,8 @@ struct Pass<'a> {
     floor: f64,
     p0: Vector2<f64>,
     b: Vector2<f64>,
+    /// `1 / |b|^2` (0 for a step without horizontal motion).
+    inv_bb: f64,
     r: f64,
     top: f64,
     area: f64,
@@ -510,8 +521,7 @@ impl Pass<'_> {
             return;
         };
 
-        let bb = self.b.norm_squared();
-        let inv_bb = if bb > 1.0e-30 { 1.0 / bb } else { 0.0 };
+        let inv_bb = self.inv_bb;
         let ball = matches!(self.cutter, Cutter::Ball { .. });
         let (r, floor) = (self.r, self.floor);
         let r2 = r * r;
