@@ -24,6 +24,7 @@ pub mod job_out;
 pub mod map_csv;
 pub mod map_json;
 pub mod points_csv;
+pub mod robot_program;
 #[cfg(feature = "urdf")]
 pub mod stiffness;
 pub mod tool_table;
