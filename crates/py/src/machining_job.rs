@@ -3,7 +3,7 @@
 //! and `MachiningResult` (every sample as arrays, the three predicted parts, the compensated
 //! program). Thin: core runs the pass, with the GIL released.
 
-use deflect_core::io::job_out;
+use deflect_core::io::{job_out, robot_program};
 use deflect_core::machining::Program;
 use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::cutting::Tool;
@@ -288,7 +288,12 @@ impl MachiningJob {
         let report = py
             .detach(|| job::run(&self.inner, &program, &seed))
             .map_err(job_err)?;
-        Ok(MachiningResult { report, program })
+        let placement = self.inner.setup().placement;
+        Ok(MachiningResult {
+            report,
+            program,
+            placement,
+        })
     }
 
     fn __repr__(&self) -> String {
@@ -311,6 +316,8 @@ impl MachiningJob {
 pub struct MachiningResult {
     report: Report,
     program: Program,
+    /// The job's workpiece frame in the base frame (robot programs are in the base frame).
+    placement: nalgebra::Isometry3<f64>,
 }
 
 impl MachiningResult {
@@ -631,6 +638,43 @@ impl MachiningResult {
             )));
         }
         Ok(job_out::compensated_gcode(&self.report, &self.program, t))
+    }
+
+    /// The compensated job as a robot controller's program text. `kind`: "urscript" (Universal
+    /// Robots: `movel` of the commanded TCP in the base frame, m and rotation vector, kept
+    /// within `tolerance` [m] of the commanded path and `tolerance / 0.1 m` rad of its
+    /// orientation, `acceleration` [m/s^2] the `a` of every move; with `joints=True`, `servoj`
+    /// of the compensated joints at every sample). The program's lines are comments.
+    #[pyo3(signature = (kind, *, tolerance=1e-6, acceleration=1.2, joints=false))]
+    fn robot_program(
+        &self,
+        kind: &str,
+        tolerance: f64,
+        acceleration: f64,
+        joints: bool,
+    ) -> PyResult<String> {
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            return Err(InputError::new_err(format!(
+                "tolerance: expected > 0 m, got {tolerance}"
+            )));
+        }
+        if !(acceleration.is_finite() && acceleration > 0.0) {
+            return Err(InputError::new_err(format!(
+                "acceleration: expected > 0 m/s^2, got {acceleration}"
+            )));
+        }
+        match kind {
+            "urscript" if joints => Ok(robot_program::urscript_servoj(&self.report)),
+            "urscript" => Ok(robot_program::urscript_movel(
+                &self.report,
+                &self.placement,
+                tolerance,
+                acceleration,
+            )),
+            other => Err(InputError::new_err(format!(
+                "kind: {other:?}; expected \"urscript\""
+            ))),
+        }
     }
 
     /// Every sample as CSV text (columns in deflect-core's `io::job_out::samples_csv`), the

@@ -355,3 +355,36 @@ def test_real_cam_programs_are_compensated_onto_the_program(kr300, name, diamete
     assert r.path_error("compensated")[0] <= 1e-6, r.deviations[:5]
     assert r.deviations == []
     assert r.path_error("uncompensated")[0] > 1e-4
+
+
+def test_the_urscript_reads_back_onto_the_compensated_joints(slot_run, kr300):
+    """The URScript of the slot, parsed here: every movel pose is the robot's FK at some
+    sample's compensated joints (1e-6 m, 1e-6 rad), every servoj row a sample's compensated
+    joints (1e-9 rad); a kind it does not know and a tolerance of 0 are InputErrors."""
+    import re
+
+    r = slot_run
+    script = r.robot_program("urscript")
+    assert script.startswith("def deflect_job():") and script.rstrip().endswith("deflect_job()")
+    fks = np.array([kr300.forward(q) for q in r.q_commanded])
+    moves = re.findall(r"movel\(p\[([^\]]*)\], a=([^,]*), v=([^,]*), r=([^)]*)\)", script)
+    assert 3 <= len(moves) < len(r) // 4
+    for m in moves:
+        p = np.array([float(x) for x in m[0].split(",")])
+        k = np.argmin(np.linalg.norm(fks[:, :3, 3] - p[:3], axis=1))
+        assert np.linalg.norm(fks[k, :3, 3] - p[:3]) < 1e-6
+        angle = np.linalg.norm(p[3:])
+        axis = p[3:] / angle if angle > 0 else np.array([0.0, 0.0, 1.0])
+        K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+        rot = np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K  # Rodrigues
+        assert np.linalg.norm(rot - fks[k, :3, :3]) < 1e-6
+    joints = r.robot_program("urscript", joints=True)
+    rows = re.findall(r"servoj\(\[([^\]]*)\]", joints)
+    assert len(rows) == len(r)
+    q = np.array([[float(x) for x in row.split(",")] for row in rows])
+    np.testing.assert_allclose(q, r.q_commanded, atol=1e-9, rtol=0)
+    assert "# line 4," in script
+    with pytest.raises(deflect.InputError, match="kind"):
+        r.robot_program("krl2")
+    with pytest.raises(deflect.InputError, match="tolerance"):
+        r.robot_program("urscript", tolerance=0.0)

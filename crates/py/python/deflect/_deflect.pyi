@@ -1243,6 +1243,12 @@ class MachiningResult:
         """Pilot-control wrenches (n, 6), base frame, ``lead`` [s] ahead."""
     def compensated_gcode(self, tolerance: float = 1e-6) -> str:
         """The compensated program as G-code text (mm)."""
+    def robot_program(
+        self, kind: str, *, tolerance: float = 1e-6, acceleration: float = 1.2, joints: bool = False
+    ) -> str:
+        """The compensated job as a robot controller's program: ``kind`` "urscript" (``movel``
+        of the commanded TCP in the base frame within ``tolerance`` [m], or ``servoj`` of the
+        compensated joints with ``joints=True``)."""
     def samples_csv(self, lead: float = 0.04) -> str:
         """Every sample as CSV text, the pilot wrench ``lead`` [s] ahead."""
 
