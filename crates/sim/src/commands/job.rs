@@ -11,7 +11,7 @@ use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::io::tool_table::{self, TblOptions};
 use deflect_core::io::{job_out, points_csv};
 use deflect_core::machining::cutting::{Coefficients, Tool};
-use deflect_core::machining::job::{self, Job, Report, Setup, Stock};
+use deflect_core::machining::job::{self, Job, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::{Motion, Program};
 use deflect_core::mechanism::PoseIkOptions;
@@ -20,7 +20,8 @@ use deflect_sim::SimError;
 use deflect_sim::scenes::milling::part_map;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::job_files::{FileOptions, JobFiles, OperationFigures};
+use super::job_files::{FileOptions, JobFiles};
+use super::job_summary::summary;
 use super::serial::{load_robot, read_program, read_text};
 use super::stdout;
 use crate::cli::{CliError, JobArgs, ToolArgs};
@@ -35,11 +36,11 @@ const START: [f64; 3] = [0.0, 0.0, 0.02];
 
 /// Everything `job` needs, read and checked.
 pub struct JobTask {
-    job: Job,
-    program: Program,
-    program_name: String,
-    robot_name: String,
-    seed: Vec<f64>,
+    pub(super) job: Job,
+    pub(super) program: Program,
+    pub(super) program_name: String,
+    pub(super) robot_name: String,
+    pub(super) seed: Vec<f64>,
 }
 
 /// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
@@ -288,295 +289,6 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         robot_name: loaded.name,
         seed,
     })
-}
-
-/// Which tool cuts each `T` of the program, and which spindle: the summary's words.
-fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
-    let used = t.program.tools();
-    let setup = t.job.setup();
-    let mut json = Vec::new();
-    let mut text = match t.job.tools() {
-        Some(table) => {
-            let mut parts = Vec::new();
-            for n in &used {
-                if let Some(spec) = table.get(*n) {
-                    parts.push(format!(
-                        "T{n} {:.3} mm {} {} flutes{}",
-                        spec.tool.diameter * 1e3,
-                        spec.shape.name(),
-                        spec.tool.flutes,
-                        if spec.name.is_empty() {
-                            String::new()
-                        } else {
-                            format!(" ({})", spec.name)
-                        }
-                    ));
-                    json.push(serde_json::json!({
-                        "tool": n, "diameter_m": spec.tool.diameter, "shape": spec.shape.name(),
-                        "flutes": spec.tool.flutes, "helix_rad": spec.tool.helix, "length_m": spec.length,
-                    }));
-                }
-            }
-            let ends = table
-                .tools()
-                .iter()
-                .any(|s| s.shape != deflect_core::machining::tools::ToolShape::Flat);
-            format!(
-                "tools (from the tool table): {}{}",
-                if parts.is_empty() {
-                    "none cut".to_string()
-                } else {
-                    parts.join("; ")
-                },
-                if ends {
-                    "; ball and bull-nose ends cut the z-map as ball and flat ends and feel the flat \
-                     end mill's force"
-                } else {
-                    ""
-                }
-            )
-        }
-        None => {
-            let names: Vec<String> = used
-                .iter()
-                .filter(|&&n| n > 0)
-                .map(|n| format!("T{n}"))
-                .collect();
-            json.push(serde_json::json!({
-                "tool": "every", "diameter_m": setup.tool.diameter, "shape": "flat",
-                "flutes": setup.tool.flutes, "helix_rad": setup.tool.helix,
-            }));
-            format!(
-                "tool: no tool table; the --diameter/--flutes tool ({:.3} mm flat, {} flutes) serves \
-                 every T of the program ({})",
-                setup.tool.diameter * 1e3,
-                setup.tool.flutes,
-                if names.is_empty() {
-                    "it names none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            )
-        }
-    };
-    if let Some(hand) = setup.hand_spindle {
-        let _ = write!(
-            text,
-            "\nspindle: hand-started at {:.0} rpm wherever the program's spindle is off",
-            hand * 60.0
-        );
-    }
-    (text, json)
-}
-
-/// The summary as text lines and JSON: the run, the tools, per operation, the ten lines of
-/// largest force, where the compensated prediction leaves the program, and the totals.
-fn summary(
-    t: &JobTask,
-    r: &Report,
-    ops: &[OperationFigures],
-    wall: f64,
-    threads: usize,
-) -> (String, serde_json::Value) {
-    let (pu, pc) = (r.path_error(false), r.path_error(true));
-    let (su, sc) = (
-        r.surface_error(&r.uncompensated),
-        r.surface_error(&r.compensated),
-    );
-    let sm = &r.summary;
-    let duration = sm.duration();
-    let fmax = sm.max_force();
-    let cell = t.job.setup().stock.cell;
-    let mut text = String::new();
-    let _ = writeln!(
-        text,
-        "job: {} on {}: {} samples at {} Hz over {duration:.2} s of program, in {wall:.2} s \
-         on {threads} thread{} ({:.0} samples/s, {:.0} z-map cell updates/s); z-map cells of \
-         {:.3} mm; {} plunge samples (no side force)",
-        t.program_name,
-        t.robot_name,
-        sm.samples(),
-        r.rate_hz,
-        if threads == 1 { "" } else { "s" },
-        sm.samples() as f64 / wall.max(1e-9),
-        r.cell_updates as f64 / wall.max(1e-9),
-        cell * 1e3,
-        r.plunge_samples
-    );
-    let (tools, tools_json) = tools_text(t);
-    let _ = writeln!(text, "{tools}");
-    if let Some(c) = r.rapid_contact {
-        let _ = writeln!(
-            text,
-            "rapids in the stock: the deepest {:.3} mm at line {} (t = {:.2} s), within --rapid-skim \
-             {:.3} mm",
-            c.depth * 1e3,
-            c.line,
-            c.time,
-            t.job.setup().rapid_skim * 1e3
-        );
-    }
-    let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
-    let _ = writeln!(
-        text,
-        "\noperations ({}): path error max [mm] uncompensated -> compensated",
-        ops.len()
-    );
-    let _ = writeln!(
-        text,
-        "{:<32} {:>6} {:>5} {:>10} {:>9} {:>9} {:>14} {:>12}",
-        "operation",
-        "line",
-        "tool",
-        "time [s]",
-        "max |F|",
-        "mean |F|",
-        "uncompensated",
-        "compensated"
-    );
-    let name_width = 32;
-    for o in ops {
-        let name = deflect_sim::scenes::milling::part_map::shorten(&o.name, 32 * 9, 16);
-        let name: String = name.chars().take(name_width).collect();
-        let _ = writeln!(
-            text,
-            "{name:<32} {:>6} {:>5} {:>10.1} {:>9.1} {:>9.1} {:>14.4} {:>12.6}",
-            o.line,
-            format!("T{}", o.tool),
-            o.end - o.start,
-            o.max_force,
-            o.sum_force / o.samples.max(1) as f64,
-            o.error_uncompensated * 1e3,
-            o.error_compensated * 1e3
-        );
-    }
-    let lines = r.line_forces();
-    let mut top: Vec<_> = lines.iter().filter(|l| l.max > 0.0).collect();
-    top.sort_by(|a, b| b.max.total_cmp(&a.max));
-    top.truncate(10);
-    let _ = writeln!(text, "\nthe ten program lines of largest force");
-    let _ = writeln!(
-        text,
-        "{:>6}  {:>7}  {:>12}  {:>11}  {:>22}",
-        "line", "samples", "mean |F| [N]", "max |F| [N]", "path error max [mm] u/c"
-    );
-    for l in &top {
-        let _ = writeln!(
-            text,
-            "{:>6}  {:>7}  {:>12.1}  {:>11.1}  {:>11.4} / {:.6}",
-            l.line,
-            l.samples,
-            l.mean.norm(),
-            l.max,
-            l.error_uncompensated * 1e3,
-            l.error_compensated * 1e3
-        );
-    }
-    let mut off: Vec<_> = lines.iter().filter(|l| l.deviation.is_some()).collect();
-    off.sort_by(|a, b| b.error_compensated.total_cmp(&a.error_compensated));
-    let tol = job::PREDICTION_TOLERANCE;
-    if off.is_empty() {
-        let _ = writeln!(
-            text,
-            "\nthe compensated prediction stays within {:.0} um of the program on every line \
-             (largest {:.2e} mm; coupling residual at most {:.1e} m)",
-            tol * 1e6,
-            pc.max * 1e3,
-            sm.max_residual()[1]
-        );
-    } else {
-        let _ = writeln!(
-            text,
-            "\nthe compensated prediction leaves the program by more than {:.0} um on {} lines \
-             ({} samples); the worst:",
-            tol * 1e6,
-            off.len(),
-            sm.deviating_samples()
-        );
-        for l in off.iter().take(10) {
-            let why = match l.deviation {
-                Some(job::Deviation::Coupling) => {
-                    "the force-deflection coupling does not converge (the force changes faster \
-                     with the tool's position than the arm holds it; a finer --cell may help)"
-                }
-                _ => {
-                    "the compensated tool meets a stock an earlier deviation left (beyond the \
-                     offline compensation)"
-                }
-            };
-            let _ = writeln!(
-                text,
-                "  line {}: {:.4} mm, residual {:.1e} m: {why}",
-                l.line,
-                l.error_compensated * 1e3,
-                l.residual
-            );
-        }
-    }
-    let _ = writeln!(text);
-    for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
-        let _ = writeln!(
-            text,
-            "{label:<13}  path error max {:.4} mm, RMS {:.4} mm; part floors max {:.4} mm, \
-             RMS {:.4} mm; walls {:.1} mm^2 left, {:.1} mm^2 overcut",
-            p.max * 1e3,
-            p.rms * 1e3,
-            s.floor.max * 1e3,
-            s.floor.rms * 1e3,
-            s.material_left * 1e6,
-            s.overcut * 1e6
-        );
-    }
-    let stats = |p: job::ErrorStats, s: job::SurfaceError| {
-        serde_json::json!({
-            "path_error_max_m": p.max, "path_error_rms_m": p.rms,
-            "floor_error_max_m": s.floor.max, "floor_error_rms_m": s.floor.rms,
-            "material_left_m2": s.material_left, "overcut_m2": s.overcut,
-        })
-    };
-    let line_json = |l: &job::LineSummary| {
-        serde_json::json!({
-            "line": l.line, "samples": l.samples,
-            "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
-            "path_error_uncompensated_m": l.error_uncompensated,
-            "path_error_compensated_m": l.error_compensated,
-            "coupling_residual_m": l.residual,
-            "deviation": l.deviation.map(job::Deviation::name),
-        })
-    };
-    let json = serde_json::json!({
-        "program": t.program_name,
-        "robot": t.robot_name,
-        "samples": sm.samples(),
-        "rate_hz": r.rate_hz,
-        "duration_s": duration,
-        "wall_time_s": wall,
-        "threads": threads,
-        "cell_m": cell,
-        "cell_updates": r.cell_updates,
-        "plunge_samples": r.plunge_samples,
-        "max_force_n": fmax,
-        "tools": tools_json,
-        "rapid_contact": r.rapid_contact.map(|c| serde_json::json!({
-            "line": c.line, "time_s": c.time, "depth_m": c.depth,
-        })),
-        "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
-        "operations": ops.iter().map(|o| serde_json::json!({
-            "name": o.name, "line": o.line, "tool": o.tool, "samples": o.samples,
-            "start_s": o.start, "end_s": o.end, "max_force_n": o.max_force,
-            "mean_force_n": o.sum_force / o.samples.max(1) as f64,
-            "path_error_uncompensated_m": o.error_uncompensated,
-            "path_error_compensated_m": o.error_compensated,
-            "deviating_samples": o.deviating,
-        })).collect::<Vec<_>>(),
-        "top_lines": top.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
-        "deviating_lines": off.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
-        "prediction_tolerance_m": tol,
-        "coupling_residual_max_m": sm.max_residual(),
-        "uncompensated": stats(pu, su),
-        "compensated": stats(pc, sc),
-    });
-    (text, json)
 }
 
 /// A progress bar over the program's duration \[s\] with its ETA on stderr: drawn once the

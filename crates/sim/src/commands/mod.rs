@@ -33,6 +33,7 @@ pub mod delta;
 pub mod fit;
 pub mod job;
 pub mod job_files;
+pub mod job_summary;
 pub mod milling;
 pub mod reproduce;
 pub mod run;
