@@ -29,6 +29,7 @@ mod grid_map;
 mod identification;
 mod machining;
 mod machining_job;
+mod machining_result;
 mod mechanism;
 mod motion;
 mod out;
