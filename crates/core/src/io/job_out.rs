@@ -31,6 +31,15 @@ use crate::machining::{Motion, Program};
 /// decimation's time to `O(n x 256)`).
 pub const MAX_DROPPED: usize = 256;
 
+/// Writes `text` to `out` once it holds 64 KiB (the writers' buffer), and clears it.
+fn spill<W: Write>(out: &mut W, text: &mut String) -> std::io::Result<()> {
+    if text.len() > 1 << 16 {
+        out.write_all(text.as_bytes())?;
+        text.clear();
+    }
+    Ok(())
+}
+
 /// The compensated program (see the module docs); `tolerance` \[m\] > 0 (1e-6 keeps the
 /// compensation to a micrometre). `program` must be the one the report was run on (for the
 /// feeds).
@@ -114,10 +123,7 @@ impl<'p, W: Write> GcodeWriter<'p, W> {
                 let changes = prev.path.move_index != s.path.move_index;
                 self.decide(prev, changes);
             }
-            if self.text.len() > 1 << 16 {
-                self.out.write_all(self.text.as_bytes())?;
-                self.text.clear();
-            }
+            spill(&mut self.out, &mut self.text)?;
         }
         Ok(())
     }
@@ -342,10 +348,7 @@ impl<W: Write> CsvWriter<W> {
                 let w = self.held.back().map_or(first.wrench, |b| b.wrench);
                 csv_row(&mut self.text, &first, &w, self.dof);
             }
-            if self.text.len() > 1 << 16 {
-                self.out.write_all(self.text.as_bytes())?;
-                self.text.clear();
-            }
+            spill(&mut self.out, &mut self.text)?;
         }
         Ok(())
     }
