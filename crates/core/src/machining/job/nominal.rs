@@ -185,23 +185,30 @@ impl<'a> Stage<'a> {
             return Ok((false, 0.0));
         };
         let program = self.program;
-        if path::between(program, from, here, |_, _, _| {}) == 0 {
-            return Ok((false, 0.0));
-        }
-        self.flush()?;
         let tools = self.tools;
         let (mut rapid, mut failed, mut cells) = (0.0f64, None, 0usize);
         let (stock, follower) = (&mut self.stock, &mut self.follower);
-        path::between(program, from, here, |w, m, _| {
+        // The held feed move is cut before the first point (and not counted as a rapid's).
+        let mut first = true;
+        let points = path::between(program, from, here, |w, m, _| {
+            if failed.is_some() {
+                return;
+            }
+            if core::mem::take(&mut first) {
+                match follower.flush(stock) {
+                    Ok(r) => cells += r.cells,
+                    Err(e) => {
+                        failed = Some(e);
+                        return;
+                    }
+                }
+            }
             let Some(mv) = program.moves.get(m) else {
                 return;
             };
             let Some(tm) = tools.get(tools.find(mv.tool)) else {
                 return;
             };
-            if failed.is_some() {
-                return;
-            }
             match follower.cut_to(stock, &tm.cutter, &w) {
                 Ok(r) => {
                     cells += r.cells;
@@ -212,6 +219,9 @@ impl<'a> Stage<'a> {
                 Err(e) => failed = Some(e),
             }
         });
+        if points == 0 {
+            return Ok((false, 0.0));
+        }
         self.cell_updates += cells;
         match failed {
             Some(e) => Err(e),
