@@ -73,6 +73,7 @@ extern crate std;
 pub mod compensation;
 pub mod compliance_map;
 pub mod contour;
+pub mod controller;
 pub mod dalembert;
 pub mod drivetrain;
 pub mod error;

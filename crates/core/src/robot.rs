@@ -24,4 +24,8 @@ pub struct SerialRobot {
     pub base_link: String,
     /// The chain's tip (TCP) link.
     pub tip_link: String,
+    /// How its controller reads the joints and frames (the `[controller]` table of the
+    /// stiffness file, [`crate::io::controller`]); `None` without one: no robot program but
+    /// CSV can be written for it.
+    pub controller: Option<crate::controller::Convention>,
 }

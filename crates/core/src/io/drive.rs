@@ -54,6 +54,8 @@ struct DriveFile {
     // Tolerated so that the drive train can share the VJM stiffness file.
     #[serde(default, rename = "virtual_joint")]
     _virtual_joint: Option<toml::Value>,
+    #[serde(default, rename = "controller")]
+    _controller: Option<toml::Value>,
 }
 
 /// Parses the `[[joint]]` entries of a drive-train (or combined stiffness) TOML text.

@@ -7,6 +7,7 @@
 //! |---|---|---|
 //! | [`urdf`] (`urdf`) | URDF + stiffness TOML | [`crate::SerialRobot`] |
 //! | [`stiffness`] (`urdf`) | stiffness TOML `[[virtual_joint]]` | specs |
+//! | [`controller`] (`urdf`) | stiffness TOML `[controller]` | [`crate::controller::Convention`] |
 //! | [`drive`] (`urdf`) | drive-train TOML `[[joint]]` + URDF masses | [`crate::drivetrain::Model`] |
 //! | [`gcode`] | RS274/NGC G-code as LinuxCNC reads it (the CAM dialect and the NGC language) | [`crate::machining::Program`], a word report |
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
@@ -16,6 +17,8 @@
 //! | [`map_json`] | versioned JSON of a map (version 2: an N-D grid map) | [`crate::ComplianceMap`], [`crate::compliance_map::GridMap`] |
 //! | [`grid_csv`] | static tests on a 1-4 D grid, axes named by their columns | [`crate::compliance_map::GridMap`] |
 
+#[cfg(feature = "urdf")]
+pub mod controller;
 #[cfg(feature = "urdf")]
 pub mod drive;
 pub mod gcode;

@@ -98,6 +98,9 @@ struct StiffnessFile {
     // Drive-train `[[joint]]` entries may share the file; `crate::drivetrain_io` reads them.
     #[serde(default, rename = "joint")]
     _joint: Option<toml::Value>,
+    // The controller's convention shares it too ([`super::controller`] reads it).
+    #[serde(default, rename = "controller")]
+    _controller: Option<toml::Value>,
 }
 
 /// Parses a stiffness TOML text (format in the module docs). Values are checked when the

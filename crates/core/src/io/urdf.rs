@@ -158,7 +158,11 @@ pub fn from_str(
 ) -> Result<SerialRobot, LoadError> {
     let robot = parse(urdf)?;
     let springs = super::stiffness::from_str(stiffness)?;
-    assemble(&robot, &springs, base_link, tip_link)
+    let mut serial = assemble(&robot, &springs, base_link, tip_link)?;
+    if let Some(spec) = super::controller::from_str(stiffness)? {
+        serial.controller = Some(super::controller::convention(&spec, &robot, &serial)?);
+    }
+    Ok(serial)
 }
 
 /// [`from_str`] on the texts of the URDF file and the stiffness file.
@@ -452,5 +456,6 @@ pub fn assemble(
         spring_names,
         base_link: base,
         tip_link: tip_link.to_string(),
+        controller: None,
     })
 }

@@ -64,6 +64,16 @@ impl Data {
     pub fn check(&self, model: &Model) -> bool {
         self.dof == model.dof && self.springs == model.springs
     }
+
+    /// The axis line of joint `i` (`q` order) at the joints of the last pass that placed the
+    /// joints ([`crate::vjm::joint_jacobian`], [`crate::vjm::deflection`]): a point on it
+    /// \[m\] and its unit direction, base frame; `None` past the model's dof.
+    pub fn joint_axis(&self, i: usize) -> Option<(Vector3<f64>, Vector3<f64>)> {
+        if i >= self.dof {
+            return None;
+        }
+        Some((*self.joint_origins.get(i)?, *self.joint_axes.get(i)?))
+    }
 }
 impl Data {
     /// [`Self::check`] as the status every per-tick function returns.
