@@ -7,6 +7,7 @@ use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::job::{self, Job, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::spin::{self, LoadPath, SpinMeasure, SpinOptions, SpinSchedule};
 use deflect_core::mechanism::PoseIkOptions;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector2, Vector3};
 use pyo3::prelude::*;
@@ -43,6 +44,109 @@ pub struct MachiningJob {
     inner: Job,
     /// The arm, kept for pickling.
     robot: Py<SerialRobot>,
+    /// What `spin=` asked for.
+    spin: Spin,
+}
+
+/// The tool's spin about its own axis (`spin=`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Spin {
+    /// The setup's orientation.
+    Keep,
+    /// A constant spin \[rad\].
+    Constant(f64),
+    /// The search's schedule (deflect-core's `machining::spin`), with its options.
+    Optimize(SpinOptions),
+}
+
+/// `spin`, `spin_step` \[deg\], `spin_rate` (deg/mm, deg/s) and `spin_measure` as pickled:
+/// (mode, constant spin [rad], step [rad], per metre [rad/m], per second [rad/s], measure).
+type SpinState = (String, f64, f64, f64, f64, String);
+
+impl Spin {
+    /// The spin of the keyword arguments; options checked by core.
+    fn from_args(
+        spin: Option<&Bound<'_, PyAny>>,
+        step_deg: f64,
+        rate: (f64, f64),
+        measure: &str,
+    ) -> PyResult<Self> {
+        let measure = SpinMeasure::from_name(measure).ok_or_else(|| {
+            InputError::new_err(format!(
+                "spin_measure: {measure:?}; expected \"normal\", \"position\", \"axial\" or \"lateral\""
+            ))
+        })?;
+        let options = SpinOptions {
+            step: step_deg.to_radians(),
+            per_metre: rate.0.to_radians() * 1e3,
+            per_second: rate.1.to_radians(),
+            measure,
+            ..SpinOptions::default()
+        };
+        let Some(spin) = spin else {
+            return Ok(Self::Keep);
+        };
+        if let Ok(name) = spin.extract::<String>() {
+            return match name.as_str() {
+                "keep" => Ok(Self::Keep),
+                "optimize" | "optimise" => {
+                    options.validate().map_err(build_err)?;
+                    Ok(Self::Optimize(options))
+                }
+                other => Err(InputError::new_err(format!(
+                    "spin: {other:?}; expected \"keep\", \"optimize\" or a spin in degrees"
+                ))),
+            };
+        }
+        let degrees = real(spin, "spin")?;
+        SpinSchedule::constant(degrees.to_radians()).map_err(build_err)?;
+        Ok(Self::Constant(degrees.to_radians()))
+    }
+
+    fn state(&self) -> SpinState {
+        let o = match self {
+            Self::Optimize(o) => *o,
+            _ => SpinOptions::default(),
+        };
+        let (mode, angle) = match self {
+            Self::Keep => ("keep", 0.0),
+            Self::Constant(a) => ("constant", *a),
+            Self::Optimize(_) => ("optimize", 0.0),
+        };
+        (
+            mode.to_string(),
+            angle,
+            o.step,
+            o.per_metre,
+            o.per_second,
+            o.measure.name().to_string(),
+        )
+    }
+
+    fn of_state(state: SpinState) -> PyResult<Self> {
+        let (mode, angle, step, per_metre, per_second, measure) = state;
+        let measure = SpinMeasure::from_name(&measure)
+            .ok_or_else(|| InputError::new_err(format!("pickled spin measure {measure:?}")))?;
+        match mode.as_str() {
+            "keep" => Ok(Self::Keep),
+            "constant" => {
+                SpinSchedule::constant(angle).map_err(build_err)?;
+                Ok(Self::Constant(angle))
+            }
+            "optimize" => {
+                let o = SpinOptions {
+                    step,
+                    per_metre,
+                    per_second,
+                    measure,
+                    ..SpinOptions::default()
+                };
+                o.validate().map_err(build_err)?;
+                Ok(Self::Optimize(o))
+            }
+            other => Err(InputError::new_err(format!("pickled spin mode {other:?}"))),
+        }
+    }
 }
 
 /// A job as pickled: the robot, the placement (translation, quaternion i j k w), the tool
@@ -62,6 +166,7 @@ type JobState = (
     Option<Vec<ToolState>>,
     Option<f64>,
     f64,
+    SpinState,
 );
 
 /// A unit quaternion from pickled coordinates, bit for bit (norm checked to 1e-12).
@@ -78,7 +183,12 @@ fn unit(q: [f64; 4], what: &str) -> PyResult<UnitQuaternion<f64>> {
 }
 
 impl MachiningJob {
-    fn build(robot: Py<SerialRobot>, setup: Setup, tools: Option<CoreTable>) -> PyResult<Self> {
+    fn build(
+        robot: Py<SerialRobot>,
+        setup: Setup,
+        tools: Option<CoreTable>,
+        spin: Spin,
+    ) -> PyResult<Self> {
         let mut inner = {
             let r = &robot.get().inner;
             Job::new(r.model.clone(), &r.joint_limits, setup).map_err(build_err)?
@@ -86,7 +196,13 @@ impl MachiningJob {
         if let Some(t) = tools {
             inner = inner.with_tools(t);
         }
-        Ok(Self { inner, robot })
+        if let Some(c) = robot.get().inner.controller {
+            inner = inner.with_controller(c);
+        }
+        if let Spin::Constant(a) = spin {
+            inner = inner.with_spin(SpinSchedule::constant(a).map_err(build_err)?);
+        }
+        Ok(Self { inner, robot, spin })
     }
 }
 
@@ -114,8 +230,8 @@ fn tool_table(t: &Bound<'_, PyAny>, flutes: u32, helix: f64) -> PyResult<CoreTab
 #[pymethods]
 impl MachiningJob {
     #[new]
-    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None, rapid_skim=None),
-           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None, rapid_skim=0.0001)")]
+    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None, rapid_skim=None, spin=None, spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure="normal"),
+           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None, rapid_skim=0.0001, spin='keep', spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure='normal')")]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: Bound<'_, SerialRobot>,
@@ -137,7 +253,12 @@ impl MachiningJob {
         tools: Option<&Bound<'_, PyAny>>,
         spindle_rpm: Option<&Bound<'_, PyAny>>,
         rapid_skim: Option<&Bound<'_, PyAny>>,
+        spin: Option<&Bound<'_, PyAny>>,
+        spin_step: f64,
+        spin_rate: (f64, f64),
+        spin_measure: &str,
     ) -> PyResult<Self> {
+        let spin = Spin::from_args(spin, spin_step, spin_rate, spin_measure)?;
         // The documented defaults (shown in the text signature).
         let or = |o: Option<&Bound<'_, PyAny>>, what: &str, default: f64| {
             o.map_or(Ok(default), |o| real(o, what))
@@ -185,7 +306,7 @@ impl MachiningJob {
         let tools = tools
             .map(|t| tool_table(t, setup.tool.flutes, setup.tool.helix))
             .transpose()?;
-        Self::build(robot.unbind(), setup, tools)
+        Self::build(robot.unbind(), setup, tools, spin)
     }
 
     /// Pickling and copy.deepcopy: the robot and the setup as plain values, rebuilt bit for
@@ -224,6 +345,7 @@ impl MachiningJob {
                 .map(|t| t.tools().iter().map(tool_state).collect()),
             s.hand_spindle,
             s.rapid_skim,
+            me.spin.state(),
         );
         Ok((rebuild, (state,)))
     }
@@ -231,7 +353,7 @@ impl MachiningJob {
     /// The job of a pickled state (see `__reduce__`).
     #[staticmethod]
     fn _from_state(state: JobState) -> PyResult<Self> {
-        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand, skim) = state;
+        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand, skim, spin) = state;
         let setup = Setup {
             placement: Isometry3::from_parts(
                 Translation3::from(Vector3::from(t)),
@@ -258,13 +380,19 @@ impl MachiningJob {
             hand_spindle: hand,
             rapid_skim: skim,
         };
-        Self::build(robot, setup, tools.map(from_states).transpose()?)
+        Self::build(
+            robot,
+            setup,
+            tools.map(from_states).transpose()?,
+            Spin::of_state(spin)?,
+        )
     }
 
     fn __eq__(&self, other: &Self) -> bool {
         self.inner.setup() == other.inner.setup()
             && self.inner.model() == other.inner.model()
             && self.inner.tools() == other.inner.tools()
+            && self.spin == other.spin
     }
 
     /// Runs the offline pass over `program` (a `GcodeProgram`) from the joints `seed` (dof,)
@@ -280,14 +408,30 @@ impl MachiningJob {
     ) -> PyResult<MachiningResult> {
         let seed = vector(seed, "seed", self.inner.model().dof())?;
         let program = program.inner.clone();
-        let report = py
-            .detach(|| job::run(&self.inner, &program, &seed))
+        let spin = self.spin;
+        let (report, job, plan) = py
+            .detach(|| -> Result<_, deflect_core::JobError> {
+                let Spin::Optimize(o) = spin else {
+                    return Ok((
+                        job::run(&self.inner, &program, &seed)?,
+                        self.inner.clone(),
+                        None,
+                    ));
+                };
+                let loads =
+                    LoadPath::new(&self.inner, &program, o.step, o.per_metre, o.per_second)?;
+                let plan = spin::plan(&self.inner, &loads, &seed, &o)?;
+                let job = self.inner.clone().with_spin(plan.schedule.clone());
+                Ok((job::run(&job, &program, &seed)?, job, Some(plan)))
+            })
             .map_err(job_err)?;
-        let placement = self.inner.setup().placement;
+        let r = &self.robot.get().inner;
         Ok(MachiningResult {
             report,
             program,
-            placement,
+            job,
+            robot_name: format!("the robot {} -> {}", r.base_link, r.tip_link),
+            spin_plan: plan,
         })
     }
 

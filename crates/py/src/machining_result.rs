@@ -24,8 +24,12 @@ use crate::arrays::{put_pose, try_array, try_rows};
 pub struct MachiningResult {
     pub(crate) report: Report,
     pub(crate) program: Program,
-    /// The job's workpiece frame in the base frame (robot programs are in the base frame).
-    pub(crate) placement: nalgebra::Isometry3<f64>,
+    /// The job it was run with (the arm, its placement and controller: the robot programs).
+    pub(crate) job: job::Job,
+    /// The robot's name in errors.
+    pub(crate) robot_name: String,
+    /// What the spin search found (`spin="optimize"`).
+    pub(crate) spin_plan: Option<deflect_core::machining::spin::SpinPlan>,
 }
 
 impl MachiningResult {
@@ -348,41 +352,104 @@ impl MachiningResult {
         Ok(job_out::compensated_gcode(&self.report, &self.program, t))
     }
 
-    /// The compensated job as a robot controller's program text. `kind`: "urscript" (Universal
-    /// Robots: `movel` of the commanded TCP in the base frame, m and rotation vector, kept
-    /// within `tolerance` [m] of the commanded path and `tolerance / 0.1 m` rad of its
-    /// orientation, `acceleration` [m/s^2] the `a` of every move; with `joints=True`, `servoj`
-    /// of the compensated joints at every sample). The program's lines are comments.
-    #[pyo3(signature = (kind, *, tolerance=1e-6, acceleration=1.2, joints=false))]
-    fn robot_program(
+    /// The compensated job as the robot controller's program (deflect-core's
+    /// `io::robot_program`): `{file name: text}`, the main file first (KRL's `.src` then its
+    /// `.dat`). `kind` "krl", "rapid", "urscript" or "csv"; `command` "cartesian" (the
+    /// commanded TCP, kept within `tolerance` [m] and `tolerance / 0.1 m` rad) or "joints"
+    /// (the compensated joints, within `joint_tolerance` [rad] for KRL and RAPID, every
+    /// sample for URScript's `servoj` and the CSV). `acceleration` [m/s^2] is URScript's `a`,
+    /// `tool_mass` [kg] RAPID's tool load, `name` the program's name. The robot's file must
+    /// declare its controller (`[controller]`) for KRL, RAPID and URScript.
+    #[pyo3(signature = (kind, *, command="cartesian", tolerance=1e-6, joint_tolerance=1e-6, acceleration=1.2, tool_mass=1.0, name="deflect_job"))]
+    #[allow(clippy::too_many_arguments)]
+    fn robot_program<'py>(
         &self,
+        py: Python<'py>,
         kind: &str,
+        command: &str,
         tolerance: f64,
+        joint_tolerance: f64,
         acceleration: f64,
-        joints: bool,
-    ) -> PyResult<String> {
-        if !(tolerance.is_finite() && tolerance > 0.0) {
-            return Err(InputError::new_err(format!(
-                "tolerance: expected > 0 m, got {tolerance}"
-            )));
+        tool_mass: f64,
+        name: &str,
+    ) -> PyResult<Bound<'py, pyo3::types::PyDict>> {
+        let err = |e: robot_program::ProgramError| match e {
+            robot_program::ProgramError::Io { .. } => {
+                pyo3::exceptions::PyOSError::new_err(e.to_string())
+            }
+            _ => InputError::new_err(e.to_string()),
+        };
+        let options = robot_program::ProgramOptions {
+            name: name.to_string(),
+            tolerance,
+            joint_tolerance,
+            acceleration,
+            tool_mass,
+            ..robot_program::ProgramOptions::new(
+                robot_program::Language::from_name(kind).map_err(err)?,
+                robot_program::Command::from_name(command).map_err(err)?,
+            )
+        };
+        let setup = self.job.setup();
+        let target = robot_program::Target {
+            model: self.job.model(),
+            convention: self.job.controller(),
+            robot: &self.robot_name,
+            placement: setup.placement,
+            program: &self.program,
+            rate_hz: self.report.rate_hz,
+            rapid_speed: setup.path.rapid_speed,
+        };
+        let files = py
+            .detach(|| robot_program::write(target, &self.report.samples, &options))
+            .map_err(err)?;
+        let out = pyo3::types::PyDict::new(py);
+        for f in files {
+            out.set_item(f.name, f.text)?;
         }
-        if !(acceleration.is_finite() && acceleration > 0.0) {
-            return Err(InputError::new_err(format!(
-                "acceleration: expected > 0 m/s^2, got {acceleration}"
-            )));
-        }
-        match kind {
-            "urscript" if joints => Ok(robot_program::urscript_servoj(&self.report)),
-            "urscript" => Ok(robot_program::urscript_movel(
-                &self.report,
-                &self.placement,
-                tolerance,
-                acceleration,
-            )),
-            other => Err(InputError::new_err(format!(
-                "kind: {other:?}; expected \"urscript\""
-            ))),
-        }
+        Ok(out)
+    }
+
+    /// The tool's spin about its own axis at each sample (n,) [rad], from the setup's
+    /// orientation (0 without `spin=`).
+    #[getter]
+    fn spin<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        self.column(py, |s| s.spin)
+    }
+
+    /// What the spin search found with `spin="optimize"` (else None): the predicted
+    /// deflection [m] (RMS and largest of the measure over the cutting samples) of the
+    /// optimised schedule (`optimised`), of the seed's constant spin (`seed`, None where it
+    /// leaves the limits or its branch) and of the best constant spin (`best_constant`,
+    /// with `best_constant_spin` [rad]); `stations`, `candidates`, `refused` nodes and the
+    /// `measure`; `schedule`: the stations' spin budgets and spins (k, 2) [rad].
+    #[getter]
+    fn spin_plan<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, pyo3::types::PyDict>>> {
+        let Some(p) = &self.spin_plan else {
+            return Ok(None);
+        };
+        let d = pyo3::types::PyDict::new(py);
+        let cost = |c: &deflect_core::machining::spin::SpinCost| (c.rms, c.max);
+        d.set_item("optimised", cost(&p.optimised))?;
+        d.set_item("seed", p.seed.as_ref().map(cost))?;
+        d.set_item(
+            "best_constant",
+            p.best_constant.as_ref().map(|(_, c)| cost(c)),
+        )?;
+        d.set_item(
+            "best_constant_spin",
+            p.best_constant.as_ref().map(|(a, _)| *a),
+        )?;
+        d.set_item("stations", p.stations)?;
+        d.set_item("candidates", p.candidates.len())?;
+        d.set_item("refused", p.refused)?;
+        d.set_item("measure", p.measure.name())?;
+        let (b, s) = (p.schedule.budgets(), p.schedule.spins());
+        let rows: Vec<f64> = b.iter().zip(s).flat_map(|(b, s)| [*b, *s]).collect();
+        let a = Array2::from_shape_vec((b.len(), 2), rows)
+            .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
+        d.set_item("schedule", a.into_pyarray(py))?;
+        Ok(Some(d))
     }
 
     /// Every sample as CSV text (columns in deflect-core's `io::job_out::samples_csv`), the

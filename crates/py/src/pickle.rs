@@ -5,6 +5,7 @@
 use deflect_core::SerialRobot as CoreRobot;
 use deflect_core::compensation::SensorCalibration;
 use deflect_core::compensation::sensor::POLY_TERMS;
+use deflect_core::controller::{Convention, Vendor};
 use deflect_core::vjm::{Element, Model, ModelBuilder};
 use nalgebra::{Isometry3, Matrix3, Quaternion, Translation3, Unit, UnitQuaternion, Vector3};
 use pyo3::prelude::*;
@@ -13,12 +14,17 @@ use crate::InputError;
 use crate::errors::build_err;
 
 /// Version of the state layout below.
-const VERSION: u32 = 1;
+const VERSION: u32 = 2;
 
 /// One chain element: its kind and its numbers (see [`element_state`]).
 pub type ElementState = (String, Vec<f64>);
 
-/// `(version, elements, joint_names, joint_limits, spring_names, base_link, tip_link)`.
+/// A controller convention: `(vendor, sign, offset, base, tool)`, frames as translation and
+/// quaternion (x, y, z, w).
+pub type ControllerState = (String, Vec<f64>, Vec<f64>, [f64; 7], [f64; 7]);
+
+/// `(version, elements, joint_names, joint_limits, spring_names, base_link, tip_link,
+/// controller)`.
 pub type RobotState = (
     u32,
     Vec<ElementState>,
@@ -27,6 +33,7 @@ pub type RobotState = (
     Vec<String>,
     String,
     String,
+    Option<ControllerState>,
 );
 
 fn iso(t: &Isometry3<f64>) -> [f64; 7] {
@@ -137,12 +144,30 @@ pub fn robot_state(r: &CoreRobot) -> RobotState {
         r.spring_names.clone(),
         r.base_link.clone(),
         r.tip_link.clone(),
+        r.controller.as_ref().map(|c| {
+            (
+                c.vendor.name().to_string(),
+                c.sign.iter().take(c.dof).copied().collect(),
+                c.offset.iter().take(c.dof).copied().collect(),
+                iso(&c.base),
+                iso(&c.tool),
+            )
+        }),
     )
 }
 
 /// The serial robot of a pickled state.
 pub fn robot_of(state: RobotState) -> PyResult<CoreRobot> {
-    let (version, elements, joint_names, joint_limits, spring_names, base_link, tip_link) = state;
+    let (
+        version,
+        elements,
+        joint_names,
+        joint_limits,
+        spring_names,
+        base_link,
+        tip_link,
+        controller,
+    ) = state;
     if version != VERSION {
         return Err(InputError::new_err(format!(
             "pickled SerialRobot: state version {version}; this deflect reads version {VERSION}"
@@ -167,6 +192,18 @@ pub fn robot_of(state: RobotState) -> PyResult<CoreRobot> {
             "pickled SerialRobot: joint limits {k} are not lower <= upper"
         )));
     }
+    let controller = match controller {
+        None => None,
+        Some((vendor, sign, offset, base, tool)) => {
+            let vendor = Vendor::from_name(&vendor).ok_or_else(|| {
+                InputError::new_err(format!("pickled SerialRobot: controller vendor {vendor:?}"))
+            })?;
+            Some(
+                Convention::new(vendor, &model, &sign, &offset, iso_of(&base), iso_of(&tool))
+                    .map_err(build_err)?,
+            )
+        }
+    };
     Ok(CoreRobot {
         model,
         joint_names,
@@ -174,6 +211,7 @@ pub fn robot_of(state: RobotState) -> PyResult<CoreRobot> {
         spring_names,
         base_link,
         tip_link,
+        controller,
     })
 }
 

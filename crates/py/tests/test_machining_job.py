@@ -2,7 +2,9 @@
 form (numpy), the deflection against the independent numpy VJM chain, the compensated arm on
 the program, the compensated G-code read back, and every fault naming its program line."""
 
+import io
 import math
+import re
 
 import numpy as np
 import pytest
@@ -357,34 +359,123 @@ def test_real_cam_programs_are_compensated_onto_the_program(kr300, name, diamete
     assert r.path_error("uncompensated")[0] > 1e-4
 
 
-def test_the_urscript_reads_back_onto_the_compensated_joints(slot_run, kr300):
-    """The URScript of the slot, parsed here: every movel pose is the robot's FK at some
-    sample's compensated joints (1e-6 m, 1e-6 rad), every servoj row a sample's compensated
-    joints (1e-9 rad); a kind it does not know and a tolerance of 0 are InputErrors."""
-    import re
+def _krl_aggregate(text):
+    """KRL's ``{E6POS: X 1, Y 2, ...}`` as a dict (the type prefix optional)."""
+    body = text[text.index("{") + 1 : text.rindex("}")]
+    body = body.split(":", 1)[1] if ":" in body else body
+    return {k: float(v) for k, v in (kv.split() for kv in body.split(","))}
 
+
+def _krl_frame(kv):
+    """X, Y, Z [mm] and Rz(A) Ry(B) Rx(C) [deg] as a 4 x 4 matrix."""
+    a, b, c = (math.radians(kv[k]) for k in "ABC")
+    rz = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1]])
+    ry = np.array([[math.cos(b), 0, math.sin(b)], [0, 1, 0], [-math.sin(b), 0, math.cos(b)]])
+    rx = np.array([[1, 0, 0], [0, math.cos(c), -math.sin(c)], [0, math.sin(c), math.cos(c)]])
+    t = np.eye(4)
+    t[:3, :3] = rz @ ry @ rx
+    t[:3, 3] = [kv["X"] * 1e-3, kv["Y"] * 1e-3, kv["Z"] * 1e-3]
+    return t
+
+
+def _nearest(fks, pose):
+    """The sample whose FK is nearest `pose`, with the position and rotation gaps."""
+    k = np.argmin(np.linalg.norm(fks[:, :3, 3] - pose[:3, 3], axis=1))
+    return k, np.linalg.norm(fks[k, :3, 3] - pose[:3, 3]), np.linalg.norm(fks[k, :3, :3] - pose[:3, :3])
+
+
+def test_the_krl_reads_back_onto_the_compensated_joints(slot_run, kr300):
+    """The KRL of the slot, parsed here: BASE (the .dat) times every LIN's E6POS is the FK
+    of some sample's compensated joints (1e-6 m, 1e-6 rad); every PTP's E6AXIS, turned back
+    by KUKA's signs (A1, A4, A6 against this URDF's axes), a sample's compensated joints
+    (1e-9 rad); the files named after the program."""
     r = slot_run
-    script = r.robot_program("urscript")
-    assert script.startswith("def deflect_job():") and script.rstrip().endswith("deflect_job()")
+    files = r.robot_program("krl")
+    assert list(files) == ["deflect_job.src", "deflect_job.dat"]
+    src, dat = files["deflect_job.src"], files["deflect_job.dat"]
+    base = _krl_frame(_krl_aggregate(next(l for l in dat.splitlines() if "DEFLECT_BASE=" in l)))
+    np.testing.assert_allclose(base, placement_under_tcp(kr300), atol=1e-9)
     fks = np.array([kr300.forward(q) for q in r.q_commanded])
+    lins = [l for l in src.splitlines() if l.startswith("LIN ")]
+    assert 3 <= len(lins) < len(r) // 4
+    for line in lins:
+        kv = _krl_aggregate(line)
+        _, dp, dr = _nearest(fks, base @ _krl_frame(kv))
+        assert dp < 1e-6 and dr < 1e-6, line
+        # Near the milling pose (A2 -0.9, A3 1.4, A5 1.07 rad): the wrist in the basic area,
+        # in front of the lower arm (A3 >= phi), A5 > 0: S = 2.
+        assert kv["S"] == 2.0, line
+    assert "; line 4," in src
+    sign = np.array([-1.0, 1.0, 1.0, -1.0, 1.0, -1.0])
+    joints = r.robot_program("krl", command="joints")["deflect_job.src"]
+    rows = [_krl_aggregate(l) for l in joints.splitlines() if l.startswith("PTP ")]
+    q = np.array([[math.radians(kv[f"A{i + 1}"]) for i in range(6)] for kv in rows]) * sign
+    for row in q:
+        assert np.abs(r.q_commanded - row).max(axis=1).min() <= 1e-9
+
+
+#: The UR10 over a table in front of it: the workpiece x along the base's -y, the tool down.
+UR10_PLACEMENT = np.array(
+    [[0.0, 1.0, 0.0, 0.86], [-1.0, 0.0, 0.0, 0.16], [0.0, 0.0, 1.0, 0.36], [0.0, 0.0, 0.0, 1.0]]
+)
+UR10_SEED = [0.0, -1.2, 1.6, -1.97, -1.5708, 0.0]
+
+
+def ur10():
+    from importlib import metadata
+
+    dist = metadata.distribution("example-robot-data")
+    urdf = dist.locate_file("cmeel.prefix/share/example-robot-data/robots/ur_description/urdf/ur10_robot.urdf")
+    return deflect.SerialRobot.from_urdf(str(urdf), str(REPO / "robots/ur10/ur10_stiffness.toml"), "tool0")
+
+
+def test_the_urscript_of_a_ur10_reads_back_onto_the_compensated_joints():
+    """A UR10 (example-robot-data's URDF, the shipped UR convention) cuts the slot: every
+    movel pose, in the controller's base frame (the URDF's `base`: base_link turned half a
+    turn about z), is the FK of a sample's compensated joints (1e-6 m; the rotation vector by
+    Rodrigues' formula, 1e-6); every servoj row a sample's joints (1e-9 rad), all of them."""
+    robot = ur10()
+    job = deflect.MachiningJob(robot, UR10_PLACEMENT, stock_min=(-0.01, -0.015), stock_max=(0.09, 0.015), cell=5e-4)
+    program = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
+    r = job.run(program, UR10_SEED)
+    script = r.robot_program("urscript")["deflect_job.script"]
+    assert script.startswith("def deflect_job():") and script.rstrip().endswith("deflect_job()")
+    turn = np.diag([-1.0, -1.0, 1.0, 1.0])  # the controller's base in base_link (and back)
+    fks = np.array([robot.forward(q) for q in r.q_commanded])
     moves = re.findall(r"movel\(p\[([^\]]*)\], a=([^,]*), v=([^,]*), r=([^)]*)\)", script)
     assert 3 <= len(moves) < len(r) // 4
     for m in moves:
         p = np.array([float(x) for x in m[0].split(",")])
-        k = np.argmin(np.linalg.norm(fks[:, :3, 3] - p[:3], axis=1))
-        assert np.linalg.norm(fks[k, :3, 3] - p[:3]) < 1e-6
         angle = np.linalg.norm(p[3:])
         axis = p[3:] / angle if angle > 0 else np.array([0.0, 0.0, 1.0])
         K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-        rot = np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K  # Rodrigues
-        assert np.linalg.norm(rot - fks[k, :3, :3]) < 1e-6
-    joints = r.robot_program("urscript", joints=True)
+        pose = np.eye(4)
+        pose[:3, :3] = np.eye(3) + math.sin(angle) * K + (1 - math.cos(angle)) * K @ K  # Rodrigues
+        pose[:3, 3] = p[:3]
+        _, dp, dr = _nearest(fks, turn @ pose)
+        assert dp < 1e-6 and dr < 1e-6
+    assert float(moves[0][3]) == 0.0 and float(moves[-1][3]) == 0.0
+    joints = r.robot_program("urscript", command="joints")["deflect_job.script"]
     rows = re.findall(r"servoj\(\[([^\]]*)\]", joints)
     assert len(rows) == len(r)
     q = np.array([[float(x) for x in row.split(",")] for row in rows])
     np.testing.assert_allclose(q, r.q_commanded, atol=1e-9, rtol=0)
-    assert "# line 4," in script
+
+
+def test_robot_programs_refuse_a_kind_a_convention_or_an_option(slot_run):
+    r = slot_run
     with pytest.raises(deflect.InputError, match="kind"):
         r.robot_program("krl2")
+    with pytest.raises(deflect.InputError, match="command"):
+        r.robot_program("krl", command="both")
     with pytest.raises(deflect.InputError, match="tolerance"):
-        r.robot_program("urscript", tolerance=0.0)
+        r.robot_program("krl", tolerance=0.0)
+    with pytest.raises(deflect.InputError, match="name"):
+        r.robot_program("krl", name="1job")
+    # The KR 300 runs KRL: RAPID and URScript are other controllers' languages.
+    with pytest.raises(deflect.InputError, match="kuka's"):
+        r.robot_program("urscript")
+    # CSV needs no convention: the joints at every sample.
+    csv = r.robot_program("csv", command="joints")["deflect_job.csv"]
+    rows = np.loadtxt(io.StringIO(csv), delimiter=",", comments="#", skiprows=2)
+    np.testing.assert_allclose(rows[:, 2:], r.q_commanded, rtol=0, atol=1e-15)

@@ -27,9 +27,8 @@ use crate::error::LoadError;
 use crate::machining::job::{JobSample, Report};
 use crate::machining::{Motion, Program};
 
-/// Most samples one dropped run may hold before a block is written anyway (bounds the
-/// decimation's time to `O(n x 256)`).
-pub const MAX_DROPPED: usize = 256;
+pub use super::decimate::MAX_DROPPED;
+use super::decimate::{Decimator, Kept};
 
 /// Writes `text` to `out` once it holds 64 KiB (the writers' buffer), and clears it.
 fn spill<W: Write>(out: &mut W, text: &mut String) -> std::io::Result<()> {
@@ -58,10 +57,7 @@ pub struct GcodeWriter<'p, W: Write> {
     out: W,
     program: &'p Program,
     tolerance: f64,
-    /// The samples from the last kept one (the anchor) to the newest not yet decided.
-    window: VecDeque<JobSample>,
-    /// The newest sample, decided when the next arrives (whether the move changes after it).
-    pending: Option<JobSample>,
+    decimator: Decimator,
     started: bool,
     state: BlockState,
     text: String,
@@ -76,7 +72,6 @@ struct BlockState {
     tool: u32,
     first: bool,
     dwelt: usize,
-    last_kept: Option<f64>,
 }
 
 impl<'p, W: Write> GcodeWriter<'p, W> {
@@ -91,8 +86,7 @@ impl<'p, W: Write> GcodeWriter<'p, W> {
             } else {
                 1.0e-6
             },
-            window: VecDeque::new(),
-            pending: None,
+            decimator: Decimator::default(),
             started: false,
             state: BlockState {
                 line: 0,
@@ -101,7 +95,6 @@ impl<'p, W: Write> GcodeWriter<'p, W> {
                 tool: 0,
                 first: true,
                 dwelt: usize::MAX,
-                last_kept: None,
             },
             text: String::new(),
         }
@@ -118,11 +111,16 @@ impl<'p, W: Write> GcodeWriter<'p, W> {
                 env!("CARGO_PKG_VERSION")
             );
         }
+        let tolerance = self.tolerance;
+        let holds = |a: &JobSample, b: &JobSample, x: &JobSample| {
+            let p = |s: &JobSample| s.commanded.translation.vector;
+            distance_to_segment(&p(x), &p(a), &p(b)) <= tolerance
+        };
         for s in chunk {
-            if let Some(prev) = self.pending.replace(*s) {
-                let changes = prev.path.move_index != s.path.move_index;
-                self.decide(prev, changes);
-            }
+            let (decimator, state, text) = (&mut self.decimator, &mut self.state, &mut self.text);
+            decimator.push(s, &holds, &mut |k: &Kept| {
+                block(state, text, self.program, &k.sample);
+            });
             spill(&mut self.out, &mut self.text)?;
         }
         Ok(())
@@ -133,107 +131,67 @@ impl<'p, W: Write> GcodeWriter<'p, W> {
         if !self.started {
             self.push(&[])?;
         }
-        if let Some(last) = self.pending.take() {
-            self.decide(last, true);
-        }
+        let tolerance = self.tolerance;
+        let holds = |a: &JobSample, b: &JobSample, x: &JobSample| {
+            let p = |s: &JobSample| s.commanded.translation.vector;
+            distance_to_segment(&p(x), &p(a), &p(b)) <= tolerance
+        };
+        let (state, text) = (&mut self.state, &mut self.text);
+        self.decimator.finish(&holds, &mut |k: &Kept| {
+            block(state, text, self.program, &k.sample);
+        });
         let _ = writeln!(self.text, "M5\nM30\n%");
         self.out.write_all(self.text.as_bytes())?;
         self.out.flush()?;
         Ok(self.out)
     }
+}
 
-    /// Sample `s` joins the window: kept (with the one before it) where the straight line
-    /// from the anchor no longer holds the dropped samples within the tolerance, and where
-    /// the move `changes` after it.
-    fn decide(&mut self, s: JobSample, changes: bool) {
-        let point = |x: &JobSample| x.commanded.translation.vector;
-        if self.window.is_empty() {
-            // The first sample is kept.
-            self.window.push_back(s);
-            self.keep(s);
-            return;
-        }
-        self.window.push_back(s);
-        let n = self.window.len();
-        let within = n - 1 <= MAX_DROPPED
-            && match (self.window.front(), self.window.back()) {
-                (Some(a), Some(p)) => {
-                    let (a, p) = (point(a), point(p));
-                    self.window
-                        .range(1..n - 1)
-                        .all(|q| distance_to_segment(&point(q), &a, &p) <= self.tolerance)
-                }
-                _ => true,
-            };
-        if !within {
-            // Keep the sample before this one; it anchors the next stretch.
-            self.window.pop_back();
-            if let Some(before) = self.window.pop_back() {
-                self.keep(before);
-                self.window.clear();
-                self.window.push_back(before);
-            }
-            self.window.push_back(s);
-        }
-        if changes {
-            self.keep(s);
-            self.window.clear();
-            self.window.push_back(s);
-        }
+/// Writes the block of a kept sample.
+fn block(st: &mut BlockState, out: &mut String, program: &Program, s: &JobSample) {
+    let p = s.commanded.translation.vector * 1e3;
+    let mv = program.moves.get(s.path.move_index);
+    if s.path.tool != st.tool {
+        st.tool = s.path.tool;
+        let _ = writeln!(out, "T{} M6", st.tool);
+        // M6 stops the spindle: it is started again below.
+        st.spindle = f64::NAN;
     }
-
-    /// Writes the block of a kept sample (once: a sample kept twice is written once).
-    fn keep(&mut self, s: JobSample) {
-        if self.state.last_kept == Some(s.path.time) {
-            return;
-        }
-        self.state.last_kept = Some(s.path.time);
-        let st = &mut self.state;
-        let out = &mut self.text;
-        let p = s.commanded.translation.vector * 1e3;
-        let mv = self.program.moves.get(s.path.move_index);
-        if s.path.tool != st.tool {
-            st.tool = s.path.tool;
-            let _ = writeln!(out, "T{} M6", st.tool);
-            // M6 stops the spindle: it is started again below.
-            st.spindle = f64::NAN;
-        }
-        if s.path.spindle != st.spindle {
-            st.spindle = s.path.spindle;
-            let rpm = st.spindle.abs() * 60.0;
-            let _ = match st.spindle {
-                v if v > 0.0 => writeln!(out, "S{rpm:.0} M3"),
-                v if v < 0.0 => writeln!(out, "S{rpm:.0} M4"),
-                _ => writeln!(out, "M5"),
-            };
-        }
-        if s.path.line != st.line {
-            st.line = s.path.line;
-            let _ = writeln!(out, "(program line {})", st.line);
-        }
-        if let Some(Motion::Dwell { seconds }) = mv.map(|m| m.motion) {
-            if st.dwelt != s.path.move_index {
-                st.dwelt = s.path.move_index;
-                let _ = writeln!(out, "G4 P{seconds:.4}");
-            }
-            return;
-        }
-        let word = if st.first || !s.path.feed_move {
-            "G0"
-        } else {
-            "G1"
+    if s.path.spindle != st.spindle {
+        st.spindle = s.path.spindle;
+        let rpm = st.spindle.abs() * 60.0;
+        let _ = match st.spindle {
+            v if v > 0.0 => writeln!(out, "S{rpm:.0} M3"),
+            v if v < 0.0 => writeln!(out, "S{rpm:.0} M4"),
+            _ => writeln!(out, "M5"),
         };
-        let _ = write!(out, "{word} X{:.4} Y{:.4} Z{:.4}", p.x, p.y, p.z);
-        if word == "G1"
-            && let Some(f) = mv.map(|m| m.feed)
-            && f != st.feed
-        {
-            st.feed = f;
-            let _ = write!(out, " F{:.1}", f * 60e3);
-        }
-        out.push('\n');
-        st.first = false;
     }
+    if s.path.line != st.line {
+        st.line = s.path.line;
+        let _ = writeln!(out, "(program line {})", st.line);
+    }
+    if let Some(Motion::Dwell { seconds }) = mv.map(|m| m.motion) {
+        if st.dwelt != s.path.move_index {
+            st.dwelt = s.path.move_index;
+            let _ = writeln!(out, "G4 P{seconds:.4}");
+        }
+        return;
+    }
+    let word = if st.first || !s.path.feed_move {
+        "G0"
+    } else {
+        "G1"
+    };
+    let _ = write!(out, "{word} X{:.4} Y{:.4} Z{:.4}", p.x, p.y, p.z);
+    if word == "G1"
+        && let Some(f) = mv.map(|m| m.feed)
+        && f != st.feed
+    {
+        st.feed = f;
+        let _ = write!(out, " F{:.1}", f * 60e3);
+    }
+    out.push('\n');
+    st.first = false;
 }
 
 /// The CSV's header for an arm of `dof` joints (see [`samples_csv`]).

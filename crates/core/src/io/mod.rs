@@ -19,6 +19,7 @@
 
 #[cfg(feature = "urdf")]
 pub mod controller;
+pub(crate) mod decimate;
 #[cfg(feature = "urdf")]
 pub mod drive;
 pub mod gcode;

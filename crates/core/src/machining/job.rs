@@ -188,6 +188,8 @@ pub struct Job {
     limits: Vec<(f64, f64)>,
     setup: Setup,
     tools: Option<ToolTable>,
+    controller: Option<crate::controller::Convention>,
+    spin: Option<super::spin::SpinSchedule>,
 }
 
 impl Job {
@@ -216,7 +218,28 @@ impl Job {
             limits: limits.to_vec(),
             setup,
             tools: None,
+            controller: None,
+            spin: None,
         })
+    }
+
+    /// The job with the tool turned about its own axis along the program by `schedule`
+    /// ([`super::spin`]): each sample's target orientation is the setup's turned by the
+    /// schedule's spin there.
+    #[must_use]
+    pub fn with_spin(mut self, schedule: super::spin::SpinSchedule) -> Self {
+        self.spin = Some(schedule);
+        self
+    }
+
+    /// The spin schedule, if the job has one (else the setup's orientation everywhere).
+    pub fn spin(&self) -> Option<&super::spin::SpinSchedule> {
+        self.spin.as_ref()
+    }
+
+    /// The joint limits `(lower, upper)` \[rad or m\], one per joint.
+    pub fn limits(&self) -> &[(f64, f64)] {
+        &self.limits
     }
 
     /// The job with a tool table: each move cuts with the tool its program line put in the
@@ -225,6 +248,19 @@ impl Job {
     pub fn with_tools(mut self, tools: ToolTable) -> Self {
         self.tools = Some(tools);
         self
+    }
+
+    /// The job with its arm's controller convention (the robot programs of
+    /// [`crate::io::robot_program`] read it; the pass does not).
+    #[must_use]
+    pub fn with_controller(mut self, controller: crate::controller::Convention) -> Self {
+        self.controller = Some(controller);
+        self
+    }
+
+    /// The arm's controller convention, if the job has one.
+    pub fn controller(&self) -> Option<&crate::controller::Convention> {
+        self.controller.as_ref()
     }
 
     /// The tool table, if the job has one.
@@ -406,6 +442,71 @@ fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
     Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
 
+/// A cell as wide as a tool's radius cannot resolve its cut (a stock of one cell reads every
+/// error as 0): at most half the radius of every tool the program uses.
+fn check_cell(st: &Stock, tools: &ToolModels) -> Result<(), BuildError> {
+    if let Some(t) = tools
+        .list
+        .iter()
+        .find(|t| st.cell > 0.5 * t.cutter.radius())
+    {
+        return Err(BuildError::InvalidParameter {
+            what: "stock cell (m), at most half the radius of every tool the program uses",
+            value: st.cell,
+            expected: if t.known {
+                "<= the radius / 2 of the program's smallest tool"
+            } else {
+                "<= the job's tool radius / 2"
+            },
+        });
+    }
+    Ok(())
+}
+
+/// One sample of the nominal pass alone ([`nominal_pass`]): what the program asks of the arm,
+/// whatever the arm and its placement.
+#[derive(Debug, Clone, Copy)]
+pub struct NominalSample {
+    /// The programmed tool.
+    pub path: PathSample,
+    /// The programmed step since the last sample \[m\] (0 at the first).
+    pub step: Vector3<f64>,
+    /// The wrench on the tool about its tip from the nominal cut \[N, N m\], workpiece frame.
+    pub wrench: Vector6,
+}
+
+/// The nominal stage of the pass alone (the nominal tool on the nominal stock: the chip and
+/// its force at every sample, the job's checks of the cut), handing each sample to `f`:
+/// what the placement and the spin about the tool axis do not change, computed once for a
+/// search over them ([`super::spin`], [`super::placement`]). Errors as [`run`]'s nominal
+/// ones, or `f`'s.
+pub fn nominal_pass(
+    job: &Job,
+    program: &Program,
+    mut f: impl FnMut(&NominalSample) -> Result<(), JobError>,
+) -> Result<(), JobError> {
+    let setup = &job.setup;
+    let sampler = path::Sampler::new(program, &setup.path)?;
+    let tools = ToolModels::new(job, program);
+    let st = &setup.stock;
+    check_cell(st, &tools)?;
+    let mut nominal = nominal::Stage::new(
+        job,
+        program,
+        &tools,
+        ZMap::new(st.min, st.max, st.top, st.cell)?,
+    );
+    for s in sampler {
+        let n = nominal.advance(&s)?;
+        f(&NominalSample {
+            path: n.path,
+            step: n.step,
+            wrench: n.wrench_work,
+        })?;
+    }
+    Ok(())
+}
+
 /// How a run is cut into chunks and spread over threads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RunOptions {
@@ -548,24 +649,7 @@ pub fn run_streaming<S: Sink + ?Sized>(
     let mut sampler = path::Sampler::new(program, &setup.path)?;
     let tools = ToolModels::new(job, program);
     let st = &setup.stock;
-    // A cell as wide as a tool's radius cannot resolve its cut (a stock of one cell reads
-    // every error as 0): at most half the radius of every tool the program uses.
-    if let Some(t) = tools
-        .list
-        .iter()
-        .find(|t| st.cell > 0.5 * t.cutter.radius())
-    {
-        return Err(BuildError::InvalidParameter {
-            what: "stock cell (m), at most half the radius of every tool the program uses",
-            value: st.cell,
-            expected: if t.known {
-                "<= the radius / 2 of the program's smallest tool"
-            } else {
-                "<= the job's tool radius / 2"
-            },
-        }
-        .into());
-    }
+    check_cell(st, &tools)?;
     let zmap = || ZMap::new(st.min, st.max, st.top, st.cell);
     let mut nominal = nominal::Stage::new(job, program, &tools, zmap()?);
     let mut unc = predict::Arm::new(job, program, &tools, zmap()?, seed, false);
@@ -653,6 +737,7 @@ pub fn run_streaming<S: Sink + ?Sized>(
                 actual_compensated: c.tip,
                 force_compensated: c.force,
                 coupling_residual: [u.residual, c.residual],
+                spin: c.spin,
             };
             summary.add(&s);
             done.push(s);

@@ -22,6 +22,8 @@ mod program;
 #[cfg(feature = "alloc")]
 pub mod report;
 #[cfg(feature = "alloc")]
+pub mod spin;
+#[cfg(feature = "alloc")]
 pub mod stock;
 #[cfg(feature = "alloc")]
 pub mod tools;

@@ -116,6 +116,10 @@ pub struct PathSample {
     /// Where on its move the sample lies: the fraction of [`super::Move::point`], in
     /// \[0, 1\].
     pub fraction: f64,
+    /// The rest-to-rest run holding the sample (0, 1, ...): the path stops where the run
+    /// changes (a corner past [`PathOptions::corner_angle`], a feed change, a rapid, a dwell):
+    /// an exact stop, what a robot program writes as one.
+    pub run: usize,
 }
 
 /// One rest-to-rest profile over the moves `segs[first..=last]`, or a dwell of `hold`
@@ -383,6 +387,7 @@ impl Iterator for Sampler<'_> {
             spindle: mv.spindle,
             tool: mv.tool,
             fraction: fraction.clamp(0.0, 1.0),
+            run: self.run,
         })
     }
 

@@ -46,6 +46,9 @@ pub struct JobSample {
     /// (uncompensated, compensated) \[m\]: the residual of the fixed point (see
     /// [`super::job`]); at most [`super::job::COUPLING_TOLERANCE`] where it converged.
     pub coupling_residual: [f64; 2],
+    /// The tool's spin about its own axis from the setup's orientation \[rad\] (the job's
+    /// spin schedule; 0 without one).
+    pub spin: f64,
 }
 
 /// Largest and root-mean-square values of a deviation \[m\].

@@ -1139,6 +1139,10 @@ class MachiningJob:
         tools: Union[ToolTable, _StrPath, None] = None,
         spindle_rpm: Optional[float] = None,
         rapid_skim: float = 0.0001,
+        spin: Union[str, float] = "keep",
+        spin_step: float = 5.0,
+        spin_rate: Tuple[float, float] = (1.0, 30.0),
+        spin_measure: str = "normal",
     ) -> Self: ...
     def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
         """The offline pass: forces, deflection, compensated joints, the part three ways."""
@@ -1244,11 +1248,31 @@ class MachiningResult:
     def compensated_gcode(self, tolerance: float = 1e-6) -> str:
         """The compensated program as G-code text (mm)."""
     def robot_program(
-        self, kind: str, *, tolerance: float = 1e-6, acceleration: float = 1.2, joints: bool = False
-    ) -> str:
-        """The compensated job as a robot controller's program: ``kind`` "urscript" (``movel``
-        of the commanded TCP in the base frame within ``tolerance`` [m], or ``servoj`` of the
-        compensated joints with ``joints=True``)."""
+        self,
+        kind: str,
+        *,
+        command: str = "cartesian",
+        tolerance: float = 1e-6,
+        joint_tolerance: float = 1e-6,
+        acceleration: float = 1.2,
+        tool_mass: float = 1.0,
+        name: str = "deflect_job",
+    ) -> Dict[str, str]:
+        """The compensated job as the robot controller's program, ``{file name: text}`` (the
+        main file first): ``kind`` "krl" (``.src`` + ``.dat``), "rapid" (``.mod``),
+        "urscript" (``.script``) or "csv"; ``command`` "cartesian" (the commanded TCP within
+        ``tolerance`` [m]) or "joints" (the compensated joints, within ``joint_tolerance``
+        [rad] for KRL and RAPID, every sample for URScript and CSV). KRL, RAPID and URScript
+        need the robot's ``[controller]`` convention (``InputError`` naming the robot)."""
+    @property
+    def spin(self) -> _FloatArray:
+        """The tool's spin about its own axis at each sample (n,) [rad]."""
+    @property
+    def spin_plan(self) -> Optional[Dict[str, Any]]:
+        """What ``spin="optimize"`` found: the predicted deflection (rms, max) [m] of the
+        ``optimised`` schedule, the ``seed``'s constant spin and the ``best_constant`` one
+        (``best_constant_spin`` [rad]), ``stations``, ``candidates``, ``refused``, ``measure``,
+        ``schedule`` (k, 2): spin budget and spin [rad] per station. None without it."""
     def samples_csv(self, lead: float = 0.04) -> str:
         """Every sample as CSV text, the pilot wrench ``lead`` [s] ahead."""
 

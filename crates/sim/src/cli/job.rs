@@ -32,6 +32,85 @@ impl DialectArg {
     }
 }
 
+/// What `--spin` asks for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SpinArg {
+    /// The setup's orientation everywhere.
+    Keep,
+    /// The stiffest schedule along the program (deflect-core's `machining::spin`).
+    Optimize,
+    /// A constant spin \[degrees\].
+    Degrees(f64),
+}
+
+impl std::str::FromStr for SpinArg {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "keep" => Ok(Self::Keep),
+            "optimize" | "optimise" => Ok(Self::Optimize),
+            other => other
+                .parse::<f64>()
+                .map(Self::Degrees)
+                .map_err(|_| format!("{other:?}: expected keep, optimize or a spin in degrees")),
+        }
+    }
+}
+
+/// What the spin search minimises (`--spin-measure`).
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SpinMeasureArg {
+    /// The deflection normal to the cut (walls and floors).
+    #[default]
+    Normal,
+    /// The whole deflection of the tip.
+    Position,
+    /// Along the tool axis (floors).
+    Axial,
+    /// Horizontal, normal to the feed (walls).
+    Lateral,
+}
+
+impl SpinMeasureArg {
+    /// The core's measure.
+    pub fn measure(self) -> deflect_core::machining::spin::SpinMeasure {
+        use deflect_core::machining::spin::SpinMeasure;
+        match self {
+            Self::Normal => SpinMeasure::Normal,
+            Self::Position => SpinMeasure::Position,
+            Self::Axial => SpinMeasure::Axial,
+            Self::Lateral => SpinMeasure::Lateral,
+        }
+    }
+}
+
+/// The robot controller language of `--robot-program`.
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RobotProgramArg {
+    /// KUKA KRL: job_program.src/.dat (LIN of E6POS with S and T), job_program_joints (PTP).
+    Krl,
+    /// ABB RAPID: job_program.mod (MoveL of robtargets with confdata), job_program_joints
+    /// (MoveAbsJ).
+    Rapid,
+    /// Universal Robots URScript: job_program.script (movel), job_program_joints (servoj).
+    Urscript,
+    /// CSV: the commanded poses, and the joints at every sample.
+    Csv,
+}
+
+impl RobotProgramArg {
+    /// The writers' language.
+    pub fn language(self) -> deflect_core::io::robot_program::Language {
+        use deflect_core::io::robot_program::Language;
+        match self {
+            Self::Krl => Language::Krl,
+            Self::Rapid => Language::Rapid,
+            Self::Urscript => Language::UrScript,
+            Self::Csv => Language::Csv,
+        }
+    }
+}
+
 // Arguments of `job` (help texts with their ranges in the `help` attributes).
 #[derive(clap::Args, Debug)]
 pub struct JobArgs {
@@ -147,6 +226,27 @@ pub struct JobArgs {
         "Largest distance of the compensated G-code from the commanded path [mm]", ""
     ))]
     pub tolerance: f64,
+    /// Also write the compensated job as the robot controller's own program, both commands
+    /// (Cartesian: job_program.*, axis-specific: job_program_joints.*), decimated to
+    /// --tolerance; KRL, RAPID and URScript need the robot's [controller] convention (the
+    /// built-in KR 300 has KUKA's).
+    #[arg(long, value_enum)]
+    pub robot_program: Option<RobotProgramArg>,
+    /// The tool's spin about its own axis: keep (the setup's orientation), optimize (the
+    /// schedule of least predicted deflection along the program, within the joint limits, a
+    /// singularity margin and --spin-rate), or a constant spin in degrees.
+    #[arg(long, default_value = "keep", allow_negative_numbers = true)]
+    pub spin: SpinArg,
+    #[arg(long, default_value_t = 5.0, help = SPIN_STEP_DEG.help(
+        "Spacing of the spin search's candidates [degrees]", "Candidates within +-180 degrees"
+    ))]
+    pub spin_step: f64,
+    /// The spin's rate bounds: DEG_PER_MM,DEG_PER_S (of path and of time) [1,30].
+    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [1.0, 30.0])]
+    pub spin_rate: Vec<f64>,
+    /// What the spin search minimises.
+    #[arg(long, value_enum, default_value_t = SpinMeasureArg::Normal)]
+    pub spin_measure: SpinMeasureArg,
 }
 
 impl JobArgs {
@@ -170,6 +270,22 @@ impl JobArgs {
         RAPID_SPEED.check(self.rapid_speed)?;
         LEAD_MS.check(self.lead_ms)?;
         TOLERANCE_MM.check(self.tolerance)?;
+        if let SpinArg::Degrees(d) = self.spin {
+            SPIN_DEG.check(d)?;
+        }
+        SPIN_STEP_DEG.check(self.spin_step)?;
+        match self.spin_rate.as_slice() {
+            [per_mm, per_s] => {
+                SPIN_RATE_PER_MM.check(*per_mm)?;
+                SPIN_RATE_PER_S.check(*per_s)?;
+            }
+            v => {
+                return Err(CliError::Usage(format!(
+                    "--spin-rate: {} values; expected 2 (degrees per mm, degrees per second)",
+                    v.len()
+                )));
+            }
+        }
         RAPID_SKIM_MM.check(self.rapid_skim)?;
         if let Some(rpm) = self.spindle_rpm {
             SPINDLE_RPM.check(rpm)?;

@@ -67,7 +67,7 @@ mod tool;
 pub use atlas::AtlasArgs;
 pub use contour::ContourArgs;
 pub use delta::DeltaArgs;
-pub use job::JobArgs;
+pub use job::{JobArgs, SpinArg};
 pub use milling::MillingArgs;
 pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
 pub use range::*;

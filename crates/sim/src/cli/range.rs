@@ -177,6 +177,16 @@ pub const PATH_JERK: Range = Range::closed("--jerk", 0.1, 10000.0, "m/s^3");
 pub const RAPID_SPEED: Range = Range::closed("--rapid-speed", 0.001, 10.0, "m/s");
 /// `job --tolerance`: decimation of the compensated program.
 pub const TOLERANCE_MM: Range = Range::closed("--tolerance", 1e-5, 1.0, "mm");
+/// `job --spin DEG`: a constant spin about the tool axis.
+pub const SPIN_DEG: Range = Range::closed("--spin", -720.0, 720.0, "degrees");
+/// `job --spin-step`: the spin search's candidate spacing.
+pub const SPIN_STEP_DEG: Range = Range::closed("--spin-step", 0.25, 90.0, "degrees");
+/// `job --spin-rate`: the spin's rate bounds, per mm of path and per second.
+pub const SPIN_RATE_PER_MM: Range =
+    Range::closed("--spin-rate (per mm)", 1e-6, 1000.0, "degrees/mm");
+/// See [`SPIN_RATE_PER_MM`].
+pub const SPIN_RATE_PER_S: Range =
+    Range::closed("--spin-rate (per second)", 1e-6, 1.0e5, "degrees/s");
 /// `job --top`: stock top.
 pub const TOP_MM: Range = Range::closed("--top", -1000.0, 1000.0, "mm");
 /// Peak acceleration of the Delta's move.

@@ -13,6 +13,7 @@ use deflect_core::io::{job_out, points_csv};
 use deflect_core::machining::cutting::{Coefficients, Tool};
 use deflect_core::machining::job::{self, Job, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::spin::{self, LoadPath, SpinOptions, SpinPlan, SpinSchedule};
 use deflect_core::machining::{Motion, Program};
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
@@ -24,7 +25,7 @@ use super::job_files::{FileOptions, JobFiles};
 use super::job_summary::summary;
 use super::serial::{load_robot, read_program, read_text};
 use super::stdout;
-use crate::cli::{CliError, JobArgs, ToolArgs};
+use crate::cli::{CliError, JobArgs, SpinArg, ToolArgs};
 
 /// The built-in program: a groove, a ramp and a circular pocket (mm).
 const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.nc");
@@ -41,6 +42,8 @@ pub struct JobTask {
     pub(super) program_name: String,
     pub(super) robot_name: String,
     pub(super) seed: Vec<f64>,
+    /// The spin search's result and its wall time \[s\] (`--spin optimize`).
+    pub(super) spin: Option<(deflect_core::machining::spin::SpinPlan, f64)>,
 }
 
 /// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
@@ -282,13 +285,61 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     if let Some(t) = table {
         job = job.with_tools(t);
     }
+    if let Some(c) = robot.controller {
+        job = job.with_controller(c);
+    }
+    let (job, spin) = spin(a, job, &program, &program_name, &seed)?;
     Ok(JobTask {
         job,
         program,
         program_name,
         robot_name: loaded.name,
         seed,
+        spin,
     })
+}
+
+/// The job with `--spin`: a constant spin, or the schedule the search finds (and what it
+/// found, with its wall time).
+fn spin(
+    a: &JobArgs,
+    job: Job,
+    program: &Program,
+    name: &str,
+    seed: &[f64],
+) -> Result<(Job, Option<(SpinPlan, f64)>), CliError> {
+    match a.spin {
+        SpinArg::Keep => Ok((job, None)),
+        SpinArg::Degrees(d) => {
+            let s = SpinSchedule::constant(d.to_radians())
+                .map_err(|e| CliError::Usage(format!("--spin: {e}")))?;
+            Ok((job.with_spin(s), None))
+        }
+        SpinArg::Optimize => {
+            let started = Instant::now();
+            let options = SpinOptions {
+                step: a.spin_step.to_radians(),
+                per_metre: a.spin_rate[0].to_radians() * 1e3,
+                per_second: a.spin_rate[1].to_radians(),
+                measure: a.spin_measure.measure(),
+                ..SpinOptions::default()
+            };
+            let fail = |e: deflect_core::JobError| {
+                CliError::Failure(format!("{name}: --spin optimize: {e}"))
+            };
+            let loads = LoadPath::new(
+                &job,
+                program,
+                options.step,
+                options.per_metre,
+                options.per_second,
+            )
+            .map_err(fail)?;
+            let plan = spin::plan(&job, &loads, seed, &options).map_err(fail)?;
+            let job = job.with_spin(plan.schedule.clone());
+            Ok((job, Some((plan, started.elapsed().as_secs_f64()))))
+        }
+    }
 }
 
 /// A progress bar over the program's duration \[s\] with its ETA on stderr: drawn once the
@@ -353,8 +404,18 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         robot: t.robot_name.clone(),
         dof: t.job.model().dof(),
         to_base: setup.placement.rotation,
+        robot_program: a.robot_program.map(|k| k.language()),
     };
-    let files = JobFiles::create(&t.program, &options)?;
+    let target = deflect_core::io::robot_program::Target {
+        model: t.job.model(),
+        convention: t.job.controller(),
+        robot: &t.robot_name,
+        placement: setup.placement,
+        program: &t.program,
+        rate_hz: setup.path.rate_hz,
+        rapid_speed: setup.path.rapid_speed,
+    };
+    let files = JobFiles::create(&t.program, target, &options)?;
     let mut progress = Progress::new(duration);
     let run_options = job::RunOptions {
         threads: a.threads,

@@ -9,6 +9,7 @@ use std::io::BufWriter;
 use std::path::{Path, PathBuf};
 
 use deflect_core::io::job_out::{CsvWriter, GcodeWriter};
+use deflect_core::io::robot_program::{Command, Language, ProgramOptions, RobotProgram, Target};
 use deflect_core::machining::Program;
 use deflect_core::machining::job::JobSample;
 use deflect_sim::SimError;
@@ -84,6 +85,8 @@ pub struct JobFiles<'p> {
     count: usize,
     gcode: GcodeWriter<'p, BufWriter<File>>,
     csv: Option<CsvWriter<BufWriter<File>>>,
+    /// The robot programs of `--robot-program` (the Cartesian command, then the joints).
+    robot_programs: Vec<(String, RobotProgram<'p, BufWriter<File>>)>,
     operations: Vec<OperationFigures>,
     tolerance: f64,
     paths: Vec<PathBuf>,
@@ -115,6 +118,8 @@ pub struct FileOptions {
     pub dof: usize,
     /// The workpiece's orientation in the base frame (the MCAP's forces are in the base frame).
     pub to_base: UnitQuaternion<f64>,
+    /// The robot program's language (`--robot-program`), written for both commands.
+    pub robot_program: Option<Language>,
 }
 
 fn create(path: &Path) -> Result<BufWriter<File>, SimError> {
@@ -125,7 +130,11 @@ fn create(path: &Path) -> Result<BufWriter<File>, SimError> {
 
 impl<'p> JobFiles<'p> {
     /// Opens every file (the archive's parts, the MCAP log, the G-code, the CSV if asked).
-    pub fn create(program: &'p Program, o: &FileOptions) -> Result<Self, SimError> {
+    pub fn create(
+        program: &'p Program,
+        target: Target<'p>,
+        o: &FileOptions,
+    ) -> Result<Self, SimError> {
         let mut npz = NpzStream::create(&o.out.join("job_samples.npz"))?;
         let dof = o.dof;
         let mut a = |name: &str, dtype: Dtype, width: usize| npz.array(name, dtype, width);
@@ -201,6 +210,30 @@ impl<'p> JobFiles<'p> {
             }
             None => None,
         };
+        let mut robot_programs = Vec::new();
+        if let Some(language) = o.robot_program {
+            for (command, name) in [
+                (Command::Cartesian, "job_program"),
+                (Command::Joints, "job_program_joints"),
+            ] {
+                let options = ProgramOptions {
+                    name: name.to_string(),
+                    tolerance: o.tolerance,
+                    ..ProgramOptions::new(language, command)
+                };
+                let path = o.out.join(format!("{name}.{}", language.extension()));
+                let w = RobotProgram::new(create(&path)?, target, &options).map_err(|e| {
+                    SimError::new(format!("--robot-program {}: {e}", language.name()))
+                })?;
+                if let Some(f) = w.companion() {
+                    let p = o.out.join(&f.name);
+                    std::fs::write(&p, &f.text).map_err(|e| SimError::file(&p, "write", e))?;
+                    paths.push(p);
+                }
+                paths.push(path.clone());
+                robot_programs.push((path.display().to_string(), w));
+            }
+        }
         Ok(Self {
             program,
             dof,
@@ -213,6 +246,7 @@ impl<'p> JobFiles<'p> {
             count: 0,
             gcode,
             csv,
+            robot_programs,
             operations: Vec::new(),
             tolerance: deflect_core::machining::job::PREDICTION_TOLERANCE,
             paths,
@@ -227,6 +261,10 @@ impl<'p> JobFiles<'p> {
             .map_err(|e| io("job_compensated.nc", e))?;
         if let Some(csv) = &mut self.csv {
             csv.push(chunk).map_err(|e| io("job_samples.csv", e))?;
+        }
+        for (name, w) in &mut self.robot_programs {
+            w.push(chunk)
+                .map_err(|e| SimError::new(format!("writing {name}: {e}")))?;
         }
         for s in chunk {
             self.arrays(s)?;
@@ -356,6 +394,10 @@ impl<'p> JobFiles<'p> {
             .map_err(|e| io("job_compensated.nc", e))?;
         if let Some(csv) = self.csv {
             csv.finish().map_err(|e| io("job_samples.csv", e))?;
+        }
+        for (name, w) in self.robot_programs {
+            w.finish()
+                .map_err(|e| SimError::new(format!("writing {name}: {e}")))?;
         }
         self.npz.finish()?;
         self.mcap.finish()?;

@@ -90,6 +90,61 @@ fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {
 
 /// The summary as text lines and JSON: the run, the tools, per operation, the ten lines of
 /// largest force, where the compensated prediction leaves the program, and the totals.
+/// The spin search's lines (`--spin optimize`): the predicted deflection of the optimised
+/// schedule against the seed's constant spin and the best constant one; its JSON.
+fn spin_text(t: &JobTask, text: &mut String) -> serde_json::Value {
+    let Some((plan, wall)) = &t.spin else {
+        return serde_json::Value::Null;
+    };
+    let mm = |c: &deflect_core::machining::spin::SpinCost| {
+        format!("RMS {:.4} mm, max {:.4} mm", c.rms * 1e3, c.max * 1e3)
+    };
+    let spins = plan.schedule.spins();
+    let (lo, hi) = spins
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), s| {
+            (a.min(*s), b.max(*s))
+        });
+    let _ = writeln!(
+        text,
+        "spin about the tool axis (--spin optimize, {} stations x {} candidates, {} refused, in {wall:.2} s): predicted deflection ({}) optimised {}; the seed's constant spin {}; the best constant spin ({}) {}; the schedule within {:.1}..{:.1} degrees",
+        plan.stations,
+        plan.candidates.len(),
+        plan.refused,
+        plan.measure.name(),
+        mm(&plan.optimised),
+        plan.seed
+            .as_ref()
+            .map_or("leaves the limits or its branch".to_string(), mm),
+        plan.best_constant
+            .as_ref()
+            .map_or("none".to_string(), |(a, _)| format!(
+                "{:.1} degrees",
+                a.to_degrees()
+            )),
+        plan.best_constant
+            .as_ref()
+            .map_or("-".to_string(), |(_, c)| mm(c)),
+        lo.to_degrees(),
+        hi.to_degrees()
+    );
+    let cost = |c: &deflect_core::machining::spin::SpinCost| serde_json::json!({"rms_m": c.rms, "max_m": c.max});
+    serde_json::json!({
+        "stations": plan.stations,
+        "candidates": plan.candidates.len(),
+        "refused_nodes": plan.refused,
+        "measure": plan.measure.name(),
+        "wall_time_s": wall,
+        "optimised": cost(&plan.optimised),
+        "seed_constant": plan.seed.as_ref().map(cost),
+        "best_constant": plan.best_constant.as_ref().map(|(a, c)| serde_json::json!({
+            "spin_rad": a, "rms_m": c.rms, "max_m": c.max,
+        })),
+        "min_spin_rad": lo,
+        "max_spin_rad": hi,
+    })
+}
+
 pub(crate) fn summary(
     t: &JobTask,
     r: &Report,
@@ -136,6 +191,7 @@ pub(crate) fn summary(
         );
     }
     let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
+    let spin_json = spin_text(t, &mut text);
     let _ = writeln!(
         text,
         "\noperations ({}): path error max [mm] uncompensated -> compensated",
@@ -280,6 +336,7 @@ pub(crate) fn summary(
             "line": c.line, "time_s": c.time, "depth_m": c.depth,
         })),
         "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
+        "spin": spin_json,
         "operations": ops.iter().map(|o| serde_json::json!({
             "name": o.name, "line": o.line, "tool": o.tool, "samples": o.samples,
             "start_s": o.start, "end_s": o.end, "max_force_n": o.max_force,

@@ -28,6 +28,8 @@ pub(super) struct Sample {
     pub force: Vector3<f64>,
     /// The wrench about the tip \[N, N m\], base frame.
     pub wrench: Vector6,
+    /// The same wrench in the workpiece frame (what does not depend on the placement).
+    pub wrench_work: Vector6,
     /// The programmed step since the last sample \[m\].
     pub step: Vector3<f64>,
     /// The nominal stock's held move was cut before this sample's chip was read.
@@ -169,6 +171,7 @@ impl<'a> Stage<'a> {
             contact,
             force,
             wrench: rotate(&self.to_base, &wrench_w),
+            wrench_work: wrench_w,
             step: p - from,
             settled,
             cut,

@@ -17,6 +17,7 @@ use crate::error::{JobError, TickError};
 use crate::machining::Program;
 use crate::machining::engagement::Chip;
 use crate::machining::path;
+use crate::machining::spin::{Cursor, SpinSchedule};
 use crate::machining::stock::{Follower, ZMap};
 use crate::mechanism::pose_ik;
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
@@ -45,6 +46,8 @@ pub(super) struct Out {
     pub force: Vector3<f64>,
     /// The coupling's last step \[m\].
     pub residual: f64,
+    /// The spin about the tool axis \[rad\].
+    pub spin: f64,
 }
 
 pub(super) struct Arm<'a> {
@@ -57,6 +60,9 @@ pub(super) struct Arm<'a> {
     data: Data,
     q: [f64; MAX_DOF],
     q_before: Option<[f64; MAX_DOF]>,
+    /// Whether `q` is a sample's solution (not the seed): only then does the next sample
+    /// extrapolate from it (a seed far from the first pose would throw the guess off).
+    solved: bool,
     to_base: Isometry3<f64>,
     to_work: Isometry3<f64>,
     pub stock: ZMap,
@@ -67,6 +73,7 @@ pub(super) struct Arm<'a> {
     follower: Follower,
     chip: Chip,
     pub cell_updates: usize,
+    spin: Cursor,
 }
 
 impl<'a> Arm<'a> {
@@ -92,6 +99,7 @@ impl<'a> Arm<'a> {
             data: Data::new(&job.model),
             q,
             q_before: None,
+            solved: false,
             to_base: job.setup.placement,
             to_work: job.setup.placement.inverse(),
             stock,
@@ -100,6 +108,7 @@ impl<'a> Arm<'a> {
             follower: Follower::new(),
             chip: Chip::default(),
             cell_updates: 0,
+            spin: Cursor::default(),
         }
     }
 
@@ -135,12 +144,13 @@ impl<'a> Arm<'a> {
 
     /// The joints at one sample: pose IK from the joints the last two samples extrapolate
     /// to (from the last one's if that fails).
-    fn joints(&mut self, n: &Sample) -> Result<(), TickError> {
+    fn joints(&mut self, n: &Sample, spin: f64) -> Result<(), TickError> {
         let job = self.job;
         let dof = job.model.dof();
         let setup = &job.setup;
-        let target = self.to_base
-            * Isometry3::from_parts(Translation3::from(n.path.position), setup.tool_orientation);
+        let orientation = SpinSchedule::turn(&setup.tool_orientation, spin);
+        let target =
+            self.to_base * Isometry3::from_parts(Translation3::from(n.path.position), orientation);
         let (wrench, load) = if self.compensated {
             (n.wrench, Load::Exact)
         } else {
@@ -168,13 +178,18 @@ impl<'a> Arm<'a> {
             Err(_) if self.q_before.is_some() => solve(&mut self.data, &self.q)?,
             Err(e) => return Err(e),
         };
-        self.q_before = Some(self.q);
+        self.q_before = self.solved.then_some(self.q);
+        self.solved = true;
         self.q = sol.q;
         in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
     }
 
     fn advance(&mut self, n: &Sample) -> Result<Out, TickError> {
-        self.joints(n)?;
+        let spin = match &self.job.spin {
+            Some(schedule) => self.spin.advance(schedule, &n.step, n.path.time),
+            None => 0.0,
+        };
+        self.joints(n, spin)?;
         if n.settled {
             self.flush()?;
         }
@@ -225,6 +240,7 @@ impl<'a> Arm<'a> {
             tip,
             force,
             residual,
+            spin,
         })
     }
 

@@ -1,0 +1,232 @@
+//! What the spin (and placement) search needs of a program, computed once: the nominal
+//! wrench at every cutting sample (the nominal tool on the nominal stock: it depends neither
+//! on the arm's placement nor on the spin about the tool axis), and the stations where the
+//! search decides the spin.
+//!
+//! Stations lie where the spin budget ([`super::schedule`]) has grown by a candidate step
+//! since the last one and the path by at least [`MIN_STATION_PATH`] (and at the first and last
+//! sample): between two stations the spin can turn by at least one step. Each cutting
+//! sample is shared between the stations before and after it by its share of the budget
+//! between them (hat weights: a linear interpolation's).
+
+use alloc::vec::Vec;
+
+use nalgebra::{Vector3, Vector6};
+
+use super::schedule::budget_step;
+use crate::error::{BuildError, JobError};
+use crate::machining::Program;
+use crate::machining::job::{self, Job};
+
+/// Least path between two stations \[m\]: 0.5 mm (fast bounds do not make a station of every
+/// sample).
+pub const MIN_STATION_PATH: f64 = 5.0e-4;
+/// Most stations: 2^17 (131 m of path at the closest spacing; the search keeps 6 bytes per
+/// station and candidate).
+pub const MAX_STATIONS: usize = 1 << 17;
+/// Most cutting samples: 2^24 (18.6 h of cutting at 250 Hz; 40 bytes each).
+pub const MAX_LOADED_SAMPLES: usize = 1 << 24;
+
+/// A station: a sample where the spin is decided.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Station {
+    /// Its sample's index in the run.
+    pub sample: usize,
+    /// Its time \[s\].
+    pub time: f64,
+    /// Its program line.
+    pub line: usize,
+    /// The spin budget there \[rad\].
+    pub budget: f64,
+    /// The programmed tool tip \[m\], workpiece frame.
+    pub position: Vector3<f64>,
+}
+
+/// A cutting sample: its wrench and feed direction (single precision: what a ranking of
+/// postures needs, at 40 bytes a sample) and its weight on the station after it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Load {
+    /// Wrench about the tip \[N, N m\], workpiece frame.
+    pub wrench: [f32; 6],
+    /// Unit feed direction, workpiece frame.
+    pub direction: [f32; 3],
+    /// Its share on the next station (1 - on the one before).
+    pub weight: f32,
+}
+
+impl Load {
+    pub fn wrench(&self) -> Vector6<f64> {
+        Vector6::from_iterator(self.wrench.iter().map(|&v| f64::from(v)))
+    }
+
+    pub fn direction(&self) -> Vector3<f64> {
+        Vector3::from_iterator(self.direction.iter().map(|&v| f64::from(v)))
+    }
+}
+
+/// The program's loads and stations for the spin rates and step it was built for.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadPath {
+    pub(crate) stations: Vec<Station>,
+    /// The cutting samples, in time order.
+    pub(crate) loads: Vec<Load>,
+    /// Per station `i`, the first load after station `i - 1` (loads up to and including the
+    /// station's sample belong to its interval); one more entry closes the last.
+    pub(crate) first_load: Vec<usize>,
+    pub(crate) samples: usize,
+    pub(crate) per_metre: f64,
+    pub(crate) per_second: f64,
+    pub(crate) step: f64,
+}
+
+impl LoadPath {
+    /// Runs the nominal pass of `job` over `program` ([`job::nominal_pass`]) and places the
+    /// stations for candidate spins `step` \[rad\] apart under the rate bounds `per_metre`
+    /// \[rad/m\] and `per_second` \[rad/s\]. [`BuildError::Budget`] past [`MAX_STATIONS`] or
+    /// [`MAX_LOADED_SAMPLES`]; the nominal pass's errors name their line.
+    pub fn new(
+        job: &Job,
+        program: &Program,
+        step: f64,
+        per_metre: f64,
+        per_second: f64,
+    ) -> Result<Self, JobError> {
+        super::schedule::check_rates(per_metre, per_second)?;
+        super::check_step(step)?;
+        let mut out = Self {
+            stations: Vec::new(),
+            loads: Vec::new(),
+            first_load: Vec::new(),
+            samples: 0,
+            per_metre,
+            per_second,
+            step,
+        };
+        // Loads of the open interval with their budgets (weights set when it closes).
+        let mut budgets: Vec<f64> = Vec::new();
+        let (mut g, mut since_path) = (0.0f64, 0.0f64);
+        let mut last_time: Option<f64> = None;
+        let mut last: Option<Station> = None;
+        let mut end: Option<Station> = None;
+        job::nominal_pass(job, program, |n| {
+            let dt = last_time
+                .replace(n.path.time)
+                .map_or(0.0, |t0| n.path.time - t0);
+            g += budget_step(per_metre, per_second, &n.step, dt);
+            since_path += n.step.norm();
+            let index = out.samples;
+            out.samples += 1;
+            let station = Station {
+                sample: index,
+                time: n.path.time,
+                line: n.path.line,
+                budget: g,
+                position: n.path.position,
+            };
+            if n.wrench.iter().any(|v| *v != 0.0) {
+                if out.loads.len() >= MAX_LOADED_SAMPLES {
+                    return Err(BuildError::Budget {
+                        what: "spin search cutting samples",
+                        budget: "MAX_LOADED_SAMPLES",
+                        limit: MAX_LOADED_SAMPLES,
+                        requested: out.loads.len() + 1,
+                    }
+                    .into());
+                }
+                let mut wrench = [0.0f32; 6];
+                for (dst, v) in wrench.iter_mut().zip(n.wrench.iter()) {
+                    *dst = *v as f32;
+                }
+                let d = n.path.direction;
+                out.loads.push(Load {
+                    wrench,
+                    direction: [d.x, d.y, d.z].map(|v| v as f32),
+                    weight: 1.0,
+                });
+                budgets.push(g);
+            }
+            let due = match last {
+                None => true,
+                Some(s) => g - s.budget >= step && since_path >= MIN_STATION_PATH,
+            };
+            if due {
+                out.close(last.as_ref(), &station, &mut budgets)?;
+                last = Some(station);
+                since_path = 0.0;
+            }
+            end = Some(station);
+            Ok(())
+        })?;
+        // The last sample is a station (unless it is one already).
+        if let (Some(end), Some(l)) = (end, last)
+            && end.sample != l.sample
+        {
+            out.close(Some(&l), &end, &mut budgets)?;
+        }
+        out.first_load.push(out.loads.len());
+        Ok(out)
+    }
+
+    /// Closes the interval ending at `station`: its loads' weights, the station.
+    fn close(
+        &mut self,
+        before: Option<&Station>,
+        station: &Station,
+        budgets: &mut Vec<f64>,
+    ) -> Result<(), BuildError> {
+        if self.stations.len() >= MAX_STATIONS {
+            return Err(BuildError::Budget {
+                what: "spin search stations (path and spin budget over the candidate step)",
+                budget: "MAX_STATIONS",
+                limit: MAX_STATIONS,
+                requested: self.stations.len() + 1,
+            });
+        }
+        let first = self.loads.len() - budgets.len();
+        let g0 = before.map_or(station.budget, |b| b.budget);
+        let span = station.budget - g0;
+        for (load, g) in self
+            .loads
+            .get_mut(first..)
+            .unwrap_or(&mut [])
+            .iter_mut()
+            .zip(budgets.iter())
+        {
+            load.weight = if span > 0.0 {
+                ((g - g0) / span).clamp(0.0, 1.0) as f32
+            } else {
+                1.0
+            };
+        }
+        budgets.clear();
+        self.first_load.push(first);
+        self.stations.push(*station);
+        Ok(())
+    }
+
+    /// The stations.
+    pub fn stations(&self) -> &[Station] {
+        &self.stations
+    }
+
+    /// Samples of the run, and of them cutting (a wrench on the tool).
+    pub fn samples(&self) -> (usize, usize) {
+        (self.samples, self.loads.len())
+    }
+
+    /// The loads of station `i`'s two intervals: those before it (weight `w` on it) and
+    /// those after it (weight `1 - w`).
+    pub(crate) fn around(&self, i: usize) -> (&[Load], &[Load]) {
+        let range = |k: usize| {
+            let (a, b) = (
+                self.first_load.get(k).copied().unwrap_or(self.loads.len()),
+                self.first_load
+                    .get(k + 1)
+                    .copied()
+                    .unwrap_or(self.loads.len()),
+            );
+            self.loads.get(a..b.max(a)).unwrap_or(&[])
+        };
+        (range(i), range(i + 1))
+    }
+}
