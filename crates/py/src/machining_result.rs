@@ -119,6 +119,12 @@ impl MachiningResult {
         self.rows(py, 3, |s, o| o.copy_from_slice(s.path.position.as_slice()))
     }
 
+    /// Unit feed direction of the programmed tool (n, 3).
+    #[getter]
+    fn direction<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| o.copy_from_slice(s.path.direction.as_slice()))
+    }
+
     /// Engagement (n, 3): first entry, last exit [rad] and mean depth [m]; NaN where the
     /// tool is not side milling (air, plunge).
     #[getter]

@@ -116,7 +116,8 @@ pub struct Setup {
     pub stock: Stock,
     /// How the program is driven and sampled.
     pub path: PathOptions,
-    /// Pose IK settings (rigid and loaded).
+    /// Pose IK settings (rigid and loaded); the full pose on an arm of fewer than six joints
+    /// runs as the largest task it controls at the seed ([`Job::at_seed`]).
     pub ik: PoseIkOptions,
     /// Speed of a spindle the program does not start \[rev/s\] (a hand-started spindle: posts
     /// for such machines write no `M3`): it turns clockwise at this speed wherever the
@@ -235,6 +236,31 @@ impl Job {
     /// The spin schedule, if the job has one (else the setup's orientation everywhere).
     pub fn spin(&self) -> Option<&super::spin::SpinSchedule> {
         self.spin.as_ref()
+    }
+
+    /// The job as it runs from `seed`: an arm of fewer than six joints cannot hold the full
+    /// pose its setup asks for ([`crate::mechanism::Task::POSE`]), so it controls the largest
+    /// task it has at the seed ([`crate::mechanism::largest_task`]: a SCARA its position and
+    /// the spin about the tool axis, a 5-axis arm its position and the tool axis). The job
+    /// itself otherwise.
+    pub fn at_seed(&self, seed: &[f64]) -> Result<alloc::borrow::Cow<'_, Self>, JobError> {
+        use alloc::borrow::Cow;
+        let dof = self.model.dof();
+        if dof >= 6 || self.setup.ik.task != crate::mechanism::Task::POSE || seed.len() != dof {
+            return Ok(Cow::Borrowed(self));
+        }
+        let mut data = crate::vjm::Data::new(&self.model);
+        let task =
+            crate::mechanism::largest_task(&self.model, &mut data, seed).map_err(|error| {
+                JobError::AtLine {
+                    line: 0,
+                    time: 0.0,
+                    error,
+                }
+            })?;
+        let mut job = self.clone();
+        job.setup.ik.task = task;
+        Ok(Cow::Owned(job))
     }
 
     /// The joint limits `(lower, upper)` \[rad or m\], one per joint.
@@ -636,6 +662,7 @@ pub fn run_streaming<S: Sink + ?Sized>(
     sink: &mut S,
 ) -> Result<Report, RunError<S::Error>> {
     options.validate()?;
+    let job = &*job.at_seed(seed)?;
     let setup = &job.setup;
     let dof = job.model.dof();
     if seed.len() != dof {

@@ -1176,6 +1176,9 @@ class MachiningResult:
     def position(self) -> _FloatArray:
         """Programmed tool tip (n, 3) [m]."""
     @property
+    def direction(self) -> _FloatArray:
+        """Unit feed direction of the programmed tool (n, 3)."""
+    @property
     def engagement(self) -> _FloatArray:
         """(n, 3): first entry, last exit [rad], mean depth [m]; NaN off the side-milling cut."""
     @property

@@ -1,4 +1,6 @@
-//! The shortest path over stations x candidate spins (see the parent's docs).
+//! The shortest path over stations x candidate spins (see the parent's docs). Costs within
+//! [`TIE`] of each other count as equal; ties go to the smaller change of spin, and at the end
+//! to the spin nearest the seed's.
 
 use alloc::vec;
 use alloc::vec::Vec;
@@ -44,6 +46,19 @@ struct Column {
     ok: bool,
 }
 
+/// Costs within this share of each other are equal: the spin changes for a real gain, not
+/// for the rounding of an arm whose deflection the spin does not change (a SCARA's).
+const TIE: f64 = 1.0e-9;
+
+/// Whether cost `a` is below `b` by more than [`TIE`] of `b`.
+fn less(a: f64, b: f64) -> bool {
+    if b.is_finite() {
+        a < b - TIE * b.abs()
+    } else {
+        a < b
+    }
+}
+
 /// The largest joint difference \[rad or m\].
 fn gap(a: &[f64; MAX_DOF], b: &[f64; MAX_DOF], dof: usize) -> f64 {
     a.iter()
@@ -81,12 +96,14 @@ struct Solver<'a> {
 
 impl Solver<'_> {
     /// The joints of spin `theta` at `position` from `seed`, if they hold (limits less the
-    /// margin, the singularity margin, within the joint step of `seed`).
+    /// margin, the singularity margin, within the joint step of `seed` unless it is the
+    /// user's seed: a branch hint, not a neighbour).
     fn joints(
         &mut self,
         position: &nalgebra::Vector3<f64>,
         theta: f64,
         seed: &[f64; MAX_DOF],
+        neighbour: bool,
     ) -> Option<[f64; MAX_DOF]> {
         let setup = self.job.setup();
         let target = self.placement
@@ -123,7 +140,7 @@ impl Solver<'_> {
             });
             return None;
         }
-        if gap(&q, seed, self.dof) > self.options.max_joint_step {
+        if neighbour && gap(&q, seed, self.dof) > self.options.max_joint_step {
             self.last_error = Some(TickError::InvalidArgument {
                 what: "spin: joints on the branch they started from (a jump)",
                 value: theta,
@@ -199,8 +216,8 @@ fn link(
             );
             for (jp, p) in prev.iter().enumerate().take(hi + 1).skip(lo) {
                 let links = p.ok && p.value.is_finite() && gap(&node.q, &p.q, dof) <= max_step;
-                let better =
-                    p.value < best.0 || (p.value == best.0 && jp.abs_diff(j) < best.1.abs_diff(j));
+                let better = less(p.value, best.0)
+                    || (!less(best.0, p.value) && jp.abs_diff(j) < best.1.abs_diff(j));
                 if links && better {
                     best = (p.value, jp);
                 }
@@ -259,6 +276,7 @@ pub fn plan_at(
         }
         .into());
     }
+    let job = &*job.at_seed(seed)?;
     let candidates = if optimise {
         options.candidates()
     } else {
@@ -317,12 +335,12 @@ pub fn plan_at(
                 .filter(|c| c.ok)
                 .map(|c| c.q);
             let start = match (from_prev, from_neighbour, i, j == center) {
-                (Some(q), _, _, _) | (None, Some(q), _, _) => Some(q),
-                (None, None, 0, true) => Some(user_seed),
+                (Some(q), _, _, _) | (None, Some(q), _, _) => Some((q, true)),
+                (None, None, 0, true) => Some((user_seed, false)),
                 _ => None,
             };
             let node = start
-                .and_then(|s| solver.joints(&st.position, theta, &s))
+                .and_then(|(s, neighbour)| solver.joints(&st.position, theta, &s, neighbour))
                 .and_then(|q| match solver.map(&q) {
                     Ok(a) => Some((q, a)),
                     Err(e) => {
@@ -390,7 +408,7 @@ pub fn plan_at(
     let mut end = (f64::INFINITY, center);
     for (j, node) in prev.iter().enumerate() {
         let v = node.value;
-        if v < end.0 || (v == end.0 && j.abs_diff(center) < end.1.abs_diff(center)) {
+        if less(v, end.0) || (!less(end.0, v) && j.abs_diff(center) < end.1.abs_diff(center)) {
             end = (v, j);
         }
     }
@@ -410,9 +428,13 @@ pub fn plan_at(
         .enumerate()
         .filter(|(_, (c, _))| c.ok)
         .min_by(|(a, (ca, _)), (b, (cb, _))| {
-            ca.sum
-                .total_cmp(&cb.sum)
-                .then(a.abs_diff(center).cmp(&b.abs_diff(center)))
+            if less(ca.sum, cb.sum) {
+                core::cmp::Ordering::Less
+            } else if less(cb.sum, ca.sum) {
+                core::cmp::Ordering::Greater
+            } else {
+                a.abs_diff(center).cmp(&b.abs_diff(center))
+            }
         })
         .map(|(_, (c, angle))| {
             (
