@@ -18,6 +18,8 @@ pub mod job;
 #[cfg(feature = "alloc")]
 pub mod path;
 #[cfg(feature = "alloc")]
+pub mod placement;
+#[cfg(feature = "alloc")]
 mod program;
 #[cfg(feature = "alloc")]
 pub mod report;

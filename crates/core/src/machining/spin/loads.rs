@@ -230,3 +230,182 @@ impl LoadPath {
         (range(i), range(i + 1))
     }
 }
+
+/// The bytes format's first bytes (and version).
+const MAGIC: &[u8; 8] = b"DFLLOAD1";
+
+/// Reads little-endian numbers off a byte slice, refusing a short one.
+struct Reader<'a> {
+    bytes: &'a [u8],
+}
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> Result<[u8; N], BuildError> {
+        let (head, rest) = self.bytes.split_at_checked(N).ok_or(BuildError::TooFew {
+            what: "load path bytes",
+            needed: N,
+            got: self.bytes.len(),
+        })?;
+        self.bytes = rest;
+        let mut out = [0u8; N];
+        out.copy_from_slice(head);
+        Ok(out)
+    }
+    fn f64(&mut self) -> Result<f64, BuildError> {
+        let v = f64::from_le_bytes(self.take()?);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(BuildError::NonFinite {
+                what: "load path bytes",
+                index: 0,
+            })
+        }
+    }
+    fn f32(&mut self) -> Result<f32, BuildError> {
+        let v = f32::from_le_bytes(self.take()?);
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(BuildError::NonFinite {
+                what: "load path bytes",
+                index: 0,
+            })
+        }
+    }
+    fn count(&mut self, limit: usize, what: &'static str) -> Result<usize, BuildError> {
+        let n = u64::from_le_bytes(self.take()?);
+        let n = usize::try_from(n).unwrap_or(usize::MAX);
+        if n > limit {
+            return Err(BuildError::Budget {
+                what,
+                budget: "MAX_STATIONS / MAX_LOADED_SAMPLES",
+                limit,
+                requested: n,
+            });
+        }
+        Ok(n)
+    }
+}
+
+impl LoadPath {
+    /// The load path as bytes (little-endian; what a worker of a placement search receives:
+    /// the nominal pass is not run again there). [`Self::from_bytes`] reads them back, bit for
+    /// bit.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        let mut out = Vec::with_capacity(64 + self.stations.len() * 56 + self.loads.len() * 40);
+        out.extend_from_slice(MAGIC);
+        for v in [self.step, self.per_metre, self.per_second] {
+            out.extend_from_slice(&v.to_le_bytes());
+        }
+        out.extend_from_slice(&(self.samples as u64).to_le_bytes());
+        out.extend_from_slice(&(self.stations.len() as u64).to_le_bytes());
+        for s in &self.stations {
+            out.extend_from_slice(&(s.sample as u64).to_le_bytes());
+            out.extend_from_slice(&s.time.to_le_bytes());
+            out.extend_from_slice(&(s.line as u64).to_le_bytes());
+            out.extend_from_slice(&s.budget.to_le_bytes());
+            for v in s.position.iter() {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        out.extend_from_slice(&(self.loads.len() as u64).to_le_bytes());
+        for l in &self.loads {
+            for v in l
+                .wrench
+                .iter()
+                .chain(&l.direction)
+                .chain(core::iter::once(&l.weight))
+            {
+                out.extend_from_slice(&v.to_le_bytes());
+            }
+        }
+        for f in &self.first_load {
+            out.extend_from_slice(&(*f as u64).to_le_bytes());
+        }
+        out
+    }
+
+    /// A load path of [`Self::to_bytes`]'s bytes, checked: sizes within the budgets, numbers
+    /// finite, budgets not decreasing, intervals in order.
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, BuildError> {
+        let mut r = Reader { bytes };
+        if r.take::<8>()? != *MAGIC {
+            return Err(BuildError::InvalidParameter {
+                what: "load path bytes (not deflect's format, or another version)",
+                value: bytes.len() as f64,
+                expected: "the bytes of LoadPath::to_bytes",
+            });
+        }
+        let (step, per_metre, per_second) = (r.f64()?, r.f64()?, r.f64()?);
+        super::schedule::check_rates(per_metre, per_second)?;
+        super::check_step(step)?;
+        let samples = r.count(usize::MAX >> 1, "load path samples")?;
+        let n = r.count(MAX_STATIONS, "load path stations")?;
+        let mut stations = Vec::new();
+        for _ in 0..n {
+            let sample = r.count(samples, "load path station sample")?;
+            let time = r.f64()?;
+            let line = r.count(usize::MAX >> 1, "load path station line")?;
+            let budget = r.f64()?;
+            let position = Vector3::new(r.f64()?, r.f64()?, r.f64()?);
+            if stations
+                .last()
+                .is_some_and(|s: &Station| budget < s.budget || sample < s.sample)
+            {
+                return Err(BuildError::NotIncreasing {
+                    what: "load path stations (budget, sample)",
+                    index: stations.len(),
+                });
+            }
+            stations.push(Station {
+                sample,
+                time,
+                line,
+                budget,
+                position,
+            });
+        }
+        let m = r.count(MAX_LOADED_SAMPLES, "load path cutting samples")?;
+        let mut loads = Vec::new();
+        for _ in 0..m {
+            let mut v = [0.0f32; 10];
+            for x in v.iter_mut() {
+                *x = r.f32()?;
+            }
+            let [w0, w1, w2, w3, w4, w5, d0, d1, d2, weight] = v;
+            loads.push(Load {
+                wrench: [w0, w1, w2, w3, w4, w5],
+                direction: [d0, d1, d2],
+                weight,
+            });
+        }
+        let mut first_load = Vec::new();
+        for _ in 0..=n {
+            let f = r.count(m, "load path interval start")?;
+            if first_load.last().is_some_and(|p| f < *p) {
+                return Err(BuildError::NotIncreasing {
+                    what: "load path intervals",
+                    index: first_load.len(),
+                });
+            }
+            first_load.push(f);
+        }
+        if !r.bytes.is_empty() {
+            return Err(BuildError::InvalidParameter {
+                what: "load path bytes (trailing bytes)",
+                value: r.bytes.len() as f64,
+                expected: "none",
+            });
+        }
+        Ok(Self {
+            stations,
+            loads,
+            first_load,
+            samples,
+            per_metre,
+            per_second,
+            step,
+        })
+    }
+}
