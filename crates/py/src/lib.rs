@@ -34,6 +34,7 @@ mod mechanism;
 mod motion;
 mod out;
 mod pickle;
+mod placement;
 mod pose_motion;
 mod posture;
 mod scalars;
@@ -78,6 +79,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     posture::register(m)?;
     machining::register(m)?;
     machining_job::register(m)?;
+    placement::register(m)?;
     tools::register(m)?;
     Ok(())
 }

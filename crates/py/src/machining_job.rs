@@ -50,7 +50,7 @@ pub struct MachiningJob {
 
 /// The tool's spin about its own axis (`spin=`).
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Spin {
+pub(crate) enum Spin {
     /// The setup's orientation.
     Keep,
     /// A constant spin \[rad\].
@@ -183,6 +183,16 @@ fn unit(q: [f64; 4], what: &str) -> PyResult<UnitQuaternion<f64>> {
 }
 
 impl MachiningJob {
+    /// The core job.
+    pub(crate) fn job(&self) -> &Job {
+        &self.inner
+    }
+
+    /// What `spin=` asked for.
+    pub(crate) fn spin(&self) -> Spin {
+        self.spin
+    }
+
     fn build(
         robot: Py<SerialRobot>,
         setup: Setup,

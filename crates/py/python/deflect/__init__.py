@@ -68,6 +68,7 @@ from ._deflect import (
     __version__,
 )
 from .atlas import AtlasResult, ChunkError, RayExecutor, atlas
+from .placement import PlacementProblem, PlacementResult, place
 
 __all__ = [
     "AL7075_T6_CARBIDE",
@@ -135,4 +136,7 @@ __all__ = [
     "AtlasResult",
     "ChunkError",
     "RayExecutor",
+    "PlacementProblem",
+    "PlacementResult",
+    "place",
 ]

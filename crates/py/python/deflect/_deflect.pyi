@@ -1154,6 +1154,31 @@ class MachiningJob:
     __hash__: ClassVar[None]  # type: ignore[assignment]
 
 @final
+class PlacementProblem:
+    """A placement search's problem: a job (its spin setting: "keep" or "optimize"), a
+    program and the seed joints; the program's nominal forces computed once."""
+    def __new__(cls, job: MachiningJob, program: GcodeProgram, seed: _ArrayLike) -> Self: ...
+    def evaluate(self, params: _ArrayLike, threads: Optional[int] = None) -> _FloatArray:
+        """Scores (m, 3) of placements (m, 4): RMS, largest deflection [m], line."""
+    def placement(self, params: _ArrayLike) -> _FloatArray:
+        """The workpiece frame (4, 4) of a placement (x, y, z, yaw)."""
+    def _search(
+        self,
+        box_min: _ArrayLike,
+        box_max: _ArrayLike,
+        steps: Sequence[int],
+        refine: int,
+        evaluate: Optional[Any] = None,
+    ) -> Tuple[_FloatArray, _FloatArray, _FloatArray, _FloatArray, int]: ...
+    @property
+    def size(self) -> Tuple[int, int, int]:
+        """Samples of the run, of them cutting, stations of the search."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, ...]]:
+        """Pickling: the job, the loads as bytes, the seed."""
+    @staticmethod
+    def _from_state(job: MachiningJob, loads: bytes, seed: List[float]) -> "PlacementProblem": ...
+
+@final
 class MachiningResult:
     """What ``MachiningJob.run`` predicts, SI, workpiece frame unless said."""
     def __len__(self) -> int: ...

@@ -39,14 +39,14 @@ _STATUS_TEXT = {
 
 
 class ChunkError(DeflectError):
-    """A chunk of an atlas failed on its worker (a killed process, a lost node, an error
+    """A chunk of an atlas (or a placement search) failed on its worker (a killed process, a lost node, an error
     raised there). The message names the chunk and its rows; no partial result is returned."""
 
-    def __init__(self, chunk: int, rows: range, cause: BaseException):
+    def __init__(self, chunk: int, rows: range, cause: BaseException, what: str = "atlas"):
         self.chunk = chunk
         self.rows = rows
         super().__init__(
-            f"atlas chunk {chunk} (tasks {rows.start}..{rows.stop - 1}) failed: "
+            f"{what} chunk {chunk} (tasks {rows.start}..{rows.stop - 1}) failed: "
             f"{type(cause).__name__}: {cause}"
         )
 
