@@ -18,7 +18,7 @@ use std::sync::Mutex;
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use commands::{atlas, contour, fit, job, milling, reproduce, run, serial, static_test};
+use commands::{atlas, contour, fit, job, milling, place, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -71,6 +71,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Job(a) => Some(job::load(a)?),
         _ => None,
     };
+    let place_task = match command {
+        Command::Place(a) => Some(place::load(a)?),
+        _ => None,
+    };
     commands::prepare_out(out)?;
     match command {
         Command::Reproduce(a) => reproduce::reproduce(a, out),
@@ -93,6 +97,10 @@ fn execute(cli: &Cli) -> Result<(), CliError> {
         Command::Job(a) => match &job_task {
             Some(t) => job::job_cmd(a, t, out),
             None => Err(deflect_sim::SimError::new("job: inputs not loaded")),
+        },
+        Command::Place(a) => match &place_task {
+            Some(t) => place::place_cmd(a, t, out),
+            None => Err(deflect_sim::SimError::new("place: inputs not loaded")),
         },
         Command::Delta(a) => commands::delta::delta_cmd(a, out),
     }

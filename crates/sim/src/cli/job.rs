@@ -112,7 +112,7 @@ impl RobotProgramArg {
 }
 
 // Arguments of `job` (help texts with their ranges in the `help` attributes).
-#[derive(clap::Args, Debug)]
+#[derive(clap::Args, Debug, Clone)]
 pub struct JobArgs {
     /// RS274/NGC G-code program, read as LinuxCNC reads it (tools, work offsets, planes,
     /// canned cycles, parameters, subroutines, control flow; see --explain), in mm unless it
@@ -242,7 +242,7 @@ pub struct JobArgs {
     ))]
     pub spin_step: f64,
     /// The spin's rate bounds: DEG_PER_MM,DEG_PER_S (of path and of time) [1,30].
-    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [1.0, 30.0])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1.0, 30.0])]
     pub spin_rate: Vec<f64>,
     /// What the spin search minimises.
     #[arg(long, value_enum, default_value_t = SpinMeasureArg::Normal)]

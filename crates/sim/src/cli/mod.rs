@@ -59,6 +59,7 @@ mod delta;
 mod job;
 mod milling;
 mod parallel;
+mod place;
 /// The ranges of the numeric flags.
 mod range;
 mod serial;
@@ -70,6 +71,7 @@ pub use delta::DeltaArgs;
 pub use job::{JobArgs, SpinArg};
 pub use milling::MillingArgs;
 pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
+pub use place::PlaceArgs;
 pub use range::*;
 pub use serial::{ModelArg, SerialArgs, TaskArg};
 pub use tool::ToolArgs;
@@ -148,6 +150,12 @@ pub enum Command {
     /// compensation) and job_summary.{txt,json} (per operation, the ten lines of largest
     /// force); job_samples.csv with --samples-csv.
     Job(JobArgs),
+    /// Where to put the workpiece: the placement (position in --box, turn about the vertical
+    /// in --yaw) of least predicted deflection along the job's program (with --spin optimize:
+    /// the spin optimised along it at every placement), a grid and a compass refinement on
+    /// --threads threads, the program's forces computed once. Takes every `job` flag. Writes
+    /// place_summary.{txt,json} (the best placement, the grid) and place.png (heat map).
+    Place(PlaceArgs),
     /// The D'Alembert correction on a Delta robot (Clavel's parallel robot of pick and
     /// place): a flexible Delta in rapier, static tests on a 3-D grid over the workspace, the
     /// compliance map fitted per node, a 0.3 m move at 5-10 g uncorrected and corrected every
@@ -174,6 +182,7 @@ impl Command {
             Self::Serial(a) => a.check(),
             Self::Atlas(a) => a.check(),
             Self::Job(a) => a.check(),
+            Self::Place(a) => a.check(),
             Self::Delta(a) => a.check(),
         }
     }

@@ -288,6 +288,32 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     if let Some(c) = robot.controller {
         job = job.with_controller(c);
     }
+    // A robot program its controller does not run is refused before any work.
+    if let Some(vendor) = a.robot_program.and_then(|k| k.language().vendor()) {
+        let language = a
+            .robot_program
+            .map(|k| k.language().name())
+            .unwrap_or_default();
+        match job.controller() {
+            None => {
+                return Err(CliError::Usage(format!(
+                    "--robot-program {language}: {} has no controller convention ([controller] \
+                     with vendor = \"{}\" in its stiffness file)",
+                    loaded.name,
+                    vendor.name()
+                )));
+            }
+            Some(c) if c.vendor != vendor => {
+                return Err(CliError::Usage(format!(
+                    "--robot-program {language}: {}'s controller convention is {}'s ({})",
+                    loaded.name,
+                    c.vendor.name(),
+                    c.vendor.language()
+                )));
+            }
+            Some(_) => {}
+        }
+    }
     let (job, spin) = spin(a, job, &program, &program_name, &seed)?;
     Ok(JobTask {
         job,

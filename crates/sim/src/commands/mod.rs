@@ -35,6 +35,7 @@ pub mod job;
 pub mod job_files;
 pub mod job_summary;
 pub mod milling;
+pub mod place;
 pub mod reproduce;
 pub mod run;
 pub mod serial;

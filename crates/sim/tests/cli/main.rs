@@ -112,4 +112,5 @@ mod atlas;
 mod files;
 mod flags;
 mod job;
+mod place;
 mod serial;

@@ -243,8 +243,43 @@ pub fn title(task: &AtlasTask) -> String {
 /// Draws `atlas.png`: the best deflection \[mm\] per grid cell (grey: unreachable), a colour
 /// bar in the column right of the plot, the best cell outlined.
 pub fn plot_heat_map(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Result<(), SimError> {
-    let root = canvas(path, (1100, 760))?;
     let mm: Vec<f64> = points.iter().map(|p| p.best_measure * 1e3).collect();
+    heat_map(
+        path,
+        &HeatMap {
+            title: &title(task),
+            xs: &task.xs,
+            ys: &task.ys,
+            mm: &mm,
+            bar: "best |dp| [mm]",
+            axes: ("x [m], base frame", "y [m], base frame"),
+        },
+    )
+}
+
+/// A heat map over an x-y grid: `mm[k]` at `(xs[k / ys.len()], ys[k % ys.len()])`, NaN or
+/// infinite where nothing reaches.
+#[derive(Debug, Clone, Copy)]
+pub struct HeatMap<'a> {
+    /// The title.
+    pub title: &'a str,
+    /// The grid's x and y values.
+    pub xs: &'a [f64],
+    /// See `xs`.
+    pub ys: &'a [f64],
+    /// The values \[mm\], x-major.
+    pub mm: &'a [f64],
+    /// The colour bar's label.
+    pub bar: &'a str,
+    /// The axes' labels.
+    pub axes: (&'a str, &'a str),
+}
+
+/// Draws a [`HeatMap`] (grey: unreachable), a colour bar in the column right of the plot, the
+/// smallest cell outlined.
+pub fn heat_map(path: &Path, m: &HeatMap<'_>) -> Result<(), SimError> {
+    let root = canvas(path, (1100, 760))?;
+    let mm = m.mm;
     let (lo, hi) = mm
         .iter()
         .filter(|v| v.is_finite())
@@ -252,9 +287,10 @@ pub fn plot_heat_map(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Re
             (l.min(*v), h.max(*v))
         });
     let span = if hi > lo { hi - lo } else { 1.0 };
+    let bar_entry = format!("{} (colour bar)", m.bar);
     let entries = [
         Entry::new(
-            "best |dp| [mm] (colour bar)",
+            &bar_entry,
             crate::plot_style::Role::Guide,
             crate::plot_style::Swatch::Marker,
         ),
@@ -269,7 +305,7 @@ pub fn plot_heat_map(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Re
             crate::plot_style::Swatch::Marker,
         ),
     ];
-    let (plot, side) = figure(&root, &title(task), 18, &entries)?;
+    let (plot, side) = figure(&root, m.title, 18, &entries)?;
     let half = |v: &[f64]| {
         if v.len() > 1 {
             0.5 * (v[1] - v[0]).abs()
@@ -277,27 +313,21 @@ pub fn plot_heat_map(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Re
             0.05
         }
     };
-    let (hx, hy) = (half(&task.xs), half(&task.ys));
-    let xr = task.xs.iter().fold(f64::INFINITY, |a, b| a.min(*b)) - hx
-        ..task.xs.iter().fold(f64::NEG_INFINITY, |a, b| a.max(*b)) + hx;
-    let yr = task.ys.iter().fold(f64::INFINITY, |a, b| a.min(*b)) - hy
-        ..task.ys.iter().fold(f64::NEG_INFINITY, |a, b| a.max(*b)) + hy;
-    let mut chart = new_chart(
-        &plot,
-        CHART,
-        xr,
-        yr,
-        ("x [m], base frame", "y [m], base frame"),
-    )?;
+    let (hx, hy) = (half(m.xs), half(m.ys));
+    let xr = m.xs.iter().fold(f64::INFINITY, |a, b| a.min(*b)) - hx
+        ..m.xs.iter().fold(f64::NEG_INFINITY, |a, b| a.max(*b)) + hx;
+    let yr = m.ys.iter().fold(f64::INFINITY, |a, b| a.min(*b)) - hy
+        ..m.ys.iter().fold(f64::NEG_INFINITY, |a, b| a.max(*b)) + hy;
+    let mut chart = new_chart(&plot, CHART, xr, yr, m.axes)?;
     let best = mm
         .iter()
         .enumerate()
         .filter(|(_, v)| v.is_finite())
         .min_by(|a, b| a.1.total_cmp(b.1))
         .map(|(k, _)| k);
-    let ny = task.ys.len();
+    let ny = m.ys.len();
     for (k, v) in mm.iter().enumerate() {
-        let (Some(x), Some(y)) = (task.xs.get(k / ny.max(1)), task.ys.get(k % ny.max(1))) else {
+        let (Some(x), Some(y)) = (m.xs.get(k / ny.max(1)), m.ys.get(k % ny.max(1))) else {
             continue;
         };
         let color = if v.is_finite() {
@@ -331,7 +361,7 @@ pub fn plot_heat_map(path: &Path, task: &AtlasTask, points: &[AtlasPoint]) -> Re
         .map_err(perr)?;
     }
     let font = ("sans-serif", LEGEND_FONT).into_font().color(&BLACK);
-    side.draw(&Text::new("best |dp| [mm]", (x0, y0 - 24), font.clone()))
+    side.draw(&Text::new(m.bar, (x0, y0 - 24), font.clone()))
         .map_err(perr)?;
     for (t, dy) in [(1.0, 0), (0.5, h / 2), (0.0, h - 1)] {
         // Three decimals: micrometres.
