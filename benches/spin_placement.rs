@@ -14,7 +14,11 @@ use nalgebra::Vector2;
 
 fn builtin() -> (Job, deflect_core::machining::Program) {
     let text = std::fs::read_to_string(repo_path("data/groove_and_pocket.nc")).unwrap();
-    let setup = job_setup(Vector2::new(0.005, -0.015), Vector2::new(0.085, 0.045), 5.0e-4);
+    let setup = job_setup(
+        Vector2::new(0.005, -0.015),
+        Vector2::new(0.085, 0.045),
+        5.0e-4,
+    );
     let robot = kr300();
     let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
     (job, read(&text))
