@@ -138,3 +138,30 @@ fn a_box_out_of_reach_or_malformed_is_refused() {
         assert!(bad.validate().is_err(), "{bad:?}");
     }
 }
+
+#[test]
+fn any_damage_to_the_loads_bytes_is_refused_or_read_whole_never_a_panic() {
+    let p = problem(false);
+    let bytes = p.loads().to_bytes();
+    let mut rng = deflect_tests::uniform(7);
+    let (mut refused, mut read) = (0, 0);
+    for _ in 0..2000 {
+        let mut b = bytes.clone();
+        let flips = 1 + (rng(0.0, 4.0) as usize);
+        for _ in 0..flips {
+            let at = rng(0.0, b.len() as f64) as usize % b.len();
+            b[at] = rng(0.0, 256.0) as u8;
+        }
+        if rng(0.0, 1.0) < 0.2 {
+            b.truncate(rng(0.0, b.len() as f64) as usize);
+        }
+        match LoadPath::from_bytes(&b) {
+            Ok(l) => {
+                read += 1;
+                assert_eq!(l.to_bytes(), b, "what reads writes back the same bytes");
+            }
+            Err(_) => refused += 1,
+        }
+    }
+    assert!(refused > 100 && read > 100, "{refused} {read}");
+}

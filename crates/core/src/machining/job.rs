@@ -57,13 +57,13 @@
 
 use alloc::vec::Vec;
 
-use nalgebra::{Isometry3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{Isometry3, Vector3};
 
 use super::Program;
 use super::chip::ChipModel;
-use super::cutting::{self, Coefficients, Tool};
+use super::cutting::{self, Tool};
 use super::engagement::{self, Chip};
-use super::path::{self, PathOptions, PathSample};
+use super::path::{self, PathSample};
 pub use super::report::{
     Deviation, ErrorStats, JobSample, LineForce, LineSummary, RapidContact, Report, Summary,
     SurfaceError,
@@ -71,11 +71,14 @@ pub use super::report::{
 use super::stock::{Cutter, ZMap};
 use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
-use crate::mechanism::PoseIkOptions;
 use crate::vjm::{Model, Vector6};
 
 mod nominal;
 mod predict;
+mod setup;
+
+pub use nominal::{NominalSample, nominal_pass};
+pub use setup::{Setup, Stock};
 
 pub use crate::mechanism::JOINT_LIMIT_TOLERANCE;
 
@@ -85,102 +88,6 @@ pub use crate::mechanism::JOINT_LIMIT_TOLERANCE;
 /// micrometres above the programmed one (tens at 125 Hz), and CAM programs rapid down to the
 /// last cut's depth.
 pub const RAPID_SKIM: f64 = 1.0e-4;
-
-/// The stock: a block over `[min, max]` (x, y) with its top at `top`, workpiece frame \[m\],
-/// resolved in square cells of `cell` \[m\] (see [`super::stock::MAX_CELLS`]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Stock {
-    /// Lower corner (x, y) \[m\].
-    pub min: Vector2<f64>,
-    /// Upper corner (x, y) \[m\].
-    pub max: Vector2<f64>,
-    /// Top face height \[m\].
-    pub top: f64,
-    /// Cell edge \[m\].
-    pub cell: f64,
-}
-
-/// Everything about a job but the arm and the program.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Setup {
-    /// The workpiece frame in the robot's base frame.
-    pub placement: Isometry3<f64>,
-    /// The TCP frame's orientation in the workpiece frame; its z axis must lie along the
-    /// workpiece's z (either way: the tool axis of a 2.5-D program).
-    pub tool_orientation: UnitQuaternion<f64>,
-    /// The end mill (a flat end mill of its diameter).
-    pub tool: Tool,
-    /// The material's cutting and edge coefficients.
-    pub coefficients: Coefficients,
-    /// The block the part is cut from.
-    pub stock: Stock,
-    /// How the program is driven and sampled.
-    pub path: PathOptions,
-    /// Pose IK settings (rigid and loaded); the full pose on an arm of fewer than six joints
-    /// runs as the largest task it controls at the seed ([`Job::at_seed`]).
-    pub ik: PoseIkOptions,
-    /// Speed of a spindle the program does not start \[rev/s\] (a hand-started spindle: posts
-    /// for such machines write no `M3`): it turns clockwise at this speed wherever the
-    /// program's spindle is off. `None`: the program's spindle only.
-    pub hand_spindle: Option<f64>,
-    /// How deep a rapid move may run into the predicted stock \[m\] before the job refuses
-    /// it ([`JobError::RapidInStock`]); the deepest contact within it is reported
-    /// ([`Report::rapid_contact`]). Default [`RAPID_SKIM`].
-    pub rapid_skim: f64,
-}
-
-impl Setup {
-    /// The TCP's z axis pointing down the workpiece z (out of the flange, into the part) and
-    /// its x along the workpiece x: a rotation of pi about x.
-    pub fn tool_down() -> UnitQuaternion<f64> {
-        UnitQuaternion::from_axis_angle(&Vector3::x_axis(), core::f64::consts::PI)
-    }
-
-    /// Checks the placement, stock (its cell budget, without allocating), tool,
-    /// coefficients, path and IK options.
-    pub fn validate(&self) -> Result<(), BuildError> {
-        let t = &self.placement;
-        if let Some(index) = t
-            .translation
-            .vector
-            .iter()
-            .chain(t.rotation.coords.iter())
-            .position(|v| !v.is_finite())
-        {
-            return Err(BuildError::NonFinite {
-                what: "placement (x, y, z, then quaternion i, j, k, w)",
-                index,
-            });
-        }
-        let z = self.tool_orientation * Vector3::z();
-        crate::error::param(
-            "tool orientation (|z_tcp . z_workpiece|, must be 1)",
-            z.z.abs(),
-            (z.z.abs() - 1.0).abs() <= 1.0e-6,
-            "the TCP z axis along the workpiece z (2.5-D program)",
-        )?;
-        let st = &self.stock;
-        ZMap::shape_for(st.min, st.max, st.top, st.cell)?;
-        self.tool.validate()?;
-        self.coefficients.validate()?;
-        self.path.validate()?;
-        crate::error::param(
-            "rapid skim (m)",
-            self.rapid_skim,
-            self.rapid_skim.is_finite() && (0.0..=0.1).contains(&self.rapid_skim),
-            "in [0, 0.1] m",
-        )?;
-        if let Some(v) = self.hand_spindle {
-            crate::error::param(
-                "hand spindle speed (rev/s)",
-                v,
-                v > 0.0 && v <= super::MAX_SPINDLE_RPM / 60.0,
-                "in (0, MAX_SPINDLE_RPM / 60] rev/s",
-            )?;
-        }
-        self.ik.validate()
-    }
-}
 
 /// The arm, its joint limits and the job's setup: immutable once built.
 #[derive(Debug, Clone)]
@@ -485,50 +392,6 @@ fn check_cell(st: &Stock, tools: &ToolModels) -> Result<(), BuildError> {
                 "<= the job's tool radius / 2"
             },
         });
-    }
-    Ok(())
-}
-
-/// One sample of the nominal pass alone ([`nominal_pass`]): what the program asks of the arm,
-/// whatever the arm and its placement.
-#[derive(Debug, Clone, Copy)]
-pub struct NominalSample {
-    /// The programmed tool.
-    pub path: PathSample,
-    /// The programmed step since the last sample \[m\] (0 at the first).
-    pub step: Vector3<f64>,
-    /// The wrench on the tool about its tip from the nominal cut \[N, N m\], workpiece frame.
-    pub wrench: Vector6,
-}
-
-/// The nominal stage of the pass alone (the nominal tool on the nominal stock: the chip and
-/// its force at every sample, the job's checks of the cut), handing each sample to `f`:
-/// what the placement and the spin about the tool axis do not change, computed once for a
-/// search over them ([`super::spin`], [`super::placement`]). Errors as [`run`]'s nominal
-/// ones, or `f`'s.
-pub fn nominal_pass(
-    job: &Job,
-    program: &Program,
-    mut f: impl FnMut(&NominalSample) -> Result<(), JobError>,
-) -> Result<(), JobError> {
-    let setup = &job.setup;
-    let sampler = path::Sampler::new(program, &setup.path)?;
-    let tools = ToolModels::new(job, program);
-    let st = &setup.stock;
-    check_cell(st, &tools)?;
-    let mut nominal = nominal::Stage::new(
-        job,
-        program,
-        &tools,
-        ZMap::new(st.min, st.max, st.top, st.cell)?,
-    );
-    for s in sampler {
-        let n = nominal.advance(&s)?;
-        f(&NominalSample {
-            path: n.path,
-            step: n.step,
-            wrench: n.wrench_work,
-        })?;
     }
     Ok(())
 }

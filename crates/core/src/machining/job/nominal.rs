@@ -4,7 +4,7 @@
 
 use nalgebra::{Isometry3, Vector3};
 
-use super::{Job, ToolModels, chip_wrench, engagement, rotate, tooth_feed};
+use super::{Job, ToolModels, check_cell, chip_wrench, engagement, rotate, tooth_feed};
 use crate::error::{JobError, TickError};
 use crate::machining::Program;
 use crate::machining::engagement::{Chip, Contact};
@@ -266,4 +266,48 @@ impl<'a> Stage<'a> {
         }
         Ok(())
     }
+}
+
+/// One sample of the nominal pass alone ([`nominal_pass`]): what the program asks of the arm,
+/// whatever the arm and its placement.
+#[derive(Debug, Clone, Copy)]
+pub struct NominalSample {
+    /// The programmed tool.
+    pub path: PathSample,
+    /// The programmed step since the last sample \[m\] (0 at the first).
+    pub step: Vector3<f64>,
+    /// The wrench on the tool about its tip from the nominal cut \[N, N m\], workpiece frame.
+    pub wrench: Vector6,
+}
+
+/// The nominal stage of the pass alone (the nominal tool on the nominal stock: the chip and
+/// its force at every sample, the job's checks of the cut), handing each sample to `f`:
+/// what the placement and the spin about the tool axis do not change, computed once for a
+/// search over them ([`super::spin`], [`super::placement`]). Errors as [`run`]'s nominal
+/// ones, or `f`'s.
+pub fn nominal_pass(
+    job: &Job,
+    program: &Program,
+    mut f: impl FnMut(&NominalSample) -> Result<(), JobError>,
+) -> Result<(), JobError> {
+    let setup = &job.setup;
+    let sampler = path::Sampler::new(program, &setup.path)?;
+    let tools = ToolModels::new(job, program);
+    let st = &setup.stock;
+    check_cell(st, &tools)?;
+    let mut nominal = Stage::new(
+        job,
+        program,
+        &tools,
+        ZMap::new(st.min, st.max, st.top, st.cell)?,
+    );
+    for s in sampler {
+        let n = nominal.advance(&s)?;
+        f(&NominalSample {
+            path: n.path,
+            step: n.step,
+            wrench: n.wrench_work,
+        })?;
+    }
+    Ok(())
 }

@@ -26,9 +26,9 @@
 //! The seed's constant spin and every other constant spin are paths of the same graph: the
 //! optimised schedule's cost is at most theirs ([`SpinPlan`] reports all three).
 
-mod loads;
+pub mod loads;
 mod plan;
-mod schedule;
+pub mod schedule;
 
 pub use loads::{LoadPath, MAX_LOADED_SAMPLES, MAX_STATIONS, MIN_STATION_PATH, Station};
 pub use plan::{plan, plan_at};
