@@ -6,26 +6,12 @@
 //! `cargo bench --bench spin_placement`
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use deflect_core::machining::job::Job;
 use deflect_core::machining::placement::{PlacementBox, Problem};
 use deflect_core::machining::spin::{self, LoadPath, SpinOptions};
-use deflect_tests::{JOB_SEED, job_setup, kr300, read_mm as read, repo_path};
-use nalgebra::Vector2;
-
-fn builtin() -> (Job, deflect_core::machining::Program) {
-    let text = std::fs::read_to_string(repo_path("data/groove_and_pocket.nc")).unwrap();
-    let setup = job_setup(
-        Vector2::new(0.005, -0.015),
-        Vector2::new(0.085, 0.045),
-        5.0e-4,
-    );
-    let robot = kr300();
-    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
-    (job, read(&text))
-}
+use deflect_tests::JOB_SEED;
 
 fn bench(c: &mut Criterion) {
-    let (job, program) = builtin();
+    let (job, program) = deflect_tests::builtin_job();
     let o = SpinOptions::default();
     let loads = LoadPath::new(&job, &program, o.step, o.per_metre, o.per_second).unwrap();
     let (samples, _) = loads.samples();

@@ -3,29 +3,13 @@
 //! spacing finds; the scores do not depend on the thread count or on a worker's copy of the
 //! loads (bytes); a box out of reach and a bad box are typed errors.
 
-use deflect_core::machining::job::Job;
 use deflect_core::machining::placement::{self, PlacementBox, Problem};
 use deflect_core::machining::spin::{LoadPath, SpinOptions};
-use deflect_tests::{JOB_SEED, job_setup, kr300, read_mm as read, repo_path};
-use nalgebra::Vector2;
+use deflect_tests::JOB_SEED;
 
 fn problem(optimise: bool) -> Problem {
-    let text = std::fs::read_to_string(repo_path("data/groove_and_pocket.nc")).unwrap();
-    let setup = job_setup(
-        Vector2::new(0.005, -0.015),
-        Vector2::new(0.085, 0.045),
-        5.0e-4,
-    );
-    let robot = kr300();
-    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
-    Problem::new(
-        job,
-        &read(&text),
-        &JOB_SEED,
-        SpinOptions::default(),
-        optimise,
-    )
-    .unwrap()
+    let (job, program) = deflect_tests::builtin_job();
+    Problem::new(job, &program, &JOB_SEED, SpinOptions::default(), optimise).unwrap()
 }
 
 #[test]

@@ -7,19 +7,11 @@
 use deflect_core::machining::Program;
 use deflect_core::machining::job::{self, Job, Report};
 use deflect_core::machining::spin::{self, LoadPath, SpinMeasure, SpinOptions, SpinSchedule};
-use deflect_tests::{JOB_SEED, job_setup, kr300, read_mm as read, repo_path};
-use nalgebra::{Vector2, Vector3};
+use deflect_tests::{JOB_SEED, kr300};
+use nalgebra::Vector3;
 
 fn builtin() -> (Job, Program) {
-    let text = std::fs::read_to_string(repo_path("data/groove_and_pocket.nc")).unwrap();
-    let setup = job_setup(
-        Vector2::new(0.005, -0.015),
-        Vector2::new(0.085, 0.045),
-        5.0e-4,
-    );
-    let robot = kr300();
-    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
-    (job, read(&text))
+    deflect_tests::builtin_job()
 }
 
 /// RMS over the cutting samples of the deflection normal to the feed \[m\], workpiece frame

@@ -271,3 +271,25 @@ pub fn read_mm(text: &str) -> deflect_core::machining::Program {
         Err(e) => panic!("the program must read: {e}"),
     }
 }
+
+/// The built-in job of `deflect-sim job` as the tests set it up: [`job_setup`] over the
+/// stock (5, -15)..(85, 45) mm in 0.5 mm cells, the KR 300, `data/groove_and_pocket.nc`.
+pub fn builtin_job() -> (
+    deflect_core::machining::job::Job,
+    deflect_core::machining::Program,
+) {
+    let text = match std::fs::read_to_string(repo_path("data/groove_and_pocket.nc")) {
+        Ok(t) => t,
+        Err(e) => panic!("the built-in program must read: {e}"),
+    };
+    let setup = job_setup(
+        nalgebra::Vector2::new(0.005, -0.015),
+        nalgebra::Vector2::new(0.085, 0.045),
+        5.0e-4,
+    );
+    let robot = kr300();
+    match deflect_core::machining::job::Job::new(robot.model.clone(), &robot.joint_limits, setup) {
+        Ok(job) => (job, read_mm(&text)),
+        Err(e) => panic!("the built-in job must build: {e}"),
+    }
+}

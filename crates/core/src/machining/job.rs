@@ -375,6 +375,19 @@ fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
     Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
 
+/// Seed joints, one per joint of the job's arm.
+pub(crate) fn check_seed(job: &Job, seed: &[f64]) -> Result<(), BuildError> {
+    let dof = job.model.dof();
+    if seed.len() != dof {
+        return Err(BuildError::WrongLength {
+            what: "seed joints",
+            expected: dof,
+            got: seed.len(),
+        });
+    }
+    Ok(())
+}
+
 /// A cell as wide as a tool's radius cannot resolve its cut (a stock of one cell reads every
 /// error as 0): at most half the radius of every tool the program uses.
 fn check_cell(st: &Stock, tools: &ToolModels) -> Result<(), BuildError> {
@@ -525,17 +538,10 @@ pub fn run_streaming<S: Sink + ?Sized>(
     sink: &mut S,
 ) -> Result<Report, RunError<S::Error>> {
     options.validate()?;
+    check_seed(job, seed)?;
     let job = &*job.at_seed(seed)?;
     let setup = &job.setup;
     let dof = job.model.dof();
-    if seed.len() != dof {
-        return Err(BuildError::WrongLength {
-            what: "seed joints",
-            expected: dof,
-            got: seed.len(),
-        }
-        .into());
-    }
     let mut sampler = path::Sampler::new(program, &setup.path)?;
     let tools = ToolModels::new(job, program);
     let st = &setup.stock;

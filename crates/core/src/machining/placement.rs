@@ -185,15 +185,7 @@ impl Problem {
         optimise: bool,
     ) -> Result<Self, JobError> {
         spin.validate()?;
-        let dof = job.model().dof();
-        if seed.len() != dof {
-            return Err(BuildError::WrongLength {
-                what: "seed joints",
-                expected: dof,
-                got: seed.len(),
-            }
-            .into());
-        }
+        crate::machining::job::check_seed(&job, seed)?;
         let loads = LoadPath::new(&job, program, spin.step, spin.per_metre, spin.per_second)?;
         Ok(Self::from_parts(job, loads, seed.to_vec(), spin, optimise))
     }

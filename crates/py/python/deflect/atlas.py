@@ -158,6 +158,31 @@ def _run_chunk(*args: Any, **kwargs: Any) -> np.ndarray:
     return _atlas_chunk(*args, **kwargs)
 
 
+def _gather(
+    pool: Executor, fn: Callable, chunks: List[range], args: Callable[[range], tuple], what: str, kwargs: Optional[dict] = None
+) -> list:
+    """Submits ``fn(*args(chunk), **kwargs)`` for every chunk and gathers the results in order;
+    a chunk that fails (at submission or on its worker) raises ``ChunkError`` naming it, the
+    chunks not yet run cancelled."""
+    futures: List[Future] = []
+    for k, r in enumerate(chunks):
+        try:
+            futures.append(pool.submit(fn, *args(r), **(kwargs or {})))
+        except Exception as e:  # a broken pool refuses at submission
+            for f in futures:
+                f.cancel()
+            raise ChunkError(k, r, e, what) from e
+    parts = []
+    for k, (r, f) in enumerate(zip(chunks, futures)):
+        try:
+            parts.append(f.result())
+        except Exception as e:
+            for g in futures[k + 1 :]:
+                g.cancel()
+            raise ChunkError(k, r, e, what) from e
+    return parts
+
+
 def _as_executor(executor: Any) -> Executor:
     """A Dask ``Client`` gives its executor; anything with ``submit`` is used as it is."""
     if hasattr(executor, "get_executor") and not isinstance(executor, Executor):
@@ -230,31 +255,11 @@ def atlas(
         )
     pool = _as_executor(executor)
     chunks: List[range] = [range(a, min(a + chunk_size, n)) for a in range(0, n, chunk_size)]
-    futures = []
-    for k, r in enumerate(chunks):
+
+    def args(r: range) -> tuple:
         sl = slice(r.start, r.stop)
-        try:
-            futures.append(
-                pool.submit(
-                    _run_chunk,
-                    robot,
-                    p[sl],
-                    t[sl] if t.ndim == 2 else t,
-                    w[sl] if w.ndim == 2 else w,
-                    **options,
-                )
-            )
-        except Exception as e:  # a broken pool refuses at submission
-            for f in futures:
-                f.cancel()
-            raise ChunkError(k, r, e) from e
-    parts = []
-    for k, (r, f) in enumerate(zip(chunks, futures)):
-        try:
-            parts.append(f.result())
-        except Exception as e:
-            for g in futures[k + 1 :]:
-                g.cancel()
-            raise ChunkError(k, r, e) from e
+        return (robot, p[sl], t[sl] if t.ndim == 2 else t, w[sl] if w.ndim == 2 else w)
+
+    parts = _gather(pool, _run_chunk, chunks, args, "atlas", options)
     rows = np.concatenate(parts) if parts else np.zeros((0, 50 + dof))
     return AtlasResult._from_rows(rows, dof)

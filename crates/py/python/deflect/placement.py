@@ -18,7 +18,7 @@ from typing import Any, List, Optional, Sequence
 import numpy as np
 
 from ._deflect import InputError, PlacementProblem
-from .atlas import ChunkError, _as_executor
+from .atlas import _as_executor, _gather
 
 __all__ = ["PlacementProblem", "PlacementResult", "place"]
 
@@ -90,22 +90,7 @@ def place(
 
         def evaluate(params: np.ndarray) -> np.ndarray:
             chunks: List[range] = [range(a, min(a + size, len(params))) for a in range(0, len(params), size)]
-            futures = []
-            for k, r in enumerate(chunks):
-                try:
-                    futures.append(pool.submit(_evaluate_chunk, problem, params[r.start : r.stop]))
-                except Exception as e:  # a broken pool refuses at submission
-                    for f in futures:
-                        f.cancel()
-                    raise ChunkError(k, r, e, "placement") from e
-            parts = []
-            for k, (r, f) in enumerate(zip(chunks, futures)):
-                try:
-                    parts.append(f.result())
-                except Exception as e:
-                    for g in futures[k + 1 :]:
-                        g.cancel()
-                    raise ChunkError(k, r, e, "placement") from e
+            parts = _gather(pool, _evaluate_chunk, chunks, lambda r: (problem, params[r.start : r.stop]), "placement")
             return np.concatenate(parts) if parts else np.zeros((0, 3))
 
     grid, scores, best, score, evaluations = problem._search(box_min, box_max, steps4, int(refine), evaluate)

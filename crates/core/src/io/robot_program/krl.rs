@@ -59,18 +59,11 @@ pub(crate) fn dat(cx: &Context<'_>) -> String {
     )
 }
 
-/// `A1 .., A2 .., ..` of the controller's axes of a sample's compensated joints.
+/// `A1 .., A2 .., ..` of the controller's axes of a sample's compensated joints (degrees, mm).
 fn axes(cx: &Context<'_>, s: &JobSample) -> String {
-    let c = cx.convention();
-    let a = c.to_controller(cx.joints(s));
     let mut out = String::new();
-    for (i, v) in a.iter().take(c.dof).enumerate() {
-        let value = if c.revolute.get(i).copied().unwrap_or(true) {
-            v.to_degrees()
-        } else {
-            v * 1e3
-        };
-        let _ = write!(out, "{}A{} {value:.9}", if i > 0 { "," } else { "" }, i + 1);
+    for (i, v) in cx.axes(s, true).iter().enumerate() {
+        let _ = write!(out, "{}A{} {v:.9}", if i > 0 { "," } else { "" }, i + 1);
     }
     out
 }
@@ -108,11 +101,7 @@ pub(crate) fn motion(
     k: &Kept,
 ) -> Result<(), ProgramError> {
     let s = &k.sample;
-    cx.line_comment(out, "", ";", s);
-    if let Some(wait) = cx.dwell(s) {
-        if let Some(seconds) = wait {
-            let _ = writeln!(out, "WAIT SEC {seconds:.4}");
-        }
+    if cx.preamble(out, "", ";", s, |t| std::format!("WAIT SEC {t:.4}")) {
         return Ok(());
     }
     let blend = cx.blend_of(k);

@@ -38,7 +38,7 @@ mod writer;
 
 pub use error::ProgramError;
 pub use writer::RobotProgram;
-pub(crate) use writer::{Context, pose};
+pub(crate) use writer::{Context, join, pose};
 
 use std::string::{String, ToString};
 use std::vec::Vec;

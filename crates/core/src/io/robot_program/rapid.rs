@@ -20,7 +20,7 @@ use std::string::String;
 
 use nalgebra::Isometry3;
 
-use super::{Command, Context, ProgramError};
+use super::{Command, Context, ProgramError, join};
 use crate::controller;
 use crate::io::decimate::Kept;
 use crate::machining::job::JobSample;
@@ -47,19 +47,7 @@ pub(crate) fn pose(t: &Isometry3<f64>) -> String {
 /// `[[j1, .., j6], [9E9, ..]]` of a sample's compensated joints (degrees, mm for a linear
 /// axis).
 fn joint_target(cx: &Context<'_>, s: &JobSample) -> String {
-    let c = cx.convention();
-    let a = c.to_controller(cx.joints(s));
-    let mut out = String::from("[[");
-    for (i, v) in a.iter().take(c.dof).enumerate() {
-        let value = if c.revolute.get(i).copied().unwrap_or(true) {
-            v.to_degrees()
-        } else {
-            v * 1e3
-        };
-        let _ = write!(out, "{}{value:.9}", if i > 0 { "," } else { "" });
-    }
-    let _ = write!(out, "],{NO_EXTERNAL}]");
-    out
+    std::format!("[[{}],{NO_EXTERNAL}]", join(&cx.axes(s, true), ",", 9))
 }
 
 /// `speeddata` of a speed \[m/s\].
@@ -121,11 +109,7 @@ pub(crate) fn motion(
     k: &Kept,
 ) -> Result<(), ProgramError> {
     let s = &k.sample;
-    cx.line_comment(out, "    ", "!", s);
-    if let Some(wait) = cx.dwell(s) {
-        if let Some(seconds) = wait {
-            let _ = writeln!(out, "    WaitTime {seconds:.4};");
-        }
+    if cx.preamble(out, "    ", "!", s, |t| std::format!("WaitTime {t:.4};")) {
         return Ok(());
     }
     let (v, z) = (speed(cx.speed_of(s)), zone(cx.blend_of(k)));

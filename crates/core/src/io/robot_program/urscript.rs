@@ -16,7 +16,7 @@ use std::string::String;
 
 use nalgebra::Isometry3;
 
-use super::{Command, Context, ProgramError};
+use super::{Command, Context, ProgramError, join};
 use crate::io::decimate::Kept;
 use crate::machining::job::JobSample;
 
@@ -37,14 +37,7 @@ pub(crate) fn pose(t: &Isometry3<f64>) -> String {
 
 /// `[q1, .., qn]` of a sample's compensated joints as the controller reads them (rad).
 fn joints(cx: &Context<'_>, s: &JobSample) -> String {
-    let c = cx.convention();
-    let a = c.to_controller(cx.joints(s));
-    let mut out = String::from("[");
-    for (i, v) in a.iter().take(c.dof).enumerate() {
-        let _ = write!(out, "{}{v:.12}", if i > 0 { ", " } else { "" });
-    }
-    out.push(']');
-    out
+    std::format!("[{}]", join(&cx.axes(s, false), ", ", 12))
 }
 
 pub(crate) fn header(
@@ -80,13 +73,9 @@ pub(crate) fn motion(
     k: &Kept,
 ) -> Result<(), ProgramError> {
     let s = &k.sample;
-    cx.line_comment(out, "  ", "#", s);
     match command {
         Command::Cartesian => {
-            if let Some(wait) = cx.dwell(s) {
-                if let Some(seconds) = wait {
-                    let _ = writeln!(out, "  sleep({seconds:.4})");
-                }
+            if cx.preamble(out, "  ", "#", s, |t| std::format!("sleep({t:.4})")) {
                 return Ok(());
             }
             let c = cx.convention();
@@ -102,6 +91,7 @@ pub(crate) fn motion(
         }
         Command::Joints => {
             // A dwell is held by its samples: servoj keeps the joints for their periods.
+            cx.line_comment(out, "  ", "#", s);
             let period = 1.0 / cx.target.rate_hz;
             let _ = writeln!(out, "  servoj({}, 0, 0, {period}, 0.1, 300)", joints(cx, s));
         }

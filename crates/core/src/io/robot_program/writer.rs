@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 use std::io::Write;
 use std::string::{String, ToString};
+use std::vec::Vec;
 
 use nalgebra::{Isometry3, UnitQuaternion};
 
@@ -55,6 +56,22 @@ impl Context<'_> {
         })
     }
 
+    /// The controller's axis values of a sample's compensated joints, as its programs write
+    /// them: degrees and mm (`degrees`, KRL and RAPID) or rad and m (URScript).
+    pub fn axes(&self, s: &JobSample, degrees: bool) -> Vec<f64> {
+        let c = self.convention();
+        let a = c.to_controller(self.joints(s));
+        a.iter()
+            .take(c.dof)
+            .zip(&c.revolute)
+            .map(|(v, revolute)| match (degrees, revolute) {
+                (false, _) => *v,
+                (true, true) => v.to_degrees(),
+                (true, false) => v * 1e3,
+            })
+            .collect()
+    }
+
     /// The model's joints of a sample (compensated) \[rad or m\].
     pub fn joints<'s>(&self, s: &'s JobSample) -> &'s [f64] {
         s.q_commanded.get(..self.target.model.dof()).unwrap_or(&[])
@@ -79,6 +96,28 @@ impl Context<'_> {
                 "{indent}{prefix} line {}, t = {:.3} s",
                 s.path.line, s.path.time
             );
+        }
+    }
+
+    /// What every language writes before a motion: the comment of a new program line
+    /// (`prefix` `;`, `!`, `#`) and, on a dwell's move, the language's `wait` once (`true`:
+    /// the motion itself is skipped).
+    pub fn preamble(
+        &mut self,
+        out: &mut String,
+        indent: &str,
+        prefix: &str,
+        s: &JobSample,
+        wait: impl Fn(f64) -> String,
+    ) -> bool {
+        self.line_comment(out, indent, prefix, s);
+        match self.dwell(s) {
+            Some(Some(seconds)) => {
+                let _ = writeln!(out, "{indent}{}", wait(seconds));
+                true
+            }
+            Some(None) => true,
+            None => false,
         }
     }
 
@@ -129,6 +168,15 @@ impl Context<'_> {
             error,
         }
     }
+}
+
+/// `values` joined by `sep`, each with `decimals` decimals.
+pub(crate) fn join(values: &[f64], sep: &str, decimals: usize) -> String {
+    let mut out = String::new();
+    for (i, v) in values.iter().enumerate() {
+        let _ = write!(out, "{}{v:.decimals$}", if i > 0 { sep } else { "" });
+    }
+    out
 }
 
 /// The pose a Cartesian program writes for a sample: the commanded TCP, workpiece frame.
@@ -262,6 +310,34 @@ impl<'a, W: Write> RobotProgram<'a, W> {
             && matches!(self.cx.options.language, Language::UrScript | Language::Csv)
     }
 
+    /// Hands `s` to the decimation (`None`: the end), writing the motions it keeps.
+    fn decimate(&mut self, s: Option<&JobSample>) -> Result<(), ProgramError> {
+        let (language, command) = (self.cx.options.language, self.cx.options.command);
+        let (tol, jtol, dof) = (
+            self.cx.options.tolerance,
+            self.cx.options.joint_tolerance,
+            self.cx.target.model.dof(),
+        );
+        let holds = |a: &JobSample, b: &JobSample, x: &JobSample| match command {
+            Command::Cartesian => pose_holds(tol, a, b, x),
+            Command::Joints => joints_hold(jtol, dof, a, b, x),
+        };
+        let mut failed = None;
+        let (cx, text) = (&mut self.cx, &mut self.text);
+        let mut keep = |k: &Kept| {
+            if failed.is_none()
+                && let Err(e) = motion(language, command, text, cx, k)
+            {
+                failed = Some(e);
+            }
+        };
+        match s {
+            Some(s) => self.decimator.push(s, &holds, &mut keep),
+            None => self.decimator.finish(&holds, &mut keep),
+        }
+        failed.map_or(Ok(()), Err)
+    }
+
     /// The next samples, in time order.
     pub fn push(&mut self, chunk: &[JobSample]) -> Result<(), ProgramError> {
         let language = self.cx.options.language;
@@ -278,27 +354,7 @@ impl<'a, W: Write> RobotProgram<'a, W> {
                 };
                 motion(language, command, &mut self.text, &mut self.cx, &k)?;
             } else {
-                let (tol, jtol, dof) = (
-                    self.cx.options.tolerance,
-                    self.cx.options.joint_tolerance,
-                    self.cx.target.model.dof(),
-                );
-                let holds = |a: &JobSample, b: &JobSample, x: &JobSample| match command {
-                    Command::Cartesian => pose_holds(tol, a, b, x),
-                    Command::Joints => joints_hold(jtol, dof, a, b, x),
-                };
-                let mut failed = None;
-                let (cx, text) = (&mut self.cx, &mut self.text);
-                self.decimator.push(s, &holds, &mut |k: &Kept| {
-                    if failed.is_none()
-                        && let Err(e) = motion(language, command, text, cx, k)
-                    {
-                        failed = Some(e);
-                    }
-                });
-                if let Some(e) = failed {
-                    return Err(e);
-                }
+                self.decimate(Some(s))?;
             }
             spill(&mut self.out, &mut self.text)?;
         }
@@ -308,29 +364,8 @@ impl<'a, W: Write> RobotProgram<'a, W> {
     /// Writes the last motion and the program's end; hands back the output.
     pub fn finish(mut self) -> Result<W, ProgramError> {
         let language = self.cx.options.language;
-        let command = self.cx.options.command;
         if !self.every_sample() {
-            let (tol, jtol, dof) = (
-                self.cx.options.tolerance,
-                self.cx.options.joint_tolerance,
-                self.cx.target.model.dof(),
-            );
-            let holds = |a: &JobSample, b: &JobSample, x: &JobSample| match command {
-                Command::Cartesian => pose_holds(tol, a, b, x),
-                Command::Joints => joints_hold(jtol, dof, a, b, x),
-            };
-            let mut failed = None;
-            let (cx, text) = (&mut self.cx, &mut self.text);
-            self.decimator.finish(&holds, &mut |k: &Kept| {
-                if failed.is_none()
-                    && let Err(e) = motion(language, command, text, cx, k)
-                {
-                    failed = Some(e);
-                }
-            });
-            if let Some(e) = failed {
-                return Err(e);
-            }
+            self.decimate(None)?;
         }
         footer(language, &mut self.text, &self.cx);
         self.out.write_all(self.text.as_bytes())?;

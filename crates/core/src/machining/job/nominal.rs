@@ -283,7 +283,7 @@ pub struct NominalSample {
 /// The nominal stage of the pass alone (the nominal tool on the nominal stock: the chip and
 /// its force at every sample, the job's checks of the cut), handing each sample to `f`:
 /// what the placement and the spin about the tool axis do not change, computed once for a
-/// search over them ([`super::spin`], [`super::placement`]). Errors as [`run`]'s nominal
+/// search over them ([`crate::machining::spin`], [`crate::machining::placement`]). Errors as [`super::run`]'s nominal
 /// ones, or `f`'s.
 pub fn nominal_pass(
     job: &Job,

@@ -10,7 +10,7 @@ use crate::machining::stock::ZMap;
 use crate::mechanism::PoseIkOptions;
 
 /// The stock: a block over `[min, max]` (x, y) with its top at `top`, workpiece frame \[m\],
-/// resolved in square cells of `cell` \[m\] (see [`super::stock::MAX_CELLS`]).
+/// resolved in square cells of `cell` \[m\] (see [`crate::machining::stock::MAX_CELLS`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Stock {
     /// Lower corner (x, y) \[m\].
@@ -40,15 +40,15 @@ pub struct Setup {
     /// How the program is driven and sampled.
     pub path: PathOptions,
     /// Pose IK settings (rigid and loaded); the full pose on an arm of fewer than six joints
-    /// runs as the largest task it controls at the seed ([`Job::at_seed`]).
+    /// runs as the largest task it controls at the seed ([`super::Job::at_seed`]).
     pub ik: PoseIkOptions,
     /// Speed of a spindle the program does not start \[rev/s\] (a hand-started spindle: posts
     /// for such machines write no `M3`): it turns clockwise at this speed wherever the
     /// program's spindle is off. `None`: the program's spindle only.
     pub hand_spindle: Option<f64>,
     /// How deep a rapid move may run into the predicted stock \[m\] before the job refuses
-    /// it ([`JobError::RapidInStock`]); the deepest contact within it is reported
-    /// ([`Report::rapid_contact`]). Default [`RAPID_SKIM`].
+    /// it ([`crate::error::JobError::RapidInStock`]); the deepest contact within it is reported
+    /// ([`super::Report::rapid_contact`]). Default [`super::RAPID_SKIM`].
     pub rapid_skim: f64,
 }
 

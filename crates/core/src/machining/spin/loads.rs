@@ -251,9 +251,9 @@ impl Reader<'_> {
         out.copy_from_slice(head);
         Ok(out)
     }
-    fn f64(&mut self) -> Result<f64, BuildError> {
-        let v = f64::from_le_bytes(self.take()?);
-        if v.is_finite() {
+    /// `v`, refused where it is not finite.
+    fn finite<T: Into<f64> + Copy>(v: T) -> Result<T, BuildError> {
+        if v.into().is_finite() {
             Ok(v)
         } else {
             Err(BuildError::NonFinite {
@@ -262,16 +262,11 @@ impl Reader<'_> {
             })
         }
     }
+    fn f64(&mut self) -> Result<f64, BuildError> {
+        Self::finite(f64::from_le_bytes(self.take()?))
+    }
     fn f32(&mut self) -> Result<f32, BuildError> {
-        let v = f32::from_le_bytes(self.take()?);
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(BuildError::NonFinite {
-                what: "load path bytes",
-                index: 0,
-            })
-        }
+        Self::finite(f32::from_le_bytes(self.take()?))
     }
     fn count(&mut self, limit: usize, what: &'static str) -> Result<usize, BuildError> {
         let n = u64::from_le_bytes(self.take()?);

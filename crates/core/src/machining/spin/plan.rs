@@ -268,14 +268,7 @@ pub fn plan_at(
         .into());
     }
     let dof = job.model().dof();
-    if seed.len() != dof {
-        return Err(BuildError::WrongLength {
-            what: "seed joints",
-            expected: dof,
-            got: seed.len(),
-        }
-        .into());
-    }
+    crate::machining::job::check_seed(job, seed)?;
     let job = &*job.at_seed(seed)?;
     let candidates = if optimise {
         options.candidates()
