@@ -64,6 +64,7 @@ __all__ = [
     "gcode_words",
     "MachiningJob",
     "MachiningResult",
+    "PlacementProblem",
     "milling_force",
     "DeflectError",
     "LoadError",
