@@ -148,7 +148,11 @@ impl<'a> Arm<'a> {
         let job = self.job;
         let dof = job.model.dof();
         let setup = &job.setup;
-        let orientation = SpinSchedule::turn(&setup.tool_orientation, spin);
+        let orientation = if spin == 0.0 {
+            setup.tool_orientation
+        } else {
+            SpinSchedule::turn(&setup.tool_orientation, spin)
+        };
         let target =
             self.to_base * Isometry3::from_parts(Translation3::from(n.path.position), orientation);
         let (wrench, load) = if self.compensated {
