@@ -166,20 +166,8 @@ impl Convention {
                 *r = step.revolute;
             }
         }
-        for (what, t) in [
-            ("controller base frame", &base),
-            ("controller tool frame", &tool),
-        ] {
-            if let Some(index) = t
-                .translation
-                .vector
-                .iter()
-                .chain(t.rotation.coords.iter())
-                .position(|v| !v.is_finite())
-            {
-                return Err(BuildError::NonFinite { what, index });
-            }
-        }
+        crate::error::check_frame("controller base frame", &base)?;
+        crate::error::check_frame("controller tool frame", &tool)?;
         Ok(c)
     }
 

@@ -458,3 +458,21 @@ pub(crate) fn param(
         })
     }
 }
+
+/// A frame's translation and quaternion (x, y, z, then i, j, k, w) all finite, else
+/// [`BuildError::NonFinite`] naming `what` and the first bad entry.
+pub(crate) fn check_frame(
+    what: &'static str,
+    t: &nalgebra::Isometry3<f64>,
+) -> Result<(), BuildError> {
+    match t
+        .translation
+        .vector
+        .iter()
+        .chain(t.rotation.coords.iter())
+        .position(|v| !v.is_finite())
+    {
+        Some(index) => Err(BuildError::NonFinite { what, index }),
+        None => Ok(()),
+    }
+}

@@ -61,4 +61,4 @@ impl Placement {
     }
 }
 
-pub(crate) use build::param;
+pub(crate) use build::{check_frame, param};

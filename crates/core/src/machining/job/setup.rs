@@ -62,19 +62,10 @@ impl Setup {
     /// Checks the placement, stock (its cell budget, without allocating), tool,
     /// coefficients, path and IK options.
     pub fn validate(&self) -> Result<(), BuildError> {
-        let t = &self.placement;
-        if let Some(index) = t
-            .translation
-            .vector
-            .iter()
-            .chain(t.rotation.coords.iter())
-            .position(|v| !v.is_finite())
-        {
-            return Err(BuildError::NonFinite {
-                what: "placement (x, y, z, then quaternion i, j, k, w)",
-                index,
-            });
-        }
+        crate::error::check_frame(
+            "placement (x, y, z, then quaternion i, j, k, w)",
+            &self.placement,
+        )?;
         let z = self.tool_orientation * Vector3::z();
         crate::error::param(
             "tool orientation (|z_tcp . z_workpiece|, must be 1)",
