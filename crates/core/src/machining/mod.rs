@@ -1,6 +1,7 @@
 //! Robot machining: the program a CAM system writes, as moves in the workpiece frame
 //! ([`Program`], read by [`crate::io::gcode`]), and the milling force it makes
-//! ([`cutting`]: the mechanistic model of end milling), and the stock it cuts ([`stock`]: a
+//! ([`cutting`]: the mechanistic model of end milling; [`profile`]: of flat, ball and
+//! bull-nose cutters along their edge), and the stock it cuts ([`stock`]: a
 //! z-map lowered by a flat or ball end mill).
 //!
 //! This is the offline half of the hybrid compensation of Hähn and Weigold ("Hybrid
@@ -19,6 +20,7 @@ pub mod job;
 pub mod path;
 #[cfg(feature = "alloc")]
 pub mod placement;
+pub mod profile;
 #[cfg(feature = "alloc")]
 mod program;
 #[cfg(feature = "alloc")]

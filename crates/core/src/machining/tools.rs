@@ -13,31 +13,7 @@ use crate::error::BuildError;
 /// Most tools one table holds: 1,000 (LinuxCNC's default pocket count is 56).
 pub const MAX_TOOLS: usize = 1_000;
 
-/// The end of a cutter.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum ToolShape {
-    /// Flat end mill.
-    #[default]
-    Flat,
-    /// Ball end mill (end radius = half the diameter).
-    Ball,
-    /// Bull-nose (torus) end mill with `corner_radius` \[m\], in `(0, diameter / 2)`.
-    BullNose {
-        /// Corner radius \[m\].
-        corner_radius: f64,
-    },
-}
-
-impl ToolShape {
-    /// "flat", "ball" or "bull-nose".
-    pub fn name(&self) -> &'static str {
-        match self {
-            Self::Flat => "flat",
-            Self::Ball => "ball",
-            Self::BullNose { .. } => "bull-nose",
-        }
-    }
-}
+pub use super::profile::ToolShape;
 
 /// One tool of a table.
 #[derive(Debug, Clone, PartialEq)]
