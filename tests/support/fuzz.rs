@@ -348,8 +348,30 @@ pub fn kr300_robot() -> &'static SerialRobot {
     )
 }
 
+/// A trunnion `A` carrying a rotary table `C`, without tool centre point control: the
+/// machine the fuzzed programs' `A` and `C` words turn.
+fn table_table() -> deflect_core::machining::Kinematics {
+    use deflect_core::machining::kinematics::{Carrier, Rotary, RotaryWord};
+    let rotary = |word, direction: [f64; 3], point: [f64; 3], limits| Rotary {
+        word,
+        carrier: Carrier::Table,
+        direction: nalgebra::Vector3::from(direction),
+        point: nalgebra::Vector3::from(point),
+        limits,
+    };
+    deflect_core::machining::Kinematics::new(
+        [
+            rotary(RotaryWord::A, [1.0, 0.0, 0.0], [0.0, 0.0, 0.1], (-2.0, 2.0)),
+            rotary(RotaryWord::C, [0.0, 0.0, 1.0], [0.01, 0.0, 0.0], (-600.0, 600.0)),
+        ],
+        false,
+    )
+    .unwrap_or_else(|_| unreachable!("a valid machine"))
+}
+
 /// Target `gcode`: a G-code program read in mm from the origin (LinuxCNC's dialect) and in
-/// inch from an offset start (the fanuc dialect, block delete on); its word report alongside.
+/// inch from an offset start (the fanuc dialect, block delete on), and for a table-table
+/// machine turning its `A` and `C`; its word report alongside.
 /// Whatever reads is a continuous path of finite moves: each starts where the one before
 /// ended, arcs have a radius > 0 and a sweep within their turns, dwells stay in place,
 /// `point(0)` and `point(1)` are the ends, feeds are finite (0 for rapids and dwells, > 0
@@ -365,6 +387,11 @@ pub fn gcode(data: &[u8]) -> bool {
             units: LengthUnit::Inch,
             dialect: gcode::Dialect::Fanuc,
             block_delete: true,
+            kinematics: None,
+        },
+        gcode::GcodeOptions {
+            kinematics: Some(table_table()),
+            ..gcode::GcodeOptions::default()
         },
     ] {
         if let Ok(words) = gcode::words(&text, &options) {

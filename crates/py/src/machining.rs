@@ -86,6 +86,7 @@ fn options(
         units,
         dialect: dialect(dialect_name)?,
         block_delete,
+        kinematics: None,
     })
 }
 

@@ -13,10 +13,12 @@
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
 //! | [`tool_table`] | LinuxCNC `.tbl`, or TOML | [`crate::machining::tools::ToolTable`] |
 //! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |
+//! | [`apt`] | APT / CL data with tool vectors (five-axis programs), cutters | [`crate::machining::Program`] |
 //! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
 //! | [`map_json`] | versioned JSON of a map (version 2: an N-D grid map) | [`crate::ComplianceMap`], [`crate::compliance_map::GridMap`] |
 //! | [`grid_csv`] | static tests on a 1-4 D grid, axes named by their columns | [`crate::compliance_map::GridMap`] |
 
+pub mod apt;
 #[cfg(feature = "urdf")]
 pub mod controller;
 pub(crate) mod decimate;

@@ -8,10 +8,11 @@
 //! | `x_mm`, `y_mm`, `z_mm` (or `x_m`, `y_m`, `z_m`) | mm (m) | the point |
 //! | `feed_mm_min` (or `feed_m_s`) | mm/min (m/s) | feed of the move; 0 for a rapid move |
 //! | `spindle_rpm` | rev/min | spindle speed during the move (0: off) |
+//! | `i`, `j`, `k` (optional, all three) | 1 | the tool axis at the point, tip towards spindle (a five-axis path; normalised within [`super::apt::AXIS_NORM_TOLERANCE`] of unit length, refused beyond); without them the axis is the workpiece's `+z` |
 //!
-//! Every column is required (a point file that leaves the spindle out would leave the force
-//! model guessing); an unknown column is refused, as is an orientation: a 2.5-D job keeps
-//! the tool along the workpiece z. Moves name their CSV line (the header is line 1) in every
+//! Every other column is required (a point file that leaves the spindle out would leave the
+//! force model guessing); an unknown column is refused. Between two rows the axis turns along
+//! the great circle; the tool stands at the start as the first row holds it. Moves name their CSV line (the header is line 1) in every
 //! later error. At most [`crate::machining::MAX_MOVES`] rows.
 
 use std::path::Path;
@@ -24,7 +25,7 @@ use super::map_csv::{check_columns, column, number, read_csv, require};
 use crate::error::LoadError;
 use crate::machining::{MAX_MOVES, Motion, Move, Program};
 
-const COLUMNS: [&str; 9] = [
+const COLUMNS: [&str; 12] = [
     "x_mm",
     "y_mm",
     "z_mm",
@@ -34,6 +35,9 @@ const COLUMNS: [&str; 9] = [
     "feed_mm_min",
     "feed_m_s",
     "spindle_rpm",
+    "i",
+    "j",
+    "k",
 ];
 
 /// A column in mm (scale 1e-3) or in m.
@@ -64,6 +68,21 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
     let z = either(&header, "z_mm", "z_m", 1e-3)?;
     let feed = either(&header, "feed_mm_min", "feed_m_s", 1e-3 / 60.0)?;
     let spindle = require(&header, "spindle_rpm")?;
+    let axis_columns = match (column(&header, "i"), column(&header, "j"), column(&header, "k")) {
+        (Some(i), Some(j), Some(k)) => Some((i, j, k)),
+        (None, None, None) => None,
+        (i, j, _) => {
+            return Err(LoadError::MissingColumn {
+                column: if i.is_none() {
+                    "i"
+                } else if j.is_none() {
+                    "j"
+                } else {
+                    "k"
+                },
+            });
+        }
+    };
     if records.len() > MAX_MOVES {
         return Err(LoadError::TooLarge {
             what: "points (rows)".into(),
@@ -73,6 +92,7 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
     }
     let mut moves = Vec::with_capacity(records.len());
     let mut at = options.start;
+    let mut axis = Vector3::z();
     for (row, rec) in records.iter().enumerate() {
         let get = |(col, scale, name): (usize, f64, &'static str)| {
             number(rec, col, row, name).map(|v| v * scale)
@@ -117,6 +137,27 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
         let line = rec
             .position()
             .map_or(row + 2, |p| usize::try_from(p.line()).unwrap_or(usize::MAX));
+        let end_axis = match axis_columns {
+            None => axis,
+            Some((i, j, k)) => {
+                let v = Vector3::new(
+                    number(rec, i, row, "i")?,
+                    number(rec, j, row, "j")?,
+                    number(rec, k, row, "k")?,
+                );
+                let n = v.norm();
+                if n == 0.0 || (n - 1.0).abs() > super::apt::AXIS_NORM_TOLERANCE {
+                    return Err(LoadError::InvalidValue {
+                        element: std::format!("points row {row}"),
+                        field: "i, j, k",
+                        expected: "a unit tool vector (within AXIS_NORM_TOLERANCE, 1e-3)"
+                            .into(),
+                        got: std::format!("({}, {}, {}), length {n}", v.x, v.y, v.z),
+                    });
+                }
+                v / n
+            }
+        };
         let motion = if f > 0.0 {
             Motion::Linear
         } else {
@@ -124,9 +165,13 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
         };
         moves.push(Move {
             spindle: s / 60.0,
+            // The tool stands at the start as the first row holds it.
+            start_axis: if row == 0 { end_axis } else { axis },
+            end_axis,
             ..Move::new(line, motion, at, end, f)
         });
         at = end;
+        axis = end_axis;
     }
     Ok(Program {
         moves,

@@ -16,6 +16,7 @@ pub mod cutting;
 pub mod engagement;
 #[cfg(feature = "alloc")]
 pub mod job;
+pub mod kinematics;
 #[cfg(feature = "alloc")]
 pub mod path;
 #[cfg(feature = "alloc")]
@@ -35,5 +36,8 @@ pub mod tools;
 #[cfg(feature = "alloc")]
 pub use program::{
     ARC_TOLERANCE, MAX_ARC_TURNS, MAX_COORDINATE, MAX_DWELL, MAX_FEED, MAX_GAP, MAX_MOVES,
-    MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, Operation, PathControl, Plane, Program,
+    AXIS_TOLERANCE, MAX_AXIS_TURN, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, Operation,
+    PathControl, Plane, Program,
 };
+
+pub use kinematics::Kinematics;

@@ -189,6 +189,13 @@ pub struct Move {
     pub tool: u32,
     /// The path control mode in effect.
     pub path_control: PathControl,
+    /// The tool axis at the start, a unit vector from the tip towards the spindle, workpiece
+    /// frame: `+z` for a 2.5-D program; a five-axis program's (APT `GOTO/x,y,z,i,j,k`, G-code
+    /// `A B C` under a [`crate::machining::Kinematics`], a points CSV's `i j k`).
+    pub start_axis: Vector3<f64>,
+    /// The tool axis at the end (unit); between the two it turns along the great circle
+    /// ([`Self::axis`]).
+    pub end_axis: Vector3<f64>,
 }
 
 impl Move {
@@ -209,7 +216,29 @@ impl Move {
             spindle: 0.0,
             tool: 0,
             path_control: PathControl::default(),
+            start_axis: Vector3::z(),
+            end_axis: Vector3::z(),
         }
+    }
+
+    /// The tool axis at the fraction `s` in \[0, 1\] of the move: the great circle from
+    /// [`Self::start_axis`] to [`Self::end_axis`], uniform in angle (the ends exactly). What
+    /// a CAM system means between two tool vectors; a machine's rotary axes interpolated
+    /// linearly leave it by a fraction of the step's turn (a step of a few degrees: a few
+    /// thousandths of a degree off).
+    pub fn axis(&self, s: f64) -> Vector3<f64> {
+        if s <= 0.0 || self.start_axis == self.end_axis {
+            return self.start_axis;
+        }
+        if s >= 1.0 {
+            return self.end_axis;
+        }
+        slerp(&self.start_axis, &self.end_axis, s)
+    }
+
+    /// The angle the tool axis turns through along the move \[rad\].
+    pub fn axis_turn(&self) -> f64 {
+        angle_between(&self.start_axis, &self.end_axis)
     }
 
     /// Arc radius \[m\] (from the start point, in the arc's plane; 0 for other moves).
@@ -379,9 +408,9 @@ impl Program {
                 requested: self.moves.len(),
             });
         }
-        let mut previous: Option<Vector3<f64>> = None;
+        let mut previous: Option<(Vector3<f64>, Vector3<f64>)> = None;
         for (i, m) in self.moves.iter().enumerate() {
-            if let Some(p) = previous {
+            if let Some((p, a)) = previous {
                 let gap = (m.start - p).norm();
                 if gap > MAX_GAP {
                     return bad(
@@ -390,9 +419,18 @@ impl Program {
                         "a start within MAX_GAP (1e-9 m) of the previous end",
                     );
                 }
+                let turn = (m.start_axis - a).norm();
+                if turn > AXIS_TOLERANCE {
+                    return bad(
+                        i,
+                        turn,
+                        "a start axis within AXIS_TOLERANCE (1e-9) of the previous end axis",
+                    );
+                }
             }
-            previous = Some(m.end);
+            previous = Some((m.end, m.end_axis));
             check_move(i, m)?;
+            check_axes(i, m)?;
         }
         let mut last: Option<usize> = None;
         for (index, o) in self.operations.iter().enumerate() {
@@ -426,6 +464,13 @@ impl Program {
             .saturating_sub(1)
     }
 
+    /// Whether any move's tool axis leaves the workpiece's `+z` (a five-axis program).
+    pub fn is_multi_axis(&self) -> bool {
+        self.moves
+            .iter()
+            .any(|m| m.start_axis != Vector3::z() || m.end_axis != Vector3::z())
+    }
+
     /// The tool numbers the program's moves use, ascending, each once.
     pub fn tools(&self) -> Vec<u32> {
         let mut t: Vec<u32> = self.moves.iter().map(|m| m.tool).collect();
@@ -433,6 +478,52 @@ impl Program {
         t.dedup();
         t
     }
+}
+
+/// How far from unit length a move's tool axis may be (\[1\]), and how far a move's start
+/// axis may be from the previous end axis: 1e-9 (the readers normalise what they read).
+pub const AXIS_TOLERANCE: f64 = 1.0e-9;
+
+/// Largest turn of the tool axis along one move \[rad\]: 179 degrees (the great circle
+/// between opposite vectors has no direction; CAM programs turn by a few degrees per point).
+pub const MAX_AXIS_TURN: f64 = 179.0 * core::f64::consts::PI / 180.0;
+
+/// The angle between two unit vectors \[rad\], accurate near 0 and pi (`atan2` of the cross
+/// and dot products).
+pub(crate) fn angle_between(a: &Vector3<f64>, b: &Vector3<f64>) -> f64 {
+    nalgebra::RealField::atan2(a.cross(b).norm(), a.dot(b))
+}
+
+/// The great circle from unit `a` to unit `b` at the fraction `s` of the angle.
+pub(crate) fn slerp(a: &Vector3<f64>, b: &Vector3<f64>, s: f64) -> Vector3<f64> {
+    let theta = angle_between(a, b);
+    if theta < 1.0e-12 {
+        return (a + (b - a) * s).normalize();
+    }
+    let sin = ComplexField::sin(theta);
+    (a * ComplexField::sin((1.0 - s) * theta) + b * ComplexField::sin(s * theta)) / sin
+}
+
+/// A move's tool axes: unit within [`AXIS_TOLERANCE`], turning at most [`MAX_AXIS_TURN`].
+fn check_axes(i: usize, m: &Move) -> Result<(), BuildError> {
+    for a in [&m.start_axis, &m.end_axis] {
+        let n = a.norm();
+        if !(n.is_finite() && ComplexField::abs(n - 1.0) <= AXIS_TOLERANCE) {
+            return bad(i, n, "a tool axis of unit length (within AXIS_TOLERANCE, 1e-9)");
+        }
+    }
+    let turn = m.axis_turn();
+    if turn > MAX_AXIS_TURN {
+        return bad(
+            i,
+            turn,
+            "a tool axis turning at most MAX_AXIS_TURN (179 degrees) along one move",
+        );
+    }
+    if matches!(m.motion, Motion::Dwell { .. }) && turn > 0.0 {
+        return bad(i, turn, "a dwell with the tool axis held");
+    }
+    Ok(())
 }
 
 fn bad(index: usize, value: f64, expected: &'static str) -> Result<(), BuildError> {

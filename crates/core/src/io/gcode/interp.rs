@@ -16,7 +16,8 @@ use nalgebra::{Vector2, Vector3};
 use super::Dialect;
 use super::params::Params;
 use super::words::{Words, g_name};
-use crate::machining::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Move, PathControl, Plane};
+use crate::machining::kinematics::RotaryWord;
+use crate::machining::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, PathControl, Plane};
 
 /// A fault inside a block: the column and the message.
 pub(super) type Fault = (usize, String);
@@ -128,6 +129,12 @@ pub(super) struct Machine {
     pub value: f64,
     pub value_returned: bool,
     pub call_level: usize,
+    /// The machine's rotary axes, if the program is read for one.
+    pub kinematics: Option<crate::machining::Kinematics>,
+    /// The rotary angles (A, B, C) \[rad\] at the current point, and where the block's words
+    /// turn them (reached by the block's first move).
+    pub rotary: [f64; 3],
+    pub rotary_end: [f64; 3],
 }
 
 /// Rotates (x, y) by `deg` counter-clockwise.
@@ -196,6 +203,42 @@ impl Machine {
             value: 0.0,
             value_returned: false,
             call_level: 0,
+            kinematics: None,
+            rotary: [0.0; 3],
+            rotary_end: [0.0; 3],
+        }
+    }
+
+    /// The machine read with `kinematics`' rotary axes.
+    pub(super) fn with_kinematics(mut self, kinematics: Option<crate::machining::Kinematics>) -> Self {
+        self.kinematics = kinematics;
+        self
+    }
+
+    /// Reads the block's words of the kinematics' rotary axes (degrees; incremental in
+    /// `G91`) into [`Self::rotary_end`]; the other rotary words were refused (or are 0).
+    fn rotary_words(&mut self, w: &mut Words) {
+        self.rotary_end = self.rotary;
+        let Some(k) = self.kinematics else {
+            for letter in [b'a', b'b', b'c'] {
+                w.take(letter);
+            }
+            return;
+        };
+        for (letter, word) in [
+            (b'a', RotaryWord::A),
+            (b'b', RotaryWord::B),
+            (b'c', RotaryWord::C),
+        ] {
+            let Some(v) = w.take(letter) else { continue };
+            if k.rotary(word).is_none() {
+                continue;
+            }
+            let i = word.index();
+            let now = self.rotary.get(i).copied().unwrap_or(0.0);
+            if let Some(slot) = self.rotary_end.get_mut(i) {
+                *slot = if self.absolute { v.to_radians() } else { now + v.to_radians() };
+            }
         }
     }
 
@@ -261,12 +304,26 @@ impl Machine {
     pub(super) fn execute(&mut self, w: &mut Words, params: &mut Params) -> Result<(), Fault> {
         super::words::check_groups(w)?;
         self.refuse_unsupported(w)?;
-        for letter in [b'a', b'b', b'c'] {
-            w.take(letter);
-        }
+        let rotary_column = [b'a', b'b', b'c']
+            .into_iter()
+            .find(|&l| w.has(l))
+            .map_or(1, |l| w.column(l));
         self.modes_before_motion(w, params)?;
+        // After the distance mode of this block, before its motion.
+        self.rotary_words(w);
         let consumed = self.non_modal(w, params)?;
         self.motion(w, consumed, params)?;
+        if self.rotary_end != self.rotary {
+            // A turn of the rotaries alone: a reorientation in place, at the rapid rate.
+            if self.motion != Some(0) {
+                return fault(
+                    rotary_column,
+                    "a turn of the rotary axes alone in G0 (in G1 it has no path speed: give \
+                     the X Y Z of the move with it)",
+                );
+            }
+            self.emit(Motion::Rapid, self.pos, 0.0, rotary_column)?;
+        }
         self.stops(w);
         if let Some((letter, column)) = w.unused() {
             return fault(column, super::words::unused_message(letter, w));
@@ -302,14 +359,26 @@ impl Machine {
             (b'w', "W"),
         ] {
             // A rotary axis held at 0 (a post for a machine with a rotary table that this
-            // program does not turn) moves nothing; one that turns is refused.
-            let held = matches!(letter, b'a' | b'b' | b'c') && w.peek(letter) == Some(0.0);
+            // program does not turn) moves nothing; one that turns is refused, but the
+            // rotaries of the kinematics the program is read for.
+            let declared = self.kinematics.is_some_and(|k| {
+                let word = match letter {
+                    b'a' => Some(RotaryWord::A),
+                    b'b' => Some(RotaryWord::B),
+                    b'c' => Some(RotaryWord::C),
+                    _ => None,
+                };
+                word.is_some_and(|r| k.rotary(r).is_some())
+            });
+            let held = declared
+                || matches!(letter, b'a' | b'b' | b'c') && w.peek(letter) == Some(0.0);
             if w.has(letter) && !held {
                 return fault(
                     w.column(letter),
                     std::format!(
-                        "{what}: rotary and secondary axes (A, B, C, U, V, W) are not modelled; \
-                         a 3-axis program moves X, Y and Z (A, B, C may only stay at 0)"
+                        "{what}: rotary and secondary axes (A, B, C, U, V, W) are not modelled \
+                         without a machine kinematics declaring them; a 3-axis program moves \
+                         X, Y and Z (A, B, C may only stay at 0)"
                     ),
                 );
             }

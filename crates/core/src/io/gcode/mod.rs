@@ -19,6 +19,7 @@
 //! | `M3` `M4` `M5` `S` | spindle clockwise, counter-clockwise (the cutting model's direction), off, speed |
 //! | `G43 H` `G43.1` `G43.2` `G49` | tool length offsets: recorded, not applied (a robot's TCP carries the tool length) |
 //! | `G61` `G61.1` `G64 P Q` | path control: recorded per move ([`crate::machining::PathControl`]) |
+//! | `A` `B` `C` | with [`GcodeOptions::kinematics`]: the rotary axes it declares (degrees), turned into the tool tip and axis of each move; a turn with `G0`/`G1` (alone only at `G0`), not on an arc or in a cycle; an angle past the axis' limits refused |
 //! | `M0` `M1` `M60` `M7`-`M9` `M19` `M48`-`M53` `M62`-`M68` `M70`-`M73` `G40` `G97` | stops, coolant, orientation, overrides, I/O, modal state save and restore: no motion |
 //! | `M2` `M30` `M99` `%` | program end (what follows is not read) |
 //! | `#1`-`#5601` `#<name>` `#<_global>` `[...]` `O` words `M98` | parameters, expressions, subroutines and control flow (see below) |
@@ -26,7 +27,7 @@
 //!
 //! Refused by name: cutter radius compensation (`G41`, `G42`), probing (`G38.x`), threading
 //! (`G33`, `G76`), lathe modes and cycles (`G7`, `G70`-`G72`, `G96`), NURBS (`G5.2`), rotary
-//! and secondary axes (`A B C U V W`), user M codes
+//! axes (`A B C`) but those of [`GcodeOptions::kinematics`], secondary axes (`U V W`), user M codes
 //! (`M100`-`M199`); and every word LinuxCNC refuses, with its reason.
 //!
 //! # The frame
@@ -169,6 +170,10 @@ pub struct GcodeOptions {
     /// The block delete switch: when on, lines starting with `/` are skipped. Default: off
     /// (LinuxCNC's), they run.
     pub block_delete: bool,
+    /// A five-axis machine's rotary axes: its `A B C` words (degrees, `G90`/`G91` like the
+    /// linear axes) turn the tool axis of the moves ([`crate::machining::Kinematics`]).
+    /// Default: none (a 3-axis program: `A B C` may only stay at 0).
+    pub kinematics: Option<crate::machining::Kinematics>,
 }
 
 impl Default for GcodeOptions {
@@ -178,6 +183,7 @@ impl Default for GcodeOptions {
             units: LengthUnit::Millimetre,
             dialect: Dialect::LinuxCnc,
             block_delete: false,
+            kinematics: None,
         }
     }
 }

@@ -279,8 +279,21 @@ impl Machine {
                 std::format!("an end point within +-{MAX_COORDINATE} m, got {v} m"),
             );
         }
+        let turning = self.rotary_end != self.rotary;
+        if turning && !matches!(motion, Motion::Rapid | Motion::Linear) {
+            return fault(
+                column,
+                "rotary axes turning on a straight move (G0, G1) only, not on an arc, a \
+                 dwell or in a canned cycle",
+            );
+        }
+        let (start, stop, start_axis, end_axis) = self.posed(start, stop, column)?;
         self.pos = end;
-        if matches!(motion, Motion::Rapid | Motion::Linear) && start == stop {
+        self.rotary = self.rotary_end;
+        if matches!(motion, Motion::Rapid | Motion::Linear)
+            && start == stop
+            && start_axis == end_axis
+        {
             return Ok(());
         }
         let motion = match motion {
@@ -288,11 +301,21 @@ impl Machine {
                 plane,
                 center,
                 sweep,
-            } => Motion::Arc {
-                plane,
-                center: self.to_machine(&center),
-                sweep,
-            },
+            } => {
+                if self.kinematics.is_some_and(|k| !k.tcp()) && self.rotary != [0.0; 3] {
+                    return fault(
+                        column,
+                        "an arc with the rotary axes at 0 (without tool centre point \
+                         control a turned table or head makes it no circle in the \
+                         workpiece: have the post write lines)",
+                    );
+                }
+                Motion::Arc {
+                    plane,
+                    center: self.to_machine(&center),
+                    sweep,
+                }
+            }
             m => m,
         };
         if self.moves.len() >= MAX_MOVES {
@@ -333,9 +356,37 @@ impl Machine {
                 self.tool
             },
             path_control: self.path_control,
+            start_axis,
+            end_axis,
             ..Move::new(self.line, motion, start, stop, feed)
         });
         Ok(())
+    }
+
+    /// The move's start and end tips and axes in the workpiece frame: the machine points as
+    /// they are without kinematics, else the kinematics' poses at the rotary angles before and
+    /// after the block's words.
+    #[allow(clippy::type_complexity)] // reason: the two poses of one move, used once
+    fn posed(
+        &self,
+        start: Vector3<f64>,
+        stop: Vector3<f64>,
+        column: usize,
+    ) -> Result<(Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>), Fault> {
+        let Some(k) = self.kinematics else {
+            return Ok((start, stop, Vector3::z(), Vector3::z()));
+        };
+        let pose = |p: &Vector3<f64>, angles: &[f64; 3]| {
+            k.pose(p, angles).map_err(|e| {
+                (
+                    column,
+                    std::format!("rotary angles the machine reaches: {e}"),
+                )
+            })
+        };
+        let a = pose(&start, &self.rotary)?;
+        let b = pose(&stop, &self.rotary_end)?;
+        Ok((a.tip, b.tip, a.axis, b.axis))
     }
 
     /// A dwell of `seconds` (`G4 P`, a cycle's `P`).

@@ -80,7 +80,8 @@ pub(super) fn run(text: &str, options: &GcodeOptions) -> Result<Program, LoadErr
         block: Block::default(),
         words: Words::default(),
         params: Params::new(),
-        m: Machine::new(options.dialect, start, options.units.to_metre()),
+        m: Machine::new(options.dialect, start, options.units.to_metre())
+            .with_kinematics(options.kinematics),
         subs: HashMap::new(),
         headers: HashMap::new(),
         frames: Vec::new(),
