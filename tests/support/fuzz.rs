@@ -362,7 +362,12 @@ fn table_table() -> deflect_core::machining::Kinematics {
     deflect_core::machining::Kinematics::new(
         [
             rotary(RotaryWord::A, [1.0, 0.0, 0.0], [0.0, 0.0, 0.1], (-2.0, 2.0)),
-            rotary(RotaryWord::C, [0.0, 0.0, 1.0], [0.01, 0.0, 0.0], (-600.0, 600.0)),
+            rotary(
+                RotaryWord::C,
+                [0.0, 0.0, 1.0],
+                [0.01, 0.0, 0.0],
+                (-600.0, 600.0),
+            ),
         ],
         false,
     )

@@ -39,8 +39,8 @@ use super::gcode::GcodeOptions;
 use crate::error::{BuildError, LoadError};
 use crate::machining::tools::ToolShape;
 use crate::machining::{
-    MAX_COORDINATE, MAX_FEED, MAX_MOVES, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move,
-    Operation, Plane, Program,
+    MAX_COORDINATE, MAX_FEED, MAX_MOVES, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, Operation,
+    Plane, Program,
 };
 use crate::units::LengthUnit;
 
@@ -242,7 +242,10 @@ impl Reader {
     fn point(&self, line: usize, v: [f64; 3]) -> Result<Vector3<f64>, LoadError> {
         let p = Vector3::from(v) * self.unit;
         if let Some(x) = p.iter().find(|x| x.is_nan() || x.abs() > MAX_COORDINATE) {
-            return fault(line, format!("a point within +-{MAX_COORDINATE} m, got {x} m"));
+            return fault(
+                line,
+                format!("a point within +-{MAX_COORDINATE} m, got {x} m"),
+            );
         }
         Ok(p)
     }
@@ -284,10 +287,7 @@ impl Reader {
         let (start, start_axis) = (self.pos, self.axis);
         self.pos = end;
         self.axis = axis;
-        if matches!(motion, Motion::Linear | Motion::Rapid)
-            && start == end
-            && start_axis == axis
-        {
+        if matches!(motion, Motion::Linear | Motion::Rapid) && start == end && start_axis == axis {
             return Ok(());
         }
         let feed = if rapid { 0.0 } else { self.speed(line)? };
@@ -400,7 +400,10 @@ impl Reader {
             Some("MMPR") => Feed::PerRevolution(v * mm),
             Some("IPR") => Feed::PerRevolution(v * inch),
             Some(other) => {
-                return fault(line, format!("FEDRAT's unit MMPM, IPM, MMPR or IPR, got {other}"));
+                return fault(
+                    line,
+                    format!("FEDRAT's unit MMPM, IPM, MMPR or IPR, got {other}"),
+                );
             }
         });
         Ok(())
@@ -443,7 +446,10 @@ impl Reader {
         }
         if let Some(s) = speed {
             if !(0.0..=MAX_SPINDLE_RPM).contains(&s) {
-                return fault(line, format!("a spindle speed in 0..={MAX_SPINDLE_RPM} rpm, got {s}"));
+                return fault(
+                    line,
+                    format!("a spindle speed in 0..={MAX_SPINDLE_RPM} rpm, got {s}"),
+                );
             }
             self.spindle_rpm = s;
             self.spindle_on = true;
@@ -456,7 +462,10 @@ impl Reader {
             return fault(line, "LOADTL/n");
         };
         if !(n.fract() == 0.0 && *n >= 1.0 && *n <= f64::from(MAX_TOOL_NUMBER)) {
-            return fault(line, format!("a tool number in 1..={MAX_TOOL_NUMBER}, got {n}"));
+            return fault(
+                line,
+                format!("a tool number in 1..={MAX_TOOL_NUMBER}, got {n}"),
+            );
         }
         let n = *n as u32;
         // A cutter defined since the last move belongs to the tool loaded now.
@@ -550,7 +559,10 @@ fn unit_axis(line: usize, what: &str, i: f64, j: f64, k: f64) -> Result<Vector3<
     let v = Vector3::new(i, j, k);
     let n = v.norm();
     if n == 0.0 {
-        return fault(line, format!("{what}: a tool vector (i, j, k) that is not zero"));
+        return fault(
+            line,
+            format!("{what}: a tool vector (i, j, k) that is not zero"),
+        );
     }
     if (n - 1.0).abs() > AXIS_NORM_TOLERANCE || n.is_nan() {
         return fault(

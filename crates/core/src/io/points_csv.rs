@@ -68,7 +68,11 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
     let z = either(&header, "z_mm", "z_m", 1e-3)?;
     let feed = either(&header, "feed_mm_min", "feed_m_s", 1e-3 / 60.0)?;
     let spindle = require(&header, "spindle_rpm")?;
-    let axis_columns = match (column(&header, "i"), column(&header, "j"), column(&header, "k")) {
+    let axis_columns = match (
+        column(&header, "i"),
+        column(&header, "j"),
+        column(&header, "k"),
+    ) {
         (Some(i), Some(j), Some(k)) => Some((i, j, k)),
         (None, None, None) => None,
         (i, j, _) => {
@@ -150,8 +154,7 @@ pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError
                     return Err(LoadError::InvalidValue {
                         element: std::format!("points row {row}"),
                         field: "i, j, k",
-                        expected: "a unit tool vector (within AXIS_NORM_TOLERANCE, 1e-3)"
-                            .into(),
+                        expected: "a unit tool vector (within AXIS_NORM_TOLERANCE, 1e-3)".into(),
                         got: std::format!("({}, {}, {}), length {n}", v.x, v.y, v.z),
                     });
                 }

@@ -35,8 +35,8 @@ pub mod tools;
 
 #[cfg(feature = "alloc")]
 pub use program::{
-    ARC_TOLERANCE, MAX_ARC_TURNS, MAX_COORDINATE, MAX_DWELL, MAX_FEED, MAX_GAP, MAX_MOVES,
-    AXIS_TOLERANCE, MAX_AXIS_TURN, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, Operation,
+    ARC_TOLERANCE, AXIS_TOLERANCE, MAX_ARC_TURNS, MAX_AXIS_TURN, MAX_COORDINATE, MAX_DWELL,
+    MAX_FEED, MAX_GAP, MAX_MOVES, MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, Operation,
     PathControl, Plane, Program,
 };
 

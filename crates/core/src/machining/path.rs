@@ -157,6 +157,25 @@ impl Plan {
 fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
     options.validate()?;
     program.validate()?;
+    // The path follows the tool tip with the axis along the workpiece z; a tilted axis would
+    // be silently dropped here.
+    if let Some((index, m)) = program
+        .moves
+        .iter()
+        .enumerate()
+        .find(|(_, m)| m.start_axis != Vector3::z() || m.end_axis != Vector3::z())
+    {
+        return Err(BuildError::InvalidEntry {
+            what: "program moves (index: the move; value: its tool axis' angle from +z, rad)",
+            index,
+            value: crate::machining::program::angle_between(&m.end_axis, &Vector3::z()).max(
+                crate::machining::program::angle_between(&m.start_axis, &Vector3::z()),
+            ),
+            expected: "a tool axis along the workpiece +z: the path and the job run 2.5-D \
+                       programs (five-axis programs read, with their tool axes, but are not \
+                       machined yet)",
+        });
+    }
     let cos_corner = ComplexField::cos(options.corner_angle);
     let mut p = Plan {
         segs: Vec::new(),

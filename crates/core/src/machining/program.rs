@@ -509,7 +509,11 @@ fn check_axes(i: usize, m: &Move) -> Result<(), BuildError> {
     for a in [&m.start_axis, &m.end_axis] {
         let n = a.norm();
         if !(n.is_finite() && ComplexField::abs(n - 1.0) <= AXIS_TOLERANCE) {
-            return bad(i, n, "a tool axis of unit length (within AXIS_TOLERANCE, 1e-9)");
+            return bad(
+                i,
+                n,
+                "a tool axis of unit length (within AXIS_TOLERANCE, 1e-9)",
+            );
         }
     }
     let turn = m.axis_turn();

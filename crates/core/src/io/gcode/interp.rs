@@ -135,6 +135,8 @@ pub(super) struct Machine {
     /// turn them (reached by the block's first move).
     pub rotary: [f64; 3],
     pub rotary_end: [f64; 3],
+    /// The column of the block's first rotary word (1 without one).
+    pub rotary_column: usize,
 }
 
 /// Rotates (x, y) by `deg` counter-clockwise.
@@ -206,11 +208,15 @@ impl Machine {
             kinematics: None,
             rotary: [0.0; 3],
             rotary_end: [0.0; 3],
+            rotary_column: 1,
         }
     }
 
     /// The machine read with `kinematics`' rotary axes.
-    pub(super) fn with_kinematics(mut self, kinematics: Option<crate::machining::Kinematics>) -> Self {
+    pub(super) fn with_kinematics(
+        mut self,
+        kinematics: Option<crate::machining::Kinematics>,
+    ) -> Self {
         self.kinematics = kinematics;
         self
     }
@@ -237,7 +243,11 @@ impl Machine {
             let i = word.index();
             let now = self.rotary.get(i).copied().unwrap_or(0.0);
             if let Some(slot) = self.rotary_end.get_mut(i) {
-                *slot = if self.absolute { v.to_radians() } else { now + v.to_radians() };
+                *slot = if self.absolute {
+                    v.to_radians()
+                } else {
+                    now + v.to_radians()
+                };
             }
         }
     }
@@ -308,6 +318,7 @@ impl Machine {
             .into_iter()
             .find(|&l| w.has(l))
             .map_or(1, |l| w.column(l));
+        self.rotary_column = rotary_column;
         self.modes_before_motion(w, params)?;
         // After the distance mode of this block, before its motion.
         self.rotary_words(w);
@@ -370,8 +381,8 @@ impl Machine {
                 };
                 word.is_some_and(|r| k.rotary(r).is_some())
             });
-            let held = declared
-                || matches!(letter, b'a' | b'b' | b'c') && w.peek(letter) == Some(0.0);
+            let held =
+                declared || matches!(letter, b'a' | b'b' | b'c') && w.peek(letter) == Some(0.0);
             if w.has(letter) && !held {
                 return fault(
                     w.column(letter),

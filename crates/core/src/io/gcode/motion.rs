@@ -287,7 +287,7 @@ impl Machine {
                  dwell or in a canned cycle",
             );
         }
-        let (start, stop, start_axis, end_axis) = self.posed(start, stop, column)?;
+        let (start, stop, start_axis, end_axis) = self.posed(start, stop)?;
         self.pos = end;
         self.rotary = self.rotary_end;
         if matches!(motion, Motion::Rapid | Motion::Linear)
@@ -371,8 +371,8 @@ impl Machine {
         &self,
         start: Vector3<f64>,
         stop: Vector3<f64>,
-        column: usize,
     ) -> Result<(Vector3<f64>, Vector3<f64>, Vector3<f64>, Vector3<f64>), Fault> {
+        let column = self.rotary_column;
         let Some(k) = self.kinematics else {
             return Ok((start, stop, Vector3::z(), Vector3::z()));
         };
