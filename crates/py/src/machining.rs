@@ -1,12 +1,12 @@
-//! Robot machining: a G-code program read into numpy arrays (`GcodeProgram`, deflect-core's
-//! `io::gcode`) and the mechanistic end-milling force (`milling_force`, deflect-core's
-//! `machining::cutting`). Everything SI: m, m/s, rev/s, N.
+//! Robot machining programs: G-code, APT / CL data and tool points read into numpy arrays
+//! (`GcodeProgram`, deflect-core's `io::gcode`, `io::apt`, `io::points_csv`), with the tool
+//! axis of every move. Everything SI: m, m/s, rev/s.
 
+use deflect_core::io::apt::{self, AptCutter};
 use deflect_core::io::gcode::{self, Dialect, GcodeOptions, WordStatus, WordUse};
 use deflect_core::io::points_csv;
-use deflect_core::machining::cutting::{self, Coefficients, Engagement, MAX_DISCS, Tool};
+use deflect_core::machining::tools::ToolShape;
 use deflect_core::machining::{Motion, Move, Operation, PathControl, Plane, Program};
-use deflect_core::motion::MAX_SAMPLES;
 use deflect_core::units::LengthUnit;
 use nalgebra::Vector3;
 use numpy::ndarray::{Array1, Array2};
@@ -15,9 +15,8 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::args;
-use crate::arrays::{try_rows, vector, vector_upto};
-use crate::errors::{build_err, load_err, tick_err};
-use crate::scalars::{count, real};
+use crate::arrays::{try_rows, vector};
+use crate::errors::{build_err, load_err};
 
 /// One move as pickled: line, kind (0 rapid, 1 linear, 2 arc, 3 dwell), start, end, arc
 /// centre (NaN for other moves), (plane 0 xy / 1 zx / 2 yz, sweep [rad] or dwell [s]),
@@ -37,7 +36,16 @@ type MoveState = (
 type WordState = (String, String, usize, usize, String);
 
 /// A program as pickled: its moves and its word report.
-type ProgramState = (Vec<MoveState>, Vec<WordState>, Vec<(String, usize)>);
+type ProgramState = (
+    Vec<MoveState>,
+    Vec<WordState>,
+    Vec<(String, usize)>,
+    Vec<([f64; 3], [f64; 3])>,
+    Vec<CutterState>,
+);
+
+/// A cutter as pickled: line, tool, diameter [m], corner radius [m] (0 flat, d/2 ball).
+type CutterState = (usize, u32, f64, f64);
 
 /// A machining program read from RS274/NGC G-code as LinuxCNC reads it (tools, work
 /// offsets, planes, canned cycles, parameters, subroutines, control flow): its moves as
@@ -52,6 +60,7 @@ type ProgramState = (Vec<MoveState>, Vec<WordState>, Vec<(String, usize)>);
 pub struct GcodeProgram {
     pub(crate) inner: Program,
     words: Vec<WordUse>,
+    cutters: Vec<AptCutter>,
 }
 
 fn dialect(name: &str) -> PyResult<Dialect> {
@@ -67,6 +76,7 @@ fn options(
     units: &str,
     dialect_name: &str,
     block_delete: bool,
+    kinematics: Option<&Bound<'_, PyAny>>,
 ) -> PyResult<GcodeOptions> {
     let units = match units {
         "mm" => LengthUnit::Millimetre,
@@ -86,7 +96,7 @@ fn options(
         units,
         dialect: dialect(dialect_name)?,
         block_delete,
-        kinematics: None,
+        kinematics: crate::kinematics::kinematics(kinematics)?,
     })
 }
 
@@ -128,7 +138,28 @@ impl GcodeProgram {
                 ))
             })
             .map_err(load_err)?;
-        Ok(Self { inner, words })
+        Ok(Self {
+            inner,
+            words,
+            cutters: Vec::new(),
+        })
+    }
+
+    fn points(inner: Program) -> Self {
+        Self {
+            inner,
+            words: Vec::new(),
+            cutters: Vec::new(),
+        }
+    }
+
+    fn apt(py: Python<'_>, text: &str, o: &GcodeOptions) -> PyResult<Self> {
+        let p = py.detach(|| apt::from_str(text, o)).map_err(load_err)?;
+        Ok(Self {
+            inner: p.program,
+            words: Vec::new(),
+            cutters: p.cutters,
+        })
     }
 }
 
@@ -137,9 +168,13 @@ impl GcodeProgram {
     /// Reads a G-code file. `start` (3,) [m]: where the tool is before the first move
     /// (default the origin); `units`: "mm" or "in" until the program says G21 or G20;
     /// `dialect`: "linuxcnc", "grbl" or "fanuc"; `block_delete`: skip the lines starting with
-    /// '/' (default False: they run, as on LinuxCNC).
+    /// '/' (default False: they run, as on LinuxCNC); `kinematics`: a five-axis machine whose
+    /// A B C words turn the tool axis, `{"tcp": bool, "rotaries": [rotary, rotary]}` with each
+    /// rotary `{"word": "A"|"B"|"C", "carrier": "table"|"head", "direction": (3,), "point":
+    /// (3,) [m], "limits": (lower, upper) [rad]}` (`tcp`: X Y Z are the tool tip in the
+    /// workpiece; default None: A B C may only stay at 0).
     #[staticmethod]
-    #[pyo3(signature = (path, *, start=None, units="mm", dialect="linuxcnc", block_delete=false))]
+    #[pyo3(signature = (path, *, start=None, units="mm", dialect="linuxcnc", block_delete=false, kinematics=None))]
     fn from_file(
         py: Python<'_>,
         path: std::path::PathBuf,
@@ -147,8 +182,9 @@ impl GcodeProgram {
         units: &str,
         dialect: &str,
         block_delete: bool,
+        kinematics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let o = options(start, units, dialect, block_delete)?;
+        let o = options(start, units, dialect, block_delete, kinematics)?;
         let text = py
             .detach(|| deflect_core::io::read_text_lossy(&path))
             .map_err(load_err)?;
@@ -157,7 +193,7 @@ impl GcodeProgram {
 
     /// Same as `from_file`, from the program's text.
     #[staticmethod]
-    #[pyo3(signature = (text, *, start=None, units="mm", dialect="linuxcnc", block_delete=false))]
+    #[pyo3(signature = (text, *, start=None, units="mm", dialect="linuxcnc", block_delete=false, kinematics=None))]
     fn from_text(
         py: Python<'_>,
         #[pyo3(from_py_with = args::text::text)] text: String,
@@ -165,26 +201,57 @@ impl GcodeProgram {
         units: &str,
         dialect: &str,
         block_delete: bool,
+        kinematics: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let o = options(start, units, dialect, block_delete)?;
+        let o = options(start, units, dialect, block_delete, kinematics)?;
         Self::read(py, &text, &o)
+    }
+
+    /// Reads an APT / CL file (what CAM systems write for any machine): GOTO with tool
+    /// vectors, FEDRAT, RAPID, CIRCLE, SPINDL, LOADTL, CUTTER, MULTAX, UNITS, FINI; an
+    /// unknown statement raises `LoadError` naming its line. `start` (3,) [m]: where the
+    /// tool is before the first move (unless FROM says); `units`: "mm" or "in" until UNITS/.
+    #[staticmethod]
+    #[pyo3(signature = (path, *, start=None, units="mm"))]
+    fn from_apt_file(
+        py: Python<'_>,
+        path: std::path::PathBuf,
+        start: Option<&Bound<'_, PyAny>>,
+        units: &str,
+    ) -> PyResult<Self> {
+        let o = options(start, units, "linuxcnc", false, None)?;
+        let text = py
+            .detach(|| deflect_core::io::read_text_lossy(&path))
+            .map_err(load_err)?;
+        Self::apt(py, &text, &o)
+    }
+
+    /// Same as `from_apt_file`, from the program's text.
+    #[staticmethod]
+    #[pyo3(signature = (text, *, start=None, units="mm"))]
+    fn from_apt_text(
+        py: Python<'_>,
+        #[pyo3(from_py_with = args::text::text)] text: String,
+        start: Option<&Bound<'_, PyAny>>,
+        units: &str,
+    ) -> PyResult<Self> {
+        let o = options(start, units, "linuxcnc", false, None)?;
+        Self::apt(py, &text, &o)
     }
 
     /// Reads a tool points CSV file: one straight move per row from the previous point (the
     /// first from `start`), columns `x_mm,y_mm,z_mm` (or `x_m,y_m,z_m`), `feed_mm_min` (or
-    /// `feed_m_s`; 0 for a rapid move) and `spindle_rpm`. `LoadError` naming the row.
+    /// `feed_m_s`; 0 for a rapid move) and `spindle_rpm`, optionally `i,j,k` (the tool axis).
+    /// `LoadError` naming the row.
     #[staticmethod]
     #[pyo3(signature = (path, *, start=None))]
     fn from_points_file(
         path: std::path::PathBuf,
         start: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let o = options(start, "mm", "linuxcnc", false)?;
+        let o = options(start, "mm", "linuxcnc", false, None)?;
         let inner = points_csv::from_path(&path, &o).map_err(load_err)?;
-        Ok(Self {
-            inner,
-            words: Vec::new(),
-        })
+        Ok(Self::points(inner))
     }
 
     /// Same as `from_points_file`, from the CSV text.
@@ -194,12 +261,9 @@ impl GcodeProgram {
         #[pyo3(from_py_with = args::text::text)] text: String,
         start: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Self> {
-        let o = options(start, "mm", "linuxcnc", false)?;
+        let o = options(start, "mm", "linuxcnc", false, None)?;
         let inner = points_csv::from_str(&text, &o).map_err(load_err)?;
-        Ok(Self {
-            inner,
-            words: Vec::new(),
-        })
+        Ok(Self::points(inner))
     }
 
     /// Pickling and copy.deepcopy: the moves and the word report as plain values, rebuilt bit
@@ -214,25 +278,76 @@ impl GcodeProgram {
             .iter()
             .map(|o| (o.name.clone(), o.first_move))
             .collect();
+        let axes = if me.inner.is_multi_axis() {
+            me.inner
+                .moves
+                .iter()
+                .map(|m| (m.start_axis.into(), m.end_axis.into()))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let cutters = me
+            .cutters
+            .iter()
+            .map(|c| (c.line, c.tool, c.diameter, corner(c)))
+            .collect();
         Ok((
             rebuild,
-            (state, me.words.iter().map(word_state).collect(), ops),
+            (
+                state,
+                me.words.iter().map(word_state).collect(),
+                ops,
+                axes,
+                cutters,
+            ),
         ))
     }
 
     /// The program of a pickled state (see `__reduce__`), checked.
     #[staticmethod]
-    #[pyo3(signature = (state, words, operations=Vec::new()))]
+    #[pyo3(signature = (state, words, operations=Vec::new(), axes=Vec::new(), cutters=Vec::new()))]
     fn _from_state(
         state: Vec<MoveState>,
         words: Vec<WordState>,
         operations: Vec<(String, usize)>,
+        axes: Vec<([f64; 3], [f64; 3])>,
+        cutters: Vec<CutterState>,
     ) -> PyResult<Self> {
-        let moves = state
+        if !axes.is_empty() && axes.len() != state.len() {
+            return Err(InputError::new_err(format!(
+                "pickled program: {} tool axes for {} moves",
+                axes.len(),
+                state.len()
+            )));
+        }
+        let mut moves = state
             .into_iter()
             .enumerate()
             .map(|(i, m)| from_move_state(i, m))
             .collect::<PyResult<Vec<_>>>()?;
+        for (m, (a, b)) in moves.iter_mut().zip(axes) {
+            m.start_axis = Vector3::from(a);
+            m.end_axis = Vector3::from(b);
+        }
+        let cutters = cutters
+            .into_iter()
+            .map(|(line, tool, diameter, r)| {
+                let shape = if r == 0.0 {
+                    ToolShape::Flat
+                } else if r == 0.5 * diameter {
+                    ToolShape::Ball
+                } else {
+                    ToolShape::BullNose { corner_radius: r }
+                };
+                AptCutter {
+                    line,
+                    tool,
+                    diameter,
+                    shape,
+                }
+            })
+            .collect();
         let operations = operations
             .into_iter()
             .map(|(name, first_move)| Operation { name, first_move })
@@ -261,7 +376,11 @@ impl GcodeProgram {
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
-        Ok(Self { inner, words })
+        Ok(Self {
+            inner,
+            words,
+            cutters,
+        })
     }
 
     fn __eq__(&self, other: &Self) -> bool {
@@ -436,12 +555,51 @@ impl GcodeProgram {
         self.inner.cutting_length()
     }
 
+    /// The tool axis at each move's start (n, 3), unit, tip towards spindle, workpiece
+    /// frame: +z for a 3-axis program; between start and end the axis turns along the great
+    /// circle.
+    #[getter]
+    fn start_axis<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |m, o| o.copy_from_slice(m.start_axis.as_slice()))
+    }
+
+    /// The tool axis at each move's end (n, 3).
+    #[getter]
+    fn end_axis<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |m, o| o.copy_from_slice(m.end_axis.as_slice()))
+    }
+
+    /// Whether any move's tool axis leaves +z (a five-axis program).
+    #[getter]
+    fn is_multi_axis(&self) -> bool {
+        self.inner.is_multi_axis()
+    }
+
+    /// The cutters an APT program defines (`CUTTER/`): `(tool, diameter [m], shape,
+    /// corner_radius [m], line)`, shape "flat", "ball" or "bull-nose"; empty for G-code.
+    #[getter]
+    fn cutters(&self) -> Vec<(u32, f64, &'static str, f64, usize)> {
+        self.cutters
+            .iter()
+            .map(|c| (c.tool, c.diameter, c.shape.name(), corner(c), c.line))
+            .collect()
+    }
+
     /// Every word the program uses: `(word, status, count, first_line, meaning)`, status
     /// "honoured" (it shapes the moves), "recorded" (read without motion: coolant,
     /// overrides, tool lengths) or "refused"; empty for a points CSV.
     #[getter]
     fn words(&self) -> Vec<WordState> {
         self.words.iter().map(word_state).collect()
+    }
+}
+
+/// A cutter's corner radius \[m\] (0 flat, half the diameter for a ball).
+fn corner(c: &AptCutter) -> f64 {
+    match c.shape {
+        ToolShape::Flat => 0.0,
+        ToolShape::Ball => 0.5 * c.diameter,
+        ToolShape::BullNose { corner_radius } => corner_radius,
     }
 }
 
@@ -552,98 +710,9 @@ impl GcodeProgram {
     }
 }
 
-/// The milling force on a flat end mill [N], tool frame (x along the feed, z along the tool
-/// axis towards the spindle, y = z x x; the force the workpiece exerts on the tool), from
-/// the mechanistic model (linear edge forces, chip thickness `h = f_z sin(phi)`).
-///
-/// `diameter` [m], `flutes`, axial `depth` [m], `feed_per_tooth` [m], immersion from `entry`
-/// to `exit` [rad] (clockwise from +y: a slot is 0..pi, up milling starts at 0, down milling
-/// ends at pi), `helix` [rad]. `coefficients`: (k_tc, k_rc, k_ac [N/m^2], k_te, k_re, k_ae
-/// [N/m]); default Al7075-T6 with a carbide tool (`AL7075_T6_CARBIDE`). Without `angles` the
-/// average over a revolution (3,); with `angles` (m,) [rad] (edge 0's angle at the tip) the
-/// instantaneous forces (m, 3), the depth cut into `discs` axial discs for the helix.
-#[pyfunction]
-#[pyo3(signature = (diameter, flutes, depth, feed_per_tooth, *, entry=None, exit=None, helix=None, coefficients=None, angles=None, discs=None),
-       text_signature = "(diameter, flutes, depth, feed_per_tooth, *, entry=0.0, exit=3.141592653589793, helix=0.0, coefficients=None, angles=None, discs=1)")]
-#[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
-fn milling_force<'py>(
-    py: Python<'py>,
-    diameter: &Bound<'py, PyAny>,
-    flutes: &Bound<'py, PyAny>,
-    depth: &Bound<'py, PyAny>,
-    feed_per_tooth: &Bound<'py, PyAny>,
-    entry: Option<&Bound<'py, PyAny>>,
-    exit: Option<&Bound<'py, PyAny>>,
-    helix: Option<&Bound<'py, PyAny>>,
-    coefficients: Option<&Bound<'py, PyAny>>,
-    angles: Option<&Bound<'py, PyAny>>,
-    discs: Option<&Bound<'py, PyAny>>,
-) -> PyResult<Bound<'py, PyAny>> {
-    let flutes = u32::try_from(count(flutes, "flutes")?).unwrap_or(u32::MAX);
-    // The documented defaults (shown in the text signature): a slot, straight flutes, one disc.
-    let or = |o: Option<&Bound<'py, PyAny>>, what: &str, default: f64| {
-        o.map_or(Ok(default), |o| real(o, what))
-    };
-    let tool = Tool::new(
-        real(diameter, "diameter")?,
-        flutes,
-        or(helix, "helix", 0.0)?,
-    )
-    .map_err(build_err)?;
-    let k = self::coefficients(coefficients)?;
-    let e = Engagement {
-        entry: or(entry, "entry", 0.0)?,
-        exit: or(exit, "exit", std::f64::consts::PI)?,
-        depth: real(depth, "depth")?,
-        feed_per_tooth: real(feed_per_tooth, "feed_per_tooth")?,
-    };
-    let Some(angles) = angles else {
-        let f = cutting::average(&k, &tool, &e).map_err(tick_err)?;
-        return Ok(f.as_slice().to_vec().into_pyarray(py).into_any());
-    };
-    let angles = vector_upto(angles, "angles", MAX_SAMPLES, "MAX_SAMPLES")?;
-    let discs = discs.map_or(Ok(1), |d| count(d, "discs"))?;
-    if !(1..=MAX_DISCS).contains(&discs) {
-        return Err(InputError::new_err(format!(
-            "discs: expected 1..={MAX_DISCS}, got {discs}"
-        )));
-    }
-    cutting::check_force_evaluations(angles.len(), discs, &tool).map_err(tick_err)?;
-    let mut out = try_rows(angles.len(), 3, "the forces")?;
-    py.detach(|| {
-        for (o, &angle) in out.chunks_mut(3).zip(&angles) {
-            let f = cutting::force(&k, &tool, &e, angle, discs)?;
-            o.copy_from_slice(f.as_slice());
-        }
-        Ok::<_, deflect_core::TickError>(())
-    })
-    .map_err(tick_err)?;
-    let arr = Array2::from_shape_vec((angles.len(), 3), out)
-        .map_err(|e| InputError::new_err(format!("internal: {e}")))?;
-    Ok(arr.into_pyarray(py).into_any())
-}
-
-/// `coefficients` as (k_tc, k_rc, k_ac, k_te, k_re, k_ae), default Al7075-T6 / carbide.
-pub(crate) fn coefficients(c: Option<&Bound<'_, PyAny>>) -> PyResult<Coefficients> {
-    match c {
-        None => Ok(Coefficients::AL7075_T6_CARBIDE),
-        Some(c) => {
-            let v = vector(c, "coefficients", 6)?;
-            let at = |i: usize| v.get(i).copied().unwrap_or(f64::NAN);
-            Coefficients::new(at(0), at(1), at(2), at(3), at(4), at(5)).map_err(build_err)
-        }
-    }
-}
-
 /// Adds the machining classes and functions to the module.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<GcodeProgram>()?;
     m.add_function(wrap_pyfunction!(gcode_words, m)?)?;
-    m.add_function(wrap_pyfunction!(milling_force, m)?)?;
-    let k = Coefficients::AL7075_T6_CARBIDE;
-    m.add(
-        "AL7075_T6_CARBIDE",
-        (k.k_tc, k.k_rc, k.k_ac, k.k_te, k.k_re, k.k_ae),
-    )?;
-    Ok(())
+    crate::cutter::register(m)
 }

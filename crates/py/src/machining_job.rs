@@ -14,8 +14,9 @@ use pyo3::prelude::*;
 
 use crate::InputError;
 use crate::arrays::{pose, rotation, vector};
+use crate::cutter::coefficients;
 use crate::errors::{build_err, job_err, load_err};
-use crate::machining::{GcodeProgram, coefficients};
+use crate::machining::GcodeProgram;
 use crate::scalars::{count, pair, real};
 use crate::tools::{ToolState, ToolTable, from_states, tool_state};
 use crate::vjm::SerialRobot;

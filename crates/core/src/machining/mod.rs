@@ -13,6 +13,8 @@
 pub mod chip;
 pub mod cutting;
 #[cfg(feature = "alloc")]
+pub mod dexel;
+#[cfg(feature = "alloc")]
 pub mod engagement;
 #[cfg(feature = "alloc")]
 pub mod job;

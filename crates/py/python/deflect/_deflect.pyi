@@ -1001,9 +1001,11 @@ class GcodeProgram:
         units: str = "mm",
         dialect: str = "linuxcnc",
         block_delete: bool = False,
+        kinematics: Optional[Dict[str, Any]] = None,
     ) -> "GcodeProgram":
         """Reads a G-code file; ``start`` (3,) [m] before the first move, ``units`` "mm" | "in",
-        ``dialect`` "linuxcnc" | "grbl" | "fanuc", ``block_delete`` skips "/" lines."""
+        ``dialect`` "linuxcnc" | "grbl" | "fanuc", ``block_delete`` skips "/" lines,
+        ``kinematics`` a five-axis machine whose A B C turn the tool axis."""
     @staticmethod
     def from_text(
         text: str,
@@ -1012,8 +1014,20 @@ class GcodeProgram:
         units: str = "mm",
         dialect: str = "linuxcnc",
         block_delete: bool = False,
+        kinematics: Optional[Dict[str, Any]] = None,
     ) -> "GcodeProgram":
         """Same as ``from_file``, from the program's text."""
+    @staticmethod
+    def from_apt_file(
+        path: _StrPath, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+    ) -> "GcodeProgram":
+        """Reads an APT / CL file: GOTO with tool vectors, FEDRAT, RAPID, CIRCLE, SPINDL,
+        LOADTL, CUTTER, MULTAX, UNITS, FINI."""
+    @staticmethod
+    def from_apt_text(
+        text: str, *, start: Optional[_ArrayLike] = None, units: str = "mm"
+    ) -> "GcodeProgram":
+        """Same as ``from_apt_file``, from the program's text."""
     @staticmethod
     def from_points_file(path: _StrPath, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
         """Tool points CSV: one straight move per row (x_mm/y_mm/z_mm or x_m/..., feed_mm_min
@@ -1021,10 +1035,25 @@ class GcodeProgram:
     @staticmethod
     def from_points_text(text: str, *, start: Optional[_ArrayLike] = None) -> "GcodeProgram":
         """Same as ``from_points_file``, from the CSV text."""
-    def __reduce__(self) -> Tuple[Any, Tuple[Any, Any, Any]]:
-        """Pickling and copy.deepcopy: the moves and the word report, rebuilt bit for bit."""
+    def __reduce__(self) -> Tuple[Any, Tuple[Any, Any, Any, Any, Any]]:
+        """Pickling and copy.deepcopy: the moves, tool axes, cutters and the word report,
+        rebuilt bit for bit."""
     @staticmethod
-    def _from_state(state: Any, words: Any, operations: Any = ...) -> "GcodeProgram": ...
+    def _from_state(
+        state: Any, words: Any, operations: Any = ..., axes: Any = ..., cutters: Any = ...
+    ) -> "GcodeProgram": ...
+    @property
+    def start_axis(self) -> _FloatArray:
+        """Tool axis at each move's start (n, 3), unit, tip towards spindle."""
+    @property
+    def end_axis(self) -> _FloatArray:
+        """Tool axis at each move's end (n, 3)."""
+    @property
+    def is_multi_axis(self) -> bool:
+        """Whether any move's tool axis leaves +z."""
+    @property
+    def cutters(self) -> List[Tuple[int, float, str, float, int]]:
+        """APT cutters: (tool, diameter [m], shape, corner_radius [m], line)."""
     def __eq__(self, value: object, /) -> bool: ...
     __hash__: ClassVar[None]  # type: ignore[assignment]
     def __len__(self) -> int: ...
@@ -1304,6 +1333,21 @@ class MachiningResult:
         ``schedule`` (k, 2): spin budget and spin [rad] per station. None without it."""
     def samples_csv(self, lead: float = 0.04) -> str:
         """Every sample as CSV text, the pilot wrench ``lead`` [s] ahead."""
+
+def cutter_force(
+    diameter: float,
+    flutes: int,
+    bands: _ArrayLike,
+    feed: _ArrayLike,
+    *,
+    shape: str = "flat",
+    corner_radius: Optional[float] = None,
+    helix: float = 0.0,
+    coefficients: Optional[_ArrayLike] = None,
+    angles: Optional[_ArrayLike] = None,
+) -> Tuple[_FloatArray, _FloatArray]:
+    """Force [N] and moment about the tip [N m] of a flat, ball or bull-nose cutter, tool
+    frame: the revolution's mean (3,), (3,), or (m, 3), (m, 3) at ``angles``."""
 
 def milling_force(
     diameter: float,

@@ -23,7 +23,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::job_files::{FileOptions, JobFiles};
 use super::job_summary::summary;
-use super::serial::{load_robot, read_program, read_text};
+use super::serial::{load_robot, program_file, read_program, read_text};
 use super::stdout;
 use crate::cli::{CliError, JobArgs, SpinArg, ToolArgs};
 
@@ -132,12 +132,10 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         ..GcodeOptions::default()
     };
     let (program, program_name) = match (&a.program, &a.points) {
-        (Some(p), _) => {
-            let text = read_program("--program", p)?;
-            let program = gcode::from_str(&text, &options)
-                .map_err(|e| CliError::Failure(format!("--program {}: {e}", p.display())))?;
-            (program, p.display().to_string())
-        }
+        (Some(p), _) => (
+            program_file("--program", p, &options)?,
+            p.display().to_string(),
+        ),
         (None, Some(p)) => {
             let text = read_text("--points", p, "tool points CSV")?;
             let program = points_csv::from_str(&text, &options)

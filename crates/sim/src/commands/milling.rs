@@ -20,7 +20,7 @@ use deflect_sim::scenes::milling::{self, MillingArm, output, part_map};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::job::{default_stock, tool_and_material};
-use super::serial::{load_arm, read_program};
+use super::serial::{load_arm, program_file};
 use crate::cli::{CliError, MillingArgs};
 
 /// deflect's test workpiece after the paper's (grooves, a ramp, a circular pocket).
@@ -67,10 +67,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         }
         Some("groove") => return Ok(MillingInput::Groove),
         Some(path) => {
-            let p = Path::new(path);
-            let text = read_program("--program", p)?;
-            let program = gcode::from_str(&text, &options)
-                .map_err(|e| CliError::Failure(format!("--program {path}: {e}")))?;
+            let program = program_file("--program", Path::new(path), &options)?;
             (program, path.to_string(), false)
         }
         None => (

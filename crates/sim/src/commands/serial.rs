@@ -53,6 +53,28 @@ pub(crate) fn read_program(flag: &str, path: &Path) -> Result<String, CliError> 
     Ok(String::from_utf8_lossy(&bytes).into_owned())
 }
 
+/// A program file read by its extension: APT / CL data (`.apt`, `.cl`, `.cls`,
+/// `.aptsource`) or G-code (anything else), every error naming the flag and the file.
+pub(crate) fn program_file(
+    flag: &str,
+    path: &Path,
+    options: &deflect_core::io::gcode::GcodeOptions,
+) -> Result<deflect_core::machining::Program, CliError> {
+    let text = read_program(flag, path)?;
+    let apt = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
+        matches!(
+            e.to_ascii_lowercase().as_str(),
+            "apt" | "cl" | "cls" | "aptsource"
+        )
+    });
+    let read = if apt {
+        deflect_core::io::apt::from_str(&text, options).map(|p| p.program)
+    } else {
+        deflect_core::io::gcode::from_str(&text, options)
+    };
+    read.map_err(|e| CliError::Failure(format!("{flag} {}: {e}", path.display())))
+}
+
 /// The bytes of an input file of at most `MAX_FILE` bytes, every error naming the flag.
 fn read_bytes(flag: &str, path: &Path, expected: &str) -> Result<Vec<u8>, CliError> {
     input_file(flag, path, expected)?;

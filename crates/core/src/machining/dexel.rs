@@ -1,0 +1,536 @@
+//! The stock as tri-dexels: three grids of rays along x, y and z of the workpiece frame, each
+//! holding the intervals of material it passes through, cut by a tool at any orientation. What
+//! a five-axis program needs where the z-map ([`super::stock`]) cannot go: a tilted tool
+//! cuts under itself, a swarf cut leaves an inclined wall, an undercut keeps material above a
+//! pocket.
+//!
+//! The tool is the cutter's solid of revolution: radius `R(z)` at height `z` above the tip
+//! along its axis (the corner's arc, then the cylinder up to the cutting length; flat, ball
+//! and bull-nose ends as [`super::profile::Profile`]), a convex solid. A straight move with a
+//! fixed axis sweeps it into a convex solid, and every ray meets that in one interval, found
+//! exactly: along the ray (parameter `t`) and the move (parameter `s`) the function
+//! `rho(t, s) - R(z(t, s))` (distance from the axis less the radius at that height) is convex
+//! on the slab `0 <= z <= length` (a norm of an affine map less a concave function of an
+//! affine one), so its minimum over `s` is convex in `t`; golden-section searches find the
+//! deepest point and bisection the interval's ends, to 1e-10 m. A move whose axis
+//! turns is cut as straight pieces with the axis of each piece's middle, as many as keep the
+//! tool's far end within a quarter cell of the turning one.
+//!
+//! Rays run through the centres of the grid's cells (`cell` apart); a point's material is
+//! read from the z-ray nearest it. Memory: 24 bytes per ray and 16 per interval, budgets
+//! [`MAX_RAYS`] and [`MAX_INTERVALS`]; a cut that would pass the latter is refused.
+
+use alloc::vec::Vec;
+
+use nalgebra::{ComplexField, Vector3};
+
+use super::profile::Profile;
+use crate::error::{BuildError, TickError};
+
+/// Most rays of one stock (the three grids together): 2^25 (33.5 million, 0.8 GB of ray
+/// headers; a 0.5 m cube at 0.15 mm).
+pub const MAX_RAYS: usize = 1 << 25;
+
+/// Most material intervals one stock may hold: 2^26 (67 million, 1.1 GB).
+pub const MAX_INTERVALS: usize = 1 << 26;
+
+/// Golden-section iterations along the ray (the bracket shrinks by 0.618 each: 3.5e-11 of
+/// it after 50) and along the move (40: 4e-9 of the move; the depth's error is second order
+/// in it where the surface is smooth).
+const GOLDEN: usize = 50;
+/// Bisection iterations for an interval's end (2^-48 of the bracket: 1e-16 m of 30 mm).
+const GOLDEN_MOVE: usize = 40;
+const BISECT: usize = 48;
+
+/// The tool as a solid of revolution: radius, corner radius and the length above the tip
+/// that removes material \[m\].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DexelTool {
+    radius: f64,
+    corner: f64,
+    length: f64,
+}
+
+impl DexelTool {
+    /// The solid of `profile` up to `length` above the tip (the flutes and the shank that
+    /// would rub: `length` at least the corner radius, at most 1 m).
+    /// [`BuildError::InvalidParameter`] otherwise.
+    pub fn new(profile: &Profile, length: f64) -> Result<Self, BuildError> {
+        crate::error::param(
+            "dexel tool length",
+            length,
+            length >= profile.corner() && length > 0.0 && length <= 1.0,
+            "finite, at least the corner radius, at most 1 m",
+        )?;
+        Ok(Self {
+            radius: profile.radius(),
+            corner: profile.corner(),
+            length,
+        })
+    }
+
+    /// The radius \[m\] at height `z` in `[0, length]` above the tip (concave in `z`).
+    pub fn radius_at(&self, z: f64) -> f64 {
+        let r = self.corner;
+        if z >= r {
+            self.radius
+        } else {
+            let d = r - z;
+            self.radius - r + ComplexField::sqrt((r * r - d * d).max(0.0))
+        }
+    }
+
+    /// The length above the tip \[m\].
+    pub fn length(&self) -> f64 {
+        self.length
+    }
+
+    /// Whether `p` lies in the tool with its tip at `tip` and axis `axis` (unit).
+    pub fn contains(&self, tip: &Vector3<f64>, axis: &Vector3<f64>, p: &Vector3<f64>) -> bool {
+        let w = p - tip;
+        let z = w.dot(axis);
+        (0.0..=self.length).contains(&z) && (w - axis * z).norm() <= self.radius_at(z)
+    }
+}
+
+/// What one cut removed.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[must_use]
+pub struct DexelRemoval {
+    /// Rays whose material changed (all three grids).
+    pub rays: usize,
+    /// Volume removed \[m^3\], from the z-rays (removed length times the cell's area).
+    pub volume: f64,
+}
+
+/// One ray's material: sorted, disjoint intervals along its direction \[m\].
+pub type Intervals = [(f64, f64)];
+
+/// A block of stock as tri-dexels (see the module docs).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dexels {
+    min: Vector3<f64>,
+    cell: f64,
+    n: [usize; 3],
+    /// Per direction (x, y, z), rays by `(i, j)` of the two other axes in cyclic order,
+    /// `i * n_v + j`, each its sorted, disjoint material intervals along the direction.
+    rays: [Vec<Vec<(f64, f64)>>; 3],
+    intervals: usize,
+}
+
+/// The two axes across direction `d`, cyclic: x -> (y, z), y -> (z, x), z -> (x, y).
+fn across(d: usize) -> (usize, usize) {
+    ((d + 1) % 3, (d + 2) % 3)
+}
+
+fn at(v: &Vector3<f64>, i: usize) -> f64 {
+    v.get(i).copied().unwrap_or(0.0)
+}
+
+fn count(n: &[usize; 3], i: usize) -> usize {
+    n.get(i).copied().unwrap_or(0)
+}
+
+impl Dexels {
+    /// A full block over `[min, max]` \[m\] with rays `cell` \[m\] apart (the block's far
+    /// faces rounded up to whole cells). [`BuildError::InvalidParameter`] for non-finite
+    /// bounds, `max <= min` or a cell not finite and > 0; [`BuildError::Budget`] past
+    /// [`MAX_RAYS`] or [`MAX_INTERVALS`], or when the memory is refused.
+    pub fn block(min: Vector3<f64>, max: Vector3<f64>, cell: f64) -> Result<Self, BuildError> {
+        crate::error::param("dexel cell", cell, cell > 0.0, "finite and > 0 m")?;
+        let mut n = [0usize; 3];
+        for (d, slot) in n.iter_mut().enumerate() {
+            let (lo, hi) = (at(&min, d), at(&max, d));
+            crate::error::param("dexel block bound", lo, lo.is_finite(), "finite")?;
+            crate::error::param(
+                "dexel block bound",
+                hi,
+                hi > lo,
+                "finite, above the minimum",
+            )?;
+            let cells = ComplexField::ceil((hi - lo) / cell - 1e-9);
+            if cells.is_nan() || cells > MAX_RAYS as f64 {
+                return Err(BuildError::Budget {
+                    what: "dexel cells along one axis",
+                    budget: "MAX_RAYS",
+                    limit: MAX_RAYS,
+                    requested: usize::MAX,
+                });
+            }
+            *slot = (cells as usize).max(1);
+        }
+        let [nx, ny, nz] = n;
+        let rays = [
+            ny.saturating_mul(nz),
+            nz.saturating_mul(nx),
+            nx.saturating_mul(ny),
+        ];
+        let total = rays.iter().fold(0usize, |a, &b| a.saturating_add(b));
+        if total > MAX_RAYS || total > MAX_INTERVALS {
+            return Err(BuildError::Budget {
+                what: "dexel rays (the three grids)",
+                budget: "MAX_RAYS",
+                limit: MAX_RAYS,
+                requested: total,
+            });
+        }
+        let mut grids: [Vec<Vec<(f64, f64)>>; 3] = [Vec::new(), Vec::new(), Vec::new()];
+        for (d, grid) in grids.iter_mut().enumerate() {
+            let count = rays.get(d).copied().unwrap_or(0);
+            grid.try_reserve_exact(count)
+                .map_err(|_| BuildError::Budget {
+                    what: "dexel rays (the allocation was refused)",
+                    budget: "MAX_RAYS",
+                    limit: MAX_RAYS,
+                    requested: total,
+                })?;
+            let lo = at(&min, d);
+            let hi = lo + cell * self::count(&n, d) as f64;
+            for _ in 0..count {
+                let mut ray = Vec::new();
+                ray.try_reserve_exact(1).map_err(|_| BuildError::Budget {
+                    what: "dexel intervals (the allocation was refused)",
+                    budget: "MAX_INTERVALS",
+                    limit: MAX_INTERVALS,
+                    requested: total,
+                })?;
+                ray.push((lo, hi));
+                grid.push(ray);
+            }
+        }
+        Ok(Self {
+            min,
+            cell,
+            n,
+            rays: grids,
+            intervals: total,
+        })
+    }
+
+    /// The spacing of the rays \[m\].
+    pub fn cell(&self) -> f64 {
+        self.cell
+    }
+
+    /// Cells along x, y and z.
+    pub fn shape(&self) -> [usize; 3] {
+        self.n
+    }
+
+    /// The intervals of material currently held (all grids).
+    pub fn intervals(&self) -> usize {
+        self.intervals
+    }
+
+    /// The ray along direction `d` (0 x, 1 y, 2 z) at cell `(i, j)` of the two axes across it
+    /// (cyclic: x -> (y, z), y -> (z, x), z -> (x, y)): its point at the block's near face and
+    /// its material intervals along `d` \[m\]; `None` outside the grid.
+    pub fn ray(&self, d: usize, i: usize, j: usize) -> Option<(Vector3<f64>, &Intervals)> {
+        let (u, v) = across(d);
+        let (nu, nv) = (count(&self.n, u), count(&self.n, v));
+        if i >= nu || j >= nv {
+            return None;
+        }
+        let ray = self.rays.get(d)?.get(i * nv + j)?;
+        let mut o = self.min;
+        if let Some(x) = o.get_mut(u) {
+            *x += (i as f64 + 0.5) * self.cell;
+        }
+        if let Some(x) = o.get_mut(v) {
+            *x += (j as f64 + 0.5) * self.cell;
+        }
+        Some((o, ray.as_slice()))
+    }
+
+    /// Whether `p` is material, read from the z-ray nearest it (outside the block: no).
+    pub fn is_material(&self, p: &Vector3<f64>) -> bool {
+        let index = |k: usize| {
+            let x = (at(p, k) - at(&self.min, k)) / self.cell;
+            (x >= 0.0 && x < count(&self.n, k) as f64).then_some(x as usize)
+        };
+        let (Some(i), Some(j)) = (index(0), index(1)) else {
+            return false;
+        };
+        self.ray(2, i, j)
+            .is_some_and(|(_, r)| r.iter().any(|&(a, b)| p.z >= a && p.z <= b))
+    }
+
+    /// The material's volume \[m^3\] from the z-rays.
+    pub fn volume(&self) -> f64 {
+        let area = self.cell * self.cell;
+        self.rays.get(2).map_or(0.0, |g| {
+            g.iter()
+                .map(|r| r.iter().map(|(a, b)| b - a).sum::<f64>())
+                .sum::<f64>()
+                * area
+        })
+    }
+
+    /// Cuts `tool` swept from `from` to `to` (tips \[m\]) with the axis turning from
+    /// `from_axis` to `to_axis` (unit; along the great circle), workpiece frame.
+    /// [`TickError::NonFinite`] for non-finite input, [`TickError::InvalidArgument`] for an
+    /// axis not of unit length (within 1e-9) or axes opposite, [`TickError::Budget`] when the
+    /// material would pass [`MAX_INTERVALS`].
+    pub fn cut(
+        &mut self,
+        tool: &DexelTool,
+        from: &Vector3<f64>,
+        from_axis: &Vector3<f64>,
+        to: &Vector3<f64>,
+        to_axis: &Vector3<f64>,
+    ) -> Result<DexelRemoval, TickError> {
+        for (what, v) in [
+            ("cut start", from),
+            ("cut start axis", from_axis),
+            ("cut end", to),
+            ("cut end axis", to_axis),
+        ] {
+            crate::error::check_finite(what, v.as_slice())?;
+        }
+        for a in [from_axis, to_axis] {
+            if (a.norm() - 1.0).abs() > 1e-9 {
+                return Err(TickError::InvalidArgument {
+                    what: "cut axis (unit length within 1e-9)",
+                    value: a.norm(),
+                });
+            }
+        }
+        let turn = super::program::angle_between(from_axis, to_axis);
+        if turn > super::MAX_AXIS_TURN {
+            return Err(TickError::InvalidArgument {
+                what: "cut axis turn (at most MAX_AXIS_TURN, 179 degrees)",
+                value: turn,
+            });
+        }
+        // Pieces keeping the far end of the tool within a quarter cell of the turning axis.
+        let reach = tool.length + tool.radius;
+        let pieces = ComplexField::ceil(turn * reach / (0.25 * self.cell)).clamp(1.0, 1e6) as usize;
+        let mut total = DexelRemoval::default();
+        for k in 0..pieces {
+            let (s0, s1) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
+            let axis = super::program::slerp(from_axis, to_axis, 0.5 * (s0 + s1));
+            let a = from + (to - from) * s0;
+            let b = from + (to - from) * s1;
+            let r = self.sweep(tool, &a, &b, &axis)?;
+            total.rays += r.rays;
+            total.volume += r.volume;
+        }
+        Ok(total)
+    }
+
+    /// One straight sweep with a fixed axis.
+    fn sweep(
+        &mut self,
+        tool: &DexelTool,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> Result<DexelRemoval, TickError> {
+        // The swept solid's box: both tools' axis segments, widened by the radius.
+        let (tops, r) = (axis * tool.length, tool.radius);
+        let mut lo = from.inf(to).inf(&(from + tops)).inf(&(to + tops));
+        let mut hi = from.sup(to).sup(&(from + tops)).sup(&(to + tops));
+        lo.add_scalar_mut(-r);
+        hi.add_scalar_mut(r);
+        let mut out = DexelRemoval::default();
+        let area = self.cell * self.cell;
+        for d in 0..3 {
+            let (u, v) = across(d);
+            let range = |k: usize| {
+                let x0 = (at(&lo, k) - at(&self.min, k)) / self.cell - 0.5;
+                let x1 = (at(&hi, k) - at(&self.min, k)) / self.cell - 0.5;
+                let n = count(&self.n, k);
+                let a = ComplexField::ceil(x0).max(0.0) as usize;
+                let b = (ComplexField::floor(x1) + 1.0).clamp(0.0, n as f64) as usize;
+                a..b.max(a)
+            };
+            let (ru, rv) = (range(u), range(v));
+            let nv = count(&self.n, v);
+            let (dlo, dhi) = (at(&lo, d), at(&hi, d));
+            for i in ru {
+                for j in rv.clone() {
+                    let mut origin = self.min;
+                    if let Some(x) = origin.get_mut(u) {
+                        *x += (i as f64 + 0.5) * self.cell;
+                    }
+                    if let Some(x) = origin.get_mut(v) {
+                        *x += (j as f64 + 0.5) * self.cell;
+                    }
+                    if let Some(x) = origin.get_mut(d) {
+                        *x = 0.0;
+                    }
+                    let Some((a, b)) = hit(tool, &origin, d, from, to, axis, dlo, dhi) else {
+                        continue;
+                    };
+                    let Some(ray) = self.rays.get_mut(d).and_then(|g| g.get_mut(i * nv + j)) else {
+                        continue;
+                    };
+                    let before = ray.len();
+                    let removed = subtract(ray, a, b, self.intervals < MAX_INTERVALS)?;
+                    if removed > 0.0 {
+                        out.rays += 1;
+                        if d == 2 {
+                            out.volume += removed * area;
+                        }
+                    }
+                    self.intervals = self.intervals + ray.len() - before;
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Removes `[a, b]` from a ray's sorted intervals; the length removed. Splitting an interval
+/// in two needs `room` ([`TickError::Budget`] otherwise).
+fn subtract(ray: &mut Vec<(f64, f64)>, a: f64, b: f64, room: bool) -> Result<f64, TickError> {
+    let mut removed = 0.0;
+    let mut k = 0;
+    while let Some(&(lo, hi)) = ray.get(k) {
+        if hi <= a || lo >= b {
+            k += 1;
+            continue;
+        }
+        removed += hi.min(b) - lo.max(a);
+        match (lo < a, hi > b) {
+            (true, true) => {
+                if !room {
+                    return Err(TickError::Budget {
+                        what: "dexel intervals",
+                        budget: "MAX_INTERVALS",
+                        limit: MAX_INTERVALS as f64,
+                        requested: (MAX_INTERVALS + 1) as f64,
+                    });
+                }
+                if let Some(x) = ray.get_mut(k) {
+                    *x = (lo, a);
+                }
+                ray.insert(k + 1, (b, hi));
+                return Ok(removed);
+            }
+            (true, false) => {
+                if let Some(x) = ray.get_mut(k) {
+                    *x = (lo, a);
+                }
+                k += 1;
+            }
+            (false, true) => {
+                if let Some(x) = ray.get_mut(k) {
+                    *x = (b, hi);
+                }
+                return Ok(removed);
+            }
+            (false, false) => {
+                ray.remove(k);
+            }
+        }
+    }
+    Ok(removed)
+}
+
+/// Golden-section minimum of a convex `f` on `[a, b]`: `(argmin, min)`.
+fn golden(a: f64, b: f64, iterations: usize, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
+    let r = 0.618_033_988_749_894_9;
+    let (mut a, mut b) = (a, b);
+    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
+    let (mut fc, mut fd) = (f(c), f(d));
+    for _ in 0..iterations {
+        if fc <= fd {
+            b = d;
+            d = c;
+            fd = fc;
+            c = b - r * (b - a);
+            fc = f(c);
+        } else {
+            a = c;
+            c = d;
+            fc = fd;
+            d = a + r * (b - a);
+            fd = f(d);
+        }
+    }
+    let (t, ft) = if fc <= fd { (c, fc) } else { (d, fd) };
+    // The ends of the bracket are candidates too (a minimum on the boundary).
+    [(a, f(a)), (b, f(b))]
+        .into_iter()
+        .fold((t, ft), |best, x| if x.1 < best.1 { x } else { best })
+}
+
+/// Where along the ray through `origin` (its coordinate `d` free) the tool swept from `from`
+/// to `to` with `axis` lies: the interval of the coordinate, within `[lo, hi]`.
+#[allow(clippy::too_many_arguments)] // reason: one ray against one sweep, called from one loop
+fn hit(
+    tool: &DexelTool,
+    origin: &Vector3<f64>,
+    d: usize,
+    from: &Vector3<f64>,
+    to: &Vector3<f64>,
+    axis: &Vector3<f64>,
+    lo: f64,
+    hi: f64,
+) -> Option<(f64, f64)> {
+    let mut e = Vector3::zeros();
+    if let Some(x) = e.get_mut(d) {
+        *x = 1.0;
+    }
+    let step = to - from;
+    // z(t, s) = alpha + beta t - gamma s along the axis.
+    let alpha = (origin - from).dot(axis);
+    let beta = e.dot(axis);
+    let gamma = step.dot(axis);
+    let h = tool.length;
+    // The s-range where 0 <= z <= h at `t`, within [0, 1].
+    let s_range = |t: f64| -> Option<(f64, f64)> {
+        let z0 = alpha + beta * t;
+        let (mut a, mut b) = (0.0f64, 1.0f64);
+        if gamma.abs() < 1e-300 {
+            return (z0 >= 0.0 && z0 <= h).then_some((a, b));
+        }
+        // 0 <= z0 - gamma s <= h  <=>  s between (z0 - h) / gamma and z0 / gamma.
+        let (p, q) = ((z0 - h) / gamma, z0 / gamma);
+        a = a.max(p.min(q));
+        b = b.min(p.max(q));
+        (a <= b).then_some((a, b))
+    };
+    let f = |t: f64, s: f64| {
+        let w = origin + e * t - (from + step * s);
+        let z = w.dot(axis).clamp(0.0, h);
+        (w - axis * w.dot(axis)).norm() - tool.radius_at(z)
+    };
+    let g = |t: f64| match s_range(t) {
+        Some((a, b)) => golden(a, b, GOLDEN_MOVE, &|s| f(t, s)).1,
+        None => f64::INFINITY,
+    };
+    // The t-range where some s keeps the slab: 0 <= alpha + beta t - gamma s <= h for an s
+    // in [0, 1], i.e. alpha + beta t in [min(0, gamma), h + max(0, gamma)].
+    let (zlo, zhi) = (gamma.min(0.0), h + gamma.max(0.0));
+    let (mut t0, mut t1) = (lo, hi);
+    if beta.abs() > 1e-300 {
+        let (p, q) = ((zlo - alpha) / beta, (zhi - alpha) / beta);
+        t0 = t0.max(p.min(q));
+        t1 = t1.min(p.max(q));
+    } else if alpha < zlo || alpha > zhi {
+        return None;
+    }
+    if t0 >= t1 {
+        return None;
+    }
+    let (tm, fm) = golden(t0, t1, GOLDEN, &g);
+    if fm.is_nan() || fm > 0.0 {
+        return None;
+    }
+    let edge = |mut inside: f64, mut outside: f64| {
+        for _ in 0..BISECT {
+            let mid = 0.5 * (inside + outside);
+            if g(mid) <= 0.0 {
+                inside = mid;
+            } else {
+                outside = mid;
+            }
+        }
+        0.5 * (inside + outside)
+    };
+    let a = if g(t0) <= 0.0 { t0 } else { edge(tm, t0) };
+    let b = if g(t1) <= 0.0 { t1 } else { edge(tm, t1) };
+    (b > a).then_some((a, b))
+}

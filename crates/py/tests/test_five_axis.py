@@ -1,0 +1,127 @@
+"""Five-axis programs and cutters from Python: the ball-end force against scipy's own
+integration of the edge written here from the geometry, the flat mill against the closed-form
+milling force, APT and A/B/C G-code with their tool axes, pickling, bad input."""
+
+import math
+import pickle
+
+import numpy as np
+import pytest
+from scipy import integrate
+
+import deflect
+
+K = np.array(deflect.AL7075_T6_CARBIDE)
+
+
+def ball_element(kappa, phi, radius, feed, component):
+    """One component of the force and moment per unit kappa and immersion on a ball."""
+    k_tc, k_rc, k_ac, k_te, k_re, k_ae = K
+    radial = np.array([math.sin(phi), math.cos(phi), 0.0])
+    n = radial * math.sin(kappa) - np.array([0.0, 0.0, math.cos(kappa)])
+    p = np.array([0.0, 0.0, radius]) + n * radius
+    t = np.array([math.cos(phi), -math.sin(phi), 0.0])
+    a = np.cross(t, n)
+    h = max(float(np.dot(feed, n)), 0.0)
+    f = (-t * (k_tc * h + k_te) - n * (k_rc * h + k_re) + a * (k_ac * h + k_ae)) * radius
+    w = np.concatenate([f, np.cross(p, f)])
+    return w[component]
+
+
+def test_ball_end_mean_is_scipys_integral():
+    radius, depth, flutes = 0.005, 0.003, 2
+    feed = np.array([0.1e-3, 0.0, 0.0])
+    top = math.acos(1.0 - depth / radius)
+    force, moment = deflect.cutter_force(
+        2 * radius, flutes, [[0.0, depth, 0.0, math.pi]], feed, shape="ball", helix=0.5
+    )
+    want = [
+        integrate.dblquad(
+            lambda phi, kappa: ball_element(kappa, phi, radius, feed, c),
+            0.0,
+            top,
+            0.0,
+            math.pi,
+            epsabs=0.0,
+            epsrel=1e-11,
+        )[0]
+        * flutes
+        / (2 * math.pi)
+        for c in range(6)
+    ]
+    got = np.concatenate([force, moment])
+    assert np.linalg.norm(got[:3] - want[:3]) < 1e-6 * np.linalg.norm(want[:3])
+    assert np.linalg.norm(got[3:] - want[3:]) < 1e-6 * np.linalg.norm(want[3:])
+
+
+def test_flat_cutter_is_the_milling_force_and_instants_have_shapes():
+    f, m = deflect.cutter_force(0.016, 3, [[0.0, 0.002, 0.5, math.pi]], [0.1e-3, 0, 0])
+    want = deflect.milling_force(0.016, 3, 0.002, 0.1e-3, entry=0.5)
+    np.testing.assert_allclose(f, want, rtol=1e-12)
+    fi, mi = deflect.cutter_force(
+        0.012, 2, np.array([[0.0, 0.004, 0.0, math.pi]]), [0.1e-3, 0, 0.02e-3],
+        shape="bull-nose", corner_radius=0.002, helix=0.6, angles=np.linspace(0, 6, 5),
+    )
+    assert fi.shape == (5, 3) and mi.shape == (5, 3)
+    with pytest.raises(deflect.DeflectError, match="corner_radius"):
+        deflect.cutter_force(0.012, 2, [[0, 1e-3, 0, 1]], [1e-4, 0, 0], shape="bull-nose")
+    with pytest.raises(deflect.DeflectError, match="band"):
+        deflect.cutter_force(0.012, 2, [[2e-3, 1e-3, 0, 1]], [1e-4, 0, 0])
+    with pytest.raises(deflect.DeflectError, match="bands"):
+        deflect.cutter_force(0.012, 2, [[0, 1e-3, 0]], [1e-4, 0, 0])
+
+
+APT = """UNITS/MM
+MULTAX
+LOADTL/4
+CUTTER/8,4
+SPINDL/10000,CLW
+FEDRAT/MMPM,900
+GOTO/10,0,5,0,0,1
+GOTO/30,0,5,0.0,0.5,0.8660254
+GOTO/50,10,5,0.5,0.0,0.8660254
+FINI
+"""
+
+
+def test_apt_programs_carry_their_axes_cutters_and_pickle():
+    p = deflect.GcodeProgram.from_apt_text(APT)
+    assert p.is_multi_axis
+    assert len(p) == 3
+    np.testing.assert_allclose(p.end_axis[1], [0.0, 0.5, math.sqrt(3) / 2], atol=1e-7)
+    np.testing.assert_array_equal(p.start_axis[1], p.end_axis[0])
+    assert p.cutters == [(4, 0.008, "ball", 0.004, 4)]
+    q = pickle.loads(pickle.dumps(p))
+    assert q == p
+    np.testing.assert_array_equal(q.end_axis, p.end_axis)
+    assert q.cutters == p.cutters
+    with pytest.raises(deflect.LoadError, match="line 2"):
+        deflect.GcodeProgram.from_apt_text("UNITS/MM\nSPLINE/1,2\n")
+
+
+def test_abc_gcode_under_a_machine_gives_the_apt_axes():
+    # Head-table with tool centre point control: B tilts the head about +y, C turns the
+    # table about +z; the axis in the workpiece is (sin b cos c, -sin b sin c, cos b).
+    machine = {
+        "tcp": True,
+        "rotaries": [
+            {"word": "B", "carrier": "head", "direction": [0, 1, 0]},
+            {"word": "C", "carrier": "table", "direction": [0, 0, 1], "limits": [-7, 7]},
+        ],
+    }
+    apt = deflect.GcodeProgram.from_apt_text(APT)
+    lines = ["G21 G90 F900"]
+    for tip, v in zip(apt.end * 1e3, apt.end_axis):
+        b, c = math.degrees(math.acos(v[2])), math.degrees(math.atan2(-v[1], v[0]))
+        lines.append(f"G1 X{tip[0]:.12f} Y{tip[1]:.12f} Z{tip[2]:.12f} B{b:.12f} C{c:.12f}")
+    g = deflect.GcodeProgram.from_text("\n".join(lines) + "\n", kinematics=machine)
+    np.testing.assert_allclose(g.end, apt.end, atol=1e-12)
+    np.testing.assert_allclose(g.end_axis, apt.end_axis, atol=1e-9)
+    with pytest.raises(deflect.LoadError, match="kinematics"):
+        deflect.GcodeProgram.from_text("G1 X1 B10 F100\n")
+    bad = {"tcp": True, "rotaries": [machine["rotaries"][0]]}
+    with pytest.raises(deflect.DeflectError, match="two rotary"):
+        deflect.GcodeProgram.from_text("G1 X1 F100\n", kinematics=bad)
+    same = {"tcp": True, "rotaries": [machine["rotaries"][0]] * 2}
+    with pytest.raises(deflect.DeflectError, match="same word"):
+        deflect.GcodeProgram.from_text("G1 X1 F100\n", kinematics=same)
