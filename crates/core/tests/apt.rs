@@ -195,10 +195,6 @@ fn rx(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
     Matrix3::new(1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
 }
-fn ry(a: f64) -> Matrix3<f64> {
-    let (s, c) = a.sin_cos();
-    Matrix3::new(c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
-}
 fn rz(a: f64) -> Matrix3<f64> {
     let (s, c) = a.sin_cos();
     Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
@@ -221,10 +217,13 @@ fn rotary(
 
 /// The G-code of the path on a machine, from the machine angles and linear axes computed
 /// for each pose by `machine`.
+/// The machine's linear axes and two rotary angles for a tool pose (tip, axis).
+type Machine<'a> = dyn Fn(&Vector3<f64>, &Vector3<f64>) -> (Vector3<f64>, f64, f64) + 'a;
+
 fn gcode_text(
     path: &[(Vector3<f64>, Vector3<f64>)],
     letters: (&str, &str),
-    machine: &dyn Fn(&Vector3<f64>, &Vector3<f64>) -> (Vector3<f64>, f64, f64),
+    machine: &Machine<'_>,
 ) -> String {
     let mut s = String::from("G21 G90 G94 F1200\n");
     for (tip, axis) in path {
@@ -321,11 +320,7 @@ fn apt_and_abc_gcode_give_the_same_tool_poses_on_three_machines() {
         (tip - pivot + r * pivot, c, a)
     };
     for (k, letters, machine) in [
-        (
-            table_table,
-            ("A", "C"),
-            &tt as &dyn Fn(&Vector3<f64>, &Vector3<f64>) -> (Vector3<f64>, f64, f64),
-        ),
+        (table_table, ("A", "C"), &tt as &Machine<'_>),
         (head_table, ("B", "C"), &ht),
         (head_head, ("C", "A"), &hh),
     ] {

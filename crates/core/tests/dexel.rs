@@ -171,8 +171,8 @@ fn tilted_slots_and_grooves_leave_the_analytic_cross_section() {
                     if d.is_material(&p) != want {
                         let near = (0..32).any(|k| {
                             let t = f64::from(k) * std::f64::consts::TAU / 32.0;
-                            !removed(shape, tilt, p.y + CELL * t.cos(), p.z + CELL * t.sin())
-                                == !want
+                            // A neighbour a cell away on the other side of the wall.
+                            removed(shape, tilt, p.y + CELL * t.cos(), p.z + CELL * t.sin()) == want
                         });
                         assert!(near, "{shape:?} {degrees}: {p} misread far from the wall");
                     }
@@ -328,7 +328,7 @@ fn bad_stocks_tools_and_cuts_are_refused() {
         ),
         "{e}"
     );
-    assert!(dexel::MAX_RAYS <= dexel::MAX_INTERVALS);
+    const { assert!(dexel::MAX_RAYS <= dexel::MAX_INTERVALS) };
     let t = Tool::new(6e-3, 2, 0.0).unwrap();
     let ball = Profile::new(&t, ToolShape::Ball).unwrap();
     assert!(

@@ -23,6 +23,7 @@ mod compensation;
 mod compliance_map;
 mod cutter;
 mod dalembert;
+mod dexel;
 mod drivetrain;
 mod errors;
 mod field;
@@ -80,6 +81,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     drivetrain::register(m)?;
     posture::register(m)?;
     machining::register(m)?;
+    dexel::register(m)?;
     machining_job::register(m)?;
     placement::register(m)?;
     tools::register(m)?;

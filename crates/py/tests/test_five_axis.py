@@ -125,3 +125,28 @@ def test_abc_gcode_under_a_machine_gives_the_apt_axes():
     same = {"tcp": True, "rotaries": [machine["rotaries"][0]] * 2}
     with pytest.raises(deflect.DeflectError, match="same word"):
         deflect.GcodeProgram.from_text("G1 X1 F100\n", kinematics=same)
+
+
+def test_dexels_cut_the_closed_form_slot_and_a_program():
+    stock = deflect.Dexels((0.0, -0.008, -0.008), (0.014, 0.008, 0.0), 0.25e-3)
+    assert stock.shape == (56, 64, 32)
+    full = stock.volume
+    rays, removed = stock.cut("flat", 0.006, 0.01, (0.0035, 0, -0.002), (0, 0, 1),
+                              (0.0105, 0, -0.002), (0, 0, 1))
+    # The stadium of the 7 mm slot of a 6 mm end mill, 2 mm deep (sampled by the rays: within
+    # its perimeter times the depth times a cell).
+    want = (0.006 * 0.007 + math.pi * 0.003**2) * 0.002
+    perimeter = 2 * 0.007 + 2 * math.pi * 0.003
+    assert rays > 0 and abs(removed - want) < perimeter * 0.002 * 0.25e-3
+    assert abs(full - stock.volume - removed) < 1e-15
+    inside = stock.is_material([[0.007, 0.0, -0.001], [0.007, 0.0, -0.003], [0.007, 0.005, -0.001]])
+    assert inside.tolist() == [False, True, True]
+    p = deflect.GcodeProgram.from_apt_text(APT)
+    _, v = stock.cut_program(p, "ball", 0.008, 0.02)
+    assert v == 0.0  # the program runs above the block
+    with pytest.raises(deflect.DeflectError, match="shape"):
+        stock.cut("cone", 0.006, 0.01, (0, 0, 0), (0, 0, 1), (0, 0, 0), (0, 0, 1))
+    with pytest.raises(deflect.DeflectError, match="axis"):
+        stock.cut("flat", 0.006, 0.01, (0, 0, 0), (0, 0, 2), (0, 0, 0), (0, 0, 1))
+    with pytest.raises(deflect.DeflectError):
+        deflect.Dexels((0, 0, 0), (1, 1, 1), 1e-4)

@@ -320,6 +320,41 @@ impl Dexels {
         Ok(total)
     }
 
+    /// Cuts every move of `program` in order (rapids too: a rapid through material is the
+    /// program's fault, and the stock shows it), arcs as chords whose sagitta stays within an
+    /// eighth of a cell, dwells cutting nothing. Errors of [`Self::cut`], and
+    /// [`TickError::InvalidArgument`] for a program [`super::Program::validate`] refuses.
+    pub fn cut_program(
+        &mut self,
+        tool: &DexelTool,
+        program: &super::Program,
+    ) -> Result<DexelRemoval, TickError> {
+        program.validate().map_err(|_| TickError::InvalidArgument {
+            what: "program (Program::validate refuses it)",
+            value: f64::NAN,
+        })?;
+        let mut total = DexelRemoval::default();
+        for m in &program.moves {
+            let chords = match m.motion {
+                super::Motion::Dwell { .. } => continue,
+                super::Motion::Arc { sweep, .. } => {
+                    let r = m.radius().max(m.end_radius());
+                    let half = ComplexField::acos((1.0 - 0.125 * self.cell / r).clamp(-1.0, 1.0));
+                    ComplexField::ceil(ComplexField::abs(sweep) / (2.0 * half).max(1e-6))
+                        .clamp(1.0, 1e6) as usize
+                }
+                _ => 1,
+            };
+            for k in 0..chords {
+                let (s0, s1) = (k as f64 / chords as f64, (k + 1) as f64 / chords as f64);
+                let r = self.cut(tool, &m.point(s0), &m.axis(s0), &m.point(s1), &m.axis(s1))?;
+                total.rays += r.rays;
+                total.volume += r.volume;
+            }
+        }
+        Ok(total)
+    }
+
     /// One straight sweep with a fixed axis.
     fn sweep(
         &mut self,

@@ -6,6 +6,7 @@ Every error raised for bad input derives from ``ValueError`` through ``DeflectEr
 
 from ._deflect import (
     AL7075_T6_CARBIDE,
+    Dexels,
     GcodeProgram,
     ToolTable,
     gcode_words,
@@ -73,6 +74,7 @@ from .placement import PlacementProblem, PlacementResult, place
 
 __all__ = [
     "AL7075_T6_CARBIDE",
+    "Dexels",
     "GcodeProgram",
     "ToolTable",
     "gcode_words",

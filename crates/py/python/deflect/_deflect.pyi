@@ -59,12 +59,14 @@ __all__ = [
     "MAX_GRID_DIMS",
     "MAX_GRID_NODES",
     "AL7075_T6_CARBIDE",
+    "Dexels",
     "GcodeProgram",
     "ToolTable",
     "gcode_words",
     "MachiningJob",
     "MachiningResult",
     "PlacementProblem",
+    "cutter_force",
     "milling_force",
     "DeflectError",
     "LoadError",
@@ -988,6 +990,42 @@ def _atlas_chunk(
     min_sigma: float = 0.001,
 ) -> _FloatArray:
     """One chunk of ``deflect.atlas``: (N, 10 + dof + 39) rows."""
+
+@final
+class Dexels:
+    """A block of stock as three grids of rays, cut exactly by a tool at any orientation."""
+    def __new__(cls, min: _ArrayLike, max: _ArrayLike, cell: float) -> "Dexels": ...
+    def cut(
+        self,
+        shape: str,
+        diameter: float,
+        length: float,
+        start: _ArrayLike,
+        start_axis: _ArrayLike,
+        end: _ArrayLike,
+        end_axis: _ArrayLike,
+        *,
+        corner_radius: Optional[float] = None,
+    ) -> Tuple[int, float]:
+        """Sweeps the tool: (rays updated, volume removed [m^3])."""
+    def cut_program(
+        self,
+        program: "GcodeProgram",
+        shape: str,
+        diameter: float,
+        length: float,
+        *,
+        corner_radius: Optional[float] = None,
+    ) -> Tuple[int, float]:
+        """Cuts every move of the program: (rays updated, volume removed [m^3])."""
+    def is_material(self, points: _ArrayLike) -> npt.NDArray[np.bool_]:
+        """Whether each point (n, 3) [m] is material."""
+    @property
+    def volume(self) -> float:
+        """The material's volume [m^3]."""
+    @property
+    def shape(self) -> Tuple[int, int, int]:
+        """Cells along x, y, z."""
 
 @final
 class GcodeProgram:
