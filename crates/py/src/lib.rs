@@ -40,6 +40,7 @@ mod pickle;
 mod placement;
 mod pose_motion;
 mod posture;
+mod program_state;
 mod scalars;
 mod tools;
 mod vjm;
