@@ -47,8 +47,9 @@ RUSTDOCFLAGS="-D warnings" cargo doc --workspace --no-deps --quiet
 # (a workspace-wide test build may only produce the rlib).
 cargo build -p deflect-ffi --quiet
 cargo test --workspace --quiet
-# The real-time core must build without std (no_std, no alloc) ...
+# The real-time core must build without std (no_std, no alloc), and with alloc alone ...
 cargo build -p deflect-core --no-default-features --quiet
+cargo build -p deflect-core --no-default-features --features alloc --quiet
 # ... and its per-tick paths must work from a #![no_std] crate without alloc. Build that crate
 # alone: built with the workspace, cargo unifies deflect-core's features and proves nothing.
 cargo build -p deflect-nostd-check --quiet

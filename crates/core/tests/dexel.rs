@@ -357,3 +357,80 @@ fn bad_stocks_tools_and_cuts_are_refused() {
         .unwrap_err();
     assert!(matches!(e, TickError::InvalidArgument { .. }), "{e:?}");
 }
+
+#[test]
+fn the_engagement_read_from_the_dexels_is_the_slots_and_its_force_the_closed_form() {
+    use deflect_core::machining::cutting::{self, Coefficients, Engagement, tool_frame};
+    use deflect_core::machining::profile::{self, Band, Cut};
+    let flat = tool(ToolShape::Flat);
+    let mut d = stock();
+    // The slot cut up to x = 7 mm; the tool there, feeding on along +x.
+    let (from, here) = (
+        Vector3::new(3.5e-3, 0.0, TIP_Z),
+        Vector3::new(7e-3, 0.0, TIP_Z),
+    );
+    let _ = d
+        .cut(&flat, &from, &Vector3::z(), &here, &Vector3::z())
+        .unwrap();
+    let frame = tool_frame(&Vector3::z(), &Vector3::x()).unwrap();
+    let mut bands = [Band::new(0.0, 0.0, 1.0); 64];
+    let n = d
+        .engagement(&flat, &here, &frame, 40, 360, &mut bands)
+        .unwrap();
+    // One band: the 2 mm under the top (8 slices of 0.25 mm), over the front half.
+    assert_eq!(n, 1, "{:?}", &bands[..n]);
+    let b = bands[0];
+    assert_eq!((b.bottom, b.top), (0.0, 2e-3));
+    // The arc from 0 to pi to a few degrees (it may start just before 0: then its entry
+    // reads in [pi, 2 pi) and its exit past 2 pi).
+    let tau = std::f64::consts::TAU;
+    let entry = if b.entry > std::f64::consts::PI {
+        b.entry - tau
+    } else {
+        b.entry
+    };
+    let exit = b.exit - (b.entry - entry);
+    assert!(
+        entry.abs() < 3f64.to_radians() && (exit - std::f64::consts::PI).abs() < 3f64.to_radians(),
+        "{b:?}"
+    );
+    // Its force is the full slot's closed form to the arc's ends.
+    let k = Coefficients::AL7075_T6_CARBIDE;
+    let t = Tool::new(2.0 * R, 2, 0.0).unwrap();
+    let p = Profile::new(&t, ToolShape::Flat).unwrap();
+    let c = 0.1e-3;
+    let got = profile::average(
+        &k,
+        &p,
+        &Cut {
+            bands: &bands[..n],
+            feed: Vector3::new(c, 0.0, 0.0),
+        },
+    )
+    .unwrap();
+    let want = cutting::average(&k, &t, &Engagement::slot(2e-3, c)).unwrap();
+    assert!(
+        (got.force - want).norm() < 0.03 * want.norm(),
+        "{} vs {want}",
+        got.force
+    );
+    // A tool in the air engages nothing; too many bands for the output is refused.
+    let air = Vector3::new(7e-3, 0.0, 0.02);
+    assert_eq!(
+        d.engagement(&flat, &air, &frame, 40, 360, &mut bands)
+            .unwrap(),
+        0
+    );
+    assert!(
+        d.engagement(&flat, &here, &frame, 40, 360, &mut [])
+            .is_err()
+    );
+    assert!(
+        d.engagement(&flat, &here, &frame, 0, 360, &mut bands)
+            .is_err()
+    );
+    assert!(
+        d.engagement(&flat, &here, &frame, 4096, 3600, &mut bands)
+            .is_err()
+    );
+}

@@ -131,7 +131,7 @@ impl Kinematics {
                 crate::error::param(
                     "rotary axis point",
                     *v,
-                    v.abs() <= crate::machining::MAX_COORDINATE,
+                    v.abs() <= 1.0e3, // MAX_COORDINATE: a robot cell is metres
                     "finite, within +-1000 m",
                 )?;
             }

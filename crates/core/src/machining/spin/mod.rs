@@ -185,7 +185,7 @@ impl SpinOptions {
 
     /// The candidate spins \[rad\], ascending (0 among them: the setup's orientation).
     pub fn candidates(&self) -> Vec<f64> {
-        let n = (self.range / self.step + 1e-9).floor() as i64;
+        let n = nalgebra::ComplexField::floor(self.range / self.step + 1e-9) as i64;
         let n = n.min(((MAX_CANDIDATES - 1) / 2) as i64);
         (-n..=n).map(|j| j as f64 * self.step).collect()
     }

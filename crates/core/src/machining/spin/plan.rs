@@ -363,8 +363,7 @@ pub fn plan_at(
         let steps = if i == 0 {
             0
         } else {
-            (((st.budget - budget_prev) / options.step) + 1e-9)
-                .floor()
+            nalgebra::ComplexField::floor(((st.budget - budget_prev) / options.step) + 1e-9)
                 .clamp(0.0, k as f64) as usize
         };
         budget_prev = st.budget;
@@ -414,7 +413,7 @@ pub fn plan_at(
         j = usize::from(parent.get(i * k + j).copied().unwrap_or(0));
     }
     let loaded = loads.loads.len().max(1) as f64;
-    let rms = |sum: f64| (sum / loaded).sqrt();
+    let rms = |sum: f64| nalgebra::ComplexField::sqrt(sum / loaded);
     let best_constant = columns
         .iter()
         .zip(&candidates)

@@ -25,7 +25,12 @@ use alloc::vec::Vec;
 use nalgebra::{ComplexField, Vector3};
 
 use super::profile::Profile;
+
+mod engage;
+mod sweep;
 use crate::error::{BuildError, TickError};
+pub use engage::MAX_ENGAGEMENT_SAMPLES;
+use sweep::{hit, subtract};
 
 /// Most rays of one stock (the three grids together): 2^25 (33.5 million, 0.8 GB of ray
 /// headers; a 0.5 m cube at 0.15 mm).
@@ -33,16 +38,6 @@ pub const MAX_RAYS: usize = 1 << 25;
 
 /// Most material intervals one stock may hold: 2^26 (67 million, 1.1 GB).
 pub const MAX_INTERVALS: usize = 1 << 26;
-
-/// Golden-section iterations along the ray (the bracket shrinks by 0.618 each: 5e-8 of it
-/// after 35; only the sign of the minimum is read from it) and along the move (28: 1.4e-6
-/// of the move; the minimum's error is second order in it, the functions being smooth on
-/// their slab).
-const GOLDEN: usize = 35;
-const GOLDEN_MOVE: usize = 28;
-/// Most steps of the Illinois search for an interval's end (it stops at 1e-13 m; convergence
-/// is superlinear, a dozen steps on these convex functions).
-const BISECT: usize = 80;
 
 /// The tool as a solid of revolution: radius, corner radius and the length above the tip
 /// that removes material \[m\].
@@ -125,7 +120,7 @@ fn across(d: usize) -> (usize, usize) {
     ((d + 1) % 3, (d + 2) % 3)
 }
 
-fn at(v: &Vector3<f64>, i: usize) -> f64 {
+pub(crate) fn at(v: &Vector3<f64>, i: usize) -> f64 {
     v.get(i).copied().unwrap_or(0.0)
 }
 
@@ -246,15 +241,24 @@ impl Dexels {
 
     /// Whether `p` is material, read from the z-ray nearest it (outside the block: no).
     pub fn is_material(&self, p: &Vector3<f64>) -> bool {
+        self.is_material_along(p, 2)
+    }
+
+    /// Whether `p` is material, read from the ray along direction `d` (0 x, 1 y, 2 z) nearest
+    /// it: exact along `d`, within half a cell across it (so read along the direction closest
+    /// to the material boundary's normal; outside the block: no).
+    pub fn is_material_along(&self, p: &Vector3<f64>, d: usize) -> bool {
+        let (u, v) = across(d);
         let index = |k: usize| {
             let x = (at(p, k) - at(&self.min, k)) / self.cell;
             (x >= 0.0 && x < count(&self.n, k) as f64).then_some(x as usize)
         };
-        let (Some(i), Some(j)) = (index(0), index(1)) else {
+        let (Some(i), Some(j)) = (index(u), index(v)) else {
             return false;
         };
-        self.ray(2, i, j)
-            .is_some_and(|(_, r)| r.iter().any(|&(a, b)| p.z >= a && p.z <= b))
+        let x = at(p, d);
+        self.ray(d, i, j)
+            .is_some_and(|(_, r)| r.iter().any(|&(a, b)| x >= a && x <= b))
     }
 
     /// The material's volume \[m^3\] from the z-rays.
@@ -416,209 +420,4 @@ impl Dexels {
         }
         Ok(out)
     }
-}
-
-/// Removes `[a, b]` from a ray's sorted intervals; the length removed. Splitting an interval
-/// in two needs `room` ([`TickError::Budget`] otherwise).
-fn subtract(ray: &mut Vec<(f64, f64)>, a: f64, b: f64, room: bool) -> Result<f64, TickError> {
-    let mut removed = 0.0;
-    let mut k = 0;
-    while let Some(&(lo, hi)) = ray.get(k) {
-        if hi <= a || lo >= b {
-            k += 1;
-            continue;
-        }
-        removed += hi.min(b) - lo.max(a);
-        match (lo < a, hi > b) {
-            (true, true) => {
-                if !room {
-                    return Err(TickError::Budget {
-                        what: "dexel intervals",
-                        budget: "MAX_INTERVALS",
-                        limit: MAX_INTERVALS as f64,
-                        requested: (MAX_INTERVALS + 1) as f64,
-                    });
-                }
-                if let Some(x) = ray.get_mut(k) {
-                    *x = (lo, a);
-                }
-                ray.insert(k + 1, (b, hi));
-                return Ok(removed);
-            }
-            (true, false) => {
-                if let Some(x) = ray.get_mut(k) {
-                    *x = (lo, a);
-                }
-                k += 1;
-            }
-            (false, true) => {
-                if let Some(x) = ray.get_mut(k) {
-                    *x = (b, hi);
-                }
-                return Ok(removed);
-            }
-            (false, false) => {
-                ray.remove(k);
-            }
-        }
-    }
-    Ok(removed)
-}
-
-/// Golden-section minimum of a convex `f` on `[a, b]`: `(argmin, min)`.
-fn golden(a: f64, b: f64, iterations: usize, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
-    let r = 0.618_033_988_749_894_9;
-    let (mut a, mut b) = (a, b);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..iterations {
-        if fc <= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = f(d);
-        }
-    }
-    let (t, ft) = if fc <= fd { (c, fc) } else { (d, fd) };
-    // The ends of the bracket are candidates too (a minimum on the boundary).
-    [(a, f(a)), (b, f(b))]
-        .into_iter()
-        .fold((t, ft), |best, x| if x.1 < best.1 { x } else { best })
-}
-
-/// Where along the ray through `origin` (its coordinate `d` free) the tool swept from `from`
-/// to `to` with `axis` lies: the interval of the coordinate, within `[lo, hi]`.
-#[allow(clippy::too_many_arguments)] // reason: one ray against one sweep, called from one loop
-fn hit(
-    tool: &DexelTool,
-    origin: &Vector3<f64>,
-    d: usize,
-    from: &Vector3<f64>,
-    to: &Vector3<f64>,
-    axis: &Vector3<f64>,
-    lo: f64,
-    hi: f64,
-) -> Option<(f64, f64)> {
-    let mut e = Vector3::zeros();
-    if let Some(x) = e.get_mut(d) {
-        *x = 1.0;
-    }
-    let step = to - from;
-    // z(t, s) = alpha + beta t - gamma s along the axis.
-    let alpha = (origin - from).dot(axis);
-    let beta = e.dot(axis);
-    let gamma = step.dot(axis);
-    let h = tool.length;
-    // The s-range where 0 <= z <= h at `t`, within [0, 1].
-    let s_range = |t: f64| -> Option<(f64, f64)> {
-        let z0 = alpha + beta * t;
-        let (mut a, mut b) = (0.0f64, 1.0f64);
-        if gamma.abs() < 1e-300 {
-            return (z0 >= 0.0 && z0 <= h).then_some((a, b));
-        }
-        // 0 <= z0 - gamma s <= h  <=>  s between (z0 - h) / gamma and z0 / gamma.
-        let (p, q) = ((z0 - h) / gamma, z0 / gamma);
-        a = a.max(p.min(q));
-        b = b.min(p.max(q));
-        (a <= b).then_some((a, b))
-    };
-    // |w|^2 of w = (origin - from) + t e - s step as a quadratic in (t, s), in plain f64: this
-    // is the inner loop (thousands of evaluations per ray), and nalgebra's small vectors are
-    // slow unoptimised.
-    let o = origin - from;
-    let (q0, qe, qd) = (o.norm_squared(), at(&o, d), o.dot(&step));
-    let (ed, dd) = (at(&step, d), step.norm_squared());
-    let f = |t: f64, s: f64| {
-        let q = q0 + t * t + s * s * dd + 2.0 * (t * qe - s * qd - t * s * ed);
-        let z = alpha + beta * t - gamma * s;
-        ComplexField::sqrt((q - z * z).max(0.0)) - tool.radius_at(z.clamp(0.0, h))
-    };
-    let g = |t: f64| match s_range(t) {
-        Some((a, b)) => golden(a, b, GOLDEN_MOVE, &|s| f(t, s)).1,
-        None => f64::INFINITY,
-    };
-    // The t-range where some s keeps the slab: 0 <= alpha + beta t - gamma s <= h for an s
-    // in [0, 1], i.e. alpha + beta t in [min(0, gamma), h + max(0, gamma)].
-    let (zlo, zhi) = (gamma.min(0.0), h + gamma.max(0.0));
-    let (mut t0, mut t1) = (lo, hi);
-    if beta.abs() > 1e-300 {
-        let (p, q) = ((zlo - alpha) / beta, (zhi - alpha) / beta);
-        t0 = t0.max(p.min(q));
-        t1 = t1.min(p.max(q));
-    } else if alpha < zlo || alpha > zhi {
-        return None;
-    }
-    if t0 >= t1 {
-        return None;
-    }
-    let (tm, fm) = golden(t0, t1, GOLDEN, &g);
-    if fm.is_nan() || fm > 0.0 {
-        return None;
-    }
-    // The zero of g between an inside point (g <= 0) and an outside one: regula falsi with
-    // the Illinois modification (the retained end's value halved), bracket kept.
-    let edge = |inside: f64, outside: f64| {
-        let (mut a, mut b) = (inside, outside);
-        let (mut fa, mut fb) = (g(a), g(b));
-        if !fb.is_finite() {
-            // Just outside the slab: pull the outer end in until g is finite.
-            for _ in 0..BISECT {
-                let m = 0.5 * (a + b);
-                let fm = g(m);
-                if fm.is_finite() && fm > 0.0 {
-                    b = m;
-                    fb = fm;
-                    break;
-                }
-                if fm <= 0.0 {
-                    a = m;
-                    fa = fm;
-                } else {
-                    b = m;
-                }
-            }
-            if !fb.is_finite() {
-                return 0.5 * (a + b);
-            }
-        }
-        let mut side = 0i8;
-        for _ in 0..BISECT {
-            if (b - a).abs() < 1e-13 {
-                break;
-            }
-            let m = (a * fb - b * fa) / (fb - fa);
-            let m = if m.is_finite() && (m - a) * (m - b) < 0.0 {
-                m
-            } else {
-                0.5 * (a + b)
-            };
-            let fm = g(m);
-            if fm <= 0.0 {
-                a = m;
-                fa = fm;
-                if side == -1 {
-                    fb *= 0.5;
-                }
-                side = -1;
-            } else {
-                b = m;
-                fb = fm;
-                if side == 1 {
-                    fa *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        0.5 * (a + b)
-    };
-    let a = if g(t0) <= 0.0 { t0 } else { edge(tm, t0) };
-    let b = if g(t1) <= 0.0 { t1 } else { edge(tm, t1) };
-    (b > a).then_some((a, b))
 }
