@@ -116,7 +116,9 @@ impl RobotProgramArg {
 pub struct JobArgs {
     /// RS274/NGC G-code program, read as LinuxCNC reads it (tools, work offsets, planes,
     /// canned cycles, parameters, subroutines, control flow; see --explain), in mm unless it
-    /// says G20; its moves in the program's machine frame = the workpiece frame. Default:
+    /// says G20; its moves in the program's machine frame = the workpiece frame; or APT / CL
+    /// data by its extension (.apt, .cl, .cls: GOTO with tool vectors; a program whose tool
+    /// axis leaves the workpiece z is refused: the job runs 2.5-D programs). Default:
     /// data/groove_and_pocket.nc, built in (a groove, a ramp and a circular pocket in mm).
     #[arg(long, conflicts_with = "points")]
     pub program: Option<PathBuf>,

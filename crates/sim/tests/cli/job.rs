@@ -402,3 +402,57 @@ fn job_runs_at_one_sample_per_second_and_with_sharp_limits() {
     assert_eq!(o.code, 0, "{}", o.stderr);
     assert!(o.stdout.contains("z-map cells of 0.075 mm"), "{}", o.stdout);
 }
+
+#[test]
+fn job_reads_apt_by_its_extension_and_refuses_a_tilted_axis() {
+    let d = scratch("job-apt");
+    let flat = d.join("slot.apt");
+    std::fs::write(
+        &flat,
+        "UNITS/MM\nSPINDL/13000,CLW\nRAPID\nGOTO/-10,0,5\nFEDRAT/MMPM,1500\nGOTO/-10,0,-2\n\
+         GOTO/40,0,-2\nRAPID\nGOTO/40,0,5\nFINI\n",
+    )
+    .unwrap();
+    let out = d.join("run");
+    let o = sim(&[
+        "job",
+        "--program",
+        flat.to_str().unwrap(),
+        "--stock",
+        "0,-20,50,20",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    let tilted = d.join("tilted.apt");
+    std::fs::write(
+        &tilted,
+        "UNITS/MM\nSPINDL/13000,CLW\nFEDRAT/MMPM,1500\nGOTO/-10,0,5,0,0,1\n\
+         GOTO/40,0,-2,0,0.2588190,0.9659258\nFINI\n",
+    )
+    .unwrap();
+    let o = sim(&[
+        "job",
+        "--program",
+        tilted.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(o.stderr.contains("2.5-D"), "{}", o.stderr);
+    let bad = d.join("bad.apt");
+    std::fs::write(&bad, "UNITS/MM\nSPLINE/1,2,3\n").unwrap();
+    let o = sim(&[
+        "job",
+        "--program",
+        bad.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 1, "{}", o.stderr);
+    assert!(
+        o.stderr.contains("line 2") && o.stderr.contains("SPLINE"),
+        "{}",
+        o.stderr
+    );
+}
