@@ -167,8 +167,9 @@ def test_programs_and_jobs_pickle_bit_for_bit(kr300):
     slot = deflect.GcodeProgram.from_text(SLOT, start=[0.0, 0.0, 0.02])
     np.testing.assert_array_equal(again.run(slot, KR300_POSE).q_commanded, job.run(slot, KR300_POSE).q_commanded)
     # A tampered state is checked like any program: a gap between moves.
-    fn, (state, words, ops) = program.__reduce__()
-    assert fn(state, words, ops) == program
+    fn, (state, words, ops, axes, cutters) = program.__reduce__()
+    assert axes == [] and cutters == []  # a 3-axis G-code program: every axis +z, no CUTTER
+    assert fn(state, words, ops, axes, cutters) == program
     state[3] = (state[3][0], state[3][1], (1.0, 1.0, 1.0), *state[3][3:])
     with pytest.raises(deflect.InputError, match="MAX_GAP"):
         fn(state, words, ops)
