@@ -1,5 +1,6 @@
 //! Golden-section search for the minimum of a function on an interval, shared by the posture
-//! refinement and the ball end mill's lowest point (both unimodal on their brackets).
+//! refinement, the ball end mill's lowest point and the dexel sweep's deepest point (each
+//! unimodal on its bracket).
 
 /// The golden ratio's conjugate: each iteration keeps this fraction of the bracket.
 const R: f64 = 0.618_033_988_749_894_9;

@@ -132,24 +132,10 @@ fn cutter_force<'py>(
     let flutes = u32::try_from(count(flutes, "flutes")?).unwrap_or(u32::MAX);
     let helix = helix.map_or(Ok(0.0), |h| real(h, "helix"))?;
     let tool = Tool::new(real(diameter, "diameter")?, flutes, helix).map_err(build_err)?;
-    let shape = match (shape, corner_radius) {
-        ("flat", None) => ToolShape::Flat,
-        ("ball", None) => ToolShape::Ball,
-        ("bull-nose", Some(r)) => ToolShape::BullNose {
-            corner_radius: real(r, "corner_radius")?,
-        },
-        ("bull-nose", None) => {
-            return Err(InputError::new_err(
-                "shape \"bull-nose\" needs corner_radius [m]",
-            ));
-        }
-        (s, _) => {
-            return Err(InputError::new_err(format!(
-                "shape must be \"flat\", \"ball\" or \"bull-nose\" (corner_radius only with \
-                 \"bull-nose\"), got {s:?}"
-            )));
-        }
-    };
+    let corner_radius = corner_radius
+        .map(|r| real(r, "corner_radius"))
+        .transpose()?;
+    let shape = self::shape(shape, corner_radius)?;
     let profile = Profile::new(&tool, shape).map_err(build_err)?;
     let k = self::coefficients(coefficients)?;
     let rows = matrix(bands, "bands", None, Some(4))?;
@@ -204,6 +190,23 @@ fn cutter_force<'py>(
         Ok(a.into_pyarray(py).into_any())
     };
     Ok((to(force)?, to(moment)?))
+}
+
+/// A cutter's end from its name: "flat", "ball" or "bull-nose" (which, alone, takes
+/// `corner_radius` [m]; the core checks its range).
+pub(crate) fn shape(name: &str, corner_radius: Option<f64>) -> PyResult<ToolShape> {
+    match (name, corner_radius) {
+        ("flat", None) => Ok(ToolShape::Flat),
+        ("ball", None) => Ok(ToolShape::Ball),
+        ("bull-nose", Some(r)) => Ok(ToolShape::BullNose { corner_radius: r }),
+        ("bull-nose", None) => Err(InputError::new_err(
+            "shape \"bull-nose\" needs corner_radius [m]",
+        )),
+        (s, _) => Err(InputError::new_err(format!(
+            "shape must be \"flat\", \"ball\" or \"bull-nose\" (corner_radius only with \
+             \"bull-nose\"), got {s:?}"
+        ))),
+    }
 }
 
 /// Adds the force functions and the coefficient set to the module.

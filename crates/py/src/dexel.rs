@@ -4,7 +4,6 @@
 use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::dexel::{DexelTool, Dexels as CoreDexels};
 use deflect_core::machining::profile::Profile;
-use deflect_core::machining::tools::ToolShape;
 use nalgebra::Vector3;
 use numpy::ndarray::Array1;
 use numpy::{IntoPyArray, PyArray1};
@@ -38,17 +37,7 @@ fn tool(
     length: f64,
     corner_radius: Option<f64>,
 ) -> PyResult<DexelTool> {
-    let shape = match (shape, corner_radius) {
-        ("flat", None) => ToolShape::Flat,
-        ("ball", None) => ToolShape::Ball,
-        ("bull-nose", Some(r)) => ToolShape::BullNose { corner_radius: r },
-        (s, _) => {
-            return Err(InputError::new_err(format!(
-                "shape must be \"flat\", \"ball\" or \"bull-nose\" (corner_radius only, and \
-                 always, with \"bull-nose\"), got {s:?}"
-            )));
-        }
-    };
+    let shape = crate::cutter::shape(shape, corner_radius)?;
     let t = Tool::new(diameter, 2, 0.0).map_err(build_err)?;
     let p = Profile::new(&t, shape).map_err(build_err)?;
     DexelTool::new(&p, length).map_err(build_err)

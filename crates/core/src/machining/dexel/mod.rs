@@ -39,6 +39,24 @@ pub const MAX_RAYS: usize = 1 << 25;
 /// Most material intervals one stock may hold: 2^26 (67 million, 1.1 GB).
 pub const MAX_INTERVALS: usize = 1 << 26;
 
+/// Most straight pieces one move is cut as (a turning axis' pieces, an arc's chords): 65,536;
+/// past it [`TickError::Budget`] (a half turn of a 1 m reach at 0.1 mm rays would be 63,000).
+pub const MAX_PIECES: usize = 1 << 16;
+
+/// `n` pieces, or [`TickError::Budget`] past [`MAX_PIECES`].
+fn pieces(n: f64, what: &'static str) -> Result<usize, TickError> {
+    let n = ComplexField::ceil(n).max(1.0);
+    if n.is_nan() || n > MAX_PIECES as f64 {
+        return Err(TickError::Budget {
+            what,
+            budget: "MAX_PIECES",
+            limit: MAX_PIECES as f64,
+            requested: n,
+        });
+    }
+    Ok(n as usize)
+}
+
 /// The tool as a solid of revolution: radius, corner radius and the length above the tip
 /// that removes material \[m\].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -276,7 +294,7 @@ impl Dexels {
     /// `from_axis` to `to_axis` (unit; along the great circle), workpiece frame.
     /// [`TickError::NonFinite`] for non-finite input, [`TickError::InvalidArgument`] for an
     /// axis not of unit length (within 1e-9) or axes opposite, [`TickError::Budget`] when the
-    /// material would pass [`MAX_INTERVALS`].
+    /// material would pass [`MAX_INTERVALS`] or the turn take more than [`MAX_PIECES`].
     pub fn cut(
         &mut self,
         tool: &DexelTool,
@@ -310,7 +328,10 @@ impl Dexels {
         }
         // Pieces keeping the far end of the tool within a quarter cell of the turning axis.
         let reach = tool.length + tool.radius;
-        let pieces = ComplexField::ceil(turn * reach / (0.25 * self.cell)).clamp(1.0, 1e6) as usize;
+        let pieces = pieces(
+            turn * reach / (0.25 * self.cell),
+            "pieces of a turning axis (a quarter cell of the tool's far end each)",
+        )?;
         let mut total = DexelRemoval::default();
         for k in 0..pieces {
             let (s0, s1) = (k as f64 / pieces as f64, (k + 1) as f64 / pieces as f64);
@@ -344,8 +365,10 @@ impl Dexels {
                 super::Motion::Arc { sweep, .. } => {
                     let r = m.radius().max(m.end_radius());
                     let half = ComplexField::acos((1.0 - 0.125 * self.cell / r).clamp(-1.0, 1.0));
-                    ComplexField::ceil(ComplexField::abs(sweep) / (2.0 * half).max(1e-6))
-                        .clamp(1.0, 1e6) as usize
+                    pieces(
+                        ComplexField::abs(sweep) / (2.0 * half).max(1e-6),
+                        "chords of an arc (an eighth of a cell of sagitta each)",
+                    )?
                 }
                 _ => 1,
             };

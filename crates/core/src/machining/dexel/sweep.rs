@@ -72,30 +72,11 @@ pub(super) fn subtract(
 
 /// Golden-section minimum of a convex `f` on `[a, b]`: `(argmin, min)`.
 fn golden(a: f64, b: f64, iterations: usize, f: &dyn Fn(f64) -> f64) -> (f64, f64) {
-    let r = 0.618_033_988_749_894_9;
-    let (mut a, mut b) = (a, b);
-    let (mut c, mut d) = (b - r * (b - a), a + r * (b - a));
-    let (mut fc, mut fd) = (f(c), f(d));
-    for _ in 0..iterations {
-        if fc <= fd {
-            b = d;
-            d = c;
-            fd = fc;
-            c = b - r * (b - a);
-            fc = f(c);
-        } else {
-            a = c;
-            c = d;
-            fc = fd;
-            d = a + r * (b - a);
-            fd = f(d);
-        }
-    }
-    let (t, ft) = if fc <= fd { (c, fc) } else { (d, fd) };
+    let best = crate::golden::minimise(a, b, iterations, |x| (x, f(x)), |p| p.1);
     // The ends of the bracket are candidates too (a minimum on the boundary).
     [(a, f(a)), (b, f(b))]
         .into_iter()
-        .fold((t, ft), |best, x| if x.1 < best.1 { x } else { best })
+        .fold(best, |best, x| if x.1 < best.1 { x } else { best })
 }
 
 /// Where along the ray through `origin` (its coordinate `d` free) the tool swept from `from`
