@@ -469,12 +469,20 @@ fn points_csv_takes_tool_vectors() {
 }
 
 #[test]
-fn the_path_refuses_a_tilted_axis_rather_than_drop_it() {
+fn the_path_samples_the_tool_axis_along_the_great_circle() {
     use deflect_core::machining::path;
     let p = read("FEDRAT/600\nGOTO/10,0,0,0,0,1\nGOTO/20,0,0,0,0.1736482,0.9848078\n").program;
-    let e = path::duration(&p, &path::PathOptions::default()).unwrap_err();
-    assert!(e.to_string().contains("2.5-D"), "{e}");
-    // Along +z the same reader's program runs.
+    let samples: Vec<_> = path::Sampler::new(&p, &path::PathOptions::default())
+        .unwrap()
+        .collect();
+    // The axis turns 10 degrees about y along the great circle with the tip's fraction.
+    for s in &samples {
+        let angle = 10f64.to_radians() * s.fraction;
+        let expected = Vector3::new(angle.sin(), 0.0, angle.cos());
+        assert!((s.axis - expected).norm() < 1e-6, "{:?}", s.axis);
+    }
+    assert!((samples.last().unwrap().axis.x - 0.1736482).abs() < 1e-6);
+    // Along +z the same reader's program samples +z.
     let flat = read("FEDRAT/600\nGOTO/10,0,0,0,0,1\nGOTO/20,0,0\n").program;
     let t = path::duration(&flat, &path::PathOptions::default()).unwrap();
     assert!(t > 1.0, "{t}");

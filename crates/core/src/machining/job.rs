@@ -77,6 +77,8 @@ mod nominal;
 mod predict;
 mod setup;
 
+pub(crate) use predict::Warm;
+
 pub use nominal::{NominalSample, nominal_pass};
 pub use setup::{Setup, Stock};
 
@@ -369,10 +371,32 @@ fn fill(
 }
 
 /// A wrench `[f; m]` turned by the rotation of `t` (the moment point moves with it).
-fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
+pub(crate) fn rotate(t: &Isometry3<f64>, w: &Vector6) -> Vector6 {
     let f = t.rotation * w.fixed_rows::<3>(0).into_owned();
     let m = t.rotation * w.fixed_rows::<3>(3).into_owned();
     Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+}
+
+/// The z-map pass runs 2.5-D programs: a tool axis off the workpiece +z would be silently
+/// dropped by it ([`crate::machining::five_axis`] runs the others).
+pub(crate) fn check_flat(program: &Program) -> Result<(), BuildError> {
+    use crate::machining::program::angle_between;
+    let z = Vector3::z();
+    if let Some((index, m)) = program
+        .moves
+        .iter()
+        .enumerate()
+        .find(|(_, m)| m.start_axis != z || m.end_axis != z)
+    {
+        return Err(BuildError::InvalidEntry {
+            what: "program moves (index: the move; value: its tool axis' angle from +z, rad)",
+            index,
+            value: angle_between(&m.end_axis, &z).max(angle_between(&m.start_axis, &z)),
+            expected: "a tool axis along the workpiece +z: the z-map job runs 2.5-D programs \
+                       (machining::five_axis runs five-axis ones)",
+        });
+    }
+    Ok(())
 }
 
 /// Seed joints, one per joint of the job's arm.
@@ -494,6 +518,7 @@ impl<E: core::fmt::Display> core::fmt::Display for RunError<E> {
 /// [`path::MAX_PATH_SAMPLES`] ([`BuildError::Budget`] past it; [`run_streaming`] takes
 /// longer programs). Errors name the program line.
 pub fn run(job: &Job, program: &Program, seed: &[f64]) -> Result<Report, JobError> {
+    check_flat(program)?;
     let count = path::Sampler::new(program, &job.setup.path)?.len();
     if count > path::MAX_PATH_SAMPLES {
         return Err(BuildError::Budget {
@@ -539,6 +564,7 @@ pub fn run_streaming<S: Sink + ?Sized>(
 ) -> Result<Report, RunError<S::Error>> {
     options.validate()?;
     check_seed(job, seed)?;
+    check_flat(program)?;
     let job = &*job.at_seed(seed)?;
     let setup = &job.setup;
     let dof = job.model.dof();

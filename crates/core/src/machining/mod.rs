@@ -17,6 +17,8 @@ pub mod dexel;
 #[cfg(feature = "alloc")]
 pub mod engagement;
 #[cfg(feature = "alloc")]
+pub mod five_axis;
+#[cfg(feature = "alloc")]
 pub mod job;
 pub mod kinematics;
 #[cfg(feature = "alloc")]

@@ -103,6 +103,9 @@ pub struct PathSample {
     pub position: Vector3<f64>,
     /// Unit feed direction (the move's tangent).
     pub direction: Vector3<f64>,
+    /// Unit tool axis, from the tip towards the spindle (the move's
+    /// [`super::Move::axis`]: `+z` in a 2.5-D program).
+    pub axis: Vector3<f64>,
     /// Path speed \[m/s\].
     pub speed: f64,
     /// Path acceleration \[m/s^2\].
@@ -157,25 +160,6 @@ impl Plan {
 fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
     options.validate()?;
     program.validate()?;
-    // The path follows the tool tip with the axis along the workpiece z; a tilted axis would
-    // be silently dropped here.
-    if let Some((index, m)) = program
-        .moves
-        .iter()
-        .enumerate()
-        .find(|(_, m)| m.start_axis != Vector3::z() || m.end_axis != Vector3::z())
-    {
-        return Err(BuildError::InvalidEntry {
-            what: "program moves (index: the move; value: its tool axis' angle from +z, rad)",
-            index,
-            value: crate::machining::program::angle_between(&m.end_axis, &Vector3::z()).max(
-                crate::machining::program::angle_between(&m.start_axis, &Vector3::z()),
-            ),
-            expected: "a tool axis along the workpiece +z: the path and the job run 2.5-D \
-                       programs (five-axis programs read, with their tool axes, but are not \
-                       machined yet)",
-        });
-    }
     let cos_corner = ComplexField::cos(options.corner_angle);
     let mut p = Plan {
         segs: Vec::new(),
@@ -400,6 +384,7 @@ impl Iterator for Sampler<'_> {
             line: mv.line,
             position: mv.point(fraction),
             direction: mv.tangent(fraction.clamp(0.0, 1.0)),
+            axis: mv.axis(fraction.clamp(0.0, 1.0)),
             speed: state.v,
             acceleration: state.a,
             feed_move: mv.is_feed(),

@@ -66,24 +66,9 @@ impl Dexels {
         let mut n = 0usize;
         for k in 0..slices {
             let z = (k as f64 + 0.5) * dz;
-            let r = tool.radius_at(z);
-            // The outward normal's parts at this height: across (sin kappa) and down (cos).
-            let slope = {
-                let h = 1e-6 * tool.length;
-                let (lo, hi) = ((z - h).max(0.0), (z + h).min(tool.length));
-                (tool.radius_at(hi) - tool.radius_at(lo)) / (hi - lo)
-            };
-            let m = ComplexField::sqrt(1.0 + slope * slope);
-            let (sk, ck) = (1.0 / m, slope / m);
             let engaged = |j: usize| {
                 let phi = (j as f64 + 0.5) * step;
-                let (s, c) = ComplexField::sin_cos(phi);
-                let local = Vector3::new(r * s, r * c, z);
-                // Read along the grid direction closest to the surface's normal there (the
-                // material's boundary near the tool runs along the tool).
-                let normal = frame * Vector3::new(sk * s, sk * c, -ck);
-                let d = normal.iamax();
-                self.is_material_along(&(tip + frame * local + ahead), d)
+                self.engaged_at(tool, tip, frame, &ahead, z, phi)
             };
             // Runs of engaged samples; a run through the last sample continues at sample 0.
             let start = (0..angles).find(|&j| !engaged(j));
@@ -106,7 +91,92 @@ impl Dexels {
                 j += 1;
             }
         }
+        self.refine(
+            tool,
+            tip,
+            frame,
+            &ahead,
+            dz,
+            out.get_mut(..n).unwrap_or(&mut []),
+        );
         Ok(n)
+    }
+
+    /// Whether the cutter's surface point at height `z` and immersion `phi` (tool frame
+    /// `frame`, tip `tip`), moved by `ahead`, is material: read along the grid direction
+    /// closest to the surface's normal there (the material's boundary near the tool runs
+    /// along the tool).
+    fn engaged_at(
+        &self,
+        tool: &DexelTool,
+        tip: &Vector3<f64>,
+        frame: &Rotation3<f64>,
+        ahead: &Vector3<f64>,
+        z: f64,
+        phi: f64,
+    ) -> bool {
+        let r = tool.radius_at(z);
+        // The outward normal's parts at this height: across (sin kappa) and down (cos).
+        let slope = {
+            let h = 1e-6 * tool.length;
+            let (lo, hi) = ((z - h).max(0.0), (z + h).min(tool.length));
+            (tool.radius_at(hi) - tool.radius_at(lo)) / (hi - lo)
+        };
+        let m = ComplexField::sqrt(1.0 + slope * slope);
+        let (sk, ck) = (1.0 / m, slope / m);
+        let (s, c) = ComplexField::sin_cos(phi);
+        let local = Vector3::new(r * s, r * c, z);
+        let normal = frame * Vector3::new(sk * s, sk * c, -ck);
+        self.is_material_along(&(tip + frame * local + ahead), normal.iamax())
+    }
+
+    /// The bands' axial ends found between the slices' middles: where the engagement at a
+    /// band's middle angle changes, by bisection to a millionth of a slice (a band's end at
+    /// a slice boundary would be off by up to half a slice: the depth of cut, and the force
+    /// with it). An end another band continues from stays where it is.
+    fn refine(
+        &self,
+        tool: &DexelTool,
+        tip: &Vector3<f64>,
+        frame: &Rotation3<f64>,
+        ahead: &Vector3<f64>,
+        dz: f64,
+        bands: &mut [Band],
+    ) {
+        let joined = |b: &Band, z: f64| (b.bottom - z).abs() <= 1e-12 || (b.top - z).abs() <= 1e-12;
+        for k in 0..bands.len() {
+            let Some(&b) = bands.get(k) else { continue };
+            let phi = 0.5 * (b.entry + b.exit);
+            let at = |z: f64| self.engaged_at(tool, tip, frame, ahead, z, phi);
+            let mut ends = [b.bottom, b.top];
+            for (e, lower) in ends.iter_mut().zip([true, false]) {
+                let z = *e;
+                let inner = if lower { z + 0.5 * dz } else { z - 0.5 * dz };
+                let outer = if lower { z - 0.5 * dz } else { z + 0.5 * dz };
+                let shared = bands
+                    .iter()
+                    .enumerate()
+                    .any(|(i, o)| i != k && joined(o, z));
+                if shared || outer < 0.0 || outer > tool.length || !at(inner) || at(outer) {
+                    continue;
+                }
+                let (mut yes, mut no) = (inner, outer);
+                while (yes - no).abs() > 1e-6 * dz {
+                    let mid = 0.5 * (yes + no);
+                    if at(mid) {
+                        yes = mid;
+                    } else {
+                        no = mid;
+                    }
+                }
+                *e = 0.5 * (yes + no);
+            }
+            let [lo, hi] = ends;
+            if let Some(slot) = bands.get_mut(k) {
+                slot.bottom = lo.min(hi);
+                slot.top = hi.max(lo);
+            }
+        }
     }
 }
 

@@ -27,6 +27,7 @@ use nalgebra::{ComplexField, Vector3};
 use super::profile::Profile;
 
 mod engage;
+pub mod surface;
 mod sweep;
 use crate::error::{BuildError, TickError};
 pub use engage::MAX_ENGAGEMENT_SAMPLES;
@@ -360,24 +361,39 @@ impl Dexels {
         })?;
         let mut total = DexelRemoval::default();
         for m in &program.moves {
-            let chords = match m.motion {
-                super::Motion::Dwell { .. } => continue,
-                super::Motion::Arc { sweep, .. } => {
-                    let r = m.radius().max(m.end_radius());
-                    let half = ComplexField::acos((1.0 - 0.125 * self.cell / r).clamp(-1.0, 1.0));
-                    pieces(
-                        ComplexField::abs(sweep) / (2.0 * half).max(1e-6),
-                        "chords of an arc (an eighth of a cell of sagitta each)",
-                    )?
-                }
-                _ => 1,
-            };
-            for k in 0..chords {
-                let (s0, s1) = (k as f64 / chords as f64, (k + 1) as f64 / chords as f64);
-                let r = self.cut(tool, &m.point(s0), &m.axis(s0), &m.point(s1), &m.axis(s1))?;
-                total.rays += r.rays;
-                total.volume += r.volume;
+            let r = self.cut_move(tool, m)?;
+            total.rays += r.rays;
+            total.volume += r.volume;
+        }
+        Ok(total)
+    }
+
+    /// Cuts one move of a program ([`Self::cut_program`] cuts them all): arcs as chords whose
+    /// sagitta stays within an eighth of a cell, a dwell cutting nothing. Errors of
+    /// [`Self::cut`].
+    pub fn cut_move(
+        &mut self,
+        tool: &DexelTool,
+        m: &super::Move,
+    ) -> Result<DexelRemoval, TickError> {
+        let chords = match m.motion {
+            super::Motion::Dwell { .. } => return Ok(DexelRemoval::default()),
+            super::Motion::Arc { sweep, .. } => {
+                let r = m.radius().max(m.end_radius());
+                let half = ComplexField::acos((1.0 - 0.125 * self.cell / r).clamp(-1.0, 1.0));
+                pieces(
+                    ComplexField::abs(sweep) / (2.0 * half).max(1e-6),
+                    "chords of an arc (an eighth of a cell of sagitta each)",
+                )?
             }
+            _ => 1,
+        };
+        let mut total = DexelRemoval::default();
+        for k in 0..chords {
+            let (s0, s1) = (k as f64 / chords as f64, (k + 1) as f64 / chords as f64);
+            let r = self.cut(tool, &m.point(s0), &m.axis(s0), &m.point(s1), &m.axis(s1))?;
+            total.rays += r.rays;
+            total.volume += r.volume;
         }
         Ok(total)
     }

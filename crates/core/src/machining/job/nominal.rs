@@ -291,6 +291,7 @@ pub fn nominal_pass(
     mut f: impl FnMut(&NominalSample) -> Result<(), JobError>,
 ) -> Result<(), JobError> {
     let setup = &job.setup;
+    super::check_flat(program)?;
     let sampler = path::Sampler::new(program, &setup.path)?;
     let tools = ToolModels::new(job, program);
     let st = &setup.stock;

@@ -59,10 +59,7 @@ pub(super) struct Arm<'a> {
     compensated: bool,
     data: Data,
     q: [f64; MAX_DOF],
-    q_before: Option<[f64; MAX_DOF]>,
-    /// Whether `q` is a sample's solution (not the seed): only then does the next sample
-    /// extrapolate from it (a seed far from the first pose would throw the guess off).
-    solved: bool,
+    warm: Warm,
     to_base: Isometry3<f64>,
     to_work: Isometry3<f64>,
     pub stock: ZMap,
@@ -98,8 +95,7 @@ impl<'a> Arm<'a> {
             compensated,
             data: Data::new(&job.model),
             q,
-            q_before: None,
-            solved: false,
+            warm: Warm::new(seed),
             to_base: job.setup.placement,
             to_work: job.setup.placement.inverse(),
             stock,
@@ -142,11 +138,9 @@ impl<'a> Arm<'a> {
         Ok(())
     }
 
-    /// The joints at one sample: pose IK from the joints the last two samples extrapolate
-    /// to (from the last one's if that fails).
+    /// The joints at one sample (see [`Warm::solve`]).
     fn joints(&mut self, n: &Sample, spin: f64) -> Result<(), TickError> {
         let job = self.job;
-        let dof = job.model.dof();
         let setup = &job.setup;
         let orientation = if spin == 0.0 {
             setup.tool_orientation
@@ -160,32 +154,10 @@ impl<'a> Arm<'a> {
         } else {
             (Vector6::zeros(), Load::Rigid)
         };
-        let mut seed = self.q;
-        if let Some(before) = self.q_before {
-            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
-                *s = 2.0 * q - b;
-            }
-        }
-        let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
-            pose_ik(
-                &job.model,
-                data,
-                &target,
-                seed.get(..dof).unwrap_or(&[]),
-                &wrench,
-                load,
-                &setup.ik,
-            )
-        };
-        let sol = match solve(&mut self.data, &seed) {
-            Ok(sol) => sol,
-            Err(_) if self.q_before.is_some() => solve(&mut self.data, &self.q)?,
-            Err(e) => return Err(e),
-        };
-        self.q_before = self.solved.then_some(self.q);
-        self.solved = true;
-        self.q = sol.q;
-        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
+        self.warm
+            .solve(job, &mut self.data, &target, &wrench, load)?;
+        self.q = self.warm.q;
+        Ok(())
     }
 
     fn advance(&mut self, n: &Sample) -> Result<Out, TickError> {
@@ -414,6 +386,72 @@ impl<'a> Arm<'a> {
         c.anchor = (wrench, tip);
         crate::error::check_output("predicted tip", tip.as_slice())?;
         Ok((tip, f))
+    }
+}
+
+/// Pose IK warm-started along a path: from the joints the last two solutions extrapolate to
+/// (from the last one's if that fails), the first from the seed.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Warm {
+    /// The last solution (the seed before the first) \[rad or m\].
+    pub q: [f64; MAX_DOF],
+    q_before: Option<[f64; MAX_DOF]>,
+    /// Whether `q` is a sample's solution (not the seed): only then does the next sample
+    /// extrapolate from it (a seed far from the first pose would throw the guess off).
+    solved: bool,
+}
+
+impl Warm {
+    /// Starting from `seed` (at most [`MAX_DOF`] joints).
+    pub fn new(seed: &[f64]) -> Self {
+        let mut q = [0.0; MAX_DOF];
+        for (d, s) in q.iter_mut().zip(seed) {
+            *d = *s;
+        }
+        Self {
+            q,
+            q_before: None,
+            solved: false,
+        }
+    }
+
+    /// The joints at which the arm of `job` (rigid, or loaded by `wrench` as `load` says)
+    /// puts its TCP on `target` (base frame), checked against the job's joint limits.
+    pub fn solve(
+        &mut self,
+        job: &Job,
+        data: &mut Data,
+        target: &Isometry3<f64>,
+        wrench: &Vector6,
+        load: Load<'_>,
+    ) -> Result<(), TickError> {
+        let dof = job.model.dof();
+        let mut seed = self.q;
+        if let Some(before) = self.q_before {
+            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
+                *s = 2.0 * q - b;
+            }
+        }
+        let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
+            pose_ik(
+                &job.model,
+                data,
+                target,
+                seed.get(..dof).unwrap_or(&[]),
+                wrench,
+                load,
+                &job.setup.ik,
+            )
+        };
+        let sol = match solve(data, &seed) {
+            Ok(sol) => sol,
+            Err(_) if self.q_before.is_some() => solve(data, &self.q)?,
+            Err(e) => return Err(e),
+        };
+        self.q_before = self.solved.then_some(self.q);
+        self.solved = true;
+        self.q = sol.q;
+        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
     }
 }
 

@@ -1,0 +1,638 @@
+//! The offline pass over a five-axis program: the tool axis of the program
+//! ([`super::Move::axis`], sampled by [`super::path`]) in the target pose, the force of each
+//! cutter along its edge ([`super::profile`]: Lee and Altintas' model, the flat, ball and
+//! bull-nose ends) on the engagement read from a tri-dexel stock ([`super::dexel`]), the
+//! exact virtual-joint deflection (Hähn and Weigold 2020, sec. 2.2, Eq. 2-9) of the position
+//! *and the tilt*, and the compensated joints at which the loaded arm holds the programmed
+//! pose. The predicted part in 3-D is the stock cut by each predicted tool
+//! ([`Report::uncompensated`], [`Report::compensated`]), compared along its surface's normal
+//! with the nominal one by [`super::dexel::surface`].
+//!
+//! Per sample (workpiece frame `W`, placed at [`Setup::placement`](super::job::Setup)):
+//!
+//! 1. the nominal stock holds every move before the sample's (cut whole by
+//!    [`Dexels::cut_move`]); the engagement of the tool at the programmed tip and axis is read
+//!    from it ([`Dexels::engagement`]). The part of the current move the tool has already
+//!    run is not cut yet, which changes nothing: it lies behind the tool, where the chip
+//!    `h = f . n` of the model is negative and cuts nothing;
+//! 2. the wrench about the tip is the per-revolution average along the edge
+//!    ([`super::profile::average`]) at the feed per tooth as a tool-frame vector (a tool tilted
+//!    to the feed moves along its axis too, [`super::profile::tool_feed`]);
+//! 3. the target pose is the setup's tool orientation turned by the shortest rotation from
+//!    `+z` to the program's axis; the rigid joints `q` (pose IK) and the deflected pose there
+//!    under the wrench are the uncompensated tool; the compensated joints `q_c` solve the
+//!    pose IK of the loaded chain, and the deflected pose at `q_c`, evaluated again by the
+//!    exact VJM (not taken from the IK), is the compensated tool;
+//! 4. each predicted tool cuts its own stock along chords through its samples (and the
+//!    program's corners between them) that stay within [`CHORD_TOLERANCE`] of them, and so
+//!    does the programmed tool for the nominal part ([`Report::nominal`]).
+//!
+//! # What this pass does not model (the 2.5-D [`super::job`] does)
+//! The force is the nominal tool's on the nominal stock: the predicted tools feel the same
+//! force, where the z-map job solves the force-deflection coupling on each tool's own stock.
+//! The spindle turns clockwise (`M4` is refused); the spin about the tool axis is the setup's
+//! (a spin schedule is refused); a rapid through material is cut and reported
+//! ([`Report::rapid_volume`]), not refused; an axis turn without tip motion is taken
+//! between two samples.
+
+use alloc::vec::Vec;
+
+use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+
+use super::Program;
+use super::cutting::Tool;
+use super::dexel::{DexelTool, Dexels};
+use super::job::{Job, Warm, check_seed, rotate};
+use super::kinematics::ToolPose;
+use super::path::{self, PathSample};
+use super::profile::{self, Band, Cut, MAX_BANDS, Profile, ToolShape};
+use super::program::slerp;
+use crate::error::{BuildError, JobError, TickError, param};
+use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
+
+mod follow;
+
+use follow::Chord;
+
+/// How far a predicted tool's cut may leave its samples \[m\]: a quarter of
+/// [`super::job::PREDICTION_TOLERANCE`] (the stock's surface is exact along its rays, so the
+/// chords, not the cells, bound what the predicted part misses of the tool's path).
+pub const CHORD_TOLERANCE: f64 = 2.5e-7;
+
+/// What the five-axis pass needs beyond the [`Job`]: the stock's depth, the cutter (when the
+/// job has no tool table) and how finely the engagement is read.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// The stock's depth below [`super::job::Stock::top`] \[m\], `(0, 1]`: the dexel block
+    /// spans the job's stock in x and y and this in z.
+    pub depth: f64,
+    /// The end of the setup's tool ([`super::job::Setup::tool`]) when the job has no tool
+    /// table (a table's tools carry their own).
+    pub shape: ToolShape,
+    /// The length of the setup's tool that removes material \[m\] (flutes and the shank that
+    /// would rub), without a tool table.
+    pub length: f64,
+    /// Axial slices of the edge the engagement is read in, `1..=256`.
+    pub slices: usize,
+    /// Immersion angles per slice, `1..=3600`.
+    pub angles: usize,
+}
+
+impl Default for Options {
+    /// 50 mm of stock, a flat end 30 mm long, 32 slices of 180 angles (2 degrees).
+    fn default() -> Self {
+        Self {
+            depth: 0.05,
+            shape: ToolShape::Flat,
+            length: 0.03,
+            slices: 32,
+            angles: 180,
+        }
+    }
+}
+
+impl Options {
+    /// Checks every option ([`BuildError::InvalidParameter`] naming it).
+    pub fn validate(&self) -> Result<(), BuildError> {
+        param(
+            "five-axis stock depth (m)",
+            self.depth,
+            self.depth > 0.0 && self.depth <= 1.0,
+            "in (0, 1] m",
+        )?;
+        param(
+            "engagement slices",
+            self.slices as f64,
+            (1..=256).contains(&self.slices),
+            "1..=256",
+        )?;
+        param(
+            "engagement angles",
+            self.angles as f64,
+            (1..=3600).contains(&self.angles),
+            "1..=3600",
+        )?;
+        Ok(())
+    }
+}
+
+/// One sample of the five-axis pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    /// The programmed tool (tip, axis, feed direction, ...), workpiece frame.
+    pub path: PathSample,
+    /// Feed per tooth \[m\] (0 off the cut).
+    pub feed_per_tooth: f64,
+    /// Engaged bands along the edge (0: the tool cuts air).
+    pub bands: usize,
+    /// Force on the tool \[N\], workpiece frame.
+    pub force: Vector3<f64>,
+    /// The wrench about the tip \[N, N m\], workpiece frame.
+    pub wrench: Vector6,
+    /// Rigid pose-IK joints \[rad or m\] (entries past the dof 0).
+    pub q: [f64; MAX_DOF],
+    /// Compensated joints \[rad or m\].
+    pub q_commanded: [f64; MAX_DOF],
+    /// The tool the uncompensated arm holds under the wrench, workpiece frame.
+    pub uncompensated: ToolPose,
+    /// The tool the compensated arm holds under the wrench, workpiece frame.
+    pub compensated: ToolPose,
+}
+
+impl Sample {
+    /// How far a predicted tool is from the program: its tip \[m\] and the angle of its axis
+    /// \[rad\].
+    pub fn error(&self, compensated: bool) -> (f64, f64) {
+        let t = if compensated {
+            &self.compensated
+        } else {
+            &self.uncompensated
+        };
+        (
+            (t.tip - self.path.position).norm(),
+            super::program::angle_between(&t.axis, &self.path.axis),
+        )
+    }
+}
+
+/// The largest and root-mean-square errors of a predicted tool over the cutting samples.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ToolErrors {
+    /// Largest tip error \[m\].
+    pub max_position: f64,
+    /// Root mean square of the tip error \[m\].
+    pub rms_position: f64,
+    /// Largest axis error \[rad\].
+    pub max_axis: f64,
+    /// The program line of the largest tip error (0 without cutting samples).
+    pub line: usize,
+}
+
+/// What the five-axis pass gives.
+#[derive(Debug, Clone)]
+pub struct Report {
+    /// Every sample, in time order.
+    pub samples: Vec<Sample>,
+    /// The stock cut by the program as sampled: the tool on the program at every sample and
+    /// between them where the program bends, cut along the chords the predicted tools' cuts
+    /// take (so the parts' differences are the tools', not the cuts' discretisation).
+    pub nominal: Dexels,
+    /// The stock cut by the uncompensated tool.
+    pub uncompensated: Dexels,
+    /// The stock cut by the compensated tool.
+    pub compensated: Dexels,
+    /// Sampling rate \[Hz\].
+    pub rate_hz: f64,
+    /// The arm's joints.
+    pub dof: usize,
+    /// Rays the three stocks' cuts changed.
+    pub ray_updates: usize,
+    /// Material the program's rapids removed from the nominal stock \[m^3\] (0 for a program
+    /// that never rapids through the stock).
+    pub rapid_volume: f64,
+}
+
+impl Report {
+    /// The errors of the uncompensated or compensated tool over the samples that cut.
+    pub fn errors(&self, compensated: bool) -> ToolErrors {
+        let mut e = ToolErrors::default();
+        let (mut sum, mut n) = (0.0, 0usize);
+        for s in self.samples.iter().filter(|s| s.bands > 0) {
+            let (p, a) = s.error(compensated);
+            if p > e.max_position {
+                e.max_position = p;
+                e.line = s.path.line;
+            }
+            e.max_axis = e.max_axis.max(a);
+            sum += p * p;
+            n += 1;
+        }
+        if n > 0 {
+            e.rms_position = nalgebra::ComplexField::sqrt(sum / n as f64);
+        }
+        e
+    }
+}
+
+/// One cutter of the program: its number, profile and solid, and whether the job knows it.
+#[derive(Debug, Clone, Copy)]
+struct Cutter {
+    number: u32,
+    tool: Tool,
+    profile: Profile,
+    solid: DexelTool,
+    known: bool,
+}
+
+fn cutters(job: &Job, program: &Program, options: &Options) -> Result<Vec<Cutter>, BuildError> {
+    let setup = job.setup();
+    let mut list = Vec::new();
+    for number in program.tools() {
+        let (tool, shape, length, known) = match job.tools() {
+            None => (setup.tool, options.shape, options.length, true),
+            Some(table) => match table.get(number) {
+                Some(spec) => (spec.tool, spec.shape, spec.length, true),
+                None => (setup.tool, options.shape, options.length, false),
+            },
+        };
+        let profile = Profile::new(&tool, shape)?;
+        param(
+            "stock cell (m), at most half the radius of every tool the program uses",
+            setup.stock.cell,
+            setup.stock.cell <= 0.5 * profile.radius(),
+            "<= the radius / 2 of the program's smallest tool",
+        )?;
+        list.push(Cutter {
+            number,
+            tool,
+            profile,
+            solid: DexelTool::new(&profile, length)?,
+            known,
+        });
+    }
+    Ok(list)
+}
+
+fn find(cutters: &[Cutter], number: u32) -> Option<&Cutter> {
+    cutters.iter().find(|c| c.number == number)
+}
+
+/// The target rotation for tool axis `axis` (workpiece frame): the setup's orientation turned
+/// by the shortest rotation from `+z` to the axis.
+fn orientation(
+    tool_orientation: &UnitQuaternion<f64>,
+    axis: &Vector3<f64>,
+) -> Result<UnitQuaternion<f64>, TickError> {
+    let turn = UnitQuaternion::rotation_between(&Vector3::z(), axis).ok_or(
+        TickError::InvalidArgument {
+            what: "tool axis (pointing down the workpiece z: no shortest turn from +z)",
+            value: axis.z,
+        },
+    )?;
+    Ok(turn * tool_orientation)
+}
+
+/// Runs the five-axis pass (see the module docs) from the joints `seed` near the first pose,
+/// keeping every sample (at most [`path::MAX_PATH_SAMPLES`]). Errors name the program line.
+pub fn run(
+    job: &Job,
+    program: &Program,
+    seed: &[f64],
+    options: &Options,
+) -> Result<Report, JobError> {
+    options.validate()?;
+    check_seed(job, seed)?;
+    if job.spin().is_some() {
+        return Err(BuildError::InvalidParameter {
+            what: "spin schedule (the five-axis pass keeps the setup's spin)",
+            value: f64::NAN,
+            expected: "a job without a spin schedule",
+        }
+        .into());
+    }
+    let job = &*job.at_seed(seed)?;
+    let setup = job.setup();
+    let sampler = path::Sampler::new(program, &setup.path)?;
+    let count = sampler.len();
+    if count > path::MAX_PATH_SAMPLES {
+        return Err(BuildError::Budget {
+            what: "five-axis samples (duration x rate + 1)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        }
+        .into());
+    }
+    let cutters = cutters(job, program, options)?;
+    let st = &setup.stock;
+    let block = || {
+        Dexels::block(
+            Vector3::new(st.min.x, st.min.y, st.top - options.depth),
+            Vector3::new(st.max.x, st.max.y, st.top),
+            st.cell,
+        )
+    };
+    let mut pass = Pass {
+        job,
+        program,
+        options,
+        cutters: &cutters,
+        nominal: block()?,
+        arms: [
+            Arm::new(job, seed, block()?),
+            Arm::new(job, seed, block()?),
+            Arm::new(job, seed, block()?),
+        ],
+        cut_moves: 0,
+        ray_updates: 0,
+        rapid_volume: 0.0,
+        bands: [Band::new(0.0, 0.0, 0.0); MAX_BANDS],
+        prev: None,
+    };
+    let mut samples = Vec::new();
+    samples
+        .try_reserve_exact(count)
+        .map_err(|_| BuildError::Budget {
+            what: "five-axis samples (the allocation was refused)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        })?;
+    let mut last = (0, 0.0);
+    for s in sampler {
+        last = (s.line, s.time);
+        let sample = pass.advance(&s).map_err(|error| match error {
+            Fault::Tick(error) => JobError::AtLine {
+                line: s.line,
+                time: s.time,
+                error,
+            },
+            Fault::Job(e) => e,
+        })?;
+        samples.push(sample);
+    }
+    pass.finish().map_err(|error| JobError::AtLine {
+        line: last.0,
+        time: last.1,
+        error,
+    })?;
+    let [part, unc, comp] = pass.arms;
+    Ok(Report {
+        samples,
+        nominal: part.stock,
+        uncompensated: unc.stock,
+        compensated: comp.stock,
+        rate_hz: setup.path.rate_hz,
+        dof: job.model().dof(),
+        ray_updates: pass.ray_updates + part.follow.rays + unc.follow.rays + comp.follow.rays,
+        rapid_volume: pass.rapid_volume,
+    })
+}
+
+/// Why a sample failed: a tick error at its line, or a job error of its own.
+enum Fault {
+    Tick(TickError),
+    Job(JobError),
+}
+
+impl From<TickError> for Fault {
+    fn from(e: TickError) -> Self {
+        Self::Tick(e)
+    }
+}
+
+/// One predicted arm: its solver, buffers and stock.
+struct Arm {
+    warm: Warm,
+    data: Data,
+    stock: Dexels,
+    follow: Chord,
+    /// The last sample's predicted tool.
+    last: Option<ToolPose>,
+}
+
+impl Arm {
+    fn new(job: &Job, seed: &[f64], stock: Dexels) -> Self {
+        Self {
+            warm: Warm::new(seed),
+            data: Data::new(job.model()),
+            stock,
+            follow: Chord::default(),
+            last: None,
+        }
+    }
+}
+
+struct Pass<'a> {
+    job: &'a Job,
+    program: &'a Program,
+    options: &'a Options,
+    cutters: &'a [Cutter],
+    nominal: Dexels,
+    /// The program as sampled (its tool on the program: the nominal part), the uncompensated
+    /// and the compensated arm.
+    arms: [Arm; 3],
+    /// The moves before this index are cut into the nominal stock.
+    cut_moves: usize,
+    ray_updates: usize,
+    rapid_volume: f64,
+    bands: [Band; MAX_BANDS],
+    /// The last sample.
+    prev: Option<PathSample>,
+}
+
+impl Pass<'_> {
+    /// Cuts arm `k`'s stock through the points where the program bends between the last
+    /// sample and `s` ([`path::between`]: corners and arcs between two samples), each moved
+    /// by the arm's offset from the program (tip and axis), interpolated along the path.
+    fn cut_between(
+        &mut self,
+        k: usize,
+        s: &PathSample,
+        pose: &ToolPose,
+        c: &Cutter,
+    ) -> Result<(), TickError> {
+        let (Some(p0), Some(arm)) = (self.prev, self.arms.get_mut(k)) else {
+            return Ok(());
+        };
+        let Some(t0) = arm.last else {
+            return Ok(());
+        };
+        let (off0, off1) = (t0.tip - p0.position, pose.tip - s.position);
+        let (tilt0, tilt1) = (t0.axis - p0.axis, pose.axis - s.axis);
+        let program = self.program;
+        let mut failed = None;
+        path::between(
+            program,
+            (p0.move_index, p0.fraction),
+            (s.move_index, s.fraction),
+            |w, m, share| {
+                let Some(mv) = program.moves.get(m) else {
+                    return;
+                };
+                let axis = if (w - mv.end).norm() <= 1e-12 {
+                    mv.end_axis
+                } else {
+                    slerp(&p0.axis, &s.axis, share)
+                };
+                let axis = (axis + tilt0 + (tilt1 - tilt0) * share).normalize();
+                let at = ToolPose {
+                    tip: w + off0 + (off1 - off0) * share,
+                    axis,
+                };
+                if failed.is_none()
+                    && let Err(e) = arm.follow.to(&mut arm.stock, &c.solid, s.tool, &at)
+                {
+                    failed = Some(e);
+                }
+            },
+        );
+        failed.map_or(Ok(()), Err)
+    }
+
+    /// Cuts the nominal stock through the moves before `index`.
+    fn cut_through(&mut self, index: usize) -> Result<(), TickError> {
+        while self.cut_moves < index {
+            let Some(m) = self.program.moves.get(self.cut_moves) else {
+                break;
+            };
+            self.cut_moves += 1;
+            let Some(c) = find(self.cutters, m.tool) else {
+                continue;
+            };
+            let before = self.nominal.volume();
+            let r = self.nominal.cut_move(&c.solid, m)?;
+            self.ray_updates += r.rays;
+            if m.motion == super::Motion::Rapid {
+                self.rapid_volume += before - self.nominal.volume();
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(&mut self) -> Result<(), TickError> {
+        self.cut_through(self.program.moves.len())?;
+        for arm in &mut self.arms {
+            arm.follow.flush(&mut arm.stock)?;
+        }
+        Ok(())
+    }
+
+    /// The force of the nominal tool at `s`: feed per tooth, bands, force and wrench about
+    /// the tip (workpiece frame).
+    fn force(
+        &mut self,
+        s: &PathSample,
+        c: &Cutter,
+    ) -> Result<(f64, usize, Vector3<f64>, Vector6), Fault> {
+        let none = (0.0, 0, Vector3::zeros(), Vector6::zeros());
+        if !s.feed_move || s.speed <= 0.0 {
+            return Ok(none);
+        }
+        // A plunge's frame: any across the axis (the chip is the same all round).
+        let Some(frame) = super::cutting::tool_frame(&s.axis, &s.direction)
+            .or_else(|| super::cutting::tool_frame(&s.axis, &s.axis.cross(&Vector3::x())))
+            .or_else(|| super::cutting::tool_frame(&s.axis, &s.axis.cross(&Vector3::y())))
+        else {
+            return Ok(none);
+        };
+        let n = self.nominal.engagement(
+            &c.solid,
+            &s.position,
+            &frame,
+            self.options.slices,
+            self.options.angles,
+            &mut self.bands,
+        )?;
+        if n == 0 {
+            return Ok(none);
+        }
+        let err = |e: JobError| Err(Fault::Job(e));
+        if !c.known {
+            return err(JobError::UnknownTool {
+                line: s.line,
+                time: s.time,
+                tool: s.tool,
+            });
+        }
+        let spindle = match (s.spindle, self.job.setup().hand_spindle) {
+            (0.0, Some(hand)) => hand,
+            (v, _) => v,
+        };
+        if spindle == 0.0 {
+            return err(JobError::SpindleOff {
+                line: s.line,
+                time: s.time,
+            });
+        }
+        if spindle < 0.0 {
+            return Err(Fault::Tick(TickError::InvalidArgument {
+                what: "spindle direction (M4: the five-axis pass cuts with a clockwise spindle)",
+                value: spindle,
+            }));
+        }
+        let fz = s.speed / (spindle * f64::from(c.tool.flutes));
+        let along = s.direction.dot(&s.axis);
+        let feed = profile::tool_feed(&s.axis, &s.direction, fz)
+            .unwrap_or_else(|| Vector3::new(0.0, 0.0, fz * along.signum()));
+        let bands = self.bands.get(..n).unwrap_or(&[]);
+        let w = profile::average(
+            &self.job.setup().coefficients,
+            &c.profile,
+            &Cut { bands, feed },
+        )?;
+        let (f, m) = (frame * w.force, frame * w.moment);
+        Ok((fz, n, f, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)))
+    }
+
+    fn advance(&mut self, s: &PathSample) -> Result<Sample, Fault> {
+        self.cut_through(s.move_index)?;
+        let Some(&c) = find(self.cutters, s.tool) else {
+            return Err(Fault::Job(JobError::UnknownTool {
+                line: s.line,
+                time: s.time,
+                tool: s.tool,
+            }));
+        };
+        let (fz, bands, force, wrench) = self.force(s, &c)?;
+        let setup = self.job.setup();
+        let to_base = setup.placement;
+        let to_work = to_base.inverse();
+        let rotation = orientation(&setup.tool_orientation, &s.axis)?;
+        let target = to_base * Isometry3::from_parts(Translation3::from(s.position), rotation);
+        let wrench_base = rotate(&to_base, &wrench);
+        let model = self.job.model();
+        let dof = model.dof();
+        let back = setup.tool_orientation.inverse();
+        let mut poses = [ToolPose {
+            tip: s.position,
+            axis: s.axis,
+        }; 3];
+        for (k, pose) in poses.iter_mut().enumerate() {
+            let (w, load) = if k == 1 {
+                (Vector6::zeros(), Load::Rigid)
+            } else {
+                (wrench_base, Load::Exact)
+            };
+            let Some(arm) = self.arms.get_mut(k) else {
+                continue;
+            };
+            if k == 0 {
+                self.cut_between(k, s, pose, &c)?;
+                if let Some(arm) = self.arms.get_mut(k) {
+                    arm.follow.to(&mut arm.stock, &c.solid, s.tool, pose)?;
+                    arm.last = Some(*pose);
+                }
+                continue;
+            }
+            arm.warm.solve(self.job, &mut arm.data, &target, &w, load)?;
+            let q = arm.warm.q;
+            let qs = q.get(..dof).unwrap_or(&[]);
+            vjm::deflection(model, &mut arm.data, qs, &wrench_base, Load::Exact)?;
+            let at = to_work * arm.data.tcp_deflected;
+            *pose = ToolPose {
+                tip: (at * Point3::origin()).coords,
+                axis: (at.rotation * back) * Vector3::z(),
+            };
+            crate::error::check_output("predicted tool", pose.tip.as_slice())?;
+            self.cut_between(k, s, pose, &c)?;
+            if let Some(arm) = self.arms.get_mut(k) {
+                arm.follow.to(&mut arm.stock, &c.solid, s.tool, pose)?;
+                arm.last = Some(*pose);
+            }
+        }
+        self.prev = Some(*s);
+        let [_, unc, comp] = &self.arms;
+        Ok(Sample {
+            path: *s,
+            feed_per_tooth: fz,
+            bands,
+            force,
+            wrench,
+            q: unc.warm.q,
+            q_commanded: comp.warm.q,
+            uncompensated: poses[1],
+            compensated: poses[2],
+        })
+    }
+}
