@@ -475,13 +475,15 @@ fn the_path_samples_the_tool_axis_along_the_great_circle() {
     let samples: Vec<_> = path::Sampler::new(&p, &path::PathOptions::default())
         .unwrap()
         .collect();
-    // The axis turns 10 degrees about y along the great circle with the tip's fraction.
-    for s in &samples {
+    // The axis turns 10 degrees about -x along the great circle with the tip's fraction.
+    let last = p.moves.len() - 1;
+    assert!(samples.iter().filter(|s| s.move_index == last).count() > 10);
+    for s in samples.iter().filter(|s| s.move_index == last) {
         let angle = 10f64.to_radians() * s.fraction;
-        let expected = Vector3::new(angle.sin(), 0.0, angle.cos());
+        let expected = Vector3::new(0.0, angle.sin(), angle.cos());
         assert!((s.axis - expected).norm() < 1e-6, "{:?}", s.axis);
     }
-    assert!((samples.last().unwrap().axis.x - 0.1736482).abs() < 1e-6);
+    assert!((samples.last().unwrap().axis.y - 0.1736482).abs() < 1e-6);
     // Along +z the same reader's program samples +z.
     let flat = read("FEDRAT/600\nGOTO/10,0,0,0,0,1\nGOTO/20,0,0\n").program;
     let t = path::duration(&flat, &path::PathOptions::default()).unwrap();
