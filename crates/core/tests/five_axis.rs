@@ -214,3 +214,50 @@ fn five_axis_input_faults_are_typed() {
     let e = five_axis::run(&job, &ccw, &seed, &Options::default()).unwrap_err();
     assert!(matches!(e, JobError::AtLine { line: 9, .. }), "{e}");
 }
+
+#[test]
+fn the_part_mesh_writes_as_ply_ascii_and_binary() {
+    use deflect_core::io::ply::{self, Format};
+    use deflect_core::machining::dexel::surface::SurfacePoint;
+    let p = |x: f64, y: f64, dev: f64| SurfacePoint {
+        position: Vector3::new(x, y, -0.001),
+        normal: Vector3::z(),
+        deviation: dev,
+        ray: (2, (x * 1e3) as usize, (y * 1e3) as usize),
+        upper: true,
+    };
+    // Four points of a square floor, 1 mm apart: two triangles.
+    let points = vec![
+        p(0.0, 0.0, 1e-5),
+        p(0.001, 0.0, -2e-5),
+        p(0.0, 0.001, 0.0),
+        p(0.001, 0.001, 3e-6),
+    ];
+    let mesh = SurfaceMesh::new(points, 1e-3).unwrap();
+    assert_eq!(mesh.triangles.len(), 2);
+    let mut ascii = Vec::new();
+    ply::write(&mesh, Format::Ascii, &mut ascii).unwrap();
+    let text = String::from_utf8(ascii).unwrap();
+    let (header, body) = text.split_once("end_header\n").unwrap();
+    assert!(header.contains("element vertex 4\n") && header.contains("element face 2\n"));
+    let rows: Vec<Vec<f32>> = body
+        .lines()
+        .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 6);
+    assert_eq!(
+        rows[1][..],
+        [0.001, 0.0, -0.001, 0.0, 0.0, 1.0, -2e-5, 4.0][..]
+    );
+    assert_eq!(rows[4][0], 3.0);
+    let mut binary = Vec::new();
+    ply::write(&mesh, Format::Binary, &mut binary).unwrap();
+    let at = binary
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    assert_eq!(binary.len() - at, 4 * 29 + 2 * 13);
+    let x1 = f32::from_le_bytes(binary[at + 29..at + 33].try_into().unwrap());
+    assert_eq!(x1, 0.001f32);
+}

@@ -13,6 +13,7 @@
 //! | [`points_csv`] | tool points with feed and spindle per row | [`crate::machining::Program`] |
 //! | [`tool_table`] | LinuxCNC `.tbl`, or TOML | [`crate::machining::tools::ToolTable`] |
 //! | [`job_out`] (writer) | compensated G-code, samples CSV | from [`crate::machining::job::Report`] |
+//! | [`ply`] (writer) | the predicted part as a mesh with its deviation | from [`crate::machining::dexel::surface::SurfaceMesh`] |
 //! | [`apt`] | APT / CL data with tool vectors (five-axis programs), cutters | [`crate::machining::Program`] |
 //! | [`map_csv`] | the paper's coefficient tables; static tests to fit | [`crate::ComplianceMap`] |
 //! | [`map_json`] | versioned JSON of a map (version 2: an N-D grid map) | [`crate::ComplianceMap`], [`crate::compliance_map::GridMap`] |
@@ -29,6 +30,7 @@ pub mod grid_csv;
 pub mod job_out;
 pub mod map_csv;
 pub mod map_json;
+pub mod ply;
 pub mod points_csv;
 pub mod robot_program;
 #[cfg(feature = "urdf")]
