@@ -47,7 +47,7 @@ fn a_tilted_floor_cut_deeper_along_its_normal_deviates_by_the_offset() {
     let _ = deeper
         .cut(&tool, &(from - a * delta), &a, &(to - a * delta), &a)
         .unwrap();
-    let (points, missing) = nominal.surface_deviation(&deeper).unwrap();
+    let (points, missing) = nominal.surface_deviation(&deeper, 2.0 * cell).unwrap();
     assert_eq!(missing, 0);
     // On the strip, away from its edges: the normal is a and the deviation -delta.
     let strip: Vec<_> = points
@@ -67,7 +67,7 @@ fn a_tilted_floor_cut_deeper_along_its_normal_deviates_by_the_offset() {
         assert_eq!(Face::of(p), Face::PlusZ);
     }
     // The same cut on both: no deviation anywhere.
-    let (same, _) = nominal.surface_deviation(&nominal.clone()).unwrap();
+    let (same, _) = nominal.surface_deviation(&nominal.clone(), 2.0 * cell).unwrap();
     assert_eq!(DeviationStats::of(&same).max_abs(), 0.0);
     // The mesh joins the strip's points: about two triangles per point.
     let strip_count = strip.len();
@@ -85,7 +85,8 @@ fn a_tilted_floor_cut_deeper_along_its_normal_deviates_by_the_offset() {
     }
     // Blocks that differ are refused.
     let other = Dexels::block(Vector3::zeros(), Vector3::repeat(0.01), cell).unwrap();
-    assert!(nominal.surface_deviation(&other).is_err());
+    assert!(nominal.surface_deviation(&other, 2.0 * cell).is_err());
+    assert!(nominal.surface_deviation(&deeper, f64::NAN).is_err());
 }
 
 /// The KR 300 holding the tool down over a table at its first pose.
@@ -157,8 +158,8 @@ fn the_compensated_swarf_cut_holds_the_program_tip_and_axis() {
     assert!(mid.force.norm() > 50.0, "{:?}", mid.force);
     // The predicted parts along the surface's normal: the compensated one on the program's to
     // the IK's tolerance, the uncompensated one off by the deflection.
-    let (pu, _) = r.nominal.surface_deviation(&r.uncompensated).unwrap();
-    let (pc, _) = r.nominal.surface_deviation(&r.compensated).unwrap();
+    let (pu, _) = r.nominal.surface_deviation(&r.uncompensated, 3.0e-3).unwrap();
+    let (pc, _) = r.nominal.surface_deviation(&r.compensated, 3.0e-3).unwrap();
     let (su, sc) = (DeviationStats::of(&pu), DeviationStats::of(&pc));
     assert!(su.max_abs() > 2.0e-5, "{su:?}");
     assert!(sc.max_abs() < ik.position_tolerance, "{sc:?}");

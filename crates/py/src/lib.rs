@@ -27,6 +27,7 @@ mod dexel;
 mod drivetrain;
 mod errors;
 mod field;
+mod five_axis;
 mod grid_map;
 mod identification;
 mod kinematics;
@@ -84,6 +85,7 @@ fn _deflect(m: &Bound<'_, PyModule>) -> PyResult<()> {
     machining::register(m)?;
     dexel::register(m)?;
     machining_job::register(m)?;
+    five_axis::register(m)?;
     placement::register(m)?;
     tools::register(m)?;
     Ok(())

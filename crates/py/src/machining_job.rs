@@ -446,6 +446,49 @@ impl MachiningJob {
         })
     }
 
+    /// Runs the five-axis pass over `program` (a `GcodeProgram` whose tool axis may leave the
+    /// workpiece z: APT with tool vectors, G-code with A/B/C under a `kinematics`, points with
+    /// `i, j, k`) from the joints `seed` (dof,): the target pose follows the program's tool
+    /// axis, the force is the cutter's along its edge on the engagement read from a tri-dexel
+    /// stock (the job's stock in x and y, `depth` [m] below its top), and the compensated
+    /// joints hold the tip and the axis under it. `shape` ("flat", "ball", "bull-nose" with
+    /// `corner_radius` [m]) is the job's tool's end when the job has no tool table; `length`
+    /// [m] the length of every tool that removes material; the engagement is read in `slices`
+    /// along the edge of `angles` each. The spindle must turn clockwise, and the job keep its
+    /// spin (`spin="keep"`). Raises as `run` does.
+    #[pyo3(signature = (program, seed, depth=0.05, shape="flat", corner_radius=None, length=0.03, slices=32, angles=180))]
+    #[allow(clippy::too_many_arguments)] // reason: the pass's options as keywords
+    fn run_five_axis(
+        &self,
+        py: Python<'_>,
+        program: &GcodeProgram,
+        seed: &Bound<'_, PyAny>,
+        depth: f64,
+        shape: &str,
+        corner_radius: Option<f64>,
+        length: f64,
+        slices: usize,
+        angles: usize,
+    ) -> PyResult<crate::five_axis::FiveAxisResult> {
+        let seed = vector(seed, "seed", self.inner.model().dof())?;
+        let options = deflect_core::machining::five_axis::Options {
+            depth,
+            shape: crate::cutter::shape(shape, corner_radius)?,
+            length,
+            slices,
+            angles,
+        };
+        let job = match self.spin {
+            Spin::Keep => &self.inner,
+            _ => {
+                return Err(InputError::new_err(
+                    "spin: the five-axis pass keeps the setup's spin (a job with spin=\"keep\")",
+                ));
+            }
+        };
+        crate::five_axis::run(py, job, &program.inner, &seed, &options)
+    }
+
     fn __repr__(&self) -> String {
         let s = self.inner.setup();
         format!(

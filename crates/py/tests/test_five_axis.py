@@ -150,3 +150,92 @@ def test_dexels_cut_the_closed_form_slot_and_a_program():
         stock.cut("flat", 0.006, 0.01, (0, 0, 0), (0, 0, 2), (0, 0, 0), (0, 0, 1))
     with pytest.raises(deflect.DeflectError):
         deflect.Dexels((0, 0, 0), (1, 1, 1), 1e-4)
+
+
+SWARF = (
+    "UNITS/MM\nSPINDL/12000,CLW\nRAPID\nGOTO/-12,-22,20,0,0,1\nRAPID\n"
+    "GOTO/-12,-22,5,0,-0.2588190,0.9659258\nFEDRAT/MMPM,1200\n"
+    "GOTO/-12,-22,-3,0,-0.2588190,0.9659258\nGOTO/60,-22,-3,0,-0.2588190,0.9659258\n"
+    "GOTO/60,-22,10,0,0,1\nFINI\n"
+)
+
+
+def under_tcp(robot, q):
+    """The workpiece frame 20 mm below the TCP at `q`, the TCP pointing down its z."""
+    tcp = robot.forward(q)
+    rot = tcp[:3, :3] @ np.diag([1.0, -1.0, -1.0]).T
+    t = np.eye(4)
+    t[:3, :3] = rot
+    t[:3, 3] = tcp[:3, 3] - rot @ [0.0, 0.0, 0.02]
+    return t
+
+
+@pytest.fixture(scope="module")
+def swarf_run(kr300):
+    q0 = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0]
+    placement = under_tcp(kr300, q0)
+    job = deflect.MachiningJob(
+        kr300, placement, stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), cell=1e-3
+    )
+    program = deflect.GcodeProgram.from_apt_text(SWARF)
+    return job, program, placement, job.run_five_axis(program, q0)
+
+
+def test_the_five_axis_swarf_cut_against_the_numpy_chain(swarf_run, kr300_ref):
+    job, program, placement, r = swarf_run
+    rot, origin = placement[:3, :3], placement[:3, 3]
+    cutting = np.flatnonzero(r.bands > 0)
+    assert len(cutting) > 100
+    for k in cutting[:: len(cutting) // 7]:
+        w = np.concatenate([rot @ r.wrench[k][:3], rot @ r.wrench[k][3:]])
+        # The loaded tips by the numpy chain (not the VJM that computed them), back in the
+        # workpiece frame: the compensated one on the program, the uncompensated as reported.
+        loaded = kr300_ref.forward(r.q_commanded[k])[:3, 3] + kr300_ref.deflection(r.q_commanded[k], w)[:3]
+        np.testing.assert_allclose(rot.T @ (loaded - origin), r.position[k], atol=2e-8)
+        free = kr300_ref.forward(r.q[k])[:3, 3] + kr300_ref.deflection(r.q[k], w)[:3]
+        np.testing.assert_allclose(rot.T @ (free - origin), r.uncompensated_tip[k], atol=1e-9)
+    off = np.linalg.norm(r.uncompensated_tip[cutting] - r.position[cutting], axis=1)
+    assert off.max() > 5e-5, off.max()
+    # The program's tool axis in the target: the rigid TCP's z at q is minus the axis.
+    k = cutting[len(cutting) // 2]
+    z = rot.T @ kr300_ref.forward(r.q[k])[:3, 2]
+    np.testing.assert_allclose(-z, r.axis[k], atol=1e-8)
+    np.testing.assert_allclose(r.axis[k], [0.0, -0.2588190, 0.9659258], atol=1e-7)
+    e = r.errors("compensated")
+    assert e["max_position"] <= 1e-8 and e["max_axis"] <= 1e-8, e
+
+
+def test_the_five_axis_parts_along_the_normal_and_as_ply(swarf_run, tmp_path):
+    _, _, _, r = swarf_run
+    comp = r.surface("compensated")
+    unc = r.surface("uncompensated")
+    assert len(comp["deviation"]) > 1000 and comp["unmatched"] == 0
+    assert np.max(np.abs(comp["deviation"])) < 1e-8
+    assert np.max(np.abs(unc["deviation"])) > 2e-5
+    np.testing.assert_allclose(np.linalg.norm(comp["normal"], axis=1), 1.0, rtol=1e-12)
+    assert set(comp["face"]) <= {"+x", "-x", "+y", "-y", "+z", "-z"}
+    path = tmp_path / "part.ply"
+    r.write_ply(path, "uncompensated", ascii=True)
+    header = path.read_text().split("end_header\n")[0]
+    assert f"element vertex {len(unc['deviation'])}\n" in header
+    with pytest.raises(OSError):
+        r.write_ply(tmp_path / "missing" / "part.ply")
+    with pytest.raises(deflect.InputError, match="part"):
+        r.surface("both")
+
+
+def test_five_axis_faults_are_typed(swarf_run, kr300):
+    job, program, _, _ = swarf_run
+    q0 = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0]
+    with pytest.raises(deflect.DeflectError, match="depth"):
+        job.run_five_axis(program, q0, depth=0.0)
+    with pytest.raises(deflect.InputError, match="shape"):
+        job.run_five_axis(program, q0, shape="cone")
+    spun = deflect.MachiningJob(
+        kr300, np.eye(4), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), cell=1e-3, spin=10.0
+    )
+    with pytest.raises(deflect.InputError, match="spin"):
+        spun.run_five_axis(program, q0)
+    # The z-map pass refuses the tilted program rather than drop its axis.
+    with pytest.raises(deflect.DeflectError, match="2.5-D"):
+        job.run(program, q0)

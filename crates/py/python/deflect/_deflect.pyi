@@ -1214,6 +1214,19 @@ class MachiningJob:
     ) -> Self: ...
     def run(self, program: GcodeProgram, seed: _ArrayLike) -> "MachiningResult":
         """The offline pass: forces, deflection, compensated joints, the part three ways."""
+    def run_five_axis(
+        self,
+        program: GcodeProgram,
+        seed: _ArrayLike,
+        depth: float = 0.05,
+        shape: str = "flat",
+        corner_radius: Optional[float] = None,
+        length: float = 0.03,
+        slices: int = 32,
+        angles: int = 180,
+    ) -> "FiveAxisResult":
+        """The five-axis pass: the program's tool axis, the cutter's force along its edge on a
+        tri-dexel stock, tip and tilt compensated, the parts cut in 3-D."""
     def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
         """Pickling and copy.deepcopy: the robot and the setup, rebuilt bit for bit."""
     @staticmethod
@@ -1247,6 +1260,53 @@ class PlacementProblem:
     def _from_state(job: MachiningJob, loads: bytes, seed: List[float]) -> "PlacementProblem": ...
 
 @final
+class FiveAxisResult:
+    """What MachiningJob.run_five_axis predicts: samples as arrays, the tools' errors, the
+    parts' machined surfaces with the deviation along the normal."""
+    def __len__(self) -> int: ...
+    @property
+    def time(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def line(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def bands(self) -> npt.NDArray[np.uint64]: ...
+    @property
+    def position(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def axis(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def force(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def wrench(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def q(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def q_commanded(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def uncompensated_tip(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def uncompensated_axis(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def compensated_tip(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def compensated_axis(self) -> npt.NDArray[np.float64]: ...
+    @property
+    def ray_updates(self) -> int: ...
+    @property
+    def rapid_volume(self) -> float: ...
+    def errors(self, part: str) -> Dict[str, Any]:
+        """max_position, rms_position [m], max_axis [rad], line over the cutting samples."""
+    def surface(self, part: str = "compensated", reach: Optional[float] = None) -> Dict[str, Any]:
+        """position, normal, deviation [m], face, unmatched of the machined surface."""
+    def write_ply(
+        self,
+        path: Union[str, "PathLike[str]"],
+        part: str = "compensated",
+        reach: Optional[float] = None,
+        ascii: bool = False,
+    ) -> None:
+        """The machined surface as a PLY mesh, the deviation as each vertex's quality."""
+
 class MachiningResult:
     """What ``MachiningJob.run`` predicts, SI, workpiece frame unless said."""
     def __len__(self) -> int: ...

@@ -117,8 +117,10 @@ pub struct JobArgs {
     /// RS274/NGC G-code program, read as LinuxCNC reads it (tools, work offsets, planes,
     /// canned cycles, parameters, subroutines, control flow; see --explain), in mm unless it
     /// says G20; its moves in the program's machine frame = the workpiece frame; or APT / CL
-    /// data by its extension (.apt, .cl, .cls: GOTO with tool vectors; a program whose tool
-    /// axis leaves the workpiece z is refused: the job runs 2.5-D programs). Default:
+    /// data by its extension (.apt, .cl, .cls: GOTO with tool vectors; its CUTTER statements
+    /// are the tools unless --tools is given). A program whose tool axis leaves the
+    /// workpiece z runs the five-axis pass (a tri-dexel stock, the cutter's force along its
+    /// edge, position and tilt compensated; the part as PLY meshes and a 3-D view). Default:
     /// data/groove_and_pocket.nc, built in (a groove, a ramp and a circular pocket in mm).
     #[arg(long, conflicts_with = "points")]
     pub program: Option<PathBuf>,
@@ -170,7 +172,9 @@ pub struct JobArgs {
     pub seed: Option<Vec<f64>>,
     /// The workpiece frame in the robot's base frame: x,y,z [m], roll,pitch,yaw [rad] (URDF
     /// convention, Rz(yaw) Ry(pitch) Rx(roll)); the tool points down its z. Default for the
-    /// KR 300: a table in front of it, 2.45,0.02,0.92,0,0,3.141592653589793.
+    /// KR 300: a table in front of it, 2.45,0.02,0.92,0,0,3.141592653589793 (for a five-axis
+    /// program lower and closer, 2.0,0,0.4,0,0,3.141592653589793: the wrist stays bent as the
+    /// tool tilts).
     #[arg(long, value_delimiter = ',', allow_hyphen_values = true)]
     pub placement: Option<Vec<f64>>,
     /// Stock block in the workpiece frame: XMIN,YMIN,XMAX,YMAX [mm]; default: the bounding
@@ -181,6 +185,18 @@ pub struct JobArgs {
         "Stock top in the workpiece frame [mm]", "CAM's usual zero"
     ))]
     pub top: f64,
+    #[arg(long, default_value_t = 50.0, allow_negative_numbers = true, help = STOCK_DEPTH_MM.help(
+        "Five-axis programs: the stock's depth below --top [mm]", ""
+    ))]
+    pub stock_depth: f64,
+    /// The end of the --diameter tool (five-axis programs; a tool table's or an APT CUTTER's
+    /// tools carry their own): flat, ball, or bull-nose:R (corner radius R mm).
+    #[arg(long, default_value = "flat", value_parser = parse_shape)]
+    pub shape: ShapeArg,
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true, help = FLUTE_LENGTH_MM.help(
+        "Five-axis programs: the length of every tool that removes material (flutes, and the shank that would rub) [mm]", ""
+    ))]
+    pub flute_length: f64,
     #[arg(long, allow_negative_numbers = true, help = CELL_MM.help(
         "Z-map cell [mm]",
         "Default: the smallest cutting tool's diameter / 12, within [0.1, 0.5] mm (at most its radius / 2, which a job requires); at most 2^24 cells (MAX_CELLS)"
@@ -251,10 +267,37 @@ pub struct JobArgs {
     pub spin_measure: SpinMeasureArg,
 }
 
+/// `--shape`: a cutter's end; a bull-nose's corner radius in mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeArg(pub deflect_core::machining::profile::ToolShape);
+
+/// `flat`, `ball` or `bull-nose:R` (R in mm, > 0).
+pub fn parse_shape(s: &str) -> Result<ShapeArg, String> {
+    use deflect_core::machining::profile::ToolShape;
+    match s.trim().to_ascii_lowercase().as_str() {
+        "flat" => Ok(ShapeArg(ToolShape::Flat)),
+        "ball" => Ok(ShapeArg(ToolShape::Ball)),
+        other => {
+            let r = other
+                .strip_prefix("bull-nose:")
+                .and_then(|r| r.parse::<f64>().ok())
+                .filter(|r| r.is_finite() && *r > 0.0)
+                .ok_or_else(|| {
+                    format!("{s:?}: expected flat, ball or bull-nose:R (corner radius R > 0 mm)")
+                })?;
+            Ok(ShapeArg(ToolShape::BullNose {
+                corner_radius: r * 1e-3,
+            }))
+        }
+    }
+}
+
 impl JobArgs {
     /// Checks every numeric flag and the lengths of the lists.
     pub fn check(&self) -> Result<(), CliError> {
         TOP_MM.check(self.top)?;
+        STOCK_DEPTH_MM.check(self.stock_depth)?;
+        FLUTE_LENGTH_MM.check(self.flute_length)?;
         if let Some(cell) = self.cell {
             CELL_MM.check(cell)?;
         }

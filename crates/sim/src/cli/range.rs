@@ -189,6 +189,10 @@ pub const SPIN_RATE_PER_S: Range =
     Range::closed("--spin-rate (per second)", 1e-6, 1.0e5, "degrees/s");
 /// `job --top`: stock top.
 pub const TOP_MM: Range = Range::closed("--top", -1000.0, 1000.0, "mm");
+/// `job --stock-depth`: the five-axis stock's depth below its top.
+pub const STOCK_DEPTH_MM: Range = Range::closed("--stock-depth", 0.1, 1000.0, "mm");
+/// `job --flute-length`: the length of the tool that removes material (five-axis).
+pub const FLUTE_LENGTH_MM: Range = Range::closed("--flute-length", 0.1, 1000.0, "mm");
 /// Peak acceleration of the Delta's move.
 pub const DELTA_G: Range = Range::closed("--g", 1.0, 15.0, "g");
 /// The Delta's payload.

@@ -23,7 +23,7 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::job_files::{FileOptions, JobFiles};
 use super::job_summary::summary;
-use super::serial::{load_robot, program_file, read_program, read_text};
+use super::serial::{load_robot, program_and_cutters, read_program, read_text};
 use super::stdout;
 use crate::cli::{CliError, JobArgs, SpinArg, ToolArgs};
 
@@ -32,6 +32,11 @@ const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.n
 /// The KR 300's defaults: the tool down over a table in front of it.
 const KR300_PLACEMENT: [f64; 6] = [2.45, 0.02, 0.92, 0.0, 0.0, std::f64::consts::PI];
 const KR300_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+/// The KR 300's default for five-axis programs: the table lower and closer, so that the
+/// wrist stays bent (A5 about -40 to -70 degrees) as the tool tilts; over the 2.5-D default
+/// A5 is near 0, the wrist's singularity, where a tilt of a few degrees turns A4 and A6 by
+/// half a turn.
+const KR300_FIVE_AXIS_PLACEMENT: [f64; 6] = [2.0, 0.0, 0.4, 0.0, 0.0, std::f64::consts::PI];
 /// Where the tool is before the program's first move, workpiece frame \[m\].
 const START: [f64; 3] = [0.0, 0.0, 0.02];
 
@@ -44,6 +49,9 @@ pub struct JobTask {
     pub(super) seed: Vec<f64>,
     /// The spin search's result and its wall time \[s\] (`--spin optimize`).
     pub(super) spin: Option<(deflect_core::machining::spin::SpinPlan, f64)>,
+    /// The setup's tool's end (five-axis programs): --shape, or the program's first
+    /// `CUTTER/`.
+    pub(super) shape: deflect_core::machining::profile::ToolShape,
 }
 
 /// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
@@ -131,11 +139,13 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         dialect: a.dialect.dialect(),
         ..GcodeOptions::default()
     };
+    let mut cutters = Vec::new();
     let (program, program_name) = match (&a.program, &a.points) {
-        (Some(p), _) => (
-            program_file("--program", p, &options)?,
-            p.display().to_string(),
-        ),
+        (Some(p), _) => {
+            let (program, c) = program_and_cutters("--program", p, &options)?;
+            cutters = c;
+            (program, p.display().to_string())
+        }
         (None, Some(p)) => {
             let text = read_text("--points", p, "tool points CSV")?;
             let program = points_csv::from_str(&text, &options)
@@ -167,7 +177,11 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             loaded.name
         )));
     }
-    let p = a.placement.clone().unwrap_or(KR300_PLACEMENT.to_vec());
+    let p = a.placement.clone().unwrap_or(if program.is_multi_axis() {
+        KR300_FIVE_AXIS_PLACEMENT.to_vec()
+    } else {
+        KR300_PLACEMENT.to_vec()
+    });
     let [x, y, z, roll, pitch, yaw] = p.as_slice() else {
         return Err(CliError::Usage(format!(
             "--placement: {} values; expected 6",
@@ -228,8 +242,17 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             }
             Some(table)
         }
-        None => None,
+        None => apt_tools(a, &cutters, &program_name)?,
     };
+    // A cutter before any LOADTL is the tool the program starts with (T0): the setup's.
+    let first = cutters.iter().rev().find(|c| c.tool == 0);
+    let tool = match first {
+        Some(c) => Tool::new(c.diameter, tool.flutes, tool.helix).map_err(|e| {
+            CliError::Failure(format!("{program_name} line {}: CUTTER: {e}", c.line))
+        })?,
+        None => tool,
+    };
+    let shape = first.map_or(a.shape.0, |c| c.shape);
     // The z-map resolves the smallest cutting tool: a twelfth of its diameter, within
     // [0.1, 0.5] mm (finer cells for small tools keep the force's sensitivity to the tool's
     // position what the cutter, not the grid, makes it).
@@ -312,6 +335,12 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             Some(_) => {}
         }
     }
+    if program.is_multi_axis() && a.spin != SpinArg::Keep {
+        return Err(CliError::Usage(format!(
+            "--spin: {program_name} is a five-axis program; its pass keeps the setup's spin \
+             (leave out --spin)"
+        )));
+    }
     let (job, spin) = spin(a, job, &program, &program_name, &seed)?;
     Ok(JobTask {
         job,
@@ -320,7 +349,40 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         robot_name: loaded.name,
         seed,
         spin,
+        shape,
     })
+}
+
+/// The tool table of an APT program's `CUTTER/` statements after `LOADTL` (the last per tool
+/// number; the flutes and helix of --flutes/--helix, the length of --flute-length), or none.
+fn apt_tools(
+    a: &JobArgs,
+    cutters: &[deflect_core::io::apt::AptCutter],
+    name: &str,
+) -> Result<Option<deflect_core::machining::tools::ToolTable>, CliError> {
+    use deflect_core::machining::tools::{ToolSpec, ToolTable};
+    if cutters.iter().all(|c| c.tool == 0) {
+        return Ok(None);
+    }
+    let mut specs: Vec<ToolSpec> = Vec::new();
+    for c in cutters.iter().filter(|c| c.tool > 0) {
+        let tool = Tool::new(c.diameter, a.tool.flutes, a.tool.helix.to_radians()).map_err(|e| {
+            CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line))
+        })?;
+        let spec = ToolSpec {
+            // T0 (a cutter before any LOADTL) is the program's tool before any change.
+            number: c.tool,
+            tool,
+            shape: c.shape,
+            length: a.flute_length * 1e-3,
+            name: format!("CUTTER line {}", c.line),
+        };
+        specs.retain(|s| s.number != c.tool);
+        specs.push(spec);
+    }
+    ToolTable::new(specs)
+        .map(Some)
+        .map_err(|e| CliError::Failure(format!("{name}: its CUTTER statements: {e}")))
 }
 
 /// The job with `--spin`: a constant spin, or the schedule the search finds (and what it
@@ -415,6 +477,9 @@ impl Progress {
 /// Runs the pass, streaming its samples to the files on a writer thread, then writes the
 /// part map and the summary.
 pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
+    if t.program.is_multi_axis() {
+        return super::job_five_axis::five_axis_cmd(a, t, out);
+    }
     let started = Instant::now();
     let setup = t.job.setup();
     let duration = deflect_core::machining::path::duration(&t.program, &setup.path)

@@ -32,6 +32,7 @@ pub mod contour;
 pub mod delta;
 pub mod fit;
 pub mod job;
+pub mod job_five_axis;
 pub mod job_files;
 pub mod job_summary;
 pub mod milling;

@@ -60,6 +60,21 @@ pub(crate) fn program_file(
     path: &Path,
     options: &deflect_core::io::gcode::GcodeOptions,
 ) -> Result<deflect_core::machining::Program, CliError> {
+    program_and_cutters(flag, path, options).map(|(p, _)| p)
+}
+
+/// [`program_file`] with the cutters an APT program defines (`CUTTER/`; none for G-code).
+pub(crate) fn program_and_cutters(
+    flag: &str,
+    path: &Path,
+    options: &deflect_core::io::gcode::GcodeOptions,
+) -> Result<
+    (
+        deflect_core::machining::Program,
+        Vec<deflect_core::io::apt::AptCutter>,
+    ),
+    CliError,
+> {
     let text = read_program(flag, path)?;
     let apt = path.extension().and_then(|e| e.to_str()).is_some_and(|e| {
         matches!(
@@ -68,9 +83,9 @@ pub(crate) fn program_file(
         )
     });
     let read = if apt {
-        deflect_core::io::apt::from_str(&text, options).map(|p| p.program)
+        deflect_core::io::apt::from_str(&text, options).map(|p| (p.program, p.cutters))
     } else {
-        deflect_core::io::gcode::from_str(&text, options)
+        deflect_core::io::gcode::from_str(&text, options).map(|p| (p, Vec::new()))
     };
     read.map_err(|e| CliError::Failure(format!("{flag} {}: {e}", path.display())))
 }

@@ -162,14 +162,23 @@ impl Dexels {
     }
 
     /// The machined surface of this (nominal) stock, each point with the deviation of
-    /// `predicted` (the same block, cut otherwise) there. A point whose ray in `predicted`
-    /// has no end of its side within two cells (the material gone, or a sliver left) counts
-    /// in the second value and is not listed. [`TickError::InvalidArgument`] when the blocks
-    /// differ.
+    /// `predicted` (the same block, cut otherwise) there: the predicted end of the same side
+    /// nearest the nominal one along the ray, within `reach` \[m\] (larger than the largest
+    /// deviation expected, smaller than the part's thinnest wall). A point whose ray has none
+    /// (the material gone, or a sliver left) counts in the second value and is not listed.
+    /// [`TickError::InvalidArgument`] when the blocks differ or `reach` is not finite and
+    /// > 0.
     pub fn surface_deviation(
         &self,
         predicted: &Dexels,
+        reach: f64,
     ) -> Result<(Vec<SurfacePoint>, usize), TickError> {
+        if !(reach.is_finite() && reach > 0.0) {
+            return Err(TickError::InvalidArgument {
+                what: "surface deviation reach (m, finite and > 0)",
+                value: reach,
+            });
+        }
         if self.n != predicted.n || self.cell != predicted.cell || self.min != predicted.min {
             return Err(TickError::InvalidArgument {
                 what: "predicted stock (the nominal one's block, cell and shape)",
@@ -217,7 +226,7 @@ impl Dexels {
                                 *c = sign;
                             }
                             let n = n.normalize();
-                            let Some(y) = end_near(other, upper, x, 2.0 * self.cell) else {
+                            let Some(y) = end_near(other, upper, x, reach) else {
                                 missing += 1;
                                 continue;
                             };

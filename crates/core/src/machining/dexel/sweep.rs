@@ -126,8 +126,30 @@ pub(super) fn hit(
         let z = alpha + beta * t - gamma * s;
         ComplexField::sqrt((q - z * z).max(0.0)) - tool.radius_at(z.clamp(0.0, h))
     };
+    // The distance from the axis squared, rho^2(s) = q - z^2 = A s^2 + B s + C at `t`: its
+    // minimiser is the minimiser of f wherever it lies on the tool's cylinder (z >= the
+    // corner radius, everywhere for a flat end), since there f = rho - R and elsewhere
+    // f >= rho - R (the radius is at most R). Only a minimiser on the corner needs the search.
+    let corner = tool.corner;
+    let quad_a = dd - gamma * gamma;
     let g = |t: f64| match s_range(t) {
-        Some((a, b)) => golden(a, b, GOLDEN_MOVE, &|s| f(t, s)).1,
+        Some((a, b)) => {
+            let z0 = alpha + beta * t;
+            let quad_b = 2.0 * (-qd - t * ed) + 2.0 * gamma * z0;
+            let rho2 = |s: f64| quad_a * s * s + quad_b * s;
+            let s_min = if quad_a > 1e-300 {
+                (-quad_b / (2.0 * quad_a)).clamp(a, b)
+            } else if rho2(a) <= rho2(b) {
+                a
+            } else {
+                b
+            };
+            if z0 - gamma * s_min >= corner {
+                f(t, s_min)
+            } else {
+                golden(a, b, GOLDEN_MOVE, &|s| f(t, s)).1
+            }
+        }
         None => f64::INFINITY,
     };
     // The t-range where some s keeps the slab: 0 <= alpha + beta t - gamma s <= h for an s

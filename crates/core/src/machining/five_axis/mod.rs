@@ -69,8 +69,8 @@ pub struct Options {
     /// The end of the setup's tool ([`super::job::Setup::tool`]) when the job has no tool
     /// table (a table's tools carry their own).
     pub shape: ToolShape,
-    /// The length of the setup's tool that removes material \[m\] (flutes and the shank that
-    /// would rub), without a tool table.
+    /// The length of every tool that removes material \[m\] (flutes and the shank that would
+    /// rub; a tool table's lengths are the tools' offsets, not this).
     pub length: f64,
     /// Axial slices of the edge the engagement is read in, `1..=256`.
     pub slices: usize,
@@ -228,11 +228,11 @@ fn cutters(job: &Job, program: &Program, options: &Options) -> Result<Vec<Cutter
     let setup = job.setup();
     let mut list = Vec::new();
     for number in program.tools() {
-        let (tool, shape, length, known) = match job.tools() {
-            None => (setup.tool, options.shape, options.length, true),
+        let (tool, shape, known) = match job.tools() {
+            None => (setup.tool, options.shape, true),
             Some(table) => match table.get(number) {
-                Some(spec) => (spec.tool, spec.shape, spec.length, true),
-                None => (setup.tool, options.shape, options.length, false),
+                Some(spec) => (spec.tool, spec.shape, true),
+                None => (setup.tool, options.shape, false),
             },
         };
         let profile = Profile::new(&tool, shape)?;
@@ -246,7 +246,7 @@ fn cutters(job: &Job, program: &Program, options: &Options) -> Result<Vec<Cutter
             number,
             tool,
             profile,
-            solid: DexelTool::new(&profile, length)?,
+            solid: DexelTool::new(&profile, options.length)?,
             known,
         });
     }

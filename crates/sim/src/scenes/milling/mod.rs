@@ -29,6 +29,7 @@ pub mod identification;
 pub mod options;
 pub mod output;
 pub mod part_map;
+pub mod part_view;
 pub mod program;
 pub mod program_output;
 pub mod run;
