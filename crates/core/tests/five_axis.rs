@@ -67,7 +67,9 @@ fn a_tilted_floor_cut_deeper_along_its_normal_deviates_by_the_offset() {
         assert_eq!(Face::of(p), Face::PlusZ);
     }
     // The same cut on both: no deviation anywhere.
-    let (same, _) = nominal.surface_deviation(&nominal.clone(), 2.0 * cell).unwrap();
+    let (same, _) = nominal
+        .surface_deviation(&nominal.clone(), 2.0 * cell)
+        .unwrap();
     assert_eq!(DeviationStats::of(&same).max_abs(), 0.0);
     // The mesh joins the strip's points: about two triangles per point.
     let strip_count = strip.len();
@@ -158,7 +160,10 @@ fn the_compensated_swarf_cut_holds_the_program_tip_and_axis() {
     assert!(mid.force.norm() > 50.0, "{:?}", mid.force);
     // The predicted parts along the surface's normal: the compensated one on the program's to
     // the IK's tolerance, the uncompensated one off by the deflection.
-    let (pu, _) = r.nominal.surface_deviation(&r.uncompensated, 3.0e-3).unwrap();
+    let (pu, _) = r
+        .nominal
+        .surface_deviation(&r.uncompensated, 3.0e-3)
+        .unwrap();
     let (pc, _) = r.nominal.surface_deviation(&r.compensated, 3.0e-3).unwrap();
     let (su, sc) = (DeviationStats::of(&pu), DeviationStats::of(&pc));
     assert!(su.max_abs() > 2.0e-5, "{su:?}");

@@ -138,7 +138,9 @@ impl FiveAxisResult {
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
         let dof = self.report.dof;
-        self.rows(py, dof, |s, o| o.copy_from_slice(s.q.get(..dof).unwrap_or(&[])))
+        self.rows(py, dof, |s, o| {
+            o.copy_from_slice(s.q.get(..dof).unwrap_or(&[]))
+        })
     }
 
     /// Compensated joints (n, dof) [rad or m].

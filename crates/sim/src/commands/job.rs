@@ -366,9 +366,8 @@ fn apt_tools(
     }
     let mut specs: Vec<ToolSpec> = Vec::new();
     for c in cutters.iter().filter(|c| c.tool > 0) {
-        let tool = Tool::new(c.diameter, a.tool.flutes, a.tool.helix.to_radians()).map_err(|e| {
-            CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line))
-        })?;
+        let tool = Tool::new(c.diameter, a.tool.flutes, a.tool.helix.to_radians())
+            .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?;
         let spec = ToolSpec {
             // T0 (a cutter before any LOADTL) is the program's tool before any change.
             number: c.tool,

@@ -18,7 +18,9 @@ use super::stdout;
 use crate::cli::JobArgs;
 
 /// The part's figures: all machined points, and per face.
-fn part_figures(points: &[deflect_core::machining::dexel::surface::SurfacePoint]) -> serde_json::Value {
+fn part_figures(
+    points: &[deflect_core::machining::dexel::surface::SurfacePoint],
+) -> serde_json::Value {
     let stats = |s: DeviationStats| {
         json!({
             "points": s.count,
@@ -98,8 +100,14 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
     let (eu, ec) = (r.errors(false), r.errors(true));
     // Ends matched within three times the tool's largest deviation (and two cells).
     let reach = (3.0 * eu.max_position).max(2.0 * cell);
-    let (pu, missing_u) = r.nominal.surface_deviation(&r.uncompensated, reach).map_err(fail)?;
-    let (pc, missing_c) = r.nominal.surface_deviation(&r.compensated, reach).map_err(fail)?;
+    let (pu, missing_u) = r
+        .nominal
+        .surface_deviation(&r.uncompensated, reach)
+        .map_err(fail)?;
+    let (pc, missing_c) = r
+        .nominal
+        .surface_deviation(&r.compensated, reach)
+        .map_err(fail)?;
     let (fu, fc) = (part_figures(&pu), part_figures(&pc));
     let (su, sc) = (DeviationStats::of(&pu), DeviationStats::of(&pc));
     let mu = SurfaceMesh::new(pu, cell).map_err(fail)?;
@@ -128,7 +136,10 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             s.rms * 1e3
         )
     };
-    let (lu, lc) = (label("uncompensated", &su), label("compensated offline", &sc));
+    let (lu, lc) = (
+        label("uncompensated", &su),
+        label("compensated offline", &sc),
+    );
     let png = out.join("part_view.png");
     part_view::plot_part_view(
         &png,

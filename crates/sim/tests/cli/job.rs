@@ -404,7 +404,7 @@ fn job_runs_at_one_sample_per_second_and_with_sharp_limits() {
 }
 
 #[test]
-fn job_reads_apt_by_its_extension_and_refuses_a_tilted_axis() {
+fn job_reads_apt_by_its_extension_and_runs_a_tilted_axis_five_axis() {
     let d = scratch("job-apt");
     let flat = d.join("slot.apt");
     std::fs::write(
@@ -424,19 +424,76 @@ fn job_reads_apt_by_its_extension_and_refuses_a_tilted_axis() {
         out.to_str().unwrap(),
     ]);
     assert_eq!(o.code, 0, "{}", o.stderr);
+    // A swarf cut with an 8 mm flat cutter (CUTTER/) tilted 15 degrees: the five-axis pass.
     let tilted = d.join("tilted.apt");
     std::fs::write(
         &tilted,
-        "UNITS/MM\nSPINDL/13000,CLW\nFEDRAT/MMPM,1500\nGOTO/-10,0,5,0,0,1\n\
-         GOTO/40,0,-2,0,0.2588190,0.9659258\nFINI\n",
+        "UNITS/MM\nCUTTER/8\nSPINDL/12000,CLW\nRAPID\nGOTO/-12,-10,20,0,0,1\nRAPID\n\
+         GOTO/-12,-10,5,0,-0.2588190,0.9659258\nFEDRAT/MMPM,1200\n\
+         GOTO/-12,-10,-3,0,-0.2588190,0.9659258\nGOTO/40,-10,-3,0,-0.2588190,0.9659258\n\
+         GOTO/40,-10,10,0,0,1\nFINI\n",
     )
     .unwrap();
+    let five = d.join("five");
     let o = sim(&[
         "job",
         "--program",
         tilted.to_str().unwrap(),
+        "--stock",
+        "0,-20,30,20",
+        "--cell",
+        "1",
+        "--stock-depth",
+        "20",
         "--out",
-        out.to_str().unwrap(),
+        five.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(o.stdout.contains("five-axis job"), "{}", o.stdout);
+    for f in [
+        "part_uncompensated.ply",
+        "part_compensated.ply",
+        "part_view.png",
+        "five_axis_samples.csv",
+        "five_axis_summary.txt",
+    ] {
+        assert!(five.join(f).is_file(), "{f}");
+    }
+    let json: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(five.join("five_axis_summary.json")).unwrap(),
+    )
+    .unwrap();
+    let mm = |p: &str| json.pointer(p).and_then(|v| v.as_f64()).unwrap();
+    // The compensated tool holds the program to the IK's 1e-8 m, its part to a few times
+    // that (tip and tilt together along the flank); the uncompensated ones are off by tenths.
+    assert!(mm("/tool/compensated/max_position_mm") <= 1e-5, "{json}");
+    assert!(mm("/tool/uncompensated/max_position_mm") > 0.01, "{json}");
+    assert!(mm("/part/compensated/all/max_left_mm") <= 3e-5, "{json}");
+    assert!(
+        mm("/part/compensated/all/max_overcut_mm") >= -3e-5,
+        "{json}"
+    );
+    assert!(mm("/part/uncompensated/all/rms_mm") > 0.005, "{json}");
+    let ply = std::fs::read(five.join("part_compensated.ply")).unwrap();
+    assert!(ply.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
+    // The five-axis pass keeps the setup's spin; the testbed's milling run is 2.5-D.
+    let o = sim(&[
+        "job",
+        "--program",
+        tilted.to_str().unwrap(),
+        "--spin",
+        "10",
+        "--out",
+        five.to_str().unwrap(),
+    ]);
+    assert_eq!(o.code, 2, "{}", o.stderr);
+    assert!(o.stderr.contains("--spin"), "{}", o.stderr);
+    let o = sim(&[
+        "milling",
+        "--program",
+        tilted.to_str().unwrap(),
+        "--out",
+        five.to_str().unwrap(),
     ]);
     assert_eq!(o.code, 1, "{}", o.stderr);
     assert!(o.stderr.contains("2.5-D"), "{}", o.stderr);

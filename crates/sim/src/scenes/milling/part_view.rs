@@ -38,7 +38,10 @@ pub fn plot_part_view(
     title: &str,
     parts: &[(&str, &SurfaceMesh)],
 ) -> Result<(), SimError> {
-    let root = canvas(path, ((620 * parts.len().max(1) as u32 + 170).max(900), 620))?;
+    let root = canvas(
+        path,
+        ((620 * parts.len().max(1) as u32 + 170).max(900), 620),
+    )?;
     let (plot, _) = figure(&root, title, 18, &[])?;
     let (w, _) = plot.dim_in_pixel();
     let (plot, side) = plot.split_horizontally(w.saturating_sub(160));
@@ -62,8 +65,12 @@ pub fn plot_part_view(
         let lines = wrap(label, pw.saturating_sub(16), 15);
         let font = ("sans-serif", 15).into_font().color(&BLACK);
         for (k, line) in lines.iter().enumerate() {
-            area.draw(&Text::new(line.clone(), (8, 4 + 19 * k as i32), font.clone()))
-                .map_err(perr)?;
+            area.draw(&Text::new(
+                line.clone(),
+                (8, 4 + 19 * k as i32),
+                font.clone(),
+            ))
+            .map_err(perr)?;
         }
         let top = 12 + 19 * lines.len() as i32;
         let (aw, ah) = (
@@ -97,7 +104,10 @@ pub fn plot_part_view(
             let Some(t) = mesh.triangles.get(k) else {
                 continue;
             };
-            let vs: Vec<_> = t.iter().filter_map(|&v| mesh.points.get(v as usize)).collect();
+            let vs: Vec<_> = t
+                .iter()
+                .filter_map(|&v| mesh.points.get(v as usize))
+                .collect();
             let [a, b, c] = vs.as_slice() else { continue };
             let dev = (a.deviation + b.deviation + c.deviation) / 3.0;
             let normal = (a.normal + b.normal + c.normal).normalize();
@@ -106,7 +116,8 @@ pub fn plot_part_view(
             let dim = |v: u8| (f64::from(v) * shade).round().clamp(0.0, 255.0) as u8;
             let color = RGBColor(dim(r), dim(g), dim(bl));
             let points = vec![to_px(&a.position), to_px(&b.position), to_px(&c.position)];
-            area.draw(&Polygon::new(points, color.filled())).map_err(perr)?;
+            area.draw(&Polygon::new(points, color.filled()))
+                .map_err(perr)?;
         }
     }
     // The colour bar.
@@ -124,10 +135,18 @@ pub fn plot_part_view(
         side.draw(&Text::new(text, (x0, y0 + dy), font.clone()))
             .map_err(perr)?;
     }
-    for (t, dy, note) in [(1.0, 0, " left"), (0.0, bh / 2, ""), (-1.0, bh - 1, " overcut")] {
+    for (t, dy, note) in [
+        (1.0, 0, " left"),
+        (0.0, bh / 2, ""),
+        (-1.0, bh - 1, " overcut"),
+    ] {
         let label = format!("{:+.3}{note}", t * limit * 1e3);
-        side.draw(&Text::new(label, (x0 + bw as i32 + 6, y0 + dy as i32 - 7), font.clone()))
-            .map_err(perr)?;
+        side.draw(&Text::new(
+            label,
+            (x0 + bw as i32 + 6, y0 + dy as i32 - 7),
+            font.clone(),
+        ))
+        .map_err(perr)?;
     }
     present(&root, path)
 }
