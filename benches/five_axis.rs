@@ -1,7 +1,10 @@
 //! Five-axis pieces (criterion): the tri-dexel stock's ray updates per second for a ball-end
 //! groove at 0 and 45 degrees of tilt (0.25 mm rays), the z-map's cell updates for the same
 //! vertical groove, the cutter forces along the edge (the revolution's mean and the
-//! instantaneous wrench of a ball end, tilted), and APT points read per second.
+//! instantaneous wrench of a ball end, tilted), APT points read per second, and the five-axis
+//! job on the KR 300 per sample (a swarf cut with a flat end, a ball-end pass with 20 degrees
+//! of lead: the path, the engagement from the dexels, the force along the edge, both IKs, the
+//! three stocks cut).
 //!
 //! `cargo bench --bench five_axis`
 
@@ -126,5 +129,60 @@ fn bench(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench);
+/// The five-axis job on the KR 300 at the testbed's five-axis placement (the table lower and
+/// closer, the wrist bent), 0.5 mm rays, 20 mm of stock.
+fn job(c: &mut Criterion) {
+    use deflect_core::machining::five_axis::{self, Options};
+    use deflect_core::machining::job::Job;
+    let mut setup =
+        deflect_tests::job_setup(Vector2::new(-0.01, -0.03), Vector2::new(0.06, 0.01), 5.0e-4);
+    setup.placement = nalgebra::Isometry3::new(
+        Vector3::new(2.0, 0.0, 0.4),
+        Vector3::new(0.0, 0.0, std::f64::consts::PI),
+    );
+    let robot = deflect_tests::kr300();
+    let seed = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+    let runs = [
+        (
+            "swarf cut, 16 mm flat end tilted 15 degrees",
+            ToolShape::Flat,
+            "UNITS/MM\nSPINDL/12000,CLW\nRAPID\nGOTO/-5,-22,20,0,0,1\nRAPID\n\
+             GOTO/-5,-22,5,0,-0.2588190,0.9659258\nFEDRAT/MMPM,1200\n\
+             GOTO/-5,-22,-3,0,-0.2588190,0.9659258\nGOTO/50,-22,-3,0,-0.2588190,0.9659258\n\
+             GOTO/50,-22,10,0,0,1\nFINI\n",
+        ),
+        (
+            "ball-end pass, 16 mm ball with 20 degrees of lead",
+            ToolShape::Ball,
+            "UNITS/MM\nSPINDL/12000,CLW\nRAPID\nGOTO/-5,-10,20,0,0,1\nRAPID\n\
+             GOTO/-5,-10,5,-0.3420201,0,0.9396926\nFEDRAT/MMPM,1200\n\
+             GOTO/-5,-10,-2,-0.3420201,0,0.9396926\nGOTO/50,-10,-2,-0.3420201,0,0.9396926\n\
+             GOTO/50,-10,10,0,0,1\nFINI\n",
+        ),
+    ];
+    let mut g = c.benchmark_group("five_axis_job");
+    g.sample_size(10);
+    for (name, shape, text) in runs {
+        let job = Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap();
+        let program = apt::from_str(text, &gcode::GcodeOptions::default())
+            .unwrap()
+            .program;
+        let options = Options {
+            depth: 0.02,
+            shape,
+            ..Options::default()
+        };
+        let n = five_axis::run(&job, &program, &seed, &options)
+            .unwrap()
+            .samples
+            .len();
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(format!("{name}, per sample"), |b| {
+            b.iter(|| five_axis::run(&job, &program, &seed, &options).unwrap())
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench, job);
 criterion_main!(benches);

@@ -129,13 +129,58 @@ pub(super) fn hit(
     // The distance from the axis squared, rho^2(s) = q - z^2 = A s^2 + B s + C at `t`: its
     // minimiser is the minimiser of f wherever it lies on the tool's cylinder (z >= the
     // corner radius, everywhere for a flat end), since there f = rho - R and elsewhere
-    // f >= rho - R (the radius is at most R). Only a minimiser on the corner needs the search.
+    // f >= rho - R (the radius is at most R). A ball end is the points within R of the axis
+    // segment from the ball's centre up (inside the slab), so the distance to that segment
+    // minus R has the same sign as f and its minimum over the move is the smaller of two
+    // quadratics' on their stretches (above the centre: rho^2; below: the squared distance to
+    // the centre). Only a bull-nose's corner needs the search.
     let corner = tool.corner;
+    let ball = (tool.radius - corner).abs() <= 1e-12 * tool.radius;
     let quad_a = dd - gamma * gamma;
+    // The least of A s^2 + B s + C on [a, b] (A >= 0), as sqrt(max(., 0)).
+    let least = |qa: f64, qb: f64, qc: f64, a: f64, b: f64| {
+        let at = |s: f64| ComplexField::sqrt((qa * s * s + qb * s + qc).max(0.0));
+        if qa > 1e-300 {
+            at((-qb / (2.0 * qa)).clamp(a, b))
+        } else {
+            at(a).min(at(b))
+        }
+    };
     let g = |t: f64| match s_range(t) {
         Some((a, b)) => {
             let z0 = alpha + beta * t;
             let quad_b = 2.0 * (-qd - t * ed) + 2.0 * gamma * z0;
+            let q_t = q0 + t * t + 2.0 * t * qe;
+            if ball {
+                // Where z = z0 - gamma s passes the centre's height R.
+                let (mut cyl, mut sph) = ((a, b), (a, b));
+                if gamma.abs() > 1e-300 {
+                    let split = ((z0 - corner) / gamma).clamp(a, b);
+                    if gamma > 0.0 {
+                        cyl.1 = split;
+                        sph.0 = split;
+                    } else {
+                        cyl.0 = split;
+                        sph.1 = split;
+                    }
+                } else if z0 >= corner {
+                    sph = (1.0, 0.0);
+                } else {
+                    cyl = (1.0, 0.0);
+                }
+                let mut best = f64::INFINITY;
+                if cyl.0 <= cyl.1 {
+                    best = best.min(least(quad_a, quad_b, q_t - z0 * z0, cyl.0, cyl.1));
+                }
+                if sph.0 <= sph.1 {
+                    let (qb, qc) = (
+                        2.0 * (-qd - t * ed) + 2.0 * corner * gamma,
+                        q_t - 2.0 * corner * z0 + corner * corner,
+                    );
+                    best = best.min(least(dd, qb, qc, sph.0, sph.1));
+                }
+                return best - tool.radius;
+            }
             let rho2 = |s: f64| quad_a * s * s + quad_b * s;
             let s_min = if quad_a > 1e-300 {
                 (-quad_b / (2.0 * quad_a)).clamp(a, b)
