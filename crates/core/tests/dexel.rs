@@ -436,3 +436,47 @@ fn the_engagement_read_from_the_dexels_is_the_slots_and_its_force_the_closed_for
             .is_err()
     );
 }
+
+#[test]
+fn a_ramp_cut_in_halves_is_the_ramp_for_every_cutter() {
+    // The swept solid of a straight move is the union of its halves' (a fixed axis): each
+    // ray's interval the same to rounding, whichever part of the tool (the end's corner,
+    // the cylinder) bounds it. The ramp climbs along the axis' lean, so the move's part along
+    // the axis (gamma) is not zero.
+    let shapes = [
+        ToolShape::Flat,
+        ToolShape::Ball,
+        ToolShape::BullNose {
+            corner_radius: 1e-3,
+        },
+    ];
+    for shape in shapes {
+        let solid = tool(shape);
+        let block = || {
+            Dexels::block(
+                Vector3::new(-6e-3, -8e-3, -6e-3),
+                Vector3::new(20e-3, 8e-3, 0.0),
+                CELL,
+            )
+            .unwrap()
+        };
+        let a = Vector3::new(-0.3634127, 0.0, 0.9316282).normalize();
+        let (p, q) = (
+            Vector3::new(0.0, 0.0, -3e-3),
+            Vector3::new(14e-3, 0.0, 1e-3),
+        );
+        let m = (p + q) * 0.5;
+        let mut whole = block();
+        let mut halves = block();
+        let _ = whole.cut(&solid, &p, &a, &q, &a).unwrap();
+        let _ = halves.cut(&solid, &p, &a, &m, &a).unwrap();
+        let _ = halves.cut(&solid, &m, &a, &q, &a).unwrap();
+        let (pts, missing) = whole.surface_deviation(&halves, 4e-3).unwrap();
+        let worst = pts.iter().map(|p| p.deviation.abs()).fold(0.0, f64::max);
+        assert!(pts.len() > 500, "{shape:?}: {}", pts.len());
+        assert!(
+            worst < 1e-9 && missing == 0,
+            "{shape:?}: {worst} ({missing} unmatched)"
+        );
+    }
+}

@@ -25,6 +25,8 @@ use crate::errors::{job_err, tick_err};
 #[derive(Debug)]
 pub struct FiveAxisResult {
     report: Report,
+    /// The tools' length that removes material \[m\] (the default reach).
+    length: f64,
 }
 
 /// Runs the pass (see `MachiningJob.run_five_axis`).
@@ -38,7 +40,10 @@ pub fn run(
     let report = py
         .detach(|| five_axis::run(job, program, seed, options))
         .map_err(job_err)?;
-    Ok(FiveAxisResult { report })
+    Ok(FiveAxisResult {
+        report,
+        length: options.length,
+    })
 }
 
 impl FiveAxisResult {
@@ -68,12 +73,13 @@ impl FiveAxisResult {
         }
     }
 
-    /// The machined surface with `part`'s deviation, matched within `reach` (default three
-    /// times the uncompensated tool's largest error, at least two cells).
+    /// The machined surface with `part`'s deviation, matched within `reach` (default: the
+    /// farthest the uncompensated tool's edge left the program, its tip and its tilt along
+    /// the flutes, plus two cells).
     fn points(&self, part: &str, reach: Option<f64>) -> PyResult<(Vec<SurfacePoint>, usize)> {
         let cell = self.report.nominal.cell();
-        let reach =
-            reach.unwrap_or_else(|| (3.0 * self.report.errors(false).max_position).max(2.0 * cell));
+        let e = self.report.errors(false);
+        let reach = reach.unwrap_or_else(|| e.max_position + e.max_axis * self.length + 2.0 * cell);
         self.report
             .nominal
             .surface_deviation(self.part(part)?, reach)
@@ -201,8 +207,8 @@ impl FiveAxisResult {
     /// The machined surface of the nominal part with `part`'s deviation along the outward
     /// normal: a dict of `position` (m, 3) [m], `normal` (m, 3), `deviation` (m,) [m] (> 0
     /// material left, < 0 overcut), `face` (m,) ("+x" .. "-z": the normal's side) and
-    /// `unmatched` (points whose predicted surface lies beyond `reach` [m]; default three
-    /// times the uncompensated tool's largest error, at least two cells).
+    /// `unmatched` (points whose predicted surface lies beyond `reach` [m]; default the
+    /// farthest the uncompensated tool's edge left the program plus two cells).
     #[pyo3(signature = (part="compensated", reach=None))]
     fn surface<'py>(
         &self,

@@ -98,8 +98,9 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
     let cell = t.job.setup().stock.cell;
     let fail = |e: deflect_core::TickError| SimError::new(format!("{}: {e}", t.program_name));
     let (eu, ec) = (r.errors(false), r.errors(true));
-    // Ends matched within three times the tool's largest deviation (and two cells).
-    let reach = (3.0 * eu.max_position).max(2.0 * cell);
+    // Ends matched within the farthest the tool's edge left the program (its tip, and its
+    // tilt along the flutes) and two cells: no surface moves farther along its normal.
+    let reach = eu.max_position + eu.max_axis * options.length + 2.0 * cell;
     let (pu, missing_u) = r
         .nominal
         .surface_deviation(&r.uncompensated, reach)

@@ -155,13 +155,15 @@ pub(super) fn hit(
                 // Where z = z0 - gamma s passes the centre's height R.
                 let (mut cyl, mut sph) = ((a, b), (a, b));
                 if gamma.abs() > 1e-300 {
-                    let split = ((z0 - corner) / gamma).clamp(a, b);
+                    // Not clamped into [a, b]: a stretch the split leaves empty stays empty
+                    // (a clamped one would read the cylinder at a point below the centre).
+                    let split = (z0 - corner) / gamma;
                     if gamma > 0.0 {
-                        cyl.1 = split;
-                        sph.0 = split;
+                        cyl.1 = cyl.1.min(split);
+                        sph.0 = sph.0.max(split);
                     } else {
-                        cyl.0 = split;
-                        sph.1 = split;
+                        cyl.0 = cyl.0.max(split);
+                        sph.1 = sph.1.min(split);
                     }
                 } else if z0 >= corner {
                     sph = (1.0, 0.0);

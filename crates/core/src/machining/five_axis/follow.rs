@@ -102,3 +102,48 @@ impl Chord {
         Ok(())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::machining::cutting::Tool;
+    use crate::machining::profile::{Profile, ToolShape};
+
+    #[test]
+    fn chords_cut_what_the_moves_cut() {
+        let t = Tool::new(0.01, 2, 0.0).unwrap();
+        let solid = DexelTool::new(&Profile::new(&t, ToolShape::Ball).unwrap(), 0.03).unwrap();
+        let block = || {
+            Dexels::block(
+                Vector3::new(-0.01, -0.02, -0.01),
+                Vector3::new(0.03, 0.02, 0.0),
+                5e-4,
+            )
+            .unwrap()
+        };
+        let a = Vector3::new(-0.3634127, 0.0, 0.9316282).normalize();
+        let pts = [
+            Vector3::new(0.0, -0.01, 0.005),
+            Vector3::new(0.0, -0.01, -0.0023),
+            Vector3::new(0.02, -0.01, 0.0017),
+            Vector3::new(0.02, -0.008, 0.0017),
+            Vector3::new(0.0, -0.008, -0.0023),
+        ];
+        let mut exact = block();
+        let mut chorded = block();
+        let mut c = Chord::default();
+        for w in pts.windows(2) {
+            let _ = exact.cut(&solid, &w[0], &a, &w[1], &a).unwrap();
+            for k in 0..=100 {
+                let p = w[0] + (w[1] - w[0]) * (k as f64 / 100.0);
+                c.to(&mut chorded, &solid, 1, &ToolPose { tip: p, axis: a })
+                    .unwrap();
+            }
+        }
+        c.flush(&mut chorded).unwrap();
+        let (pts, missing) = exact.surface_deviation(&chorded, 5e-3).unwrap();
+        let worst = pts.iter().map(|p| p.deviation.abs()).fold(0.0, f64::max);
+        assert_eq!(missing, 0);
+        assert!(worst < 1e-9, "{worst}");
+    }
+}

@@ -3,7 +3,8 @@
 //! triangle coloured by its vertices' mean deviation along the normal (red material left,
 //! blue overcut, white on the nominal part: [`super::part_map::deviation_color`]) and shaded
 //! by a light from the viewer's upper left so the shape reads. One panel per predicted part,
-//! one colour scale for all, symmetric and saturating at the largest deviation of any.
+//! one colour scale for all, symmetric and saturating at the 99th percentile of the
+//! deviations.
 
 use std::path::Path;
 
@@ -24,12 +25,21 @@ fn view() -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
     (right, up, toward)
 }
 
-/// The colour scale's end \[m\]: the largest deviation of any part, at least 1 um.
+/// The colour scale's end \[m\]: the 99th percentile of every part's deviation (a few
+/// points at the cut's edges, where a surface ends, would otherwise wash the rest out), at
+/// least 1 um.
 pub fn scale(parts: &[(&str, &SurfaceMesh)]) -> f64 {
-    parts
+    let mut all: Vec<f64> = parts
         .iter()
         .flat_map(|(_, m)| m.points.iter().map(|p| p.deviation.abs()))
-        .fold(1.0e-6, f64::max)
+        .filter(|d| d.is_finite())
+        .collect();
+    all.sort_by(f64::total_cmp);
+    let k = (all.len() as f64 * 0.99) as usize;
+    all.get(k.min(all.len().saturating_sub(1)))
+        .copied()
+        .unwrap_or(0.0)
+        .max(1.0e-6)
 }
 
 /// Draws `parts` (label, mesh) side by side into the PNG at `path`.
@@ -141,12 +151,8 @@ pub fn plot_part_view(
         (-1.0, bh - 1, " overcut"),
     ] {
         let label = format!("{:+.3}{note}", t * limit * 1e3);
-        side.draw(&Text::new(
-            label,
-            (x0 + bw as i32 + 6, y0 + dy as i32 - 7),
-            font.clone(),
-        ))
-        .map_err(perr)?;
+        side.draw(&Text::new(label, (x0 + bw + 6, y0 + dy - 7), font.clone()))
+            .map_err(perr)?;
     }
     present(&root, path)
 }
