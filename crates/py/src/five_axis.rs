@@ -79,7 +79,7 @@ impl FiveAxisResult {
     fn points(&self, part: &str, reach: Option<f64>) -> PyResult<(Vec<SurfacePoint>, usize)> {
         let cell = self.report.nominal.cell();
         let e = self.report.errors(false);
-        let reach = reach.unwrap_or_else(|| e.max_position + e.max_axis * self.length + 2.0 * cell);
+        let reach = reach.unwrap_or(e.max_position + e.max_axis * self.length + 2.0 * cell);
         self.report
             .nominal
             .surface_deviation(self.part(part)?, reach)
