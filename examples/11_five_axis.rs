@@ -1,18 +1,28 @@
 //! Example 11: a five-axis program in: ball-end finishing across a tilted plane and a swarf
 //! cut along a leaning wall (`data/five_axis_finish.apt`), read with its tool axes and cutters;
 //! the ball end's cutting wrench with the tool leaning 10 degrees to the feed; the program cut
-//! into a tri-dexel stock, each operation with its own cutter.
-//! Prints the program's operations and tilts, the wrench and the volumes removed.
+//! into a tri-dexel stock, each operation with its own cutter; then the five-axis job on the
+//! KR 300: the tool axis in every pose, the force along each cutter's edge, the tip and the
+//! tilt compensated, and the parts predicted along the surface's normal.
+//! Prints the program's operations and tilts, the wrench, the volumes removed, the tools'
+//! errors and the parts' deviations.
 //!
 //! Run: `cargo run --release --example 11_five_axis`
 
+use deflect_core::SerialRobot;
 use deflect_core::io::apt;
 use deflect_core::io::gcode::GcodeOptions;
 use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::dexel::surface::DeviationStats;
 use deflect_core::machining::dexel::{DexelTool, Dexels};
+use deflect_core::machining::five_axis::{self, Options};
+use deflect_core::machining::job::{self, Job, Setup, Stock};
+use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::profile::{self, Band, Cut, Profile};
+use deflect_core::machining::tools::{ToolSpec, ToolTable};
 use deflect_core::machining::{Motion, Program};
-use nalgebra::Vector3;
+use deflect_core::mechanism::PoseIkOptions;
+use nalgebra::{Isometry3, Vector2, Vector3};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/data/five_axis_finish.apt");
@@ -131,5 +141,69 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         before * 1e9,
         stock.volume() * 1e9
     );
+
+    // The job on the KR 300: the table low and close (the wrist stays bent as the tool
+    // tilts), each operation's cutter from its CUTTER statement, 0.5 mm rays.
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/");
+    let robot = SerialRobot::from_path(
+        format!("{dir}robots/kr300/kr300_r2500.urdf"),
+        format!("{dir}robots/kr300/kr300_r2500_stiffness.toml"),
+        "tcp",
+    )?;
+    let mut tools = Vec::new();
+    for c in &apt.cutters {
+        tools.push(ToolSpec {
+            number: c.tool,
+            tool: Tool::new(c.diameter, 2, 0.0)?,
+            shape: c.shape,
+            length: 0.0,
+            name: String::new(),
+        });
+    }
+    let setup = Setup {
+        placement: Isometry3::new(
+            Vector3::new(2.0, 0.0, 0.4),
+            Vector3::new(0.0, 0.0, std::f64::consts::PI),
+        ),
+        tool_orientation: Setup::tool_down(),
+        tool: Tool::new(0.01, 2, 0.0)?,
+        coefficients: Coefficients::AL7075_T6_CARBIDE,
+        stock: Stock {
+            min: Vector2::new(-0.006, -0.016),
+            max: Vector2::new(0.056, 0.026),
+            top: 0.0,
+            cell: 5e-4,
+        },
+        path: PathOptions::default(),
+        ik: PoseIkOptions::default(),
+        hand_spindle: None,
+        rapid_skim: job::RAPID_SKIM,
+    };
+    let job = Job::new(robot.model.clone(), &robot.joint_limits, setup)?
+        .with_tools(ToolTable::new(tools)?);
+    let seed = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
+    let options = Options {
+        depth: 0.02,
+        ..Options::default()
+    };
+    let r = five_axis::run(&job, program, &seed, &options)?;
+    for (name, compensated) in [("uncompensated", false), ("compensated", true)] {
+        let e = r.errors(compensated);
+        let stock = if compensated {
+            &r.compensated
+        } else {
+            &r.uncompensated
+        };
+        let (points, _) = r.nominal.surface_deviation(stock, 3e-3)?;
+        let s = DeviationStats::of(&points);
+        println!(
+            "{name:<13} tool: tip max {:.4} mm, axis max {:.4} mrad; part: {:+.4} / {:+.4} mm, RMS {:.4} mm",
+            e.max_position * 1e3,
+            e.max_axis * 1e3,
+            s.max_left * 1e3,
+            s.max_overcut * 1e3,
+            s.rms * 1e3
+        );
+    }
     Ok(())
 }
