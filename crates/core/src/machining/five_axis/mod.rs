@@ -40,18 +40,19 @@ use alloc::vec::Vec;
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
 use super::Program;
-use super::cutting::Tool;
-use super::dexel::{DexelTool, Dexels};
+use super::dexel::Dexels;
 use super::job::{Job, Warm, check_seed, rotate};
 use super::kinematics::ToolPose;
 use super::path::{self, PathSample};
-use super::profile::{self, Band, Cut, MAX_BANDS, Profile, ToolShape};
+use super::profile::{Band, MAX_BANDS, ToolShape};
 use super::program::slerp;
 use crate::error::{BuildError, JobError, TickError, param};
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
 
+mod cutter;
 mod follow;
 
+pub use cutter::{CutterModel, edge_wrench, frame};
 use follow::Chord;
 
 /// How far a predicted tool's cut may leave its samples \[m\]: a quarter of
@@ -214,13 +215,11 @@ impl Report {
     }
 }
 
-/// One cutter of the program: its number, profile and solid, and whether the job knows it.
+/// One cutter of the program: its number, model, and whether the job knows it.
 #[derive(Debug, Clone, Copy)]
 struct Cutter {
     number: u32,
-    tool: Tool,
-    profile: Profile,
-    solid: DexelTool,
+    model: CutterModel,
     known: bool,
 }
 
@@ -235,18 +234,16 @@ fn cutters(job: &Job, program: &Program, options: &Options) -> Result<Vec<Cutter
                 None => (setup.tool, options.shape, false),
             },
         };
-        let profile = Profile::new(&tool, shape)?;
+        let model = CutterModel::new(&tool, shape, options.length)?;
         param(
             "stock cell (m), at most half the radius of every tool the program uses",
             setup.stock.cell,
-            setup.stock.cell <= 0.5 * profile.radius(),
+            setup.stock.cell <= 0.5 * model.profile.radius(),
             "<= the radius / 2 of the program's smallest tool",
         )?;
         list.push(Cutter {
             number,
-            tool,
-            profile,
-            solid: DexelTool::new(&profile, options.length)?,
+            model,
             known,
         });
     }
@@ -461,7 +458,7 @@ impl Pass<'_> {
                     axis,
                 };
                 if failed.is_none()
-                    && let Err(e) = arm.follow.to(&mut arm.stock, &c.solid, s.tool, &at)
+                    && let Err(e) = arm.follow.to(&mut arm.stock, &c.model.solid, s.tool, &at)
                 {
                     failed = Some(e);
                 }
@@ -481,7 +478,7 @@ impl Pass<'_> {
                 continue;
             };
             let before = self.nominal.volume();
-            let r = self.nominal.cut_move(&c.solid, m)?;
+            let r = self.nominal.cut_move(&c.model.solid, m)?;
             self.ray_updates += r.rays;
             if m.motion == super::Motion::Rapid {
                 self.rapid_volume += before - self.nominal.volume();
@@ -509,15 +506,11 @@ impl Pass<'_> {
         if !s.feed_move || s.speed <= 0.0 {
             return Ok(none);
         }
-        // A plunge's frame: any across the axis (the chip is the same all round).
-        let Some(frame) = super::cutting::tool_frame(&s.axis, &s.direction)
-            .or_else(|| super::cutting::tool_frame(&s.axis, &s.axis.cross(&Vector3::x())))
-            .or_else(|| super::cutting::tool_frame(&s.axis, &s.axis.cross(&Vector3::y())))
-        else {
+        let Some(frame) = cutter::frame(&s.axis, &s.direction) else {
             return Ok(none);
         };
         let n = self.nominal.engagement(
-            &c.solid,
+            &c.model.solid,
             &s.position,
             &frame,
             self.options.slices,
@@ -551,18 +544,18 @@ impl Pass<'_> {
                 value: spindle,
             }));
         }
-        let fz = s.speed / (spindle * f64::from(c.tool.flutes));
-        let along = s.direction.dot(&s.axis);
-        let feed = profile::tool_feed(&s.axis, &s.direction, fz)
-            .unwrap_or_else(|| Vector3::new(0.0, 0.0, fz * along.signum()));
+        let fz = s.speed / (spindle * f64::from(c.model.tool.flutes));
         let bands = self.bands.get(..n).unwrap_or(&[]);
-        let w = profile::average(
+        let (f, w) = cutter::edge_wrench(
             &self.job.setup().coefficients,
-            &c.profile,
-            &Cut { bands, feed },
+            &c.model,
+            &frame,
+            bands,
+            &s.axis,
+            &s.direction,
+            fz,
         )?;
-        let (f, m) = (frame * w.force, frame * w.moment);
-        Ok((fz, n, f, Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)))
+        Ok((fz, n, f, w))
     }
 
     fn advance(&mut self, s: &PathSample) -> Result<Sample, Fault> {
@@ -600,7 +593,7 @@ impl Pass<'_> {
             if k == 0 {
                 self.cut_between(k, s, pose, &c)?;
                 if let Some(arm) = self.arms.get_mut(k) {
-                    arm.follow.to(&mut arm.stock, &c.solid, s.tool, pose)?;
+                    arm.follow.to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
                     arm.last = Some(*pose);
                 }
                 continue;
@@ -617,7 +610,7 @@ impl Pass<'_> {
             crate::error::check_output("predicted tool", pose.tip.as_slice())?;
             self.cut_between(k, s, pose, &c)?;
             if let Some(arm) = self.arms.get_mut(k) {
-                arm.follow.to(&mut arm.stock, &c.solid, s.tool, pose)?;
+                arm.follow.to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
                 arm.last = Some(*pose);
             }
         }
