@@ -11,7 +11,9 @@ use super::{CliError, ToolArgs, count};
 #[derive(clap::Args, Debug)]
 pub struct MillingArgs {
     /// Machining program cut by the flexible arm (G-code in the workpiece frame, mm per
-    /// G21; APT / CL data by the extension .apt, .cl or .cls, 2.5-D only), or `groove` for the straight groove with a prescribed force step (the scenario
+    /// G21; APT / CL data by the extension .apt, .cl or .cls; a program whose tool axis leaves
+    /// the workpiece z runs the uncompensated and offline compensated joints of the five-axis
+    /// pass, the force read where the simulated tool is and as it is tilted), or `groove` for the straight groove with a prescribed force step (the scenario
     /// before programs, which uses --feed, --force, --cut, --rise-ms and --estimate-error);
     /// default: deflect's test workpiece (data/test_workpiece.nc, built in).
     #[arg(long)]

@@ -36,7 +36,8 @@ const KR300_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
 /// wrist stays bent (A5 about -40 to -70 degrees) as the tool tilts; over the 2.5-D default
 /// A5 is near 0, the wrist's singularity, where a tilt of a few degrees turns A4 and A6 by
 /// half a turn.
-const KR300_FIVE_AXIS_PLACEMENT: [f64; 6] = [2.0, 0.0, 0.4, 0.0, 0.0, std::f64::consts::PI];
+pub(crate) const KR300_FIVE_AXIS_PLACEMENT: [f64; 6] =
+    [2.0, 0.0, 0.4, 0.0, 0.0, std::f64::consts::PI];
 /// Where the tool is before the program's first move, workpiece frame \[m\].
 const START: [f64; 3] = [0.0, 0.0, 0.02];
 
@@ -242,7 +243,15 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             }
             Some(table)
         }
-        None => apt_tools(a, &cutters, &program_name)?,
+        None => apt_tools(
+            (
+                a.tool.flutes,
+                a.tool.helix.to_radians(),
+                a.flute_length * 1e-3,
+            ),
+            &cutters,
+            &program_name,
+        )?,
     };
     // A cutter before any LOADTL is the tool the program starts with (T0): the setup's.
     let first = cutters.iter().rev().find(|c| c.tool == 0);
@@ -355,8 +364,8 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
 
 /// The tool table of an APT program's `CUTTER/` statements after `LOADTL` (the last per tool
 /// number; the flutes and helix of --flutes/--helix, the length of --flute-length), or none.
-fn apt_tools(
-    a: &JobArgs,
+pub(crate) fn apt_tools(
+    (flutes, helix, length): (u32, f64, f64),
     cutters: &[deflect_core::io::apt::AptCutter],
     name: &str,
 ) -> Result<Option<deflect_core::machining::tools::ToolTable>, CliError> {
@@ -366,14 +375,14 @@ fn apt_tools(
     }
     let mut specs: Vec<ToolSpec> = Vec::new();
     for c in cutters.iter().filter(|c| c.tool > 0) {
-        let tool = Tool::new(c.diameter, a.tool.flutes, a.tool.helix.to_radians())
+        let tool = Tool::new(c.diameter, flutes, helix)
             .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?;
         let spec = ToolSpec {
             // T0 (a cutter before any LOADTL) is the program's tool before any change.
             number: c.tool,
             tool,
             shape: c.shape,
-            length: a.flute_length * 1e-3,
+            length,
             name: format!("CUTTER line {}", c.line),
         };
         specs.retain(|s| s.number != c.tool);

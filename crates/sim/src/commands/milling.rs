@@ -20,8 +20,9 @@ use deflect_sim::scenes::milling::{self, MillingArm, output, part_map};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
 use super::job::{default_stock, tool_and_material};
-use super::serial::{load_arm, program_file};
+use super::serial::{load_arm, program_and_cutters};
 use crate::cli::{CliError, MillingArgs};
+use deflect_core::machining::five_axis::Options;
 
 /// deflect's test workpiece after the paper's (grooves, a ramp, a circular pocket).
 const TEST_WORKPIECE: &str = include_str!("../../../../data/test_workpiece.nc");
@@ -48,6 +49,10 @@ pub struct ProgramInput {
     pub q0: Vec<f64>,
     /// The arm.
     pub arm: MillingArm,
+    /// The tools of an APT program's numbered `CUTTER/` statements (five-axis programs).
+    pub tools: Option<deflect_core::machining::tools::ToolTable>,
+    /// The setup's tool's end (five-axis programs): the program's first `CUTTER/`, or flat.
+    pub shape: deflect_core::machining::profile::ToolShape,
 }
 
 /// Reads and checks the program, the stock and the placement before any work.
@@ -57,6 +62,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         units: LengthUnit::Millimetre,
         ..GcodeOptions::default()
     };
+    let mut cutters = Vec::new();
     let (program, name, builtin) = match a.program.as_deref() {
         Some("groove") if a.urdf.is_some() => {
             return Err(CliError::Usage(
@@ -67,7 +73,8 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         }
         Some("groove") => return Ok(MillingInput::Groove),
         Some(path) => {
-            let program = program_file("--program", Path::new(path), &options)?;
+            let (program, c) = program_and_cutters("--program", Path::new(path), &options)?;
+            cutters = c;
             (program, path.to_string(), false)
         }
         None => (
@@ -78,6 +85,25 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         ),
     };
     let (tool, coefficients) = tool_and_material(&a.tool)?;
+    // A five-axis program's cutters: before any LOADTL the setup's tool, after one a table.
+    let first = cutters.iter().rev().find(|c| c.tool == 0);
+    let tool = match first {
+        Some(c) => deflect_core::machining::cutting::Tool::new(c.diameter, tool.flutes, tool.helix)
+            .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?,
+        None => tool,
+    };
+    let shape = first.map_or(deflect_core::machining::profile::ToolShape::Flat, |c| {
+        c.shape
+    });
+    let tools = super::job::apt_tools(
+        (
+            a.tool.flutes,
+            a.tool.helix.to_radians(),
+            Options::default().length,
+        ),
+        &cutters,
+        &name,
+    )?;
     let files = load_arm(
         a.urdf.as_deref(),
         a.stiffness.as_deref(),
@@ -142,6 +168,13 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
             UnitQuaternion::from_euler_angles(*r, *p, *w),
         ),
         Some(_) => return Err(CliError::Usage("--placement: expected 6 values".into())),
+        None if program.is_multi_axis() => {
+            let [x, y, z, r, p, w] = super::job::KR300_FIVE_AXIS_PLACEMENT;
+            Isometry3::from_parts(
+                Translation3::new(x, y, z),
+                UnitQuaternion::from_euler_angles(r, p, w),
+            )
+        }
         None => program::kr300_placement(),
     };
     let setup = Setup {
@@ -172,6 +205,8 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         setup,
         q0,
         arm,
+        tools,
+        shape,
     })))
 }
 
@@ -212,6 +247,8 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
         setup,
         q0,
         arm,
+        tools,
+        shape,
     } = p.as_ref();
     // An arm of the user's is identified at its start joints (the KR 300 at the paper's
     // milling pose, as in the groove scenario).
@@ -223,6 +260,19 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
             ..opts
         }
     };
+    if program.is_multi_axis() {
+        let options = Options {
+            shape: *shape,
+            ..Options::default()
+        };
+        return super::milling_five_axis::run_and_write(
+            &opts,
+            p.as_ref(),
+            tools.as_ref(),
+            &options,
+            out,
+        );
+    }
     let r = program::milling_program(&opts, arm, program, setup, q0)?;
     let text = program_output::table(name, &r);
     put!("{text}");

@@ -36,6 +36,7 @@ pub mod job_files;
 pub mod job_five_axis;
 pub mod job_summary;
 pub mod milling;
+pub mod milling_five_axis;
 pub mod place;
 pub mod reproduce;
 pub mod run;

@@ -54,16 +54,8 @@ pub(crate) fn read_program(flag: &str, path: &Path) -> Result<String, CliError> 
 }
 
 /// A program file read by its extension: APT / CL data (`.apt`, `.cl`, `.cls`,
-/// `.aptsource`) or G-code (anything else), every error naming the flag and the file.
-pub(crate) fn program_file(
-    flag: &str,
-    path: &Path,
-    options: &deflect_core::io::gcode::GcodeOptions,
-) -> Result<deflect_core::machining::Program, CliError> {
-    program_and_cutters(flag, path, options).map(|(p, _)| p)
-}
-
-/// [`program_file`] with the cutters an APT program defines (`CUTTER/`; none for G-code).
+/// `.aptsource`) or G-code (anything else), every error naming the flag and the file; with
+/// the cutters an APT program defines (`CUTTER/`; none for G-code).
 pub(crate) fn program_and_cutters(
     flag: &str,
     path: &Path,

@@ -593,7 +593,8 @@ impl Pass<'_> {
             if k == 0 {
                 self.cut_between(k, s, pose, &c)?;
                 if let Some(arm) = self.arms.get_mut(k) {
-                    arm.follow.to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
+                    arm.follow
+                        .to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
                     arm.last = Some(*pose);
                 }
                 continue;
@@ -610,7 +611,8 @@ impl Pass<'_> {
             crate::error::check_output("predicted tool", pose.tip.as_slice())?;
             self.cut_between(k, s, pose, &c)?;
             if let Some(arm) = self.arms.get_mut(k) {
-                arm.follow.to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
+                arm.follow
+                    .to(&mut arm.stock, &c.model.solid, s.tool, pose)?;
                 arm.last = Some(*pose);
             }
         }

@@ -25,6 +25,7 @@
 //! * [`part_map`]: the machined part against the nominal one as a heat map (Fig. 10-13).
 
 pub mod arm;
+pub mod five_axis;
 pub mod identification;
 pub mod options;
 pub mod output;
