@@ -267,3 +267,57 @@ fn the_part_mesh_writes_as_ply_ascii_and_binary() {
     let x1 = f32::from_le_bytes(binary[at + 29..at + 33].try_into().unwrap());
     assert_eq!(x1, 0.001f32);
 }
+
+#[test]
+fn the_spin_turns_the_tool_about_the_programs_axis_and_the_search_lowers_the_deflection() {
+    use deflect_core::machining::spin::{self, LoadPath, SpinOptions, SpinSchedule};
+    let (job, seed) = kr300_job(1.0e-3);
+    let program = read(SWARF);
+    let options = Options::default();
+    let plain = five_axis::run(&job, &program, &seed, &options).unwrap();
+    // A constant 30 degrees: the rigid TCP's z stays on the program's axis (reversed) and
+    // its x turns by 30 degrees about it.
+    let turned = job
+        .clone()
+        .with_spin(SpinSchedule::constant(30f64.to_radians()).unwrap());
+    let r = five_axis::run(&turned, &program, &seed, &options).unwrap();
+    let robot = fixtures::kr300();
+    let mut data = Data::new(&robot.model);
+    let rot = job.setup().placement.rotation;
+    let k = r.samples.iter().position(|s| s.bands > 0).unwrap() + 40;
+    let (a, b) = (&plain.samples[k], &r.samples[k]);
+    assert_eq!(b.spin, 30f64.to_radians());
+    let mut frame = |q: &[f64; 8]| {
+        let t = vjm::forward(&robot.model, &mut data, &q[..6]).unwrap();
+        rot.inverse() * t.rotation
+    };
+    let (fa, fb) = (frame(&a.q), frame(&b.q));
+    assert!((fb * Vector3::z() + b.path.axis).norm() < 1e-8);
+    let (xa, xb) = (fa * Vector3::x(), fb * Vector3::x());
+    let angle = xa.cross(&xb).dot(&(fa * Vector3::z())).atan2(xa.dot(&xb));
+    assert!(
+        (angle.abs() - 30f64.to_radians()).abs() < 1e-7,
+        "{}",
+        angle.to_degrees()
+    );
+    // The compensated tool still holds the program.
+    assert!(r.errors(true).max_position <= job.setup().ik.position_tolerance);
+    // The search over the five-axis loads: no worse than the seed's spin, and the run with
+    // its schedule follows it.
+    let o = SpinOptions::default();
+    let loads =
+        LoadPath::new_five_axis(&job, &program, &options, o.step, o.per_metre, o.per_second)
+            .unwrap();
+    let plan = spin::plan(&job, &loads, &seed, &o).unwrap();
+    let seed_cost = plan.seed.unwrap();
+    assert!(
+        plan.optimised.rms <= seed_cost.rms * (1.0 + 1e-12),
+        "{plan:?}"
+    );
+    let searched = job.clone().with_spin(plan.schedule.clone());
+    let r = five_axis::run(&searched, &program, &seed, &options).unwrap();
+    assert!(r.errors(true).max_position <= job.setup().ik.position_tolerance);
+    // The load path's bytes carry the stations' axes.
+    let back = LoadPath::from_bytes(&loads.to_bytes()).unwrap();
+    assert_eq!(back, loads);
+}

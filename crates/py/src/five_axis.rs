@@ -109,6 +109,12 @@ impl FiveAxisResult {
         Array1::from_iter(self.report.samples.iter().map(|s| s.path.line as u64)).into_pyarray(py)
     }
 
+    /// The spin about the tool axis per sample (n,) [rad] (the job's `spin`).
+    #[getter]
+    fn spin<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        Array1::from_iter(self.report.samples.iter().map(|s| s.spin)).into_pyarray(py)
+    }
+
     /// Engaged bands along the edge per sample (n,): 0 where the tool cuts air.
     #[getter]
     fn bands<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<u64>> {

@@ -454,8 +454,9 @@ impl MachiningJob {
     /// joints hold the tip and the axis under it. `shape` ("flat", "ball", "bull-nose" with
     /// `corner_radius` [m]) is the job's tool's end when the job has no tool table; `length`
     /// [m] the length of every tool that removes material; the engagement is read in `slices`
-    /// along the edge of `angles` each. The spindle must turn clockwise, and the job keep its
-    /// spin (`spin="keep"`). Raises as `run` does.
+    /// along the edge of `angles` each. The job's `spin` turns the tool about the program's
+    /// axis (`"optimize"`: the search over the five-axis pass's loads). The spindle must turn
+    /// clockwise. Raises as `run` does.
     #[pyo3(signature = (program, seed, depth=0.05, shape="flat", corner_radius=None, length=0.03, slices=32, angles=180))]
     #[allow(clippy::too_many_arguments)] // reason: the pass's options as keywords
     fn run_five_axis(
@@ -478,15 +479,28 @@ impl MachiningJob {
             slices,
             angles,
         };
+        let program = &program.inner;
         let job = match self.spin {
-            Spin::Keep => &self.inner,
-            _ => {
-                return Err(InputError::new_err(
-                    "spin: the five-axis pass keeps the setup's spin (a job with spin=\"keep\")",
-                ));
+            Spin::Optimize(o) => {
+                let plan = py
+                    .detach(|| -> Result<_, deflect_core::JobError> {
+                        let loads = LoadPath::new_five_axis(
+                            &self.inner,
+                            program,
+                            &options,
+                            o.step,
+                            o.per_metre,
+                            o.per_second,
+                        )?;
+                        spin::plan(&self.inner, &loads, &seed, &o)
+                    })
+                    .map_err(job_err)?;
+                std::borrow::Cow::Owned(self.inner.clone().with_spin(plan.schedule))
             }
+            // A constant spin is in the job already.
+            _ => std::borrow::Cow::Borrowed(&self.inner),
         };
-        crate::five_axis::run(py, job, &program.inner, &seed, &options)
+        crate::five_axis::run(py, &job, program, &seed, &options)
     }
 
     fn __repr__(&self) -> String {

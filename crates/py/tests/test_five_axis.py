@@ -224,6 +224,23 @@ def test_the_five_axis_parts_along_the_normal_and_as_ply(swarf_run, tmp_path):
         r.surface("both")
 
 
+def test_the_five_axis_spin_turns_about_the_programs_axis(swarf_run, kr300):
+    _, program, placement, r = swarf_run
+    q0 = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0]
+    spun = deflect.MachiningJob(
+        kr300, placement, stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), cell=1e-3,
+        spin=10.0,  # degrees
+    ).run_five_axis(program, q0)
+    np.testing.assert_allclose(spun.spin, math.radians(10.0), rtol=1e-15)
+    k = int(np.flatnonzero(spun.bands > 0)[40])
+    rot = placement[:3, :3]
+    a, b = (rot.T @ kr300.forward(x[k])[:3, :3] for x in (r.q, spun.q))
+    np.testing.assert_allclose(-b[:, 2], spun.axis[k], atol=1e-8)
+    angle = math.atan2(np.cross(a[:, 0], b[:, 0]) @ a[:, 2], a[:, 0] @ b[:, 0])
+    assert abs(abs(angle) - math.radians(10.0)) < 1e-7
+    assert spun.errors("compensated")["max_position"] <= 1e-8
+
+
 def test_five_axis_faults_are_typed(swarf_run, kr300):
     job, program, _, _ = swarf_run
     q0 = [0.0, -0.9, 1.4, 0.0, 1.0708, 0.0]
@@ -231,11 +248,6 @@ def test_five_axis_faults_are_typed(swarf_run, kr300):
         job.run_five_axis(program, q0, depth=0.0)
     with pytest.raises(deflect.InputError, match="shape"):
         job.run_five_axis(program, q0, shape="cone")
-    spun = deflect.MachiningJob(
-        kr300, np.eye(4), stock_min=(0.0, -0.03), stock_max=(0.08, 0.03), cell=1e-3, spin=10.0
-    )
-    with pytest.raises(deflect.InputError, match="spin"):
-        spun.run_five_axis(program, q0)
     # The z-map pass refuses the tilted program rather than drop its axis.
     with pytest.raises(deflect.DeflectError, match="2.5-D"):
         job.run(program, q0)

@@ -344,13 +344,8 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             Some(_) => {}
         }
     }
-    if program.is_multi_axis() && a.spin != SpinArg::Keep {
-        return Err(CliError::Usage(format!(
-            "--spin: {program_name} is a five-axis program; its pass keeps the setup's spin \
-             (leave out --spin)"
-        )));
-    }
-    let (job, spin) = spin(a, job, &program, &program_name, &seed)?;
+    let five = program.is_multi_axis().then(|| five_axis_options(a, shape));
+    let (job, spin) = spin(a, job, &program, &program_name, &seed, five.as_ref())?;
     Ok(JobTask {
         job,
         program,
@@ -360,6 +355,20 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         spin,
         shape,
     })
+}
+
+/// The five-axis pass's options of the flags: the stock's depth, the setup's tool's end, the
+/// tools' length.
+pub(crate) fn five_axis_options(
+    a: &JobArgs,
+    shape: deflect_core::machining::profile::ToolShape,
+) -> deflect_core::machining::five_axis::Options {
+    deflect_core::machining::five_axis::Options {
+        depth: a.stock_depth * 1e-3,
+        shape,
+        length: a.flute_length * 1e-3,
+        ..deflect_core::machining::five_axis::Options::default()
+    }
 }
 
 /// The tool table of an APT program's `CUTTER/` statements after `LOADTL` (the last per tool
@@ -401,6 +410,7 @@ fn spin(
     program: &Program,
     name: &str,
     seed: &[f64],
+    five: Option<&deflect_core::machining::five_axis::Options>,
 ) -> Result<(Job, Option<(SpinPlan, f64)>), CliError> {
     match a.spin {
         SpinArg::Keep => Ok((job, None)),
@@ -421,13 +431,23 @@ fn spin(
             let fail = |e: deflect_core::JobError| {
                 CliError::Failure(format!("{name}: --spin optimize: {e}"))
             };
-            let loads = LoadPath::new(
-                &job,
-                program,
-                options.step,
-                options.per_metre,
-                options.per_second,
-            )
+            let loads = match five {
+                Some(o) => LoadPath::new_five_axis(
+                    &job,
+                    program,
+                    o,
+                    options.step,
+                    options.per_metre,
+                    options.per_second,
+                ),
+                None => LoadPath::new(
+                    &job,
+                    program,
+                    options.step,
+                    options.per_metre,
+                    options.per_second,
+                ),
+            }
             .map_err(fail)?;
             let plan = spin::plan(&job, &loads, seed, &options).map_err(fail)?;
             let job = job.with_spin(plan.schedule.clone());

@@ -86,12 +86,7 @@ fn samples_csv(r: &Report) -> String {
 /// Runs the five-axis pass and writes its files.
 pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
     let started = Instant::now();
-    let options = Options {
-        depth: a.stock_depth * 1e-3,
-        shape: t.shape,
-        length: a.flute_length * 1e-3,
-        ..Options::default()
-    };
+    let options: Options = super::job::five_axis_options(a, t.shape);
     let r = five_axis::run(&t.job, &t.program, &t.seed, &options)
         .map_err(|e| SimError::new(format!("{}: {e}", t.program_name)))?;
     let pass = started.elapsed().as_secs_f64();
@@ -193,6 +188,35 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             s.max_overcut * 1e3,
             s.rms * 1e3,
             s.count
+        );
+    }
+    if let Some((plan, seconds)) = &t.spin {
+        let rms = |c: Option<deflect_core::machining::spin::SpinCost>| {
+            c.map_or("unreachable".to_string(), |c| {
+                format!("{:.4} mm", c.rms * 1e3)
+            })
+        };
+        let _ = writeln!(
+            text,
+            "  spin about the tool axis (searched in {seconds:.1} s): predicted RMS deflection \
+             {:.4} mm optimised, {} at the seed's spin",
+            plan.optimised.rms * 1e3,
+            rms(plan.seed)
+        );
+    }
+    let spin_range = r
+        .samples
+        .iter()
+        .map(|s| s.spin)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+    if spin_range.0 != 0.0 || spin_range.1 != 0.0 {
+        let _ = writeln!(
+            text,
+            "  the tool turned about its axis by {:.1} .. {:.1} degrees",
+            spin_range.0.to_degrees(),
+            spin_range.1.to_degrees()
         );
     }
     if r.rapid_volume > 0.0 {

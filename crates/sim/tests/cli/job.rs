@@ -476,18 +476,27 @@ fn job_reads_apt_by_its_extension_and_runs_a_tilted_axis_five_axis() {
     assert!(mm("/part/uncompensated/all/rms_mm") > 0.005, "{json}");
     let ply = std::fs::read(five.join("part_compensated.ply")).unwrap();
     assert!(ply.starts_with(b"ply\nformat binary_little_endian 1.0\n"));
-    // The five-axis pass keeps the setup's spin.
+    // A spin turns the tool about the program's axis.
     let o = sim(&[
         "job",
         "--program",
         tilted.to_str().unwrap(),
+        "--stock",
+        "0,-20,30,20",
+        "--cell",
+        "1",
         "--spin",
         "10",
         "--out",
         five.to_str().unwrap(),
     ]);
-    assert_eq!(o.code, 2, "{}", o.stderr);
-    assert!(o.stderr.contains("--spin"), "{}", o.stderr);
+    assert_eq!(o.code, 0, "{}", o.stderr);
+    assert!(
+        o.stdout
+            .contains("turned about its axis by 10.0 .. 10.0 degrees"),
+        "{}",
+        o.stdout
+    );
     // The testbed runs it in rapier: the force where the simulated tool is and as it is
     // tilted; the offline compensated joints leave less error than the rigid ones.
     let o = sim(&[

@@ -19,7 +19,9 @@
 //!    ([`super::profile::average`]) at the feed per tooth as a tool-frame vector (a tool tilted
 //!    to the feed moves along its axis too, [`super::profile::tool_feed`]);
 //! 3. the target pose is the setup's tool orientation turned by the shortest rotation from
-//!    `+z` to the program's axis; the rigid joints `q` (pose IK) and the deflected pose there
+//!    `+z` to the program's axis ([`orientation`]), then about that axis by the job's spin
+//!    schedule ([`Job::with_spin`]; [`crate::machining::spin::LoadPath::new_five_axis`] finds
+//!    one, from [`nominal_pass`]); the rigid joints `q` (pose IK) and the deflected pose there
 //!    under the wrench are the uncompensated tool; the compensated joints `q_c` solve the
 //!    pose IK of the loaded chain, and the deflected pose at `q_c`, evaluated again by the
 //!    exact VJM (not taken from the IK), is the compensated tool;
@@ -30,8 +32,7 @@
 //! # What this pass does not model (the 2.5-D [`super::job`] does)
 //! The force is the nominal tool's on the nominal stock: the predicted tools feel the same
 //! force, where the z-map job solves the force-deflection coupling on each tool's own stock.
-//! The spindle turns clockwise (`M4` is refused); the spin about the tool axis is the setup's
-//! (a spin schedule is refused); a rapid through material is cut and reported
+//! The spindle turns clockwise (`M4` is refused); a rapid through material is cut and reported
 //! ([`Report::rapid_volume`]), not refused; an axis turn without tip motion is taken
 //! between two samples.
 
@@ -46,6 +47,7 @@ use super::kinematics::ToolPose;
 use super::path::{self, PathSample};
 use super::profile::{Band, MAX_BANDS, ToolShape};
 use super::program::slerp;
+use super::spin::{Cursor, SpinSchedule};
 use crate::error::{BuildError, JobError, TickError, param};
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
 
@@ -138,6 +140,8 @@ pub struct Sample {
     pub uncompensated: ToolPose,
     /// The tool the compensated arm holds under the wrench, workpiece frame.
     pub compensated: ToolPose,
+    /// The spin about the tool axis \[rad\] (the job's schedule; 0 without one).
+    pub spin: f64,
 }
 
 impl Sample {
@@ -255,11 +259,15 @@ fn find(cutters: &[Cutter], number: u32) -> Option<&Cutter> {
 }
 
 /// The target rotation for tool axis `axis` (workpiece frame): the setup's orientation turned
-/// by the shortest rotation from `+z` to the axis.
-fn orientation(
+/// by the shortest rotation from `+z` to the axis (the setup's own for `+z`, bit for bit).
+/// [`TickError::InvalidArgument`] for an axis pointing down the workpiece z.
+pub fn orientation(
     tool_orientation: &UnitQuaternion<f64>,
     axis: &Vector3<f64>,
 ) -> Result<UnitQuaternion<f64>, TickError> {
+    if *axis == Vector3::z() {
+        return Ok(*tool_orientation);
+    }
     let turn = UnitQuaternion::rotation_between(&Vector3::z(), axis).ok_or(
         TickError::InvalidArgument {
             what: "tool axis (pointing down the workpiece z: no shortest turn from +z)",
@@ -279,14 +287,6 @@ pub fn run(
 ) -> Result<Report, JobError> {
     options.validate()?;
     check_seed(job, seed)?;
-    if job.spin().is_some() {
-        return Err(BuildError::InvalidParameter {
-            what: "spin schedule (the five-axis pass keeps the setup's spin)",
-            value: f64::NAN,
-            expected: "a job without a spin schedule",
-        }
-        .into());
-    }
     let job = &*job.at_seed(seed)?;
     let setup = job.setup();
     let sampler = path::Sampler::new(program, &setup.path)?;
@@ -301,31 +301,11 @@ pub fn run(
         .into());
     }
     let cutters = cutters(job, program, options)?;
-    let st = &setup.stock;
-    let block = || {
-        Dexels::block(
-            Vector3::new(st.min.x, st.min.y, st.top - options.depth),
-            Vector3::new(st.max.x, st.max.y, st.top),
-            st.cell,
-        )
-    };
-    let mut pass = Pass {
-        job,
-        program,
-        options,
-        cutters: &cutters,
-        nominal: block()?,
-        arms: [
-            Arm::new(job, seed, block()?),
-            Arm::new(job, seed, block()?),
-            Arm::new(job, seed, block()?),
-        ],
-        cut_moves: 0,
-        ray_updates: 0,
-        rapid_volume: 0.0,
-        bands: [Band::new(0.0, 0.0, 0.0); MAX_BANDS],
-        prev: None,
-    };
+    let block = || stock_block(job, options);
+    let mut pass = Pass::new(job, program, options, &cutters, block()?);
+    for _ in 0..3 {
+        pass.arms.push(Arm::new(job, seed, block()?));
+    }
     let mut samples = Vec::new();
     samples
         .try_reserve_exact(count)
@@ -353,7 +333,15 @@ pub fn run(
         time: last.1,
         error,
     })?;
-    let [part, unc, comp] = pass.arms;
+    let mut arms = core::mem::take(&mut pass.arms).into_iter();
+    let (Some(part), Some(unc), Some(comp)) = (arms.next(), arms.next(), arms.next()) else {
+        return Err(BuildError::InvalidParameter {
+            what: "five-axis pass arms (three)",
+            value: 0.0,
+            expected: "three",
+        }
+        .into());
+    };
     Ok(Report {
         samples,
         nominal: part.stock,
@@ -364,6 +352,52 @@ pub fn run(
         ray_updates: pass.ray_updates + part.follow.rays + unc.follow.rays + comp.follow.rays,
         rapid_volume: pass.rapid_volume,
     })
+}
+
+/// The stock block of the pass: the job's stock in x and y, `options.depth` below its top.
+fn stock_block(job: &Job, options: &Options) -> Result<Dexels, BuildError> {
+    let st = &job.setup().stock;
+    Dexels::block(
+        Vector3::new(st.min.x, st.min.y, st.top - options.depth),
+        Vector3::new(st.max.x, st.max.y, st.top),
+        st.cell,
+    )
+}
+
+/// The nominal stage of the five-axis pass alone (the nominal tool on the nominal stock:
+/// the force at every sample, the checks of the cut), handing each sample to `f`: what the
+/// placement and the spin about the tool axis do not change, for a search over them
+/// ([`crate::machining::spin::LoadPath::new_five_axis`]). Errors as [`run`]'s nominal ones,
+/// or `f`'s.
+pub fn nominal_pass(
+    job: &Job,
+    program: &Program,
+    options: &Options,
+    f: &mut dyn FnMut(&super::job::NominalSample) -> Result<(), JobError>,
+) -> Result<(), JobError> {
+    options.validate()?;
+    let sampler = path::Sampler::new(program, &job.setup().path)?;
+    let cutters = cutters(job, program, options)?;
+    let mut pass = Pass::new(job, program, options, &cutters, stock_block(job, options)?);
+    let mut prev: Option<Vector3<f64>> = None;
+    for s in sampler {
+        let (_, _, _, _, wrench) = pass.nominal(&s).map_err(|error| match error {
+            Fault::Tick(error) => JobError::AtLine {
+                line: s.line,
+                time: s.time,
+                error,
+            },
+            Fault::Job(e) => e,
+        })?;
+        let step = prev.map_or(Vector3::zeros(), |p| s.position - p);
+        prev = Some(s.position);
+        f(&super::job::NominalSample {
+            path: s,
+            step,
+            wrench,
+        })?;
+    }
+    Ok(())
 }
 
 /// Why a sample failed: a tick error at its line, or a job error of its own.
@@ -407,8 +441,10 @@ struct Pass<'a> {
     cutters: &'a [Cutter],
     nominal: Dexels,
     /// The program as sampled (its tool on the program: the nominal part), the uncompensated
-    /// and the compensated arm.
-    arms: [Arm; 3],
+    /// and the compensated arm (none for the nominal stage alone, [`nominal_pass`]).
+    arms: Vec<Arm>,
+    /// Where the job's spin schedule stands.
+    spin: Cursor,
     /// The moves before this index are cut into the nominal stock.
     cut_moves: usize,
     ray_updates: usize,
@@ -418,7 +454,48 @@ struct Pass<'a> {
     prev: Option<PathSample>,
 }
 
-impl Pass<'_> {
+impl<'a> Pass<'a> {
+    fn new(
+        job: &'a Job,
+        program: &'a Program,
+        options: &'a Options,
+        cutters: &'a [Cutter],
+        nominal: Dexels,
+    ) -> Self {
+        Self {
+            job,
+            program,
+            options,
+            cutters,
+            nominal,
+            arms: Vec::new(),
+            spin: Cursor::default(),
+            cut_moves: 0,
+            ray_updates: 0,
+            rapid_volume: 0.0,
+            bands: [Band::new(0.0, 0.0, 0.0); MAX_BANDS],
+            prev: None,
+        }
+    }
+
+    /// The nominal stage at `s`: the stock cut through the moves before it, the cutter in the
+    /// spindle and its feed per tooth, bands, force and wrench (workpiece frame).
+    fn nominal(
+        &mut self,
+        s: &PathSample,
+    ) -> Result<(Cutter, f64, usize, Vector3<f64>, Vector6), Fault> {
+        self.cut_through(s.move_index)?;
+        let Some(&c) = find(self.cutters, s.tool) else {
+            return Err(Fault::Job(JobError::UnknownTool {
+                line: s.line,
+                time: s.time,
+                tool: s.tool,
+            }));
+        };
+        let (fz, bands, force, wrench) = self.force(s, &c)?;
+        Ok((c, fz, bands, force, wrench))
+    }
+
     /// Cuts arm `k`'s stock through the points where the program bends between the last
     /// sample and `s` ([`path::between`]: corners and arcs between two samples), each moved
     /// by the arm's offset from the program (tip and axis), interpolated along the path.
@@ -559,19 +636,23 @@ impl Pass<'_> {
     }
 
     fn advance(&mut self, s: &PathSample) -> Result<Sample, Fault> {
-        self.cut_through(s.move_index)?;
-        let Some(&c) = find(self.cutters, s.tool) else {
-            return Err(Fault::Job(JobError::UnknownTool {
-                line: s.line,
-                time: s.time,
-                tool: s.tool,
-            }));
-        };
-        let (fz, bands, force, wrench) = self.force(s, &c)?;
+        let (c, fz, bands, force, wrench) = self.nominal(s)?;
         let setup = self.job.setup();
         let to_base = setup.placement;
         let to_work = to_base.inverse();
-        let rotation = orientation(&setup.tool_orientation, &s.axis)?;
+        let step = self
+            .prev
+            .map_or(Vector3::zeros(), |p| s.position - p.position);
+        let spin = match self.job.spin() {
+            Some(schedule) => self.spin.advance(schedule, &step, s.time),
+            None => 0.0,
+        };
+        let tilted = orientation(&setup.tool_orientation, &s.axis)?;
+        let rotation = if spin == 0.0 {
+            tilted
+        } else {
+            SpinSchedule::turn(&tilted, spin)
+        };
         let target = to_base * Isometry3::from_parts(Translation3::from(s.position), rotation);
         let wrench_base = rotate(&to_base, &wrench);
         let model = self.job.model();
@@ -617,17 +698,18 @@ impl Pass<'_> {
             }
         }
         self.prev = Some(*s);
-        let [_, unc, comp] = &self.arms;
+        let q = |k: usize| self.arms.get(k).map_or([0.0; MAX_DOF], |a| a.warm.q);
         Ok(Sample {
             path: *s,
             feed_per_tooth: fz,
             bands,
             force,
             wrench,
-            q: unc.warm.q,
-            q_commanded: comp.warm.q,
+            q: q(1),
+            q_commanded: q(2),
             uncompensated: poses[1],
             compensated: poses[2],
+            spin,
         })
     }
 }

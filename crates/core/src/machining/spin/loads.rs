@@ -4,8 +4,8 @@
 //! search decides the spin.
 //!
 //! Stations lie where the spin budget ([`super::schedule`]) has grown by a candidate step
-//! since the last one and the path by at least [`MIN_STATION_PATH`] (and at the first and last
-//! sample): between two stations the spin can turn by at least one step. Each cutting
+//! since the last one and the path by at least [`MIN_STATION_PATH`], where a five-axis
+//! program's tool axis has turned by a step (and at the first and last sample): between two stations the spin can turn by at least one step. Each cutting
 //! sample is shared between the stations before and after it by its share of the budget
 //! between them (hat weights: a linear interpolation's).
 
@@ -40,6 +40,8 @@ pub struct Station {
     pub budget: f64,
     /// The programmed tool tip \[m\], workpiece frame.
     pub position: Vector3<f64>,
+    /// The programmed tool axis (unit, workpiece frame): `+z` in a 2.5-D program.
+    pub axis: Vector3<f64>,
 }
 
 /// A cutting sample: its wrench and feed direction (single precision: what a ranking of
@@ -91,6 +93,37 @@ impl LoadPath {
         per_metre: f64,
         per_second: f64,
     ) -> Result<Self, JobError> {
+        Self::build(step, per_metre, per_second, |f| {
+            job::nominal_pass(job, program, f)
+        })
+    }
+
+    /// [`Self::new`] for a five-axis program: the nominal stage of
+    /// [`crate::machining::five_axis`] (the cutters' forces along their edges on the
+    /// engagement read from the tri-dexel stock, `options`), each station with the program's
+    /// tool axis, about which the search turns the tool.
+    pub fn new_five_axis(
+        job: &Job,
+        program: &Program,
+        options: &crate::machining::five_axis::Options,
+        step: f64,
+        per_metre: f64,
+        per_second: f64,
+    ) -> Result<Self, JobError> {
+        Self::build(step, per_metre, per_second, |f| {
+            crate::machining::five_axis::nominal_pass(job, program, options, f)
+        })
+    }
+
+    /// The load path of the samples `pass` hands its callback.
+    fn build(
+        step: f64,
+        per_metre: f64,
+        per_second: f64,
+        pass: impl FnOnce(
+            &mut dyn FnMut(&job::NominalSample) -> Result<(), JobError>,
+        ) -> Result<(), JobError>,
+    ) -> Result<Self, JobError> {
         super::schedule::check_rates(per_metre, per_second)?;
         super::check_step(step)?;
         let mut out = Self {
@@ -108,7 +141,7 @@ impl LoadPath {
         let mut last_time: Option<f64> = None;
         let mut last: Option<Station> = None;
         let mut end: Option<Station> = None;
-        job::nominal_pass(job, program, |n| {
+        pass(&mut |n: &job::NominalSample| {
             let dt = last_time
                 .replace(n.path.time)
                 .map_or(0.0, |t0| n.path.time - t0);
@@ -122,6 +155,7 @@ impl LoadPath {
                 line: n.path.line,
                 budget: g,
                 position: n.path.position,
+                axis: n.path.axis,
             };
             if n.wrench.iter().any(|v| *v != 0.0) {
                 if out.loads.len() >= MAX_LOADED_SAMPLES {
@@ -145,9 +179,15 @@ impl LoadPath {
                 });
                 budgets.push(g);
             }
+            // A station where the budget allows another step, or where the program's tool
+            // axis has turned by a step since the last one (the joints follow the axis: the
+            // next node must lie within the search's joint step of this one).
             let due = match last {
                 None => true,
-                Some(s) => g - s.budget >= step && since_path >= MIN_STATION_PATH,
+                Some(s) => {
+                    (g - s.budget >= step && since_path >= MIN_STATION_PATH)
+                        || crate::machining::program::angle_between(&s.axis, &n.path.axis) >= step
+                }
             };
             if due {
                 out.close(last.as_ref(), &station, &mut budgets)?;
@@ -232,7 +272,7 @@ impl LoadPath {
 }
 
 /// The bytes format's first bytes (and version).
-const MAGIC: &[u8; 8] = b"DFLLOAD1";
+const MAGIC: &[u8; 8] = b"DFLLOAD2";
 
 /// Reads little-endian numbers off a byte slice, refusing a short one.
 struct Reader<'a> {
@@ -288,7 +328,7 @@ impl LoadPath {
     /// the nominal pass is not run again there). [`Self::from_bytes`] reads them back, bit for
     /// bit.
     pub fn to_bytes(&self) -> Vec<u8> {
-        let mut out = Vec::with_capacity(64 + self.stations.len() * 56 + self.loads.len() * 40);
+        let mut out = Vec::with_capacity(64 + self.stations.len() * 80 + self.loads.len() * 40);
         out.extend_from_slice(MAGIC);
         for v in [self.step, self.per_metre, self.per_second] {
             out.extend_from_slice(&v.to_le_bytes());
@@ -300,7 +340,7 @@ impl LoadPath {
             out.extend_from_slice(&s.time.to_le_bytes());
             out.extend_from_slice(&(s.line as u64).to_le_bytes());
             out.extend_from_slice(&s.budget.to_le_bytes());
-            for v in s.position.iter() {
+            for v in s.position.iter().chain(s.axis.iter()) {
                 out.extend_from_slice(&v.to_le_bytes());
             }
         }
@@ -344,6 +384,15 @@ impl LoadPath {
             let line = r.count(usize::MAX >> 1, "load path station line")?;
             let budget = r.f64()?;
             let position = Vector3::new(r.f64()?, r.f64()?, r.f64()?);
+            let axis = Vector3::new(r.f64()?, r.f64()?, r.f64()?);
+            if (axis.norm() - 1.0).abs() > crate::machining::AXIS_TOLERANCE {
+                return Err(BuildError::InvalidEntry {
+                    what: "load path station tool axis (its length)",
+                    index: stations.len(),
+                    value: axis.norm(),
+                    expected: "a unit vector (within AXIS_TOLERANCE)",
+                });
+            }
             if stations
                 .last()
                 .is_some_and(|s: &Station| budget < s.budget || sample < s.sample)
@@ -359,6 +408,7 @@ impl LoadPath {
                 line,
                 budget,
                 position,
+                axis,
             });
         }
         let m = r.count(MAX_LOADED_SAMPLES, "load path cutting samples")?;

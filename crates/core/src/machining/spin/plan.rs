@@ -101,15 +101,23 @@ impl Solver<'_> {
     fn joints(
         &mut self,
         position: &nalgebra::Vector3<f64>,
+        axis: &nalgebra::Vector3<f64>,
         theta: f64,
         seed: &[f64; MAX_DOF],
         neighbour: bool,
     ) -> Option<[f64; MAX_DOF]> {
         let setup = self.job.setup();
+        let tilted = match crate::machining::five_axis::orientation(&setup.tool_orientation, axis) {
+            Ok(r) => r,
+            Err(e) => {
+                self.last_error = Some(e);
+                return None;
+            }
+        };
         let target = self.placement
             * Isometry3::from_parts(
                 Translation3::from(*position),
-                SpinSchedule::turn(&setup.tool_orientation, theta),
+                SpinSchedule::turn(&tilted, theta),
             );
         let model = self.job.model();
         let solved = pose_ik(
@@ -333,7 +341,9 @@ pub fn plan_at(
                 _ => None,
             };
             let node = start
-                .and_then(|(s, neighbour)| solver.joints(&st.position, theta, &s, neighbour))
+                .and_then(|(s, neighbour)| {
+                    solver.joints(&st.position, &st.axis, theta, &s, neighbour)
+                })
                 .and_then(|q| match solver.map(&q) {
                     Ok(a) => Some((q, a)),
                     Err(e) => {
