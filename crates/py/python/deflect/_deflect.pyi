@@ -65,6 +65,7 @@ __all__ = [
     "gcode_words",
     "MachiningJob",
     "MachiningResult",
+    "FiveAxisResult",
     "PlacementProblem",
     "cutter_force",
     "milling_force",
@@ -1309,6 +1310,7 @@ class FiveAxisResult:
     ) -> None:
         """The machined surface as a PLY mesh, the deviation as each vertex's quality."""
 
+@final
 class MachiningResult:
     """What ``MachiningJob.run`` predicts, SI, workpiece frame unless said."""
     def __len__(self) -> int: ...
