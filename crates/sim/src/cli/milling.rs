@@ -94,6 +94,16 @@ pub struct MillingArgs {
         "Fewer poses: a faster run, fewer identifiable axes"
     ))]
     pub id_poses: usize,
+    #[arg(long, default_value_t = 1.0, help = PHYSICS_STEP_MS.help(
+        "Largest physics step of the program runs [ms] (shortened to divide the control cycle)",
+        "The step-size check: 0.5 against the default 1"
+    ))]
+    pub step_ms: f64,
+    #[arg(long, default_value_t = 2, help = SUBSTEPS.help(
+        "rapier substeps per physics step of the program scenarios (rapier's default: 4)",
+        "Each substep rebuilds the arm's mass matrix, most of a run's time"
+    ))]
+    pub substeps: usize,
 }
 
 impl MillingArgs {
@@ -139,6 +149,8 @@ impl MillingArgs {
             )));
         }
         self.tool.check()?;
+        PHYSICS_STEP_MS.check(self.step_ms)?;
+        SUBSTEPS.check_int(count(self.substeps))?;
         ID_POSES.check_int(count(self.id_poses))
     }
 }

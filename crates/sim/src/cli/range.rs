@@ -124,6 +124,10 @@ pub const LEAD_MS: Range = Range::closed("--lead-ms", 0.0, 500.0, "ms");
 pub const ESTIMATE_ERROR: Range = Range::closed("--estimate-error", -1.0, 1.0, "");
 /// `milling --id-poses`: poses of the stiffness identification.
 pub const ID_POSES: Range = Range::closed("--id-poses", 1.0, 3.0, "");
+/// `milling --step-ms` \[ms\]: the program runs' largest physics step.
+pub const PHYSICS_STEP_MS: Range = Range::closed("--step-ms", 0.1, 2.0, "ms");
+/// `milling --substeps`: rapier substeps per physics step of the program scenarios.
+pub const SUBSTEPS: Range = Range::closed("--substeps", 1.0, 8.0, "");
 /// `contour --step-mm` \[mm\].
 pub const STEP_MM: Range = Range::closed("--step-mm", 0.2, 20.0, "mm");
 /// `contour --target-force` \[N\]: strictly between the tracer's contact and jam forces.

@@ -223,6 +223,8 @@ fn options(a: &MillingArgs) -> milling::MillingOptions {
     opts.estimate_error = a.estimate_error;
     opts.seed = a.seed;
     opts.id_poses = a.id_poses;
+    opts.program_dt = a.step_ms * 1e-3;
+    opts.program_substeps = a.substeps;
     opts.jobs = a.jobs;
     opts
 }

@@ -60,11 +60,15 @@ pub struct ServoParams {
     pub filler_mass: f64,
     /// Time step \[s\].
     pub dt: f64,
+    /// rapier substeps per time step (its `num_solver_iterations`): each one integrates
+    /// `dt / substeps` and rebuilds the multibody mass matrix, most of a step's cost.
+    pub substeps: usize,
 }
 
 impl Default for ServoParams {
     /// 150 Hz, 0.7; loop 50x and drive 100x the stiffest virtual joint; drive 0.7 damped;
-    /// beta 1 ms (2-4 % of critical on the arms' first modes); 0.5 kg fillers; 0.5 ms.
+    /// beta 1 ms (2-4 % of critical on the arms' first modes); 0.5 kg fillers; 0.5 ms in
+    /// rapier's default 4 substeps.
     fn default() -> Self {
         Self {
             bandwidth_hz: 150.0,
@@ -75,6 +79,7 @@ impl Default for ServoParams {
             beta: 1.0e-3,
             filler_mass: 0.5,
             dt: 1.0 / 2000.0,
+            substeps: 4,
         }
     }
 }
@@ -197,7 +202,13 @@ impl FlexSerialArm {
         } else {
             servo.filler_mass
         };
+        if servo.substeps == 0 {
+            return Err(SimError::new(
+                "servo settings: substeps must be at least 1, got 0",
+            ));
+        }
         let mut world = new_world(Vector::ZERO, servo.dt);
+        world.integration_parameters.num_solver_iterations = servo.substeps;
         let mut parent = world.insert_body(RigidBodyBuilder::fixed());
         let mut at = Isometry3::identity();
         let (mut bodies, mut joints, mut actuated, mut axes, mut spring_bodies) =

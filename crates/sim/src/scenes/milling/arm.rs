@@ -159,11 +159,18 @@ impl MillingArm {
         Ok(tick.joints.iter().take(self.dof()).copied().collect())
     }
 
-    /// The arm in rapier at rest at `q0`, physics step `dt`, every damping times
-    /// `damping_scale` (> 1 settles static tests quickly).
-    pub fn sim(&self, q0: &[f64], damping_scale: f64, dt: f64) -> Result<FlexSerialArm, SimError> {
+    /// The arm in rapier at rest at `q0`, physics step `dt` in `substeps` rapier substeps,
+    /// every damping times `damping_scale` (> 1 settles static tests quickly).
+    pub fn sim(
+        &self,
+        q0: &[f64],
+        damping_scale: f64,
+        dt: f64,
+        substeps: usize,
+    ) -> Result<FlexSerialArm, SimError> {
         let servo = ServoParams {
             dt,
+            substeps,
             ..ServoParams::default()
         };
         FlexSerialArm::new(&self.spec, q0, None, &servo, damping_scale)

@@ -18,7 +18,7 @@ use nalgebra::{Point3, Vector3};
 
 use super::arm::MillingArm;
 use super::options::MillingOptions;
-use super::program::{PROGRAM_DT, ProgramMode};
+use super::program::ProgramMode;
 use crate::SimError;
 
 /// A finished run.
@@ -64,6 +64,7 @@ pub fn milling_five_axis(
     seed: &[f64],
 ) -> Result<AxisResult, SimError> {
     let start = std::time::Instant::now();
+    let opts = &super::program::scenario_options(opts);
     let stiffness = super::identification::identify_stiffness(arm, opts, opts.jobs)?;
     let identified: Vec<(usize, usize, f64)> = stiffness
         .iter()
@@ -79,11 +80,7 @@ pub fn milling_five_axis(
     }
     let offline = five_axis::run(&job, program, seed, options)
         .map_err(|e| SimError::new(format!("five-axis pass: {e}")))?;
-    let steps = (opts.cycle / PROGRAM_DT - 1e-9).ceil().max(1.0);
-    let run_opts = MillingOptions {
-        dt: opts.cycle / steps,
-        ..opts.clone()
-    };
+    let run_opts = super::program::run_options(opts);
     let runs = crate::jobs::parallel_map(&MODES, opts.jobs, |&mode| {
         run(arm, &run_opts, &job, &offline, mode, options)
     })?
@@ -140,7 +137,7 @@ fn run(
         .first()
         .ok_or_else(|| SimError::new("five-axis run: the pass has no samples"))?;
     let q_start = joints(first);
-    let mut sim = arm.sim(&q_start, 1.0, opts.dt)?;
+    let mut sim = arm.sim(&q_start, 1.0, opts.dt, opts.substeps)?;
     let st = &setup.stock;
     let mut part = Dexels::block(
         Vector3::new(st.min.x, st.min.y, st.top - options.depth),

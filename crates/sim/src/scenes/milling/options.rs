@@ -47,6 +47,13 @@ pub struct MillingOptions {
     pub pilot: (f64, f64),
     /// Physics step \[s\] (0.5 ms; tests use 2 ms).
     pub dt: f64,
+    /// rapier substeps per physics step (4, rapier's default).
+    pub substeps: usize,
+    /// Largest physics step of the program runs \[s\] ([`super::program::PROGRAM_DT`]).
+    pub program_dt: f64,
+    /// rapier substeps per physics step of the program scenarios, identification and runs
+    /// ([`super::program::PROGRAM_SUBSTEPS`]).
+    pub program_substeps: usize,
     /// Static test loads for the stiffness identification: forces \[N\] along +-x, +-y, +-z
     /// and moments of a quarter of it \[N m\] about them.
     pub id_load: f64,
@@ -82,6 +89,9 @@ impl Default for MillingOptions {
             estimate_error: 0.1,
             pilot: (150.0, 0.08),
             dt: DT,
+            substeps: 4,
+            program_dt: super::program::PROGRAM_DT,
+            program_substeps: super::program::PROGRAM_SUBSTEPS,
             id_load: 800.0,
             id_poses: 3,
             id_hold: 0.25,

@@ -205,7 +205,7 @@ pub fn run_program(
         .ok_or_else(|| SimError::new("program run: the offline pass has no samples"))?;
     let q_start: Vec<f64> = first.q.iter().take(dof).copied().collect();
     let truth = opts.sensor.calibration(arm.sensor_to_tcp);
-    let mut sim = arm.sim(&q_start, 1.0, opts.dt)?;
+    let mut sim = arm.sim(&q_start, 1.0, opts.dt, opts.substeps)?;
     let mut comp = match mode {
         ProgramMode::Uncompensated | ProgramMode::Offline => None,
         ProgramMode::Cartesian | ProgramMode::Hybrid | ProgramMode::AxisSpecific => {
@@ -370,11 +370,36 @@ pub fn kr300_placement() -> Isometry3<f64> {
     )
 }
 
-/// Largest physics step of the program runs \[s\]: 1 ms, twice the groove scenario's. On the
-/// test workpiece the path errors differ from those at 0.5 ms by 1-5 % (max 1.832 against
-/// 1.853 mm uncompensated, 0.576 against 0.600 mm hybrid) and the five runs take 54 s instead
-/// of 108 s on 2 cores; the step is shortened to divide the control cycle.
+/// Largest physics step of the program runs \[s\]: 1 ms, twice the groove scenario's; the step
+/// is shortened to divide the control cycle. See [`PROGRAM_SUBSTEPS`] for what it changes.
 pub const PROGRAM_DT: f64 = 1.0e-3;
+
+/// rapier substeps per physics step of the program scenarios (identification and runs): 2, half
+/// rapier's default 4. rapier rebuilds the multibody mass matrix of the KR 300 (36 degrees of
+/// freedom) in every substep, and that is most of a run's time. On the test workpiece (maximum
+/// path deviation, uncompensated / offline / Cartesian / hybrid, mm): 1 ms in 2 substeps 1.939 /
+/// 0.400 / 0.987 / 0.732; 1 ms in 4 1.952 / 0.415 / 0.998 / 0.741; 0.5 ms in 4 1.971 / 0.430 /
+/// 0.983 / 0.743. Halving the substeps moves the figures by less than halving the step does (at
+/// most 1.5 % against 2 %), and the scenario takes 36 s instead of 78 s on 2 cores.
+pub const PROGRAM_SUBSTEPS: usize = 2;
+
+/// The program scenarios' options: `opts` in its `program_substeps` substeps.
+pub(super) fn scenario_options(opts: &MillingOptions) -> MillingOptions {
+    MillingOptions {
+        substeps: opts.program_substeps,
+        ..opts.clone()
+    }
+}
+
+/// The program runs' options: `opts` with the physics step at most its `program_dt`, a whole
+/// fraction of the control cycle.
+pub(super) fn run_options(opts: &MillingOptions) -> MillingOptions {
+    let steps = (opts.cycle / opts.program_dt - 1e-9).ceil().max(1.0);
+    MillingOptions {
+        dt: opts.cycle / steps,
+        ..opts.clone()
+    }
+}
 
 /// Joints near the start of a program on [`kr300_placement`]: the tool down over the table.
 pub const PROGRAM_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
@@ -406,6 +431,7 @@ pub fn milling_program(
     seed: &[f64],
 ) -> Result<ProgramResult, SimError> {
     let start = std::time::Instant::now();
+    let opts = &scenario_options(opts);
     let stiffness = super::identification::identify_stiffness(arm, opts, opts.jobs)?;
     let identified: Vec<(usize, usize, f64)> = stiffness
         .iter()
@@ -419,12 +445,7 @@ pub fn milling_program(
         .map_err(|e| SimError::new(format!("machining job: {e}")))?;
     let offline =
         job::run(&job, program, seed).map_err(|e| SimError::new(format!("offline pass: {e}")))?;
-    // The runs' physics step: at most PROGRAM_DT, a whole fraction of the control cycle.
-    let steps = (opts.cycle / PROGRAM_DT - 1e-9).ceil().max(1.0);
-    let run_opts = MillingOptions {
-        dt: opts.cycle / steps,
-        ..opts.clone()
-    };
+    let run_opts = run_options(opts);
     let runs = crate::jobs::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
         run_program(arm, &run_opts, &job, &offline, mode, &model, &calibration)
     })?
