@@ -371,7 +371,7 @@ pub type Tick = super::Tick<Isometry3<f64>, Vector6, [f64; MAX_DOF], Diagnostics
 
 /// A solution this far from the warm start \[rad or m\] gets its link loads' joint rates
 /// recomputed at the solution (see [`step`]).
-const RATE_REFRESH: f64 = 1.0e-7;
+pub(crate) const RATE_REFRESH: f64 = 1.0e-7;
 
 /// The loaded pose IK of one tick from `seed`, with the link loads of `data.qd`, `data.qdd`
 /// when `arm`.
@@ -420,17 +420,38 @@ fn dls_solve(
 }
 
 /// The tick's joint rates and accelerations from the desired TCP motion, at `q` (the warm
-/// start): `qd = J^+ [v; w]`, `qdd = J^+ ([a; alpha] - Jd qd)` (damped least squares with the
-/// IK's damping, over the task's rows), into `data.qd` and `data.qdd`.
+/// start), into `data.qd` and `data.qdd` (see [`joint_rates`]).
 fn joint_motion(
     model: &Model,
     data: &mut Data,
     q: &[f64],
     desired: &PoseState,
 ) -> Result<(), TickError> {
-    let dof = model.chain.dof();
-    let lambda2 = model.ik.damping * model.ik.damping;
-    vjm::joint_jacobian(&model.chain, &mut data.vjm, q)?;
+    joint_rates(
+        &model.chain,
+        &mut data.vjm,
+        &model.ik,
+        q,
+        desired,
+        (&mut data.qd, &mut data.qdd),
+    )
+}
+
+/// The joint rates and accelerations `(qd, qdd)` of the desired TCP motion at joints `q`:
+/// `qd = J^+ [v; w]`, `qdd = J^+ ([a; alpha] - Jd qd)` (damped least squares with `ik`'s
+/// damping, over the rows of `ik`'s task). What the link masses' loads of
+/// [`vjm::Load::ExactWithArm`] need; the machining job's inertial loads use it too.
+pub(crate) fn joint_rates(
+    chain: &vjm::Model,
+    vjm_data: &mut vjm::Data,
+    ik: &PoseIkOptions,
+    q: &[f64],
+    desired: &PoseState,
+    (qd, qdd): (&mut [f64; MAX_DOF], &mut [f64; MAX_DOF]),
+) -> Result<(), TickError> {
+    let dof = chain.dof();
+    let lambda2 = ik.damping * ik.damping;
+    vjm::joint_jacobian(chain, vjm_data, q)?;
     let singular = TickError::Singular {
         what: "joint Jacobian (joint rates of the link inertia)",
         sigma_min: 0.0,
@@ -439,9 +460,9 @@ fn joint_motion(
     // it controls), and its joint rates are those of that motion, not a least-squares
     // compromise with the rotation it cannot make.
     // (The full pose stays in the base frame, the same least squares without the turn.)
-    let task = model.ik.task;
+    let task = ik.task;
     let full = task == Task::POSE;
-    let rotation = data.vjm.tcp.rotation;
+    let rotation = vjm_data.tcp.rotation;
     let rows = |x: Vector6| {
         if full {
             x
@@ -450,24 +471,19 @@ fn joint_motion(
         }
     };
     let j = if full {
-        data.vjm.jacobian
+        vjm_data.jacobian
     } else {
-        task_jacobian(&data.vjm.jacobian, &rotation, task, dof)
+        task_jacobian(&vjm_data.jacobian, &rotation, task, dof)
     };
     let (v, w) = (desired.velocity, desired.angular_velocity);
     let twist = rows(Vector6::new(v.x, v.y, v.z, w.x, w.y, w.z));
-    data.qd = dls_solve(&j, task, dof, &twist, lambda2).ok_or(singular)?;
-    let bias = vjm::tcp_acceleration_bias(
-        &model.chain,
-        &mut data.vjm,
-        q,
-        data.qd.get(..dof).unwrap_or(&[]),
-    )?;
+    *qd = dls_solve(&j, task, dof, &twist, lambda2).ok_or(singular)?;
+    let bias = vjm::tcp_acceleration_bias(chain, vjm_data, q, qd.get(..dof).unwrap_or(&[]))?;
     let (a, al) = (desired.acceleration, desired.angular_acceleration);
     let x = rows(Vector6::new(a.x, a.y, a.z, al.x, al.y, al.z) - bias);
-    data.qdd = dls_solve(&j, task, dof, &x, lambda2).ok_or(singular)?;
-    check_output("joint rates", &data.qd)?;
-    check_output("joint accelerations", &data.qdd)
+    *qdd = dls_solve(&j, task, dof, &x, lambda2).ok_or(singular)?;
+    check_output("joint rates", qd.as_slice())?;
+    check_output("joint accelerations", qdd.as_slice())
 }
 
 /// One tick (see the module docs): the desired pose state `desired` (base frame) and an

@@ -73,12 +73,14 @@ use super::tools::ToolTable;
 use crate::error::{BuildError, JobError, TickError};
 use crate::vjm::{Model, Vector6};
 
+mod inertia;
 mod nominal;
 mod predict;
 mod setup;
 
 pub(crate) use predict::Warm;
 
+pub use inertia::Inertia;
 pub use nominal::{NominalSample, nominal_pass};
 pub use setup::{Setup, Stock};
 
@@ -100,6 +102,7 @@ pub struct Job {
     tools: Option<ToolTable>,
     controller: Option<crate::controller::Convention>,
     spin: Option<super::spin::SpinSchedule>,
+    inertia: Option<Inertia>,
 }
 
 impl Job {
@@ -130,7 +133,25 @@ impl Job {
             tools: None,
             controller: None,
             spin: None,
+            inertia: None,
         })
+    }
+
+    /// The job with inertial loads ([`Inertia`], the `inertia` module's docs): the tool and
+    /// spindle's D'Alembert wrench in the path's planned motion, and the link masses' loads,
+    /// join the process wrench of every sample before the deflection, in the compensated
+    /// joints and in both predictions; the report splits the deflection into its process and
+    /// inertial parts ([`JobSample::deflection_inertial`]). An inertia that counts nothing
+    /// ([`Inertia::is_zero`]) leaves the job as it was.
+    pub fn with_inertia(mut self, inertia: Inertia) -> Result<Self, BuildError> {
+        inertia.validate()?;
+        self.inertia = (!inertia.is_zero()).then_some(inertia);
+        Ok(self)
+    }
+
+    /// The inertial loads the job counts, if any.
+    pub fn inertia(&self) -> Option<&Inertia> {
+        self.inertia.as_ref()
     }
 
     /// The job with the tool turned about its own axis along the program by `schedule`
@@ -652,6 +673,9 @@ pub fn run_streaming<S: Sink + ?Sized>(
                 wrench: n.wrench,
                 q: u.q,
                 deflection: u.deflection,
+                inertial_wrench: u.inertial_wrench,
+                deflection_inertial: u.deflection_inertial,
+                tool_acceleration: inertia::tool_acceleration(program, &n.path),
                 q_commanded: c.q,
                 commanded: c.commanded,
                 actual_uncompensated: u.tip,

@@ -360,6 +360,28 @@ impl Move {
         if n > 0.0 { t / n } else { Vector3::zeros() }
     }
 
+    /// The path's curvature vector `dT/ds` at the fraction `s` \[1/m\], workpiece frame: the
+    /// normal acceleration of a tool at speed `v` there is `v^2` times it (towards an arc's
+    /// centre, `1 / r` long on a circle); zero on a straight move and a dwell. A second-order
+    /// difference of [`Self::tangent`] over 1e-5 of the move (central, one-sided at the ends):
+    /// the tangent is smooth along an arc, so the difference is exact to about 1e-9 relative.
+    pub fn curvature(&self, s: f64) -> Vector3<f64> {
+        let length = self.length();
+        if !matches!(self.motion, Motion::Arc { .. }) || length <= 0.0 {
+            return Vector3::zeros();
+        }
+        const H: f64 = 1.0e-5;
+        let s = s.clamp(0.0, 1.0);
+        let d = if s < H {
+            self.tangent(s) * -3.0 + self.tangent(s + H) * 4.0 - self.tangent(s + 2.0 * H)
+        } else if s > 1.0 - H {
+            self.tangent(s) * 3.0 - self.tangent(s - H) * 4.0 + self.tangent(s - 2.0 * H)
+        } else {
+            self.tangent(s + H) - self.tangent(s - H)
+        };
+        d / (2.0 * H * length)
+    }
+
     /// Whether the move cuts at a feed (`G1`-`G3`): not a rapid, not a dwell.
     pub fn is_feed(&self) -> bool {
         matches!(self.motion, Motion::Linear | Motion::Arc { .. })

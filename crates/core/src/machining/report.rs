@@ -28,8 +28,20 @@ pub struct JobSample {
     pub wrench: Vector6,
     /// Rigid pose-IK joints of the programmed pose \[rad or m\]; entries past the dof are 0.
     pub q: [f64; MAX_DOF],
-    /// Deflection `[dp; dr]` of the tip at `q` under `wrench` \[m, rad\], base frame.
+    /// Deflection `[dp; dr]` of the tip at `q` under `wrench` \[m, rad\], base frame: the
+    /// process part.
     pub deflection: Vector6,
+    /// The tool and spindle's D'Alembert wrench `[F; M]` \[N, N m\], base frame, about the tip,
+    /// in the planned motion (zero without the job's [`super::job::Inertia`]).
+    pub inertial_wrench: Vector6,
+    /// Deflection `[dp; dr]` of the tip at `q` under the inertial loads alone (the wrench
+    /// above and, when counted, the link masses') \[m, rad\], base frame: the inertial part
+    /// (zero without the job's inertia). The predictions and the compensated joints carry
+    /// both parts in one deflection.
+    pub deflection_inertial: Vector6,
+    /// The tool's planned acceleration \[m/s^2\], workpiece frame: along the feed and, on an
+    /// arc, towards its centre ([`crate::machining::Move::curvature`]).
+    pub tool_acceleration: Vector3<f64>,
     /// Compensated joints: the loaded tip reaches the programmed pose \[rad or m\].
     pub q_commanded: [f64; MAX_DOF],
     /// The Cartesian command: the rigid pose at `q_commanded`, workpiece frame.
@@ -145,6 +157,13 @@ pub struct LineSummary {
     pub error_compensated: f64,
     /// Largest coupling residual of the compensated prediction \[m\].
     pub residual: f64,
+    /// Largest position part of the process deflection at the rigid joints \[m\].
+    pub deflection_process: f64,
+    /// Largest position part of the inertial deflection at the rigid joints \[m\] (0
+    /// without the job's inertia).
+    pub deflection_inertial: f64,
+    /// Largest planned tool acceleration \[m/s^2\].
+    pub peak_acceleration: f64,
     /// Why the compensated prediction leaves the program by more than
     /// [`super::job::PREDICTION_TOLERANCE`] here (`None` where it does not).
     pub deviation: Option<Deviation>,
@@ -163,6 +182,9 @@ impl LineSummary {
             error_uncompensated: 0.0,
             error_compensated: 0.0,
             residual: 0.0,
+            deflection_process: 0.0,
+            deflection_inertial: 0.0,
+            peak_acceleration: 0.0,
             deviation: None,
         }
     }
@@ -174,6 +196,12 @@ impl LineSummary {
         self.max = self.max.max(s.force.norm());
         let [_, residual] = s.coupling_residual;
         self.residual = self.residual.max(residual);
+        let position = |d: &Vector6| d.fixed_rows::<3>(0).norm();
+        self.deflection_process = self.deflection_process.max(position(&s.deflection));
+        self.deflection_inertial = self
+            .deflection_inertial
+            .max(position(&s.deflection_inertial));
+        self.peak_acceleration = self.peak_acceleration.max(s.tool_acceleration.norm());
         if s.path.feed_move {
             let p = s.path.position;
             let (eu, ec) = (

@@ -8,6 +8,7 @@ use alloc::vec::Vec;
 
 use nalgebra::{Isometry3, Matrix3, Matrix6, Point3, Translation3, Vector3};
 
+use super::inertia::{self, Motion};
 use super::nominal::Sample;
 use super::{
     COUPLING_TOLERANCE, Job, MAX_COUPLING_ITERATIONS, RunOptions, ToolModels, chip_wrench,
@@ -38,6 +39,11 @@ pub(super) struct Out {
     /// Deflection of the tip at the rigid joints under the nominal wrench (uncompensated arm
     /// only; zero for the other).
     pub deflection: Vector6,
+    /// The payload's D'Alembert wrench, base frame (zero without the job's inertia).
+    pub inertial_wrench: Vector6,
+    /// Deflection of the tip at the rigid joints under the inertial loads alone
+    /// (uncompensated arm with the job's inertia; zero otherwise).
+    pub deflection_inertial: Vector6,
     /// The rigid pose at the joints, workpiece frame (the compensated arm's command).
     pub commanded: Isometry3<f64>,
     /// The predicted tip \[m\], workpiece frame.
@@ -71,6 +77,8 @@ pub(super) struct Arm<'a> {
     chip: Chip,
     pub cell_updates: usize,
     spin: Cursor,
+    /// The sample's inertial loads (with the job's inertia).
+    motion: Option<Motion>,
 }
 
 impl<'a> Arm<'a> {
@@ -105,6 +113,7 @@ impl<'a> Arm<'a> {
             chip: Chip::default(),
             cell_updates: 0,
             spin: Cursor::default(),
+            motion: None,
         }
     }
 
@@ -149,13 +158,49 @@ impl<'a> Arm<'a> {
         };
         let target =
             self.to_base * Isometry3::from_parts(Translation3::from(n.path.position), orientation);
-        let (wrench, load) = if self.compensated {
-            (n.wrench, Load::Exact)
-        } else {
-            (Vector6::zeros(), Load::Rigid)
-        };
-        self.warm
-            .solve(job, &mut self.data, &target, &wrench, load)?;
+        self.motion = job.inertia.as_ref().map(|i| {
+            let state = inertia::pose_state(self.program, &self.to_base.rotation, &n.path, &target);
+            Motion::new(i, state)
+        });
+        let (model, ik, dof) = (&job.model, &job.setup.ik, job.model.dof());
+        match (&mut self.motion, self.compensated) {
+            (None, true) => {
+                self.warm
+                    .solve(job, &mut self.data, &target, &n.wrench, Load::Exact)?;
+            }
+            (None, false) => {
+                self.warm
+                    .solve(job, &mut self.data, &target, &Vector6::zeros(), Load::Rigid)?;
+            }
+            (Some(m), true) => {
+                // The link loads' joint rates at the warm start; at the solution again when it
+                // moved away (as the serial corrector's tick does).
+                let seed = self.warm.seed(dof);
+                m.rates_at(model, &mut self.data, ik, seed.get(..dof).unwrap_or(&[]))?;
+                let wrench = n.wrench + m.wrench;
+                self.warm
+                    .solve(job, &mut self.data, &target, &wrench, m.load(model))?;
+                let moved = self
+                    .warm
+                    .q
+                    .iter()
+                    .zip(&seed)
+                    .take(dof)
+                    .fold(0.0f64, |a, (x, y)| a.max((x - y).abs()));
+                if m.has_links(model) && moved > crate::dalembert::serial::RATE_REFRESH {
+                    let q = self.warm.q;
+                    m.rates_at(model, &mut self.data, ik, q.get(..dof).unwrap_or(&[]))?;
+                    self.warm
+                        .refine(job, &mut self.data, &target, &wrench, m.load(model))?;
+                }
+            }
+            (Some(m), false) => {
+                self.warm
+                    .solve(job, &mut self.data, &target, &Vector6::zeros(), Load::Rigid)?;
+                let q = self.warm.q;
+                m.rates_at(model, &mut self.data, ik, q.get(..dof).unwrap_or(&[]))?;
+            }
+        }
         self.q = self.warm.q;
         Ok(())
     }
@@ -174,17 +219,35 @@ impl<'a> Arm<'a> {
         let q = self.q;
         let qs = q.get(..job.model.dof()).unwrap_or(&[]);
         // The loaded tip under the nominal wrench: the coupling's first anchor.
-        let (deflection, commanded) = if self.compensated {
+        let (deflection, commanded, deflection_inertial) = if self.compensated {
             // The loaded IK's last pass: the rigid pose to command, the loaded one on target.
-            (Vector6::zeros(), self.to_work * self.data.tcp)
+            (
+                Vector6::zeros(),
+                self.to_work * self.data.tcp,
+                Vector6::zeros(),
+            )
         } else {
             let d = vjm::deflection(model, &mut self.data, qs, &n.wrench, Load::Exact)?;
-            (d, Isometry3::identity())
+            let di = match &self.motion {
+                Some(m) => {
+                    let di = vjm::deflection(model, &mut self.data, qs, &m.wrench, m.load(model))?;
+                    // Both parts in one deflection: the coupling's first anchor.
+                    let w = n.wrench + m.wrench;
+                    vjm::deflection(model, &mut self.data, qs, &w, m.load(model))?;
+                    di
+                }
+                None => Vector6::zeros(),
+            };
+            (d, Isometry3::identity(), di)
         };
         let tip_at = |data: &Data, to_work: &Isometry3<f64>| {
             (to_work * Point3::from(data.tcp_deflected.translation.vector)).coords
         };
-        let anchor = (n.wrench, tip_at(&self.data, &self.to_work));
+        let (inertial_wrench, anchor_wrench) = match &self.motion {
+            Some(m) => (m.wrench, n.wrench + m.wrench),
+            None => (Vector6::zeros(), n.wrench),
+        };
+        let anchor = (anchor_wrench, tip_at(&self.data, &self.to_work));
         let (tip, force, residual) = self.couple(n, qs, anchor)?;
         let Some(tm) = self.tools.get(n.tool) else {
             return Err(TickError::InvalidArgument {
@@ -212,6 +275,8 @@ impl<'a> Arm<'a> {
         Ok(Out {
             q,
             deflection,
+            inertial_wrench,
+            deflection_inertial,
             commanded,
             tip,
             force,
@@ -364,7 +429,10 @@ impl<'a> Arm<'a> {
         self.cell_updates += self.follower.settle(&mut self.stock, t, &dir)?.cells;
         engagement::read(&self.stock, &tm.probes, t, &dir, ccw, &mut self.chip);
         let (f, w) = chip_wrench(&tm.chip, &self.chip, &dir, n.fz, ccw)?;
-        let wrench = rotate(&self.to_base, &w);
+        let wrench = match &self.motion {
+            Some(m) => rotate(&self.to_base, &w) + m.wrench,
+            None => rotate(&self.to_base, &w),
+        };
         let change = wrench - c.anchor.0;
         if change.iter().all(|v| *v == 0.0) {
             return Ok((c.anchor.1, f));
@@ -381,7 +449,8 @@ impl<'a> Arm<'a> {
         if shift.norm() <= RELINEARISE {
             return Ok((c.anchor.1 + self.to_work.rotation * shift, f));
         }
-        vjm::deflection(model, &mut self.data, qs, &wrench, Load::Exact)?;
+        let load = self.motion.as_ref().map_or(Load::Exact, |m| m.load(model));
+        vjm::deflection(model, &mut self.data, qs, &wrench, load)?;
         let tip = (self.to_work * Point3::from(self.data.tcp_deflected.translation.vector)).coords;
         c.anchor = (wrench, tip);
         crate::error::check_output("predicted tip", tip.as_slice())?;
@@ -415,6 +484,18 @@ impl Warm {
         }
     }
 
+    /// The next solve's first guess: the last two solutions extrapolated (the last one, or
+    /// the seed, before there are two).
+    pub fn seed(&self, dof: usize) -> [f64; MAX_DOF] {
+        let mut seed = self.q;
+        if let Some(before) = self.q_before {
+            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
+                *s = 2.0 * q - b;
+            }
+        }
+        seed
+    }
+
     /// The joints at which the arm of `job` (rigid, or loaded by `wrench` as `load` says)
     /// puts its TCP on `target` (base frame), checked against the job's joint limits.
     pub fn solve(
@@ -426,12 +507,7 @@ impl Warm {
         load: Load<'_>,
     ) -> Result<(), TickError> {
         let dof = job.model.dof();
-        let mut seed = self.q;
-        if let Some(before) = self.q_before {
-            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
-                *s = 2.0 * q - b;
-            }
-        }
+        let seed = self.seed(dof);
         let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
             pose_ik(
                 &job.model,
@@ -450,6 +526,30 @@ impl Warm {
         };
         self.q_before = self.solved.then_some(self.q);
         self.solved = true;
+        self.q = sol.q;
+        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
+    }
+
+    /// [`Self::solve`] again from the last solution (a load that changed with it), in its
+    /// place: the history the next guess extrapolates is kept.
+    pub fn refine(
+        &mut self,
+        job: &Job,
+        data: &mut Data,
+        target: &Isometry3<f64>,
+        wrench: &Vector6,
+        load: Load<'_>,
+    ) -> Result<(), TickError> {
+        let dof = job.model.dof();
+        let sol = pose_ik(
+            &job.model,
+            data,
+            target,
+            self.q.get(..dof).unwrap_or(&[]),
+            wrench,
+            load,
+            &job.setup.ik,
+        )?;
         self.q = sol.q;
         in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
     }
