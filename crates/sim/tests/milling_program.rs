@@ -1,4 +1,6 @@
-//! The paper's validation on a program: a short groove cut by the flexible KR 300 five ways.
+//! The paper's validation on a program: a short groove cut by the flexible KR 300 six ways;
+//! with nothing for the inertial feed-forward to count (a massless spindle, the link loads
+//! off) the combined run is the hybrid one bit for bit.
 
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::cutting::{Coefficients, Tool};
@@ -12,7 +14,7 @@ use deflect_sim::scenes::milling::program::{self, ProgramMode};
 use nalgebra::{Vector2, Vector3};
 
 #[test]
-fn a_short_groove_five_ways() {
+fn a_short_groove_six_ways() {
     let text = "G0 X-12 Y20 Z5\nS13000 M3\nG1 Z-6 F1500\nX40\nG0 Z5\n";
     let p = gcode::from_str(
         text,
@@ -39,7 +41,11 @@ fn a_short_groove_five_ways() {
         hand_spindle: None,
         rapid_skim: deflect_core::machining::job::RAPID_SKIM,
     };
-    let opts = MillingOptions::short();
+    let opts = MillingOptions {
+        spindle_mass: 0.0,
+        link_inertia: false,
+        ..MillingOptions::short()
+    };
     // On a thread with a 16 MB stack: in a debug build the scenario's frames hold the 70 KB
     // arm and 35 KB models several times over, past a test thread's 2 MB (release frames are
     // a fraction of it; the command line's main thread has 8 MB).
@@ -106,6 +112,17 @@ fn a_short_groove_five_ways() {
     assert!(axis.metrics.max_mm < cart.metrics.max_mm);
     assert!(
         off.metrics.max_mm < hyb.metrics.max_mm && off.metrics.rms_mm < 0.1 * un.metrics.rms_mm
+    );
+    let combined = by(ProgramMode::Combined);
+    assert_eq!(combined.samples.len(), hyb.samples.len());
+    for (c, h) in combined.samples.iter().zip(&hyb.samples) {
+        assert_eq!(c.actual, h.actual, "t = {}", c.t);
+        assert_eq!(c.force, h.force, "t = {}", c.t);
+    }
+    assert_eq!(combined.part_error.floor.max, hyb.part_error.floor.max);
+    assert!(
+        r.lines.is_empty(),
+        "no inertial pass when it counts nothing"
     );
     for run in [off, cart, hyb, axis] {
         assert!(run.part_error.floor.max < un.part_error.floor.max);

@@ -104,6 +104,15 @@ pub struct MillingArgs {
         "Each substep rebuilds the arm's mass matrix, most of a run's time"
     ))]
     pub substeps: usize,
+    #[arg(long, default_value_t = 0.0, help = SPINDLE_MASS.help(
+        "Mass of the spindle and tool beyond the TCP [kg] in programs (a point halfway to the sensor): the simulated arm carries it, the combined run's inertial feed-forward counts it",
+        "0: the built-in KR 300's massless spindle"
+    ))]
+    pub spindle_mass: f64,
+    /// Leave the link masses' loads out of the combined run's inertial feed-forward (with
+    /// --spindle-mass 0 the combined run is then the hybrid one).
+    #[arg(long)]
+    pub no_link_inertia: bool,
 }
 
 impl MillingArgs {
@@ -151,6 +160,7 @@ impl MillingArgs {
         self.tool.check()?;
         PHYSICS_STEP_MS.check(self.step_ms)?;
         SUBSTEPS.check_int(count(self.substeps))?;
+        SPINDLE_MASS.check(self.spindle_mass)?;
         ID_POSES.check_int(count(self.id_poses))
     }
 }

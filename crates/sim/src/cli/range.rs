@@ -126,6 +126,8 @@ pub const ESTIMATE_ERROR: Range = Range::closed("--estimate-error", -1.0, 1.0, "
 pub const ID_POSES: Range = Range::closed("--id-poses", 1.0, 3.0, "");
 /// `milling --step-ms` \[ms\]: the program runs' largest physics step.
 pub const PHYSICS_STEP_MS: Range = Range::closed("--step-ms", 0.1, 2.0, "ms");
+/// `milling --spindle-mass` \[kg\]: the KR 300's spindles weigh tens of kg.
+pub const SPINDLE_MASS: Range = Range::closed("--spindle-mass", 0.0, 500.0, "kg");
 /// `milling --substeps`: rapier substeps per physics step of the program scenarios.
 pub const SUBSTEPS: Range = Range::closed("--substeps", 1.0, 8.0, "");
 /// `contour --step-mm` \[mm\].

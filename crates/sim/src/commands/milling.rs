@@ -225,6 +225,8 @@ fn options(a: &MillingArgs) -> milling::MillingOptions {
     opts.id_poses = a.id_poses;
     opts.program_dt = a.step_ms * 1e-3;
     opts.program_substeps = a.substeps;
+    opts.spindle_mass = a.spindle_mass;
+    opts.link_inertia = !a.no_link_inertia;
     opts.jobs = a.jobs;
     opts
 }

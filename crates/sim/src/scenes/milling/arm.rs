@@ -160,20 +160,21 @@ impl MillingArm {
     }
 
     /// The arm in rapier at rest at `q0`, physics step `dt` in `substeps` rapier substeps,
-    /// every damping times `damping_scale` (> 1 settles static tests quickly).
+    /// every damping times `damping_scale` (> 1 settles static tests quickly), carrying
+    /// `spindle` beyond the TCP (TCP frame) when given.
     pub fn sim(
         &self,
         q0: &[f64],
         damping_scale: f64,
-        dt: f64,
-        substeps: usize,
+        (dt, substeps): (f64, usize),
+        spindle: Option<&Payload>,
     ) -> Result<FlexSerialArm, SimError> {
         let servo = ServoParams {
             dt,
             substeps,
             ..ServoParams::default()
         };
-        FlexSerialArm::new(&self.spec, q0, None, &servo, damping_scale)
+        FlexSerialArm::new(&self.spec, q0, spindle, &servo, damping_scale)
     }
 
     /// The sensor's pose in the simulated arm (base frame).

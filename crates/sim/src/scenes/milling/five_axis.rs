@@ -137,7 +137,7 @@ fn run(
         .first()
         .ok_or_else(|| SimError::new("five-axis run: the pass has no samples"))?;
     let q_start = joints(first);
-    let mut sim = arm.sim(&q_start, 1.0, opts.dt, opts.substeps)?;
+    let mut sim = arm.sim(&q_start, 1.0, (opts.dt, opts.substeps), None)?;
     let st = &setup.stock;
     let mut part = Dexels::block(
         Vector3::new(st.min.x, st.min.y, st.top - options.depth),

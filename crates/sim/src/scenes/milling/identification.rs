@@ -138,7 +138,7 @@ fn static_tests(
     seed: u64,
 ) -> Result<PoseReadings, SimError> {
     let mut noise = Noise::new(seed);
-    let mut sim = arm.sim(q, STATIC_DAMPING, opts.dt, opts.substeps)?;
+    let mut sim = arm.sim(q, STATIC_DAMPING, (opts.dt, opts.substeps), None)?;
     let hold = (opts.id_hold / opts.dt).round().max(1.0) as usize;
     let ramp = (0.03 / opts.dt).round().max(1.0) as usize;
     sim.step_locked(&Vector6::zeros());

@@ -63,6 +63,13 @@ pub struct MillingOptions {
     pub id_hold: f64,
     /// Noise of the frame-pair rotation measurements \[rad\] and TCP deflections \[m\].
     pub id_noise: [f64; 2],
+    /// Mass of the spindle and tool beyond the TCP \[kg\] in the program scenarios: the
+    /// simulated arm carries it (a point mass halfway between the TCP and the sensor) and the
+    /// combined run's inertial feed-forward counts it. 0: the built-in KR 300's massless
+    /// spindle.
+    pub spindle_mass: f64,
+    /// Whether the combined run's inertial feed-forward counts the link masses' loads.
+    pub link_inertia: bool,
     /// Seed of all noise.
     pub seed: u64,
     /// Worker threads (identification poses, runs); results do not depend on it.
@@ -96,6 +103,8 @@ impl Default for MillingOptions {
             id_poses: 3,
             id_hold: 0.25,
             id_noise: [2.0e-6, 2.0e-6],
+            spindle_mass: 0.0,
+            link_inertia: true,
             seed: 6,
             jobs: 2,
         }

@@ -4,8 +4,17 @@
 //! the run's own z-map *where the simulated tool really is*, so a tool the force pushes away
 //! cuts less, as on the robot. Runs ([`ProgramMode`]): uncompensated; the offline compensated
 //! joints of deflect-core's `machining::job`; online Cartesian compensation; online Cartesian
-//! with pilot control from the offline forces (hybrid); online axis-specific. Each run's part is
-//! compared with the nominal one.
+//! with pilot control from the offline forces (hybrid); online axis-specific; hybrid with the
+//! offline inertial feed-forward (combined). Each run's part is compared with the nominal one.
+//!
+//! The combined run adds to the hybrid one's joints, sample by sample, what the inertial loads
+//! change in the offline compensated joints: the offline pass once more with the job's inertia
+//! (the spindle's D'Alembert wrench and the link masses' loads in the path's planned motion,
+//! `deflect_core::machining::job::Inertia`), its compensated joints less those of the pass
+//! without it. The online loop goes on compensating the measured process force as the hybrid
+//! run does (the simulated sensor reads the process force; the spindle's inertial force on it
+//! is not simulated). With nothing to count (a massless spindle, the link loads off) the
+//! feed-forward is zero and the combined run is the hybrid one bit for bit.
 
 use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
 use deflect_core::machining::chip::ChipModel;
@@ -34,16 +43,19 @@ pub enum ProgramMode {
     Hybrid,
     /// Online axis-specific compensation (measured forces, pilot control).
     AxisSpecific,
+    /// Hybrid, with the offline inertial feed-forward (see the module docs).
+    Combined,
 }
 
 impl ProgramMode {
     /// Every mode, in the order the summary reports them.
-    pub const ALL: [Self; 5] = [
+    pub const ALL: [Self; 6] = [
         Self::Uncompensated,
         Self::Offline,
         Self::Cartesian,
         Self::Hybrid,
         Self::AxisSpecific,
+        Self::Combined,
     ];
 
     /// Short name for topics and files.
@@ -54,6 +66,7 @@ impl ProgramMode {
             Self::Cartesian => "cartesian",
             Self::Hybrid => "hybrid",
             Self::AxisSpecific => "axis_specific",
+            Self::Combined => "combined",
         }
     }
 }
@@ -184,18 +197,38 @@ fn rotate(r: &UnitQuaternion<f64>, w: &Vector6) -> Vector6 {
     Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
 }
 
-/// One run of `program` with `mode` on `arm`: `job` the offline pass's setup (placement, tool,
-/// material, stock, path at the control cycle), `offline` its report, the compensator using
-/// `model` (identified stiffnesses) and `calibration` (identified sensor).
+/// What a program run is given beside its mode: `job` the offline pass's setup (placement,
+/// tool, material, stock, path at the control cycle), `offline` its report, `feedforward` the
+/// combined run's inertial joint offsets per sample, the compensator using `model`
+/// (identified stiffnesses) and `calibration` (identified sensor).
+#[derive(Debug, Clone, Copy)]
+pub struct RunInputs<'a> {
+    /// The offline pass's job.
+    pub job: &'a Job,
+    /// Its report.
+    pub offline: &'a Report,
+    /// The inertial feed-forward per sample \[rad\] (the combined run; see the module docs).
+    pub feedforward: &'a [[f64; deflect_core::vjm::MAX_DOF]],
+    /// The compensator's model.
+    pub model: &'a Model,
+    /// The compensator's sensor calibration.
+    pub calibration: &'a SensorCalibration,
+}
+
+/// One run of the program of `inputs` with `mode` on `arm`.
 pub fn run_program(
     arm: &MillingArm,
     opts: &MillingOptions,
-    job: &Job,
-    offline: &Report,
+    inputs: &RunInputs<'_>,
     mode: ProgramMode,
-    model: &Model,
-    calibration: &SensorCalibration,
 ) -> Result<ProgramRun, SimError> {
+    let RunInputs {
+        job,
+        offline,
+        feedforward,
+        model,
+        calibration,
+    } = *inputs;
     let setup = job.setup();
     let (to_base, to_work) = (setup.placement, setup.placement.inverse());
     let dof = arm.dof();
@@ -205,10 +238,14 @@ pub fn run_program(
         .ok_or_else(|| SimError::new("program run: the offline pass has no samples"))?;
     let q_start: Vec<f64> = first.q.iter().take(dof).copied().collect();
     let truth = opts.sensor.calibration(arm.sensor_to_tcp);
-    let mut sim = arm.sim(&q_start, 1.0, opts.dt, opts.substeps)?;
+    let spindle = spindle(arm, opts);
+    let mut sim = arm.sim(&q_start, 1.0, (opts.dt, opts.substeps), spindle.as_ref())?;
     let mut comp = match mode {
         ProgramMode::Uncompensated | ProgramMode::Offline => None,
-        ProgramMode::Cartesian | ProgramMode::Hybrid | ProgramMode::AxisSpecific => {
+        ProgramMode::Cartesian
+        | ProgramMode::Hybrid
+        | ProgramMode::AxisSpecific
+        | ProgramMode::Combined => {
             let mut cfg = CompensatorConfig::paper(1.0 / offline.rate_hz, *calibration);
             cfg.pilot = (mode != ProgramMode::Cartesian).then_some(opts.pilot);
             if mode == ProgramMode::AxisSpecific {
@@ -246,17 +283,22 @@ pub fn run_program(
     let mut engaged: Option<(f64, [f64; 2], usize)> = None;
     let mut samples = Vec::with_capacity(offline.samples.len());
     let mut cutting = Vec::with_capacity(offline.samples.len());
-    let joints = |s: &job::JobSample| -> Vec<f64> {
+    let joints = |k: usize, s: &job::JobSample| -> Vec<f64> {
         let q = if mode == ProgramMode::Offline {
             &s.q_commanded
         } else {
             &s.q
         };
-        q.iter().take(dof).copied().collect()
+        match (mode, feedforward.get(k)) {
+            (ProgramMode::Combined, Some(ff)) => {
+                q.iter().zip(ff).take(dof).map(|(a, b)| a + b).collect()
+            }
+            _ => q.iter().take(dof).copied().collect(),
+        }
     };
     for (k, s) in offline.samples.iter().enumerate() {
-        let next = offline.samples.get(k + 1).unwrap_or(s);
-        let (q_a, q_b) = (joints(s), joints(next));
+        let (kn, next) = offline.samples.get(k + 1).map_or((k, s), |n| (k + 1, n));
+        let (q_a, q_b) = (joints(k, s), joints(kn, next));
         let p_nom = s.path.position;
         let dir_base = to_base.rotation * s.path.direction;
         let v_nom = dir_base * s.path.speed;
@@ -360,6 +402,68 @@ pub fn run_program(
     })
 }
 
+/// The spindle the simulated arm carries ([`MillingOptions::spindle_mass`]): a point mass
+/// halfway between the TCP and the sensor (TCP frame), none when massless.
+pub fn spindle(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+) -> Option<deflect_core::dalembert::serial::Payload> {
+    (opts.spindle_mass > 0.0).then(|| {
+        let sensor = arm.sensor_to_tcp.inverse().translation.vector;
+        deflect_core::dalembert::serial::Payload::point(opts.spindle_mass, sensor * 0.5)
+    })
+}
+
+/// The combined run's inertial feed-forward per sample of `offline` (see the module docs):
+/// the compensated joints of the pass of `job` with the inertia of `opts` less `offline`'s.
+/// Empty when the inertia counts nothing; with it the loaded pass's figures per line.
+#[allow(clippy::type_complexity)]
+fn feedforward(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+    job: &Job,
+    program: &deflect_core::machining::Program,
+    seed: &[f64],
+    offline: &Report,
+) -> Result<
+    (
+        Vec<[f64; deflect_core::vjm::MAX_DOF]>,
+        Vec<job::LineSummary>,
+    ),
+    SimError,
+> {
+    let payload = spindle(arm, opts).unwrap_or(deflect_core::dalembert::serial::Payload::point(
+        0.0,
+        Vector3::zeros(),
+    ));
+    let inertia = job::Inertia {
+        payload,
+        links: opts.link_inertia,
+    };
+    let with = job
+        .clone()
+        .with_inertia(inertia)
+        .map_err(|e| SimError::new(format!("spindle inertia: {e}")))?;
+    if with.inertia().is_none() {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let loaded = job::run(&with, program, seed)
+        .map_err(|e| SimError::new(format!("offline pass with inertia: {e}")))?;
+    let ff = loaded
+        .samples
+        .iter()
+        .zip(&offline.samples)
+        .map(|(a, b)| {
+            let mut d = [0.0; deflect_core::vjm::MAX_DOF];
+            for ((d, x), y) in d.iter_mut().zip(&a.q_commanded).zip(&b.q_commanded) {
+                *d = x - y;
+            }
+            d
+        })
+        .collect();
+    Ok((ff, loaded.summary.lines()))
+}
+
 /// The KR 300's workpiece placement for the program scenario: a table in front of it, the
 /// workpiece frame's origin at (2.52, 0.07, 0.92) m, z up, x towards the robot; the tool points
 /// down from the joints [`PROGRAM_SEED`].
@@ -416,6 +520,10 @@ pub struct ProgramResult {
     pub cuts: Vec<Cut>,
     /// One run per mode, in [`ProgramMode::ALL`] order.
     pub runs: Vec<ProgramRun>,
+    /// The offline pass with the combined run's inertia, per program line: the process and
+    /// inertial parts of the deflection and the peak acceleration (empty when the inertia
+    /// counts nothing).
+    pub lines: Vec<job::LineSummary>,
     /// Wall-clock seconds.
     pub wall_seconds: f64,
 }
@@ -445,9 +553,17 @@ pub fn milling_program(
         .map_err(|e| SimError::new(format!("machining job: {e}")))?;
     let offline =
         job::run(&job, program, seed).map_err(|e| SimError::new(format!("offline pass: {e}")))?;
+    let (feedforward, lines) = feedforward(arm, opts, &job, program, seed, &offline)?;
     let run_opts = run_options(opts);
+    let inputs = RunInputs {
+        job: &job,
+        offline: &offline,
+        feedforward: &feedforward,
+        model: &model,
+        calibration: &calibration,
+    };
     let runs = crate::jobs::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
-        run_program(arm, &run_opts, &job, &offline, mode, &model, &calibration)
+        run_program(arm, &run_opts, &inputs, mode)
     })?
     .into_iter()
     .collect::<Result<Vec<_>, _>>()?;
@@ -456,6 +572,7 @@ pub fn milling_program(
         cuts: cuts(&offline, setup.tool.diameter / 2.0),
         offline,
         runs,
+        lines,
         wall_seconds: start.elapsed().as_secs_f64(),
     })
 }

@@ -18,10 +18,11 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
     let n = r.offline.samples.len();
     let _ = writeln!(
         t,
-        "milling: {name} on the flexible {} (rapier), {n} cycles of {:.0} ms, five runs in \
+        "milling: {name} on the flexible {} (rapier), {n} cycles of {:.0} ms, {} runs in \
          {:.1} s wall time",
         r.robot,
         1e3 / r.offline.rate_hz,
+        r.runs.len(),
         r.wall_seconds
     );
     let fmax = r
@@ -81,8 +82,60 @@ pub fn table(name: &str, r: &ProgramResult) -> String {
             100.0 * (1.0 - c.max_mm / u.max_mm),
             100.0 * (1.0 - h.max_mm / u.max_mm)
         );
+        if let Some(m) = by(ProgramMode::Combined) {
+            let _ = writeln!(
+                t,
+                "combined (hybrid with the inertial feed-forward): max {:.2} mm, at the cutter \
+                 exits {:.2} mm; max deviation reduced by {:.0} %",
+                m.max_mm,
+                m.exit_max_mm,
+                100.0 * (1.0 - m.max_mm / u.max_mm)
+            );
+        }
     }
+    sources(&mut t, r);
     t
+}
+
+/// Where the error comes from, per program line that cuts: the offline pass's process and
+/// inertial deflections at the rigid joints (largest position part) and peak acceleration, and
+/// each run's largest deviation across the feed there.
+fn sources(t: &mut String, r: &ProgramResult) {
+    if r.lines.is_empty() {
+        return;
+    }
+    let _ = write!(
+        t,
+        "by source, per cutting line: line  process  inertial [mm]  peak acc [m/s^2] |"
+    );
+    for run in &r.runs {
+        let _ = write!(t, " {}", run.mode.label());
+    }
+    let _ = writeln!(t, " [mm]");
+    for l in &r.lines {
+        let worst = |run: &ProgramRun| {
+            run.samples
+                .iter()
+                .filter(|s| s.line == l.line && s.depth > 0.0)
+                .map(|s| s.error_mm)
+                .fold(f64::NAN, f64::max)
+        };
+        if r.runs.first().is_none_or(|u| worst(u).is_nan()) {
+            continue;
+        }
+        let _ = write!(
+            t,
+            "  {:>4}  {:>7.3}  {:>8.3}       {:>8.3}         |",
+            l.line,
+            l.deflection_process * 1e3,
+            l.deflection_inertial * 1e3,
+            l.peak_acceleration
+        );
+        for run in &r.runs {
+            let _ = write!(t, " {:.3}", worst(run));
+        }
+        let _ = writeln!(t);
+    }
 }
 
 /// The summary as JSON.
@@ -156,7 +209,7 @@ fn role(mode: ProgramMode) -> Role {
         ProgramMode::Uncompensated => Role::Uncorrected,
         ProgramMode::Offline | ProgramMode::AxisSpecific => Role::Uncalibrated,
         ProgramMode::Cartesian => Role::Corrected,
-        ProgramMode::Hybrid => Role::Pilot,
+        ProgramMode::Hybrid | ProgramMode::Combined => Role::Pilot,
     }
 }
 

@@ -153,7 +153,7 @@ pub fn run(
     let start = start_pose.translation.vector;
     let pose_at =
         |p: &Vector3<f64>| Isometry3::from_parts(Translation3::from(*p), start_pose.rotation);
-    let mut sim = arm.sim(&opts.q0, 1.0, opts.dt, opts.substeps)?;
+    let mut sim = arm.sim(&opts.q0, 1.0, (opts.dt, opts.substeps), None)?;
     let mut comp = match mode {
         Mode::Uncompensated => None,
         Mode::Cartesian | Mode::Pilot | Mode::Uncalibrated => {
