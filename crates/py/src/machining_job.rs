@@ -167,8 +167,33 @@ type JobState = (
     Option<Vec<ToolState>>,
     Option<f64>,
     f64,
-    SpinState,
+    (SpinState, InertiaState),
 );
+
+/// A job's inertia as pickled: payload mass [kg], centre of mass [m], inertia (row-major)
+/// [kg m^2], link loads.
+type InertiaState = Option<(f64, [f64; 3], [f64; 9], bool)>;
+
+fn inertia_state(i: Option<&job::Inertia>) -> InertiaState {
+    i.map(|i| {
+        let p = &i.payload;
+        let m = p.inertia.transpose();
+        let mut flat = [0.0; 9];
+        flat.copy_from_slice(m.as_slice());
+        (p.mass, p.com.into(), flat, i.links)
+    })
+}
+
+fn of_inertia_state(s: InertiaState) -> Option<job::Inertia> {
+    s.map(|(mass, com, i, links)| job::Inertia {
+        payload: deflect_core::dalembert::serial::Payload {
+            mass,
+            com: Vector3::from(com),
+            inertia: nalgebra::Matrix3::from_row_slice(&i),
+        },
+        links,
+    })
+}
 
 /// A unit quaternion from pickled coordinates, bit for bit (norm checked to 1e-12).
 fn unit(q: [f64; 4], what: &str) -> PyResult<UnitQuaternion<f64>> {
@@ -199,6 +224,7 @@ impl MachiningJob {
         setup: Setup,
         tools: Option<CoreTable>,
         spin: Spin,
+        inertia: Option<job::Inertia>,
     ) -> PyResult<Self> {
         let mut inner = {
             let r = &robot.get().inner;
@@ -212,6 +238,9 @@ impl MachiningJob {
         }
         if let Spin::Constant(a) = spin {
             inner = inner.with_spin(SpinSchedule::constant(a).map_err(build_err)?);
+        }
+        if let Some(i) = inertia {
+            inner = inner.with_inertia(i).map_err(build_err)?;
         }
         Ok(Self { inner, robot, spin })
     }
@@ -317,7 +346,36 @@ impl MachiningJob {
         let tools = tools
             .map(|t| tool_table(t, setup.tool.flutes, setup.tool.helix))
             .transpose()?;
-        Self::build(robot.unbind(), setup, tools, spin)
+        Self::build(robot.unbind(), setup, tools, spin, None)
+    }
+
+    /// The job with inertial loads: the tool and spindle beyond the TCP (`mass` [kg], `com`
+    /// (3,) [m] and `inertia` (3, 3) about it [kg m^2], TCP frame) in the path's planned
+    /// motion and, with `links`, the arm's link masses (the URDF's `<inertial>`) join the
+    /// process wrench of every sample before the deflection. `MachiningResult`'s
+    /// `deflection_inertial` is the inertial part. A negative or non-finite mass, an
+    /// asymmetric or indefinite inertia or one no rigid body has (a principal moment above
+    /// the sum of the other two) raises an `InputError`.
+    #[pyo3(signature = (mass, com=None, inertia=None, links=false))]
+    fn with_inertia(
+        &self,
+        py: Python<'_>,
+        mass: f64,
+        com: Option<&Bound<'_, PyAny>>,
+        inertia: Option<&Bound<'_, PyAny>>,
+        links: bool,
+    ) -> PyResult<Self> {
+        let payload = crate::dalembert::serial::payload(mass, com, inertia)?;
+        let inner = self
+            .inner
+            .clone()
+            .with_inertia(job::Inertia { payload, links })
+            .map_err(build_err)?;
+        Ok(Self {
+            inner,
+            robot: self.robot.clone_ref(py),
+            spin: self.spin,
+        })
     }
 
     /// Pickling and copy.deepcopy: the robot and the setup as plain values, rebuilt bit for
@@ -356,7 +414,7 @@ impl MachiningJob {
                 .map(|t| t.tools().iter().map(tool_state).collect()),
             s.hand_spindle,
             s.rapid_skim,
-            me.spin.state(),
+            (me.spin.state(), inertia_state(me.inner.inertia())),
         );
         Ok((rebuild, (state,)))
     }
@@ -364,7 +422,8 @@ impl MachiningJob {
     /// The job of a pickled state (see `__reduce__`).
     #[staticmethod]
     fn _from_state(state: JobState) -> PyResult<Self> {
-        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand, skim, spin) = state;
+        let (robot, t, pq, tq, st, (d, flutes, helix), k, p, tools, hand, skim, (spin, inertia)) =
+            state;
         let setup = Setup {
             placement: Isometry3::from_parts(
                 Translation3::from(Vector3::from(t)),
@@ -396,6 +455,7 @@ impl MachiningJob {
             setup,
             tools.map(from_states).transpose()?,
             Spin::of_state(spin)?,
+            of_inertia_state(inertia),
         )
     }
 
@@ -404,6 +464,7 @@ impl MachiningJob {
             && self.inner.model() == other.inner.model()
             && self.inner.tools() == other.inner.tools()
             && self.spin == other.spin
+            && self.inner.inertia() == other.inner.inertia()
     }
 
     /// Runs the offline pass over `program` (a `GcodeProgram`) from the joints `seed` (dof,)

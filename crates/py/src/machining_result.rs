@@ -229,6 +229,33 @@ impl MachiningResult {
         self.rows(py, 6, |s, o| o.copy_from_slice(s.deflection.as_slice()))
     }
 
+    /// The inertial part of the deflection at `q` (n, 6) [m, rad], base frame: under the
+    /// tool and spindle's D'Alembert wrench and the link loads alone (zero without
+    /// `MachiningJob.with_inertia`).
+    #[getter]
+    fn deflection_inertial<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 6, |s, o| {
+            o.copy_from_slice(s.deflection_inertial.as_slice())
+        })
+    }
+
+    /// The tool and spindle's D'Alembert wrench (n, 6) [N, N m], base frame, about the tip.
+    #[getter]
+    fn inertial_wrench<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 6, |s, o| {
+            o.copy_from_slice(s.inertial_wrench.as_slice())
+        })
+    }
+
+    /// The tool's planned acceleration (n, 3) [m/s^2]: along the feed and towards an arc's
+    /// centre.
+    #[getter]
+    fn tool_acceleration<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {
+        self.rows(py, 3, |s, o| {
+            o.copy_from_slice(s.tool_acceleration.as_slice())
+        })
+    }
+
     /// Rigid pose-IK joints of the programmed path (n, dof).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<f64>>> {

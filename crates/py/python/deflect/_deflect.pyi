@@ -1228,6 +1228,15 @@ class MachiningJob:
     ) -> "FiveAxisResult":
         """The five-axis pass: the program's tool axis, the cutter's force along its edge on a
         tri-dexel stock, tip and tilt compensated, the parts cut in 3-D."""
+    def with_inertia(
+        self,
+        mass: float,
+        com: Optional[_ArrayLike] = None,
+        inertia: Optional[_ArrayLike] = None,
+        links: bool = False,
+    ) -> "MachiningJob":
+        """The job with the tool and spindle's inertia (mass [kg], com (3,) [m], inertia (3, 3)
+        [kg m^2], TCP frame) and, with links, the link masses' loads in the planned motion."""
     def __reduce__(self) -> Tuple[Any, Tuple[Any]]:
         """Pickling and copy.deepcopy: the robot and the setup, rebuilt bit for bit."""
     @staticmethod
@@ -1368,6 +1377,15 @@ class MachiningResult:
     @property
     def deflection(self) -> _FloatArray:
         """Deflection [dp; dr] of the tip (n, 6) [m, rad], base frame."""
+    @property
+    def deflection_inertial(self) -> _FloatArray:
+        """The inertial part of the deflection at q (n, 6) [m, rad], base frame."""
+    @property
+    def inertial_wrench(self) -> _FloatArray:
+        """The tool and spindle's D'Alembert wrench (n, 6) [N, N m], base frame."""
+    @property
+    def tool_acceleration(self) -> _FloatArray:
+        """The tool's planned acceleration (n, 3) [m/s^2]."""
     @property
     def q(self) -> _FloatArray:
         """Rigid pose-IK joints of the programmed path (n, dof)."""

@@ -31,6 +31,23 @@ fn model_name(d: Deflection) -> &'static str {
     }
 }
 
+/// A payload of `mass` \[kg\], centre of mass `com` (3,) \[m\] (default the TCP) and inertia
+/// about it (3, 3) \[kg m^2\] (default zero), TCP frame; checked by the core where it is used.
+pub(crate) fn payload(
+    mass: f64,
+    com: Option<&Bound<'_, PyAny>>,
+    inertia: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Payload> {
+    Ok(Payload {
+        mass,
+        com: vec3(com, "com")?,
+        inertia: match inertia {
+            None => Matrix3::zeros(),
+            Some(i) => fixed_matrix::<3, 3>(i, "inertia")?,
+        },
+    })
+}
+
 fn vec3(o: Option<&Bound<'_, PyAny>>, what: &str) -> PyResult<Vector3<f64>> {
     match o {
         None => Ok(Vector3::zeros()),
@@ -148,14 +165,7 @@ impl SerialDalembertCorrector {
         let robot = robot.get();
         let chain = robot.inner.model.clone();
         let dof = chain.dof();
-        let payload = Payload {
-            mass,
-            com: vec3(com, "com")?,
-            inertia: match inertia {
-                None => Matrix3::zeros(),
-                Some(i) => fixed_matrix::<3, 3>(i, "inertia")?,
-            },
-        };
+        let payload = payload(mass, com, inertia)?;
         let deflection = match model {
             "exact" => Deflection::Exact,
             "linearized" => Deflection::Linearized,
