@@ -9,14 +9,11 @@ mod fixtures;
 use deflect_core::BuildError;
 use deflect_core::dalembert::serial::{self, Payload};
 use deflect_core::io::gcode::{self, GcodeOptions};
-use deflect_core::machining::cutting::{Coefficients, Tool};
-use deflect_core::machining::job::{self, Inertia, Job, Setup, Stock};
-use deflect_core::machining::path::PathOptions;
-use deflect_core::mechanism::PoseIkOptions;
+use deflect_core::machining::job::{self, Inertia, Setup};
 use deflect_core::motion::PoseState;
 use deflect_core::units::LengthUnit;
 use deflect_core::vjm::{self, Data};
-use nalgebra::{Isometry3, Matrix3, Translation3, Vector2, Vector3};
+use nalgebra::{Isometry3, Matrix3, Translation3, Vector3};
 
 fn program(text: &str) -> deflect_core::machining::Program {
     gcode::from_str(
@@ -30,34 +27,7 @@ fn program(text: &str) -> deflect_core::machining::Program {
     .unwrap()
 }
 
-/// The KR 300 with the workpiece under its TCP at the usual start joints (as the job tests).
-fn kr300_job() -> (Job, Vec<f64>) {
-    let robot = fixtures::kr300();
-    let q0 = vec![0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
-    let tcp = vjm::forward(&robot.model, &mut Data::new(&robot.model), &q0).unwrap();
-    let rotation = tcp.rotation * Setup::tool_down().inverse();
-    let origin = tcp.translation.vector - rotation * Vector3::new(0.0, 0.0, 0.02);
-    let setup = Setup {
-        placement: Isometry3::from_parts(Translation3::from(origin), rotation),
-        tool_orientation: Setup::tool_down(),
-        tool: Tool::new(0.016, 3, 0.0).unwrap(),
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
-        stock: Stock {
-            min: Vector2::new(0.0, -0.03),
-            max: Vector2::new(0.08, 0.03),
-            top: 0.0,
-            cell: 5.0e-4,
-        },
-        path: PathOptions::default(),
-        ik: PoseIkOptions::default(),
-        hand_spindle: None,
-        rapid_skim: job::RAPID_SKIM,
-    };
-    (
-        Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap(),
-        q0,
-    )
-}
+use fixtures::kr300_job;
 
 /// A 60 kg spindle and tool, its centre of mass 0.2 m behind the tip.
 fn spindle() -> Payload {

@@ -10,17 +10,15 @@ mod fixtures;
 use std::f64::consts::PI;
 
 use deflect_core::io::gcode::{self, GcodeOptions};
-use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::engagement::{self, Contact};
-use deflect_core::machining::job::{self, Job, Setup, Stock};
+use deflect_core::machining::job;
 use deflect_core::machining::path::{self, PathOptions};
 use deflect_core::machining::stock::{Cutter, ZMap};
-use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::motion::{Limits, Profile};
 use deflect_core::units::LengthUnit;
-use deflect_core::vjm::{self, Data};
 use deflect_core::{JobError, TickError};
-use nalgebra::{Isometry3, Translation3, Vector2, Vector3};
+use nalgebra::{Vector2, Vector3};
 
 fn program(text: &str) -> deflect_core::machining::Program {
     gcode::from_str(
@@ -164,35 +162,7 @@ fn a_slot_engages_zero_to_pi_at_its_depth_and_half_immersion_a_quarter() {
     assert!(matches!(c, Contact::Plunge { depth } if (depth - a).abs() < 1e-12));
 }
 
-/// A job on the KR 300 with the workpiece placed under its TCP at the usual start joints:
-/// the workpiece z along the tool axis (TCP z reversed), its origin 20 mm below the tip.
-fn kr300_job() -> (Job, Vec<f64>) {
-    let robot = fixtures::kr300();
-    let q0 = vec![0.0, -0.9, 1.4, 0.0, 1.0708, 0.0];
-    let tcp = vjm::forward(&robot.model, &mut Data::new(&robot.model), &q0).unwrap();
-    let rotation = tcp.rotation * Setup::tool_down().inverse();
-    let origin = tcp.translation.vector - rotation * Vector3::new(0.0, 0.0, 0.02);
-    let setup = Setup {
-        placement: Isometry3::from_parts(Translation3::from(origin), rotation),
-        tool_orientation: Setup::tool_down(),
-        tool: Tool::new(0.016, 3, 0.0).unwrap(),
-        coefficients: Coefficients::AL7075_T6_CARBIDE,
-        stock: Stock {
-            min: Vector2::new(0.0, -0.03),
-            max: Vector2::new(0.08, 0.03),
-            top: 0.0,
-            cell: 5.0e-4,
-        },
-        path: PathOptions::default(),
-        ik: PoseIkOptions::default(),
-        hand_spindle: None,
-        rapid_skim: job::RAPID_SKIM,
-    };
-    (
-        Job::new(robot.model.clone(), &robot.joint_limits, setup).unwrap(),
-        q0,
-    )
-}
+use fixtures::kr300_job;
 
 /// The slotting average of the 16 mm three-flute mill in Al7075 at depth `a` and feed per
 /// tooth `c`, tool frame: Altintas' closed forms (2.14-2.16 of Manufacturing Automation).

@@ -509,24 +509,16 @@ impl Warm {
         let dof = job.model.dof();
         let seed = self.seed(dof);
         let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
-            pose_ik(
-                &job.model,
-                data,
-                target,
-                seed.get(..dof).unwrap_or(&[]),
-                wrench,
-                load,
-                &job.setup.ik,
-            )
+            loaded_ik(job, data, target, seed, (wrench, load))
         };
-        let sol = match solve(data, &seed) {
-            Ok(sol) => sol,
+        let q = match solve(data, &seed) {
+            Ok(q) => q,
             Err(_) if self.q_before.is_some() => solve(data, &self.q)?,
             Err(e) => return Err(e),
         };
         self.q_before = self.solved.then_some(self.q);
         self.solved = true;
-        self.q = sol.q;
+        self.q = q;
         in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
     }
 
@@ -540,19 +532,22 @@ impl Warm {
         wrench: &Vector6,
         load: Load<'_>,
     ) -> Result<(), TickError> {
-        let dof = job.model.dof();
-        let sol = pose_ik(
-            &job.model,
-            data,
-            target,
-            self.q.get(..dof).unwrap_or(&[]),
-            wrench,
-            load,
-            &job.setup.ik,
-        )?;
-        self.q = sol.q;
-        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
+        self.q = loaded_ik(job, data, target, &self.q, (wrench, load))?;
+        in_limits(self.q.get(..job.model.dof()).unwrap_or(&[]), &job.limits)
     }
+}
+
+/// The pose IK of `job`'s arm onto `target` from `seed`, loaded by `wrench` as `load` says.
+fn loaded_ik(
+    job: &Job,
+    data: &mut Data,
+    target: &Isometry3<f64>,
+    seed: &[f64; MAX_DOF],
+    (wrench, load): (&Vector6, Load<'_>),
+) -> Result<[f64; MAX_DOF], TickError> {
+    let dof = job.model.dof();
+    let seed = seed.get(..dof).unwrap_or(&[]);
+    Ok(pose_ik(&job.model, data, target, seed, wrench, load, &job.setup.ik)?.q)
 }
 
 /// The state of one sample's coupling: the wrench and tip of the last exact deflection, the
