@@ -128,7 +128,9 @@ def test_a_users_arm_tool_and_program(ur5_out):
     s = json.loads((ur5_out / "milling_summary.json").read_text())
     assert s["robot"] == "ur5"
     m = {r["mode"]: r["metrics"] for r in s["runs"]}
-    assert list(m) == ["uncompensated", "offline", "cartesian", "hybrid", "axis_specific"]
+    assert list(m) == [
+        "uncompensated", "offline", "cartesian", "hybrid", "axis_specific", "combined"
+    ]
     # One cut from the block's edge at x = 0 to its end at x = 30 mm.
     assert len(s["cuts"]) == 1
     cut = s["cuts"][0]
