@@ -8,24 +8,12 @@ mod fixtures;
 
 use deflect_core::BuildError;
 use deflect_core::dalembert::serial::{self, Payload};
-use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::job::{self, Inertia, Setup};
 use deflect_core::motion::PoseState;
-use deflect_core::units::LengthUnit;
 use deflect_core::vjm::{self, Data};
 use nalgebra::{Isometry3, Matrix3, Translation3, Vector3};
 
-fn program(text: &str) -> deflect_core::machining::Program {
-    gcode::from_str(
-        text,
-        &GcodeOptions {
-            start: Vector3::new(0.0, 0.0, 0.02),
-            units: LengthUnit::Millimetre,
-            ..GcodeOptions::default()
-        },
-    )
-    .unwrap()
-}
+use fixtures::mm_program as program;
 
 use fixtures::kr300_job;
 

@@ -20,17 +20,7 @@ use deflect_core::units::LengthUnit;
 use deflect_core::{JobError, TickError};
 use nalgebra::{Vector2, Vector3};
 
-fn program(text: &str) -> deflect_core::machining::Program {
-    gcode::from_str(
-        text,
-        &GcodeOptions {
-            start: Vector3::new(0.0, 0.0, 0.02),
-            units: LengthUnit::Millimetre,
-            ..GcodeOptions::default()
-        },
-    )
-    .unwrap()
-}
+use fixtures::mm_program as program;
 
 #[test]
 fn a_line_takes_the_closed_form_profile_time_and_ends_exactly() {
