@@ -6,7 +6,7 @@
 use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::job::{self, Job, Setup, Stock};
-use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::path::{Blending, PathOptions};
 use deflect_core::machining::spin::{self, LoadPath, SpinMeasure, SpinOptions, SpinSchedule};
 use deflect_core::mechanism::PoseIkOptions;
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector2, Vector3};
@@ -32,7 +32,10 @@ use deflect_core::units::LengthUnit;
 /// `milling_force`), the stock block (`stock_min`, `stock_max` (x, y) [m], `stock_top` [m],
 /// `cell` [m]), and how the program is driven: sampled at `rate_hz` (default 250, the 4 ms
 /// cycle), path `acceleration` [m/s^2] and `jerk` [m/s^3], `rapid_speed` [m/s] and the
-/// `corner_angle` [rad] driven through without a stop. `tools`: a `ToolTable` (or the path of a
+/// `corner_angle` [rad] driven through without a stop; `blending`: how the other corners are
+/// driven, `"stop"` (the default: an exact stop, the tool on the programmed geometry),
+/// `"program"` (the program's `G64 P` tolerance per move, `G61` stops) or a tolerance [m]
+/// for every corner (0: as fast as the ramps allow). `tools`: a `ToolTable` (or the path of a
 /// `.tbl` / `.toml` table, its `.tbl` tools taking `flutes` and `helix`): each move cuts with
 /// the tool its program put in the spindle; without one the `diameter` tool serves every `T`.
 /// `spindle_rpm`: the speed of a spindle the program never starts (a hand-started spindle),
@@ -153,7 +156,7 @@ impl Spin {
 /// A job as pickled: the robot, the placement (translation, quaternion i j k w), the tool
 /// orientation (quaternion), the stock (min x, min y, max x, max y, top, cell), the tool
 /// (diameter, flutes, helix), the coefficients, the path options (rate, acceleration, jerk,
-/// rapid speed, corner angle), the tool table, the hand spindle [rev/s] and the rapid skim
+/// rapid speed, corner angle, blending as [`blending_state`] writes it), the tool table, the hand spindle [rev/s] and the rapid skim
 /// [m].
 type JobState = (
     Py<SerialRobot>,
@@ -163,12 +166,50 @@ type JobState = (
     [f64; 6],
     (f64, u32, f64),
     [f64; 6],
-    [f64; 5],
+    [f64; 6],
     Option<Vec<ToolState>>,
     Option<f64>,
     f64,
     (SpinState, InertiaState),
 );
+
+/// `blending=`: `None` or `"stop"`, `"program"`, or a tolerance [m] (validated by the job).
+fn blending(o: Option<&Bound<'_, PyAny>>) -> PyResult<Blending> {
+    let Some(o) = o else {
+        return Ok(Blending::ExactStop);
+    };
+    if let Ok(name) = o.extract::<String>() {
+        return match name.as_str() {
+            "stop" => Ok(Blending::ExactStop),
+            "program" => Ok(Blending::Program),
+            other => Err(InputError::new_err(format!(
+                "blending: {other:?}; expected \"stop\", \"program\" or a tolerance in metres"
+            ))),
+        };
+    }
+    Ok(Blending::Tolerance(real(o, "blending")?))
+}
+
+/// Blending as pickled, one number: -1 an exact stop, -2 the program's, a tolerance >= 0 [m]
+/// (what `Blending::validate` accepts) as itself.
+fn blending_state(b: &Blending) -> f64 {
+    match *b {
+        Blending::ExactStop => -1.0,
+        Blending::Program => -2.0,
+        Blending::Tolerance(p) => p,
+    }
+}
+
+/// The blending of a pickled number ([`blending_state`]).
+fn of_blending_state(x: f64) -> Blending {
+    if x == -1.0 {
+        Blending::ExactStop
+    } else if x == -2.0 {
+        Blending::Program
+    } else {
+        Blending::Tolerance(x)
+    }
+}
 
 /// A job's inertia as pickled: payload mass [kg], centre of mass [m], inertia (row-major)
 /// [kg m^2], link loads.
@@ -270,8 +311,8 @@ fn tool_table(t: &Bound<'_, PyAny>, flutes: u32, helix: f64) -> PyResult<CoreTab
 #[pymethods]
 impl MachiningJob {
     #[new]
-    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, tools=None, spindle_rpm=None, rapid_skim=None, spin=None, spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure="normal"),
-           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, tools=None, spindle_rpm=None, rapid_skim=0.0001, spin='keep', spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure='normal')")]
+    #[pyo3(signature = (robot, placement, *, stock_min, stock_max, stock_top=None, cell=None, tool_orientation=None, diameter=None, flutes=None, helix=None, coefficients=None, rate_hz=None, acceleration=None, jerk=None, rapid_speed=None, corner_angle=None, blending=None, tools=None, spindle_rpm=None, rapid_skim=None, spin=None, spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure="normal"),
+           text_signature = "(robot, placement, *, stock_min, stock_max, stock_top=0.0, cell=0.0005, tool_orientation=None, diameter=0.016, flutes=3, helix=0.0, coefficients=None, rate_hz=250.0, acceleration=2.0, jerk=20.0, rapid_speed=0.25, corner_angle=0.017453292519943295, blending='stop', tools=None, spindle_rpm=None, rapid_skim=0.0001, spin='keep', spin_step=5.0, spin_rate=(1.0, 30.0), spin_measure='normal')")]
     #[allow(clippy::too_many_arguments)] // reason: the documented Python keyword arguments
     fn new(
         robot: Bound<'_, SerialRobot>,
@@ -290,6 +331,7 @@ impl MachiningJob {
         jerk: Option<&Bound<'_, PyAny>>,
         rapid_speed: Option<&Bound<'_, PyAny>>,
         corner_angle: Option<&Bound<'_, PyAny>>,
+        blending: Option<&Bound<'_, PyAny>>,
         tools: Option<&Bound<'_, PyAny>>,
         spindle_rpm: Option<&Bound<'_, PyAny>>,
         rapid_skim: Option<&Bound<'_, PyAny>>,
@@ -335,6 +377,7 @@ impl MachiningJob {
                 jerk: or(jerk, "jerk", d.jerk)?,
                 rapid_speed: or(rapid_speed, "rapid_speed", d.rapid_speed)?,
                 corner_angle: or(corner_angle, "corner_angle", d.corner_angle)?,
+                blending: self::blending(blending)?,
             },
             ik: PoseIkOptions::default(),
             hand_spindle: spindle_rpm
@@ -408,6 +451,7 @@ impl MachiningJob {
                 s.path.jerk,
                 s.path.rapid_speed,
                 s.path.corner_angle,
+                blending_state(&s.path.blending),
             ],
             me.inner
                 .tools()
@@ -445,6 +489,7 @@ impl MachiningJob {
                 jerk: p[2],
                 rapid_speed: p[3],
                 corner_angle: p[4],
+                blending: of_blending_state(p[5]),
             },
             ik: PoseIkOptions::default(),
             hand_spindle: hand,

@@ -597,7 +597,7 @@ pub fn run_streaming<S: Sink + ?Sized>(
                 deflection: u.deflection,
                 inertial_wrench: u.inertial_wrench,
                 deflection_inertial: u.deflection_inertial,
-                tool_acceleration: inertia::tool_acceleration(program, &n.path),
+                tool_acceleration: n.path.acceleration_vector,
                 q_commanded: c.q,
                 commanded: c.commanded,
                 actual_uncompensated: u.tip,

@@ -40,7 +40,8 @@ pub struct JobSample {
     /// both parts in one deflection.
     pub deflection_inertial: Vector6,
     /// The tool's planned acceleration \[m/s^2\], workpiece frame: along the feed and, on an
-    /// arc, towards its centre ([`crate::machining::Move::curvature`]).
+    /// arc, towards its centre ([`crate::machining::Move::curvature`]); in a corner blend the
+    /// sum of both runs' ([`crate::machining::path::PathSample::acceleration_vector`]).
     pub tool_acceleration: Vector3<f64>,
     /// Compensated joints: the loaded tip reaches the programmed pose \[rad or m\].
     pub q_commanded: [f64; MAX_DOF],

@@ -1205,6 +1205,7 @@ class MachiningJob:
         jerk: float = 20.0,
         rapid_speed: float = 0.25,
         corner_angle: float = 0.017453292519943295,
+        blending: Union[str, float] = "stop",
         tools: Union[ToolTable, _StrPath, None] = None,
         spindle_rpm: Optional[float] = None,
         rapid_skim: float = 0.0001,

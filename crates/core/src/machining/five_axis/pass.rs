@@ -131,6 +131,10 @@ impl<'a> Pass<'a> {
         let Some(t0) = arm.last else {
             return Ok(());
         };
+        // In a corner blend the tool leaves the program's corners: its chord is the path.
+        if p0.blend || s.blend {
+            return Ok(());
+        }
         let (off0, off1) = (t0.tip - p0.position, pose.tip - s.position);
         let (tilt0, tilt1) = (t0.axis - p0.axis, pose.axis - s.axis);
         let program = self.program;

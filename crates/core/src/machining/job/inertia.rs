@@ -5,8 +5,9 @@
 //!
 //! Per sample the planned motion of the tool is the path's: the tip at `p`, the feed
 //! direction `T`, the path speed `v` and acceleration `a_t` along it and the curvature `k` of
-//! the move ([`crate::machining::Move::curvature`]), in the base frame through the placement
-//! `R`:
+//! the move ([`crate::machining::Move::curvature`]; in a corner blend the sum of both runs',
+//! [`crate::machining::path::PathSample::acceleration_vector`]), in the base frame through
+//! the placement `R`:
 //!
 //! ```text
 //! velocity     = R T v
@@ -23,7 +24,6 @@ use nalgebra::{Isometry3, UnitQuaternion, Vector3};
 
 use crate::dalembert::serial::Payload;
 use crate::error::{BuildError, TickError};
-use crate::machining::Program;
 use crate::machining::path::PathSample;
 use crate::mechanism::PoseIkOptions;
 use crate::motion::PoseState;
@@ -53,20 +53,9 @@ impl Inertia {
     }
 }
 
-/// The tool's planned acceleration at sample `s` \[m/s^2\], workpiece frame: `T a_t + k v^2`
-/// (see the module docs).
-pub(super) fn tool_acceleration(program: &Program, s: &PathSample) -> Vector3<f64> {
-    let curvature = program
-        .moves
-        .get(s.move_index)
-        .map_or_else(Vector3::zeros, |m| m.curvature(s.fraction));
-    s.direction * s.acceleration + curvature * (s.speed * s.speed)
-}
-
 /// The planned motion of the tool at sample `s` (see the module docs): pose `target` (base
 /// frame), velocity and acceleration through the placement's rotation `to_base`.
 pub(super) fn pose_state(
-    program: &Program,
     to_base: &UnitQuaternion<f64>,
     s: &PathSample,
     target: &Isometry3<f64>,
@@ -75,7 +64,7 @@ pub(super) fn pose_state(
         t: s.time,
         pose: *target,
         velocity: to_base * (s.direction * s.speed),
-        acceleration: to_base * tool_acceleration(program, s),
+        acceleration: to_base * s.acceleration_vector,
         angular_velocity: Vector3::zeros(),
         angular_acceleration: Vector3::zeros(),
     }

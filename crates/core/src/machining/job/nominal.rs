@@ -46,7 +46,7 @@ pub(super) struct Stage<'a> {
     job: &'a Job,
     program: &'a Program,
     /// The last sample's move and fraction on it.
-    prev_at: Option<(usize, f64)>,
+    prev_at: Option<(usize, f64, bool)>,
     tools: &'a ToolModels,
     to_base: Isometry3<f64>,
     pub stock: ZMap,
@@ -184,9 +184,14 @@ impl<'a> Stage<'a> {
     /// and the deepest cut of a stretch on a rapid move \[m\].
     fn cut_between(&mut self, s: &PathSample) -> Result<(bool, f64), TickError> {
         let here = (s.move_index, s.fraction);
-        let Some(from) = self.prev_at.replace(here) else {
+        let Some((m0, f0, blend)) = self.prev_at.replace((here.0, here.1, s.blend)) else {
             return Ok((false, 0.0));
         };
+        // In a corner blend the tool leaves the program's corners: its chord is the path.
+        if blend || s.blend {
+            return Ok((false, 0.0));
+        }
+        let from = (m0, f0);
         let program = self.program;
         let tools = self.tools;
         let (mut rapid, mut failed, mut cells) = (0.0f64, None, 0usize);

@@ -159,7 +159,7 @@ impl<'a> Arm<'a> {
         let target =
             self.to_base * Isometry3::from_parts(Translation3::from(n.path.position), orientation);
         self.motion = job.inertia.as_ref().map(|i| {
-            let state = inertia::pose_state(self.program, &self.to_base.rotation, &n.path, &target);
+            let state = inertia::pose_state(&self.to_base.rotation, &n.path, &target);
             Motion::new(i, state)
         });
         let (model, ik, dof) = (&job.model, &job.setup.ik, job.model.dof());

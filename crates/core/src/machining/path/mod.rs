@@ -16,10 +16,12 @@
 //!   corners, feed changes and between rapid and feed moves.
 //!
 //! The tool therefore stays exactly on the programmed geometry (no corner rounding), which
-//! is what a prediction of the machined part needs; the price is the stop at each corner,
-//! which a real controller's blending would shorten (the program's `G64` tolerance is
-//! recorded per move, [`super::PathControl`], not yet used here). A dwell (`G4`, a drilling
-//! cycle's pause) holds the tool at rest for its time between two runs.
+//! is what a prediction of the programmed part needs; the price is the stop at each corner,
+//! and the arm's ringing after it. [`PathOptions::blending`] drives the corners as a
+//! controller in blending mode does instead (the program's `G64 P` per move, or one
+//! tolerance for all): the next run starts while the last one decelerates, within the
+//! tolerance of the corner ([`blend`]). A dwell (`G4`, a drilling cycle's pause) holds the
+//! tool at rest for its time between two runs.
 
 use alloc::vec::Vec;
 
@@ -27,7 +29,13 @@ use nalgebra::{ComplexField, Vector3};
 
 use super::{Motion, Program};
 use crate::error::{BuildError, param};
-use crate::motion::{Limits, Profile};
+use crate::motion::{Limits, PathState, Profile};
+
+mod between;
+pub mod blend;
+
+pub use between::{MAX_ARC_CHORDS, WAYPOINT_TOLERANCE, between};
+pub use blend::{Blending, MAX_BLEND_TOLERANCE};
 
 /// Highest sampling rate \[Hz\] (10 kHz; servo loops run at 1-8 kHz).
 pub const MAX_RATE_HZ: f64 = 1.0e4;
@@ -55,10 +63,13 @@ pub struct PathOptions {
     pub rapid_speed: f64,
     /// Largest change of direction \[rad\] driven through without stopping, `[0, pi/2)`.
     pub corner_angle: f64,
+    /// How the corners past `corner_angle` are driven: an exact stop (the default) or a
+    /// blend ([`blend`]).
+    pub blending: Blending,
 }
 
 impl Default for PathOptions {
-    /// 250 Hz (the 4 ms cycle), 2 m/s^2, 20 m/s^3, rapids at 0.25 m/s, 1 degree.
+    /// 250 Hz (the 4 ms cycle), 2 m/s^2, 20 m/s^3, rapids at 0.25 m/s, 1 degree, exact stops.
     fn default() -> Self {
         Self {
             rate_hz: 250.0,
@@ -66,6 +77,7 @@ impl Default for PathOptions {
             jerk: 20.0,
             rapid_speed: 0.25,
             corner_angle: 1.0_f64.to_radians(),
+            blending: Blending::ExactStop,
         }
     }
 }
@@ -86,7 +98,7 @@ impl PathOptions {
             (0.0..core::f64::consts::FRAC_PI_2).contains(&self.corner_angle),
             "in [0, pi/2) rad",
         )?;
-        Ok(())
+        self.blending.validate()
     }
 }
 
@@ -108,8 +120,16 @@ pub struct PathSample {
     pub axis: Vector3<f64>,
     /// Path speed \[m/s\].
     pub speed: f64,
-    /// Path acceleration \[m/s^2\].
+    /// Path acceleration \[m/s^2\]: along [`Self::direction`].
     pub acceleration: f64,
+    /// The tool's acceleration \[m/s^2\], workpiece frame: along the path and towards its
+    /// centre of curvature (`T a + k v^2`, [`super::Move::curvature`]); in a blend the sum
+    /// of both runs'.
+    pub acceleration_vector: Vector3<f64>,
+    /// Whether the sample lies in a corner blend (two runs moving at once): the tool is off
+    /// the programmed path there, within the blending tolerance of the corner, and the move,
+    /// line and fraction are those of the faster run.
+    pub blend: bool,
     /// Whether the move is a feed move (`G1`-`G3`), not a rapid.
     pub feed_move: bool,
     /// Spindle speed \[rev/s\] (< 0 counter-clockwise, `M4`).
@@ -126,7 +146,8 @@ pub struct PathSample {
 }
 
 /// One rest-to-rest profile over the moves `segs[first..=last]`, or a dwell of `hold`
-/// seconds at the one move `segs[first]` (then `profile` is the zero-length profile).
+/// seconds at the one move `segs[first]` (then `profile` is the zero-length profile);
+/// `blend_in` \[s\] is how long it overlaps the run before (0: it starts from rest).
 #[derive(Debug, Clone, Copy)]
 struct Run {
     first: usize,
@@ -134,6 +155,7 @@ struct Run {
     t0: f64,
     profile: Profile,
     hold: f64,
+    blend_in: f64,
 }
 
 impl Run {
@@ -187,6 +209,7 @@ fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
             t0,
             profile,
             hold,
+            blend_in: 0.0,
         };
         p.runs.push(run);
         t0 += run.duration();
@@ -248,6 +271,7 @@ fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
     if first < p.segs.len() {
         close(&mut p, first, s)?;
     }
+    blend::overlap(program, &options.blending, &mut p)?;
     Ok(p)
 }
 
@@ -345,6 +369,64 @@ impl<'a> Sampler<'a> {
     }
 }
 
+/// One run's part of a sample: the move holding its arc length and the (unclamped)
+/// fraction on it, the run's path state, and the tool's place, tangent and acceleration.
+struct Part<'p> {
+    index: usize,
+    mv: &'p super::Move,
+    fraction: f64,
+    state: PathState,
+    position: Vector3<f64>,
+    direction: Vector3<f64>,
+    acceleration: Vector3<f64>,
+}
+
+impl<'p> Part<'p> {
+    fn new(program: &'p Program, plan: &Plan, seg: usize, state: PathState) -> Option<Self> {
+        let (&index, &s) = (plan.segs.get(seg)?, plan.s0.get(seg)?);
+        let mv = program.moves.get(index)?;
+        let length = mv.length();
+        let fraction = if length > 0.0 {
+            (state.s - s) / length
+        } else {
+            0.0
+        };
+        let f = fraction.clamp(0.0, 1.0);
+        let direction = mv.tangent(f);
+        Some(Self {
+            index,
+            mv,
+            fraction,
+            state,
+            position: mv.point(fraction),
+            direction,
+            acceleration: direction * state.a + mv.curvature(f) * (state.v * state.v),
+        })
+    }
+}
+
+impl Plan {
+    /// The move of `run` holding arc length `s`: the last one starting at or before it,
+    /// searched forwards from `seg`.
+    fn locate(&self, run: &Run, s: f64, seg: usize) -> usize {
+        let mut seg = seg.max(run.first);
+        while seg < run.last && self.s0.get(seg + 1).is_some_and(|&x| s >= x) {
+            seg += 1;
+        }
+        seg
+    }
+
+    /// [`Self::locate`] searched backwards from the run's last move (a blend's tail is near
+    /// the end).
+    fn locate_back(&self, run: &Run, s: f64) -> usize {
+        let mut seg = run.last;
+        while seg > run.first && self.s0.get(seg).is_some_and(|&x| s < x) {
+            seg -= 1;
+        }
+        seg
+    }
+}
+
 impl Iterator for Sampler<'_> {
     type Item = PathSample;
 
@@ -355,44 +437,67 @@ impl Iterator for Sampler<'_> {
         let plan = &self.plan;
         let t = (self.tick as f64 / self.rate_hz).min(self.total);
         self.tick += 1;
-        while self.run + 1 < plan.runs.len()
-            && plan
-                .runs
-                .get(self.run)
-                .is_some_and(|run| t > run.t0 + run.duration())
-        {
+        // The latest run started: a blended run from its start, one after a stop once the
+        // run before has ended.
+        while let (Some(run), Some(next)) = (plan.runs.get(self.run), plan.runs.get(self.run + 1)) {
+            let started = if next.blend_in > 0.0 {
+                t >= next.t0
+            } else {
+                t > run.t0 + run.duration()
+            };
+            if !started {
+                break;
+            }
             self.run += 1;
         }
         let run = plan.runs.get(self.run)?;
         let state = run.profile.sample(t - run.t0);
-        // The move holding arc length `s`: the last one of the run starting at or before it.
-        self.seg = self.seg.max(run.first);
-        while self.seg < run.last && plan.s0.get(self.seg + 1).is_some_and(|&s| state.s >= s) {
-            self.seg += 1;
-        }
-        let (&m, &s) = (plan.segs.get(self.seg)?, plan.s0.get(self.seg)?);
-        let mv = self.program.moves.get(m)?;
-        let length = mv.length();
-        let fraction = if length > 0.0 {
-            (state.s - s) / length
-        } else {
-            0.0
+        self.seg = plan.locate(run, state.s, self.seg);
+        let head = Part::new(self.program, plan, self.seg, state)?;
+        // The run before, while it still decelerates into the blend.
+        let tail = (run.blend_in > 0.0 && t < run.t0 + run.blend_in)
+            .then(|| self.run.checked_sub(1).and_then(|k| plan.runs.get(k)))
+            .flatten()
+            .and_then(|before| {
+                let state = before.profile.sample(t - before.t0);
+                let seg = plan.locate_back(before, state.s);
+                Part::new(self.program, plan, seg, state)
+            });
+        let Some(tail) = tail else {
+            return Some(make(
+                t,
+                self.run,
+                &head,
+                head.position,
+                head.direction,
+                false,
+            ));
         };
-        Some(PathSample {
-            time: t,
-            move_index: m,
-            line: mv.line,
-            position: mv.point(fraction),
-            direction: mv.tangent(fraction.clamp(0.0, 1.0)),
-            axis: mv.axis(fraction.clamp(0.0, 1.0)),
-            speed: state.v,
-            acceleration: state.a,
-            feed_move: mv.is_feed(),
-            spindle: mv.spindle,
-            tool: mv.tool,
-            fraction: fraction.clamp(0.0, 1.0),
-            run: self.run,
-        })
+        // Both runs' displacements from the corner (the tail's end, the head's start).
+        let corner = plan
+            .segs
+            .get(run.first)
+            .and_then(|&m| self.program.moves.get(m))
+            .map_or(head.position, |m| m.point(0.0));
+        let position = tail.position + head.position - corner;
+        let velocity = tail.direction * tail.state.v + head.direction * head.state.v;
+        let speed = velocity.norm();
+        let direction = if speed > 0.0 {
+            velocity / speed
+        } else {
+            head.direction
+        };
+        let acceleration = tail.acceleration + head.acceleration;
+        let (owner, index) = if head.state.v >= tail.state.v {
+            (&head, self.run)
+        } else {
+            (&tail, self.run - 1)
+        };
+        let mut s = make(t, index, owner, position, direction, true);
+        s.speed = speed;
+        s.acceleration = acceleration.dot(&direction);
+        s.acceleration_vector = acceleration;
+        Some(s)
     }
 
     fn size_hint(&self) -> (usize, Option<usize>) {
@@ -401,89 +506,32 @@ impl Iterator for Sampler<'_> {
     }
 }
 
-/// How far the stock's cut may leave the programmed path between two samples \[m\]: 1 um. An
-/// arc is cut along chords whose sagitta stays below it (at the 4 ms cycle a sample's chord
-/// on a 10 mm arc at 25 mm/s has 0.13 um, so none is added there).
-pub const WAYPOINT_TOLERANCE: f64 = 1.0e-6;
-
-/// Most chords one arc is cut into between two samples: past it (a kilometre arc at one
-/// sample per second) its chords' sagitta exceeds [`WAYPOINT_TOLERANCE`].
-pub const MAX_ARC_CHORDS: usize = 4096;
-
-/// The points where the programmed path bends strictly between two samples at `from` and
-/// `to` (each `(move index, fraction)` of [`PathSample`], `from` not after `to`): every
-/// move's end between them and the points that cut each arc into chords within
-/// [`WAYPOINT_TOLERANCE`]. Calls `visit(point, move index, share)` in path order, `share` the
-/// part of the path's length from `from` to the point (0..1), the move index that of the
-/// move the segment *ending* at the point lies on; returns how many points it visited. None
-/// for two samples on one straight move. Allocation-free.
-pub fn between(
-    program: &Program,
-    from: (usize, f64),
-    to: (usize, f64),
-    mut visit: impl FnMut(Vector3<f64>, usize, f64),
-) -> usize {
-    let (m0, f0) = from;
-    let (m1, f1) = to;
-    if m1 < m0 || (m1 == m0 && f1 <= f0) {
-        return 0;
+/// The sample at `t` of `part` on run `run`, the tool at `position` moving along
+/// `direction`.
+fn make(
+    t: f64,
+    run: usize,
+    part: &Part<'_>,
+    position: Vector3<f64>,
+    direction: Vector3<f64>,
+    blend: bool,
+) -> PathSample {
+    let (mv, f) = (part.mv, part.fraction.clamp(0.0, 1.0));
+    PathSample {
+        time: t,
+        move_index: part.index,
+        line: mv.line,
+        position,
+        direction,
+        axis: mv.axis(f),
+        speed: part.state.v,
+        acceleration: part.state.a,
+        acceleration_vector: part.acceleration,
+        blend,
+        feed_move: mv.is_feed(),
+        spindle: mv.spindle,
+        tool: mv.tool,
+        fraction: f,
+        run,
     }
-    // The stretches of moves between the samples: (move, fraction from, fraction to).
-    let stretch = |m: usize| -> (f64, f64) {
-        let a = if m == m0 { f0 } else { 0.0 };
-        let b = if m == m1 { f1 } else { 1.0 };
-        (a, b)
-    };
-    // Chords per stretch of an arc, so that each one's sagitta is within the tolerance.
-    let chords = |mv: &super::Move, a: f64, b: f64| -> usize {
-        match mv.motion {
-            super::Motion::Arc { sweep, .. } => {
-                let r = mv.radius().max(mv.end_radius());
-                if r.is_nan() || r <= WAYPOINT_TOLERANCE {
-                    return 1;
-                }
-                let step = 2.0 * ComplexField::acos(1.0 - WAYPOINT_TOLERANCE / r);
-                let angle = ComplexField::abs(sweep) * (b - a);
-                let n = ComplexField::ceil(angle / step);
-                if n.is_finite() && n >= 1.0 {
-                    (n as usize).min(MAX_ARC_CHORDS)
-                } else {
-                    1
-                }
-            }
-            _ => 1,
-        }
-    };
-    let moves = program.moves.get(m0..=m1).unwrap_or(&[]);
-    let total: f64 = moves
-        .iter()
-        .zip(m0..)
-        .map(|(mv, m)| {
-            let (a, b) = stretch(m);
-            mv.length() * (b - a)
-        })
-        .sum();
-    let mut done = 0.0;
-    let mut count = 0;
-    for (mv, m) in moves.iter().zip(m0..) {
-        let (a, b) = stretch(m);
-        let n = chords(mv, a, b);
-        let length = mv.length() * (b - a);
-        for k in 1..=n {
-            // The stretch's inner chord ends, and its end unless it is the sample itself.
-            if k == n && m == m1 {
-                break;
-            }
-            let f = a + (b - a) * k as f64 / n as f64;
-            let share = if total > 0.0 {
-                (done + length * k as f64 / n as f64) / total
-            } else {
-                0.0
-            };
-            visit(mv.point(f), m, share.clamp(0.0, 1.0));
-            count += 1;
-        }
-        done += length;
-    }
-    count
 }
