@@ -2,6 +2,7 @@
 
 use deflect_sim::scenes::parallel::params;
 
+use deflect_core::machining::path::{Blending, MAX_BLEND_TOLERANCE};
 use std::path::PathBuf;
 
 use super::range::*;
@@ -113,6 +114,12 @@ pub struct MillingArgs {
     /// --spindle-mass 0 the combined run is then the hybrid one).
     #[arg(long)]
     pub no_link_inertia: bool,
+    /// How a program's corners are driven: `stop` (an exact stop at each, the tool on the
+    /// programmed geometry), `program` (the program's G64 P tolerance, G61 / G61.1 stop) or a
+    /// tolerance [mm] in [0, 100] for every corner (0: as fast as the ramps allow); a
+    /// tolerance past both moves at a corner is refused.
+    #[arg(long, default_value = "stop")]
+    pub blend: String,
 }
 
 impl MillingArgs {
@@ -161,6 +168,23 @@ impl MillingArgs {
         PHYSICS_STEP_MS.check(self.step_ms)?;
         SUBSTEPS.check_int(count(self.substeps))?;
         SPINDLE_MASS.check(self.spindle_mass)?;
+        self.blending()?;
         ID_POSES.check_int(count(self.id_poses))
+    }
+
+    /// `--blend` as the path's blending (the tolerance in metres).
+    pub fn blending(&self) -> Result<Blending, CliError> {
+        match self.blend.as_str() {
+            "stop" => Ok(Blending::ExactStop),
+            "program" => Ok(Blending::Program),
+            mm => match mm.parse::<f64>() {
+                Ok(v) if (0.0..=MAX_BLEND_TOLERANCE * 1e3).contains(&v) => {
+                    Ok(Blending::Tolerance(v * 1e-3))
+                }
+                _ => Err(CliError::Usage(format!(
+                    "--blend {mm}: expected stop, program or a tolerance in [0, 100] mm"
+                ))),
+            },
+        }
     }
 }

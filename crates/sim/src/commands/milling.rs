@@ -190,6 +190,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         },
         path: PathOptions {
             rate_hz: 1.0 / (a.cycle_ms * 1e-3),
+            blending: a.blending()?,
             ..PathOptions::default()
         },
         ik: PoseIkOptions::default(),

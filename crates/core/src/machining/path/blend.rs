@@ -127,7 +127,7 @@ pub(super) fn overlap(
 fn window(a: &Run, b: &Run, p: f64) -> f64 {
     let most = a.profile.accel_time().min(b.profile.accel_time());
     let reach = |t: f64| a.profile.sample(t).s + b.profile.sample(t).s;
-    if !(most > 0.0) {
+    if most.is_nan() || most <= 0.0 {
         return 0.0;
     }
     if p == 0.0 || reach(most) <= p {
