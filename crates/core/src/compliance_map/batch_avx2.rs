@@ -15,7 +15,7 @@ use core::arch::x86_64::{__m128d, __m128i, __m256d, _CMP_EQ_OQ, _CMP_GE_OQ, _CMP
 use pulp::cast;
 use pulp::x86::V3;
 
-use super::batch::{Row, one_row};
+use super::batch_row::{Row, one_row};
 use super::grid::EvenAxis;
 use super::interp::{BatchError, BatchSummary};
 use super::kernel::packed_block;

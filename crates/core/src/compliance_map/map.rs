@@ -4,7 +4,8 @@
 use alloc::vec::Vec;
 
 use super::view::ComplianceMapView;
-use super::{BatchError, BatchSummary, Interpolation, NodeFit, QueryOptions, grid};
+use super::fit_stats::NodeFit;
+use super::{BatchError, BatchSummary, Interpolation, QueryOptions, grid};
 use crate::error::{BuildError, Placement, TickError};
 
 /// Owning compliance map (`alloc`): grid, per-node line coefficients, default query options

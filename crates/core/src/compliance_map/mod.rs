@@ -42,6 +42,7 @@
 //! ```
 
 mod batch;
+mod batch_row;
 #[cfg(all(feature = "std", target_arch = "x86_64"))]
 mod batch_avx2;
 mod grid;
@@ -56,6 +57,8 @@ mod field;
 #[cfg(feature = "alloc")]
 mod fit;
 #[cfg(feature = "alloc")]
+mod fit_stats;
+#[cfg(feature = "alloc")]
 mod map;
 #[cfg(feature = "alloc")]
 mod nd;
@@ -67,7 +70,9 @@ pub use field::DisplacementField;
 #[cfg(feature = "std")]
 pub(crate) use fit::grid_of;
 #[cfg(feature = "alloc")]
-pub use fit::{FitOptions, LineStats, Measurement, NodeFit, fit, two_point_displacement};
+pub use fit::{FitOptions, Measurement, fit, two_point_displacement};
+#[cfg(feature = "alloc")]
+pub use fit_stats::{LineStats, NodeFit};
 pub use interp::{BatchError, BatchSummary};
 #[cfg(feature = "alloc")]
 pub use map::ComplianceMap;

@@ -30,50 +30,16 @@ use nalgebra::{ComplexField, Vector2, Vector3};
 
 use crate::error::{BuildError, TickError, check_finite};
 
+mod cutter;
 mod follower;
 mod pass;
+pub use cutter::{Cutter, Removal};
 pub use follower::{FOLLOW_TOLERANCE, Follower, MAX_HELD, Step};
 use pass::Pass;
 
 /// Most cells of one z-map: 2^24 (16.8 million, 134 MB of heights; a 1 m x 1 m stock at
 /// 0.25 mm). [`BuildError::Budget`] past it.
 pub const MAX_CELLS: usize = 1 << 24;
-
-/// A vertical cutter, its tip on the tool path (the tool axis along +z of the workpiece).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Cutter {
-    /// Flat end mill of radius \[m\].
-    Flat {
-        /// Radius \[m\].
-        radius: f64,
-    },
-    /// Ball end mill of radius \[m\] (the tip is the lowest point of the ball).
-    Ball {
-        /// Radius \[m\].
-        radius: f64,
-    },
-}
-
-impl Cutter {
-    /// The radius \[m\].
-    pub fn radius(&self) -> f64 {
-        match *self {
-            Self::Flat { radius } | Self::Ball { radius } => radius,
-        }
-    }
-}
-
-/// What one cut removed.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[must_use]
-pub struct Removal {
-    /// Cells whose height went down.
-    pub cells: usize,
-    /// Volume removed \[m^3\] (height drops times the cell area).
-    pub volume: f64,
-    /// The largest height drop of a cell \[m\].
-    pub deepest: f64,
-}
 
 /// A rectangular stock of square cells, heights \[m\] in the workpiece frame.
 #[derive(Debug, Clone, PartialEq)]

@@ -25,6 +25,7 @@ mod loads;
 mod model;
 mod rows;
 mod trig;
+mod rotation;
 mod turns;
 
 pub use correction::{
@@ -33,10 +34,9 @@ pub use correction::{
 };
 pub(crate) use data::check_joint_range;
 pub use data::{Data, MAX_JOINT_POSITION};
-pub(crate) use deflection::rotation_vector;
-pub use deflection::{
-    MAX_SPRING_ANGLE, compliance, deflection, forward, joint_jacobian, linear_deflection,
-};
+pub use deflection::{compliance, deflection, forward, joint_jacobian, linear_deflection};
+pub use rotation::MAX_SPRING_ANGLE;
+pub(crate) use rotation::rotation_vector;
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
 pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};

@@ -14,7 +14,7 @@
 use nalgebra::{Isometry3, Quaternion, UnitQuaternion};
 
 use super::data::check_q;
-use super::deflection::rotation_vector;
+use super::rotation::rotation_vector;
 use super::lanes::{LaneKernel, Lanes, V4, dispatch};
 use super::model::{MAX_SPRINGS, Pass};
 use super::turns::{Frames4, Motion4, SERIES_ANGLE, splat3};

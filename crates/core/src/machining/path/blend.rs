@@ -22,7 +22,7 @@
 //!
 //! `P = 0` is LinuxCNC's "as fast as possible". The overlap is then the whole shorter ramp.
 
-use super::{Plan, Run};
+use super::plan::{Plan, Run};
 use crate::error::{BuildError, param};
 use crate::machining::{Motion, PathControl, Program};
 

@@ -33,6 +33,9 @@ use crate::motion::{Limits, PathState, Profile};
 
 mod between;
 pub mod blend;
+mod plan;
+
+use plan::{Plan, Run};
 
 pub use between::{MAX_ARC_CHORDS, WAYPOINT_TOLERANCE, between};
 pub use blend::{Blending, MAX_BLEND_TOLERANCE};
@@ -143,40 +146,6 @@ pub struct PathSample {
     /// changes (a corner past [`PathOptions::corner_angle`], a feed change, a rapid, a dwell):
     /// an exact stop, what a robot program writes as one.
     pub run: usize,
-}
-
-/// One rest-to-rest profile over the moves `segs[first..=last]`, or a dwell of `hold`
-/// seconds at the one move `segs[first]` (then `profile` is the zero-length profile);
-/// `blend_in` \[s\] is how long it overlaps the run before (0: it starts from rest).
-#[derive(Debug, Clone, Copy)]
-struct Run {
-    first: usize,
-    last: usize,
-    t0: f64,
-    profile: Profile,
-    hold: f64,
-    blend_in: f64,
-}
-
-impl Run {
-    fn duration(&self) -> f64 {
-        self.profile.duration() + self.hold
-    }
-}
-
-/// The program planned: the moves with motion (`segs`, indices into the program), the arc
-/// length at which each starts within its run (`s0`, parallel to `segs`), and the runs.
-#[derive(Debug, Clone)]
-struct Plan {
-    segs: Vec<usize>,
-    s0: Vec<f64>,
-    runs: Vec<Run>,
-}
-
-impl Plan {
-    fn duration(&self) -> f64 {
-        self.runs.last().map_or(0.0, |r| r.t0 + r.duration())
-    }
 }
 
 fn plan(program: &Program, options: &PathOptions) -> Result<Plan, BuildError> {
@@ -402,28 +371,6 @@ impl<'p> Part<'p> {
             direction,
             acceleration: direction * state.a + mv.curvature(f) * (state.v * state.v),
         })
-    }
-}
-
-impl Plan {
-    /// The move of `run` holding arc length `s`: the last one starting at or before it,
-    /// searched forwards from `seg`.
-    fn locate(&self, run: &Run, s: f64, seg: usize) -> usize {
-        let mut seg = seg.max(run.first);
-        while seg < run.last && self.s0.get(seg + 1).is_some_and(|&x| s >= x) {
-            seg += 1;
-        }
-        seg
-    }
-
-    /// [`Self::locate`] searched backwards from the run's last move (a blend's tail is near
-    /// the end).
-    fn locate_back(&self, run: &Run, s: f64) -> usize {
-        let mut seg = run.last;
-        while seg > run.first && self.s0.get(seg).is_some_and(|&x| s < x) {
-            seg -= 1;
-        }
-        seg
     }
 }
 

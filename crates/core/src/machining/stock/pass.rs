@@ -3,7 +3,7 @@
 
 use nalgebra::{ComplexField, Vector2, Vector3};
 
-use super::{Cutter, Removal};
+use super::cutter::{Cutter, Removal};
 
 /// One sweep of a cutter, cell by cell.
 pub(super) struct Pass<'a> {
