@@ -27,7 +27,7 @@ use std::vec::Vec;
 use nalgebra::Isometry3;
 use serde::Deserialize;
 
-use super::urdf::pose;
+use super::origin::pose;
 use crate::controller::{Convention, Vendor};
 use crate::error::LoadError;
 use crate::robot::SerialRobot;

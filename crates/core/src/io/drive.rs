@@ -119,7 +119,7 @@ pub fn link_masses(robot: &urdf_rs::Robot, serial: &SerialRobot) -> Result<LinkM
             n_moving += 1;
             offset = Isometry3::identity();
         } else {
-            offset *= super::urdf::pose(
+            offset *= super::origin::pose(
                 &j.origin.xyz.0,
                 &j.origin.rpy.0,
                 &format!("joint '{}'", j.name),

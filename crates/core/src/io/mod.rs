@@ -30,6 +30,8 @@ pub mod grid_csv;
 pub mod job_out;
 pub mod map_csv;
 pub mod map_json;
+#[cfg(feature = "urdf")]
+mod origin;
 pub mod ply;
 pub mod points_csv;
 pub mod robot_program;

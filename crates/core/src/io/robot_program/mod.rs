@@ -29,6 +29,7 @@
 //! are in the controller's base frame. A controller reads the robot program's numbers in its
 //! own precision (KRL's `REAL` has 24 bits); the files carry nanometres and nanodegrees.
 
+mod context;
 pub mod csv;
 mod error;
 pub mod krl;
@@ -38,7 +39,7 @@ mod writer;
 
 pub use error::ProgramError;
 pub use writer::RobotProgram;
-pub(crate) use writer::{Context, join, pose};
+pub(crate) use context::{Context, join, pose};
 
 use std::string::{String, ToString};
 use std::vec::Vec;
