@@ -13,8 +13,8 @@
 //! four rows at a time through `super::batch_avx2` instead; these blocks serve the other
 //! CPUs, the no_std build and positions with a z column.
 
-use super::grid::EvenAxis;
 use super::batch_row::{Row, cell, finish_row};
+use super::grid::EvenAxis;
 use super::interp::{BatchError, BatchSummary};
 use super::{ComplianceMapView, QueryOptions};
 

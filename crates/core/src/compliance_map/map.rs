@@ -3,8 +3,8 @@
 
 use alloc::vec::Vec;
 
-use super::view::ComplianceMapView;
 use super::fit_stats::NodeFit;
+use super::view::ComplianceMapView;
 use super::{BatchError, BatchSummary, Interpolation, QueryOptions, grid};
 use crate::error::{BuildError, Placement, TickError};
 

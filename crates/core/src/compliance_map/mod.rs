@@ -42,9 +42,9 @@
 //! ```
 
 mod batch;
-mod batch_row;
 #[cfg(all(feature = "std", target_arch = "x86_64"))]
 mod batch_avx2;
+mod batch_row;
 mod grid;
 mod interp;
 mod kernel;

@@ -23,9 +23,9 @@ mod equilibrium;
 mod lanes;
 mod loads;
 mod model;
+mod rotation;
 mod rows;
 mod trig;
-mod rotation;
 mod turns;
 
 pub use correction::{
@@ -35,14 +35,14 @@ pub use correction::{
 pub(crate) use data::check_joint_range;
 pub use data::{Data, MAX_JOINT_POSITION};
 pub use deflection::{compliance, deflection, forward, joint_jacobian, linear_deflection};
-pub use rotation::MAX_SPRING_ANGLE;
-pub(crate) use rotation::rotation_vector;
 #[cfg(feature = "alloc")]
 pub use equilibrium::{Equilibrium, EquilibriumOptions, equilibrium};
 pub use loads::{ArmMotion, Deflection, Load, tcp_acceleration_bias};
 pub use model::{
     Element, MAX_DOF, MAX_ELEMENTS, MAX_MASSES, MAX_SPRINGS, Model, ModelBuilder, valid_stiffness,
 };
+pub use rotation::MAX_SPRING_ANGLE;
+pub(crate) use rotation::rotation_vector;
 pub use rows::exact_deflection_x4;
 
 /// A 6-vector `[x, y, z, rx, ry, rz]`: a wrench `[Fx, Fy, Fz, Mx, My, Mz]` \[N, N m\] or a small

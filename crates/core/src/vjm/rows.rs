@@ -14,9 +14,9 @@
 use nalgebra::{Isometry3, Quaternion, UnitQuaternion};
 
 use super::data::check_q;
-use super::rotation::rotation_vector;
 use super::lanes::{LaneKernel, Lanes, V4, dispatch};
 use super::model::{MAX_SPRINGS, Pass};
+use super::rotation::rotation_vector;
 use super::turns::{Frames4, Motion4, SERIES_ANGLE, splat3};
 use super::{Data, MAX_SPRING_ANGLE, Model, Vector6};
 use crate::error::check_finite;

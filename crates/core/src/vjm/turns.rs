@@ -16,8 +16,8 @@
 
 use nalgebra::{Isometry3, Quaternion, Translation3, UnitQuaternion, Vector3};
 
-use super::rotation::{MAX_SPRING_ANGLE, euler_zyx, rotation_vector};
 use super::lanes::{Arith, LaneKernel, Lanes, V4, dispatch};
+use super::rotation::{MAX_SPRING_ANGLE, euler_zyx, rotation_vector};
 use super::{Data, Model, Vector6};
 use crate::error::TickError;
 

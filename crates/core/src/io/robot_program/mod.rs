@@ -37,9 +37,9 @@ pub mod rapid;
 pub mod urscript;
 mod writer;
 
+pub(crate) use context::{Context, join, pose};
 pub use error::ProgramError;
 pub use writer::RobotProgram;
-pub(crate) use context::{Context, join, pose};
 
 use std::string::{String, ToString};
 use std::vec::Vec;

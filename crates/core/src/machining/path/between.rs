@@ -15,7 +15,7 @@ pub const WAYPOINT_TOLERANCE: f64 = 1.0e-6;
 pub const MAX_ARC_CHORDS: usize = 4096;
 
 /// The points where the programmed path bends strictly between two samples at `from` and
-/// `to` (each `(move index, fraction)` of [`PathSample`], `from` not after `to`): every
+/// `to` (each `(move index, fraction)` of [`PathSample`](super::PathSample), `from` not after `to`): every
 /// move's end between them and the points that cut each arc into chords within
 /// [`WAYPOINT_TOLERANCE`]. Calls `visit(point, move index, share)` in path order, `share` the
 /// part of the path's length from `from` to the point (0..1), the move index that of the
