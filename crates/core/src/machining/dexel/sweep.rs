@@ -1,12 +1,77 @@
-//! One ray against one straight sweep of the tool (see the parent module), and the
-//! subtraction of the interval it finds from the ray's material.
+//! One straight sweep of the tool through the three grids (see the parent module): each ray
+//! against the swept solid, and the subtraction of the interval it finds from the ray's
+//! material.
 
 use alloc::vec::Vec;
 
 use nalgebra::{ComplexField, Vector3};
 
-use super::{DexelTool, MAX_INTERVALS, at};
+use super::{DexelRemoval, DexelTool, Dexels, MAX_INTERVALS, across, at, count};
 use crate::error::TickError;
+
+impl Dexels {
+    /// One straight sweep with a fixed axis.
+    pub(super) fn sweep(
+        &mut self,
+        tool: &DexelTool,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> Result<DexelRemoval, TickError> {
+        // The swept solid's box: both tools' axis segments, widened by the radius.
+        let (tops, r) = (axis * tool.length, tool.radius);
+        let mut lo = from.inf(to).inf(&(from + tops)).inf(&(to + tops));
+        let mut hi = from.sup(to).sup(&(from + tops)).sup(&(to + tops));
+        lo.add_scalar_mut(-r);
+        hi.add_scalar_mut(r);
+        let mut out = DexelRemoval::default();
+        let area = self.cell * self.cell;
+        for d in 0..3 {
+            let (u, v) = across(d);
+            let range = |k: usize| {
+                let x0 = (at(&lo, k) - at(&self.min, k)) / self.cell - 0.5;
+                let x1 = (at(&hi, k) - at(&self.min, k)) / self.cell - 0.5;
+                let n = count(&self.n, k);
+                let a = ComplexField::ceil(x0).max(0.0) as usize;
+                let b = (ComplexField::floor(x1) + 1.0).clamp(0.0, n as f64) as usize;
+                a..b.max(a)
+            };
+            let (ru, rv) = (range(u), range(v));
+            let nv = count(&self.n, v);
+            let (dlo, dhi) = (at(&lo, d), at(&hi, d));
+            for i in ru {
+                for j in rv.clone() {
+                    let mut origin = self.min;
+                    if let Some(x) = origin.get_mut(u) {
+                        *x += (i as f64 + 0.5) * self.cell;
+                    }
+                    if let Some(x) = origin.get_mut(v) {
+                        *x += (j as f64 + 0.5) * self.cell;
+                    }
+                    if let Some(x) = origin.get_mut(d) {
+                        *x = 0.0;
+                    }
+                    let Some((a, b)) = hit(tool, &origin, d, from, to, axis, dlo, dhi) else {
+                        continue;
+                    };
+                    let Some(ray) = self.rays.get_mut(d).and_then(|g| g.get_mut(i * nv + j)) else {
+                        continue;
+                    };
+                    let before = ray.len();
+                    let removed = subtract(ray, a, b, self.intervals < MAX_INTERVALS)?;
+                    if removed > 0.0 {
+                        out.rays += 1;
+                        if d == 2 {
+                            out.volume += removed * area;
+                        }
+                    }
+                    self.intervals = self.intervals + ray.len() - before;
+                }
+            }
+        }
+        Ok(out)
+    }
+}
 
 /// Golden-section iterations along the ray (the bracket shrinks by 0.618 each: 5e-8 of it
 /// after 35; only the sign of the minimum is read from it) and along the move (28: 1.4e-6

@@ -7,11 +7,11 @@ use alloc::vec::Vec;
 use nalgebra::{Isometry3, Point3, Translation3, Vector3};
 
 use super::follow::Chord;
-use super::{Cutter, Options, Sample, cutter, find, orientation};
-use crate::error::{JobError, TickError};
+use super::{Cutter, Options, Report, Sample, cutter, cutters, find, orientation};
+use crate::error::{BuildError, JobError, TickError};
 use crate::machining::Program;
 use crate::machining::dexel::Dexels;
-use crate::machining::job::{Job, Warm, rotate};
+use crate::machining::job::{Job, NominalSample, Warm, check_seed, rotate};
 use crate::machining::kinematics::ToolPose;
 use crate::machining::path::{self, PathSample};
 use crate::machining::profile::{Band, MAX_BANDS};
@@ -335,4 +335,127 @@ impl<'a> Pass<'a> {
             spin,
         })
     }
+}
+
+/// Runs the five-axis pass (see the module docs) from the joints `seed` near the first pose,
+/// keeping every sample (at most [`path::MAX_PATH_SAMPLES`]). Errors name the program line.
+pub fn run(
+    job: &Job,
+    program: &Program,
+    seed: &[f64],
+    options: &Options,
+) -> Result<Report, JobError> {
+    options.validate()?;
+    check_seed(job, seed)?;
+    let job = &*job.at_seed(seed)?;
+    let setup = job.setup();
+    let sampler = path::Sampler::new(program, &setup.path)?;
+    let count = sampler.len();
+    if count > path::MAX_PATH_SAMPLES {
+        return Err(BuildError::Budget {
+            what: "five-axis samples (duration x rate + 1)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        }
+        .into());
+    }
+    let cutters = cutters(job, program, options)?;
+    let block = || stock_block(job, options);
+    let mut pass = Pass::new(job, program, options, &cutters, block()?);
+    for _ in 0..3 {
+        pass.arms.push(Arm::new(job, seed, block()?));
+    }
+    let mut samples = Vec::new();
+    samples
+        .try_reserve_exact(count)
+        .map_err(|_| BuildError::Budget {
+            what: "five-axis samples (the allocation was refused)",
+            budget: "MAX_PATH_SAMPLES",
+            limit: path::MAX_PATH_SAMPLES,
+            requested: count,
+        })?;
+    let mut last = (0, 0.0);
+    for s in sampler {
+        last = (s.line, s.time);
+        let sample = pass.advance(&s).map_err(|error| match error {
+            Fault::Tick(error) => JobError::AtLine {
+                line: s.line,
+                time: s.time,
+                error,
+            },
+            Fault::Job(e) => e,
+        })?;
+        samples.push(sample);
+    }
+    pass.finish().map_err(|error| JobError::AtLine {
+        line: last.0,
+        time: last.1,
+        error,
+    })?;
+    let mut arms = core::mem::take(&mut pass.arms).into_iter();
+    let (Some(part), Some(unc), Some(comp)) = (arms.next(), arms.next(), arms.next()) else {
+        return Err(BuildError::InvalidParameter {
+            what: "five-axis pass arms (three)",
+            value: 0.0,
+            expected: "three",
+        }
+        .into());
+    };
+    Ok(Report {
+        samples,
+        nominal: part.stock,
+        uncompensated: unc.stock,
+        compensated: comp.stock,
+        rate_hz: setup.path.rate_hz,
+        dof: job.model().dof(),
+        ray_updates: pass.ray_updates + part.follow.rays + unc.follow.rays + comp.follow.rays,
+        rapid_volume: pass.rapid_volume,
+    })
+}
+
+/// The stock block of the pass: the job's stock in x and y, `options.depth` below its top.
+fn stock_block(job: &Job, options: &Options) -> Result<Dexels, BuildError> {
+    let st = &job.setup().stock;
+    Dexels::block(
+        Vector3::new(st.min.x, st.min.y, st.top - options.depth),
+        Vector3::new(st.max.x, st.max.y, st.top),
+        st.cell,
+    )
+}
+
+/// The nominal stage of the five-axis pass alone (the nominal tool on the nominal stock:
+/// the force at every sample, the checks of the cut), handing each sample to `f`: what the
+/// placement and the spin about the tool axis do not change, for a search over them
+/// ([`crate::machining::spin::LoadPath::new_five_axis`]). Errors as [`run`]'s nominal ones,
+/// or `f`'s.
+pub fn nominal_pass(
+    job: &Job,
+    program: &Program,
+    options: &Options,
+    f: &mut dyn FnMut(&NominalSample) -> Result<(), JobError>,
+) -> Result<(), JobError> {
+    options.validate()?;
+    let sampler = path::Sampler::new(program, &job.setup().path)?;
+    let cutters = cutters(job, program, options)?;
+    let mut pass = Pass::new(job, program, options, &cutters, stock_block(job, options)?);
+    let mut prev: Option<Vector3<f64>> = None;
+    for s in sampler {
+        let (_, _, _, _, wrench) = pass.nominal(&s).map_err(|error| match error {
+            Fault::Tick(error) => JobError::AtLine {
+                line: s.line,
+                time: s.time,
+                error,
+            },
+            Fault::Job(e) => e,
+        })?;
+        let step = prev.map_or(Vector3::zeros(), |p| s.position - p);
+        prev = Some(s.position);
+        f(&NominalSample {
+            path: s,
+            step,
+            wrench,
+        })?;
+    }
+    Ok(())
 }
