@@ -5,7 +5,8 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use super::interp::{Fault, INCH, Machine, fault};
+use super::fault::{Fault, fault};
+use super::interp::{INCH, Machine};
 use super::words::Words;
 use crate::machining::{MAX_ARC_TURNS, MAX_COORDINATE, Motion, Plane};
 

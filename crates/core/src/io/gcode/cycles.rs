@@ -9,7 +9,8 @@ use std::string::String;
 
 use nalgebra::Vector3;
 
-use super::interp::{Fault, FeedMode, Machine, fault};
+use super::fault::{Fault, fault};
+use super::interp::{FeedMode, Machine};
 use super::words::{Words, g_name};
 use crate::machining::{Motion, Plane};
 

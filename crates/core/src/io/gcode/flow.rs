@@ -6,67 +6,14 @@
 //! subroutine they are in.
 
 use std::string::{String, ToString};
-use std::vec::Vec;
 
 use super::MAX_CALL_DEPTH;
 use super::expr::{self, integer};
-use super::interp::{Fault, Modal};
+use super::fault::Fault;
 use super::lex::{self, Keyword, Label};
 use super::read::{Reader, at};
+use super::stack::{Frame, Loop, Skip};
 use crate::error::LoadError;
-
-/// A call in progress.
-#[derive(Debug, Clone)]
-pub(super) struct Frame {
-    /// The subroutine's name (labels inside it are scoped by it).
-    name: String,
-    /// Where to go on return.
-    return_to: usize,
-    /// The caller's `#1`-`#30` (O-word calls; M98 shares them).
-    saved: Option<[f64; 30]>,
-    /// The caller's loops.
-    loops: Vec<Loop>,
-    /// M98: the line after the program number, and the passes left.
-    fanuc: Option<(usize, u32)>,
-    /// The modal state M73 saved in this call, restored on return.
-    pub m73: Option<Modal>,
-}
-
-/// A loop in progress.
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct Loop {
-    label: String,
-    kind: Keyword,
-    /// The index of its `while`, `do` or `repeat` line.
-    line: usize,
-    remaining: i64,
-}
-
-/// Lines being skipped up to an O-word with `label` (and keyword `until`, if given).
-#[derive(Debug, Clone, PartialEq)]
-pub(super) struct Skip {
-    label: String,
-    pub until: Option<Keyword>,
-    /// Run the line found (a branch reached from a false condition), or go on after it.
-    then_run: bool,
-    /// Skipping a subroutine's definition.
-    definition: bool,
-    /// The line the skip started at (index).
-    pub from: usize,
-}
-
-impl Skip {
-    /// The label as written, for messages.
-    pub(super) fn label_text(&self) -> &str {
-        self.label.rsplit('#').next().unwrap_or(&self.label)
-    }
-
-    /// Whether running off the end of the file while skipping is fine (never: an open
-    /// definition or block is an error).
-    pub(super) fn resume_after_definition_end(&self) -> bool {
-        false
-    }
-}
 
 impl Reader<'_> {
     /// The label of the block's O-word: `<name>`, or a number's decimal form.

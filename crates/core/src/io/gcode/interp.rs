@@ -14,17 +14,11 @@ use std::vec::Vec;
 use nalgebra::{Vector2, Vector3};
 
 use super::Dialect;
+use super::fault::{Fault, fault};
 use super::params::Params;
 use super::words::{Words, g_name};
 use crate::machining::kinematics::RotaryWord;
 use crate::machining::{MAX_SPINDLE_RPM, MAX_TOOL_NUMBER, Motion, Move, PathControl, Plane};
-
-/// A fault inside a block: the column and the message.
-pub(super) type Fault = (usize, String);
-
-pub(super) fn fault<T>(column: usize, message: impl Into<String>) -> Result<T, Fault> {
-    Err((column, message.into()))
-}
 
 /// Millimetres per inch.
 pub(super) const INCH: f64 = 25.4e-3;

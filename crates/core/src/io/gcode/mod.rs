@@ -1,11 +1,11 @@
 //! RS274/NGC G-code programs (`std`), read as LinuxCNC's interpreter reads them, into a
-//! [`Program`] of moves in the workpiece frame, SI: what a CAM post-processor writes for a
+//! [`Program`](crate::machining::Program) of moves in the workpiece frame, SI: what a CAM post-processor writes for a
 //! mill, and the NGC language of parametric programs.
 //!
 //! The reference is LinuxCNC's RS274/NGC interpreter (the descendant of NIST's RS274NGC;
 //! `rs274 -g FILE` prints its canonical moves): where it accepts a program, the moves here are
 //! its moves (kind, end point, arc centre and plane, feed), and where it refuses one, this
-//! reader refuses it with a [`LoadError::Program`] naming the line, the column and the word.
+//! reader refuses it with a [`LoadError::Program`](crate::error::LoadError::Program) naming the line, the column and the word.
 //!
 //! | words | meaning here |
 //! |---|---|
@@ -59,6 +59,7 @@
 mod arc;
 mod cycles;
 mod expr;
+mod fault;
 mod flow;
 mod interp;
 mod lex;
@@ -67,15 +68,13 @@ mod offsets;
 mod params;
 mod read;
 pub(crate) use read::check_start;
+pub use read::{from_path, from_str};
 pub mod report;
+mod stack;
 mod words;
-
-use std::path::Path;
 
 use nalgebra::Vector3;
 
-use crate::error::LoadError;
-use crate::machining::Program;
 use crate::units::LengthUnit;
 
 pub use cycles::PECK_CLEARANCE;
@@ -97,7 +96,7 @@ pub const MAX_CALL_DEPTH: usize = 9;
 
 /// Most lines one reading runs or skips: 5,000,000 (five times the longest program, about
 /// 1 s of reading; a loop that never ends, or one that runs a billion times, is refused
-/// with [`LoadError::ProgramBudget`]).
+/// with [`LoadError::ProgramBudget`](crate::error::LoadError::ProgramBudget)).
 pub const MAX_BLOCKS: usize = 5_000_000;
 
 /// The control a program is read for.
@@ -186,27 +185,6 @@ impl Default for GcodeOptions {
             kinematics: None,
         }
     }
-}
-
-/// Reads a G-code file (at most [`super::MAX_FILE_BYTES`]; bytes that are not UTF-8 become
-/// U+FFFD, [`super::read_text_lossy`]).
-pub fn from_path(path: &Path, options: &GcodeOptions) -> Result<Program, LoadError> {
-    let text = super::read_text_lossy(path)?;
-    from_str(&text, options)
-}
-
-/// Reads a G-code program from its text.
-pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError> {
-    super::check_size("G-code program", text)?;
-    let lines = text.lines().count();
-    if lines > MAX_PROGRAM_LINES {
-        return Err(LoadError::TooLarge {
-            what: "G-code program lines".into(),
-            limit: MAX_PROGRAM_LINES,
-            got: lines,
-        });
-    }
-    read::run(text, options)
 }
 
 /// The modal group of a G code (ten times its number), as LinuxCNC groups them; `None` for

@@ -6,7 +6,8 @@ use std::string::ToString;
 
 use nalgebra::{Vector2, Vector3};
 
-use super::interp::{Fault, FeedMode, Machine, fault};
+use super::fault::{Fault, fault};
+use super::interp::{FeedMode, Machine};
 use super::params::Params;
 use super::words::{Words, g_name};
 use crate::LoadError;

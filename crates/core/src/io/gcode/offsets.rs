@@ -5,7 +5,8 @@
 
 use nalgebra::{Vector2, Vector3};
 
-use super::interp::{Fault, Machine, fault, rotate};
+use super::fault::{Fault, fault};
+use super::interp::{Machine, rotate};
 use super::params::Params;
 use super::words::{Words, g_name};
 

@@ -4,16 +4,17 @@
 //! program end and the budgets of [`super`].
 
 use std::collections::HashMap;
+use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
 use super::expr::{self, Scope, integer};
-use super::flow::{Frame, Loop, Skip};
+use super::stack::{Frame, Loop, Skip};
 use super::interp::{INCH, Machine};
 use super::lex::{self, Block, CommentKind, Item, Keyword, Label, Param};
 use super::params::{MAX_PARAMETER, Params};
 use super::words::Words;
-use super::{GcodeOptions, MAX_BLOCKS};
+use super::{GcodeOptions, MAX_BLOCKS, MAX_PROGRAM_LINES};
 use crate::error::LoadError;
 use crate::machining::{MAX_MOVES, Program};
 
@@ -516,4 +517,25 @@ impl Machine {
             _ => return None,
         })
     }
+}
+
+/// Reads a G-code file (at most [`crate::io::MAX_FILE_BYTES`]; bytes that are not UTF-8 become
+/// U+FFFD, [`crate::io::read_text_lossy`]).
+pub fn from_path(path: &Path, options: &GcodeOptions) -> Result<Program, LoadError> {
+    let text = crate::io::read_text_lossy(path)?;
+    from_str(&text, options)
+}
+
+/// Reads a G-code program from its text.
+pub fn from_str(text: &str, options: &GcodeOptions) -> Result<Program, LoadError> {
+    crate::io::check_size("G-code program", text)?;
+    let lines = text.lines().count();
+    if lines > MAX_PROGRAM_LINES {
+        return Err(LoadError::TooLarge {
+            what: "G-code program lines".into(),
+            limit: MAX_PROGRAM_LINES,
+            got: lines,
+        });
+    }
+    run(text, options)
 }

@@ -5,7 +5,7 @@
 use std::string::String;
 use std::vec::Vec;
 
-use super::interp::{Fault, fault};
+use super::fault::{Fault, fault};
 
 /// Letters `a`-`z`, then `@` (polar radius), `^` (polar angle), `$` (spindle).
 const SLOTS: usize = 29;
