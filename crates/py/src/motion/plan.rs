@@ -9,11 +9,13 @@ use numpy::PyUntypedArrayMethods;
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use pyo3::prelude::*;
 
-use super::MAX_DIM;
 use crate::InputError;
 use crate::arrays::{float_array, try_rows, try_zeros, vector};
 use crate::errors::{build_err, shape_error, tick_err};
 use crate::scalars::real;
+
+/// Most coordinates of a planned or sampled motion (joint vectors of up to 8 joints).
+pub const MAX_DIM: usize = 8;
 
 /// A plan in `N` coordinates, `N` known at run time. Boxed: a trajectory holds room for its
 /// 31 segments inline (up to 8 KB), and moving that through the binding's layers cost more

@@ -10,8 +10,8 @@ use numpy::ndarray::Array2;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use super::plan::{LimitSpec, Plan, with_plan};
-use super::{MAX_DIM, Recipe, Trajectory, plan_at};
+use super::plan::{LimitSpec, MAX_DIM, Plan, with_plan};
+use super::trajectory::{Recipe, Trajectory, plan_at};
 use crate::InputError;
 use crate::args;
 use crate::arrays::{fill_fast, vector};
