@@ -12,7 +12,7 @@ use deflect_sim::scenes::serial::atlas::{self, AtlasTask};
 use deflect_sim::urdf_arm::KR300_Q0;
 use nalgebra::Vector3;
 
-use super::serial::load_robot;
+use super::inputs::load_robot;
 use super::stdout;
 use crate::cli::{AtlasArgs, CliError};
 

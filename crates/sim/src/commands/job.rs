@@ -10,22 +10,24 @@ use std::time::Instant;
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::io::tool_table::{self, TblOptions};
 use deflect_core::io::{job_out, points_csv};
-use deflect_core::machining::cutting::{Coefficients, Tool};
+use deflect_core::machining::Program;
+use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::job::{self, Job, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::spin::{self, LoadPath, SpinOptions, SpinPlan, SpinSchedule};
-use deflect_core::machining::{Motion, Program};
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
 use deflect_sim::SimError;
 use deflect_sim::scenes::milling::part_map;
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
+use super::inputs::{
+    apt_tools, load_robot, program_and_cutters, read_program, read_text, tool_and_material,
+};
 use super::job_files::{FileOptions, JobFiles};
 use super::job_summary::summary;
-use super::serial::{load_robot, program_and_cutters, read_program, read_text};
 use super::stdout;
-use crate::cli::{CliError, JobArgs, SpinArg, ToolArgs};
+use crate::cli::{CliError, JobArgs, SpinArg};
 
 /// The built-in program: a groove, a ramp and a circular pocket (mm).
 const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.nc");
@@ -53,32 +55,6 @@ pub struct JobTask {
     /// The setup's tool's end (five-axis programs): --shape, or the program's first
     /// `CUTTER/`.
     pub(super) shape: deflect_core::machining::profile::ToolShape,
-}
-
-/// The stock by default: the feed moves' bounding box grown by the tool radius \[m\].
-pub(crate) fn default_stock(
-    program: &Program,
-    radius: f64,
-) -> Option<(Vector2<f64>, Vector2<f64>)> {
-    let mut lo = Vector2::repeat(f64::INFINITY);
-    let mut hi = Vector2::repeat(f64::NEG_INFINITY);
-    for m in program.moves.iter().filter(|m| m.is_feed()) {
-        for p in [m.start.xy(), m.end.xy()] {
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
-        if let Motion::Arc { sweep, .. } = m.motion {
-            // Points along the arc (a spiral in any plane) every 5 degrees.
-            let n = ((sweep.abs() / 5f64.to_radians()).ceil() as usize).clamp(2, 10_000);
-            for k in 1..n {
-                let p = m.point(k as f64 / n as f64).xy();
-                lo = lo.inf(&p);
-                hi = hi.sup(&p);
-            }
-        }
-    }
-    (lo.x.is_finite() && hi.x.is_finite())
-        .then(|| (lo - Vector2::repeat(radius), hi + Vector2::repeat(radius)))
 }
 
 /// `job --explain FILE`: the program's word report and whether it reads, on stdout.
@@ -199,7 +175,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             [x0, y0, x1, y1] => (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3),
             _ => return Err(CliError::Usage("--stock: expected 4 values".into())),
         },
-        None => default_stock(&program, radius).ok_or_else(|| {
+        None => Stock::around(&program, radius).ok_or_else(|| {
             CliError::Failure(format!(
                 "{program_name}: no feed move (G1-G3) to size the stock from; give --stock"
             ))
@@ -369,37 +345,6 @@ pub(crate) fn five_axis_options(
         length: a.flute_length * 1e-3,
         ..deflect_core::machining::five_axis::Options::default()
     }
-}
-
-/// The tool table of an APT program's `CUTTER/` statements after `LOADTL` (the last per tool
-/// number; the flutes and helix of --flutes/--helix, the length of --flute-length), or none.
-pub(crate) fn apt_tools(
-    (flutes, helix, length): (u32, f64, f64),
-    cutters: &[deflect_core::io::apt::AptCutter],
-    name: &str,
-) -> Result<Option<deflect_core::machining::tools::ToolTable>, CliError> {
-    use deflect_core::machining::tools::{ToolSpec, ToolTable};
-    if cutters.iter().all(|c| c.tool == 0) {
-        return Ok(None);
-    }
-    let mut specs: Vec<ToolSpec> = Vec::new();
-    for c in cutters.iter().filter(|c| c.tool > 0) {
-        let tool = Tool::new(c.diameter, flutes, helix)
-            .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?;
-        let spec = ToolSpec {
-            // T0 (a cutter before any LOADTL) is the program's tool before any change.
-            number: c.tool,
-            tool,
-            shape: c.shape,
-            length,
-            name: format!("CUTTER line {}", c.line),
-        };
-        specs.retain(|s| s.number != c.tool);
-        specs.push(spec);
-    }
-    ToolTable::new(specs)
-        .map(Some)
-        .map_err(|e| CliError::Failure(format!("{name}: its CUTTER statements: {e}")))
 }
 
 /// The job with `--spin`: a constant spin, or the schedule the search finds (and what it
@@ -623,20 +568,4 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         out.display(),
         names.join(", ")
     ))
-}
-
-/// The cutter and the material of `--diameter/--flutes/--helix` and `--coefficients` (ranges
-/// checked by [`crate::cli::ToolArgs::check`]; the core's checks name what else is wrong).
-pub(crate) fn tool_and_material(a: &ToolArgs) -> Result<(Tool, Coefficients), CliError> {
-    let tool = Tool::new(a.diameter * 1e-3, a.flutes, a.helix.to_radians())
-        .map_err(|e| CliError::Usage(format!("--diameter/--flutes/--helix: {e}")))?;
-    let coefficients = match a.coefficients.as_deref() {
-        Some(&[tc, rc, ac, te, re, ae]) => {
-            Coefficients::new(tc * 1e6, rc * 1e6, ac * 1e6, te * 1e3, re * 1e3, ae * 1e3)
-                .map_err(|e| CliError::Usage(format!("--coefficients: {e}")))?
-        }
-        Some(_) => return Err(CliError::Usage("--coefficients: expected 6 values".into())),
-        None => Coefficients::AL7075_T6_CARBIDE,
-    };
-    Ok((tool, coefficients))
 }

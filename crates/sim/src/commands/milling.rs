@@ -19,8 +19,7 @@ use deflect_sim::scenes::milling::program_output;
 use deflect_sim::scenes::milling::{self, MillingArm, output, part_map};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::job::{default_stock, tool_and_material};
-use super::serial::{load_arm, program_and_cutters};
+use super::inputs::{apt_tools, load_arm, program_and_cutters, tool_and_material};
 use crate::cli::{CliError, MillingArgs};
 use deflect_core::machining::five_axis::Options;
 
@@ -95,7 +94,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
     let shape = first.map_or(deflect_core::machining::profile::ToolShape::Flat, |c| {
         c.shape
     });
-    let tools = super::job::apt_tools(
+    let tools = apt_tools(
         (
             a.tool.flutes,
             a.tool.helix.to_radians(),
@@ -156,7 +155,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
                 }
             }
         }
-        (None, false) => default_stock(&program, tool.diameter / 2.0).ok_or_else(|| {
+        (None, false) => Stock::around(&program, tool.diameter / 2.0).ok_or_else(|| {
             CliError::Failure(format!(
                 "{name}: no feed move (G1-G3) to size the stock from; give --stock"
             ))

@@ -6,7 +6,6 @@
 use std::fmt;
 use std::path::Path;
 
-use deflect_core::LoadError;
 use deflect_sim::SimError;
 
 use crate::cli::CliError;
@@ -31,6 +30,7 @@ pub mod calibrate;
 pub mod contour;
 pub mod delta;
 pub mod fit;
+pub mod inputs;
 pub mod job;
 pub mod job_files;
 pub mod job_five_axis;
@@ -50,36 +50,6 @@ pub fn stdout(args: fmt::Arguments<'_>) -> Result<(), SimError> {
         .lock()
         .write_fmt(args)
         .map_err(|e| SimError::new(format!("cannot write to standard output: {e}")))
-}
-
-/// Checks an input file given by `flag` before any work: it exists and is a regular file (a
-/// directory, FIFO or device could fail late, block or never end). Otherwise a usage error
-/// naming the flag, the path and what was `expected`.
-pub fn input_file(flag: &str, path: &Path, expected: &str) -> Result<(), CliError> {
-    let meta = std::fs::metadata(path).map_err(|e| {
-        CliError::Usage(format!(
-            "{flag} {}: cannot open the {expected}: {e}",
-            path.display()
-        ))
-    })?;
-    if meta.is_file() {
-        Ok(())
-    } else {
-        Err(CliError::Usage(format!(
-            "{flag} {}: not a regular file; expected the {expected}",
-            path.display()
-        )))
-    }
-}
-
-/// A loader's error on the input file of `flag` as a failure naming the flag, the path and
-/// what was `expected` (the loaders name the file only in their I/O errors).
-pub fn load_error(flag: &str, path: &Path, expected: &str, e: LoadError) -> CliError {
-    let detail = match e {
-        LoadError::Io { message, .. } => format!("cannot read the {expected}: {message}"),
-        other => format!("not a valid {expected}: {other}"),
-    };
-    CliError::Failure(format!("{flag} {}: {detail}", path.display()))
 }
 
 /// Creates the output directory `out` if missing and checks that it takes files, before any

@@ -13,7 +13,7 @@ use deflect_sim::scenes::parallel::run::{self, RunOptions, RunResult};
 use deflect_sim::{SimError, write_file};
 
 use super::calibrate::calibrate_all;
-use super::{input_file, load_error};
+use super::inputs::{input_file, load_error};
 use crate::cli::{CliError, Correction, RunArgs};
 
 /// What `run --map` expects.

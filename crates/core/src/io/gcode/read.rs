@@ -9,10 +9,10 @@ use std::string::{String, ToString};
 use std::vec::Vec;
 
 use super::expr::{self, Scope, integer};
-use super::stack::{Frame, Loop, Skip};
 use super::interp::{INCH, Machine};
 use super::lex::{self, Block, CommentKind, Item, Keyword, Label, Param};
 use super::params::{MAX_PARAMETER, Params};
+use super::stack::{Frame, Loop, Skip};
 use super::words::Words;
 use super::{GcodeOptions, MAX_BLOCKS, MAX_PROGRAM_LINES};
 use crate::error::LoadError;

@@ -1,12 +1,13 @@
 //! Everything about a job but the arm and the program: the workpiece's placement, the tool
 //! and material, the stock, how the program is driven and solved.
 
-use nalgebra::{Isometry3, UnitQuaternion, Vector2, Vector3};
+use nalgebra::{ComplexField, Isometry3, UnitQuaternion, Vector2, Vector3};
 
 use crate::error::BuildError;
 use crate::machining::cutting::{Coefficients, Tool};
 use crate::machining::path::PathOptions;
 use crate::machining::stock::ZMap;
+use crate::machining::{Motion, Program};
 use crate::mechanism::PoseIkOptions;
 
 /// The stock: a block over `[min, max]` (x, y) with its top at `top`, workpiece frame \[m\],
@@ -21,6 +22,35 @@ pub struct Stock {
     pub top: f64,
     /// Cell edge \[m\].
     pub cell: f64,
+}
+
+impl Stock {
+    /// The (x, y) corners of a stock around `program`: the bounding box of its feed moves
+    /// (arcs and helices sampled every 5 degrees) grown by `margin` \[m\] (a tool radius, so
+    /// that the whole cut lies inside); `None` for a program without a feed move. What a user
+    /// who gives no stock means: "a block that holds the part".
+    pub fn around(program: &Program, margin: f64) -> Option<(Vector2<f64>, Vector2<f64>)> {
+        let mut lo = Vector2::repeat(f64::INFINITY);
+        let mut hi = Vector2::repeat(f64::NEG_INFINITY);
+        for m in program.moves.iter().filter(|m| m.is_feed()) {
+            for p in [m.start.xy(), m.end.xy()] {
+                lo = lo.inf(&p);
+                hi = hi.sup(&p);
+            }
+            if let Motion::Arc { sweep, .. } = m.motion {
+                let n = (ComplexField::ceil(ComplexField::abs(sweep) / (5.0f64).to_radians())
+                    as usize)
+                    .clamp(2, 10_000);
+                for k in 1..n {
+                    let p = m.point(k as f64 / n as f64).xy();
+                    lo = lo.inf(&p);
+                    hi = hi.sup(&p);
+                }
+            }
+        }
+        (lo.x.is_finite() && hi.x.is_finite())
+            .then(|| (lo - Vector2::repeat(margin), hi + Vector2::repeat(margin)))
+    }
 }
 
 /// Everything about a job but the arm and the program.

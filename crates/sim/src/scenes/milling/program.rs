@@ -474,19 +474,6 @@ pub fn kr300_placement() -> Isometry3<f64> {
     )
 }
 
-/// Largest physics step of the program runs \[s\]: 1 ms, twice the groove scenario's; the step
-/// is shortened to divide the control cycle. See [`PROGRAM_SUBSTEPS`] for what it changes.
-pub const PROGRAM_DT: f64 = 1.0e-3;
-
-/// rapier substeps per physics step of the program scenarios (identification and runs): 2, half
-/// rapier's default 4. rapier rebuilds the multibody mass matrix of the KR 300 (36 degrees of
-/// freedom) in every substep, and that is most of a run's time. On the test workpiece (maximum
-/// path deviation, uncompensated / offline / Cartesian / hybrid, mm): 1 ms in 2 substeps 1.939 /
-/// 0.400 / 0.987 / 0.732; 1 ms in 4 1.952 / 0.415 / 0.998 / 0.741; 0.5 ms in 4 1.971 / 0.430 /
-/// 0.983 / 0.743. Halving the substeps moves the figures by less than halving the step does (at
-/// most 1.5 % against 2 %), and the scenario takes 36 s instead of 78 s on 2 cores.
-pub const PROGRAM_SUBSTEPS: usize = 2;
-
 /// The program scenarios' options: `opts` in its `program_substeps` substeps.
 pub(super) fn scenario_options(opts: &MillingOptions) -> MillingOptions {
     MillingOptions {
