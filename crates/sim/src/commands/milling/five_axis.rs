@@ -13,8 +13,8 @@ use deflect_sim::SimError;
 use deflect_sim::scenes::milling::{self, five_axis, part_view};
 use serde_json::json;
 
-use super::milling::ProgramInput;
-use super::stdout;
+use super::input::ProgramInput;
+use crate::commands::stdout;
 
 /// Runs the scenario and writes `milling_summary.{txt,json}`, `milling_part_<mode>.ply` and
 /// `milling_part_view.png`.

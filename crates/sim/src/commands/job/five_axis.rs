@@ -13,9 +13,9 @@ use deflect_sim::SimError;
 use deflect_sim::scenes::milling::part_view;
 use serde_json::json;
 
-use super::job::JobTask;
-use super::stdout;
+use super::task::{JobTask, five_axis_options};
 use crate::cli::JobArgs;
+use crate::commands::stdout;
 
 /// The part's figures: all machined points, and per face.
 fn part_figures(
@@ -86,7 +86,7 @@ fn samples_csv(r: &Report) -> String {
 /// Runs the five-axis pass and writes its files.
 pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
     let started = Instant::now();
-    let options: Options = super::job::five_axis_options(a, t.shape);
+    let options: Options = five_axis_options(a, t.shape);
     let r = five_axis::run(&t.job, &t.program, &t.seed, &options)
         .map_err(|e| SimError::new(format!("{}: {e}", t.program_name)))?;
     let pass = started.elapsed().as_secs_f64();

@@ -24,13 +24,20 @@ use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 use super::inputs::{
     apt_tools, load_robot, program_and_cutters, read_program, read_text, tool_and_material,
 };
-use super::job_files::{FileOptions, JobFiles};
-use super::job_summary::summary;
+mod files;
+mod five_axis;
+mod summary;
+mod task;
+
 use super::stdout;
 use crate::cli::{CliError, JobArgs, SpinArg};
+use files::{FileOptions, JobFiles};
+use summary::summary;
+pub use task::JobTask;
+use task::five_axis_options;
 
 /// The built-in program: a groove, a ramp and a circular pocket (mm).
-const DEFAULT_PROGRAM: &str = include_str!("../../../../data/groove_and_pocket.nc");
+const DEFAULT_PROGRAM: &str = include_str!("../../../../../data/groove_and_pocket.nc");
 /// The KR 300's defaults: the tool down over a table in front of it.
 const KR300_PLACEMENT: [f64; 6] = [2.45, 0.02, 0.92, 0.0, 0.0, std::f64::consts::PI];
 const KR300_SEED: [f64; 6] = [0.0, -0.9, 1.4, 0.0, -0.5, 0.0];
@@ -42,20 +49,6 @@ pub(crate) const KR300_FIVE_AXIS_PLACEMENT: [f64; 6] =
     [2.0, 0.0, 0.4, 0.0, 0.0, std::f64::consts::PI];
 /// Where the tool is before the program's first move, workpiece frame \[m\].
 const START: [f64; 3] = [0.0, 0.0, 0.02];
-
-/// Everything `job` needs, read and checked.
-pub struct JobTask {
-    pub(super) job: Job,
-    pub(super) program: Program,
-    pub(super) program_name: String,
-    pub(super) robot_name: String,
-    pub(super) seed: Vec<f64>,
-    /// The spin search's result and its wall time \[s\] (`--spin optimize`).
-    pub(super) spin: Option<(deflect_core::machining::spin::SpinPlan, f64)>,
-    /// The setup's tool's end (five-axis programs): --shape, or the program's first
-    /// `CUTTER/`.
-    pub(super) shape: deflect_core::machining::profile::ToolShape,
-}
 
 /// `job --explain FILE`: the program's word report and whether it reads, on stdout.
 pub fn explain(a: &JobArgs, path: &Path) -> Result<(), CliError> {
@@ -333,20 +326,6 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
     })
 }
 
-/// The five-axis pass's options of the flags: the stock's depth, the setup's tool's end, the
-/// tools' length.
-pub(crate) fn five_axis_options(
-    a: &JobArgs,
-    shape: deflect_core::machining::profile::ToolShape,
-) -> deflect_core::machining::five_axis::Options {
-    deflect_core::machining::five_axis::Options {
-        depth: a.stock_depth * 1e-3,
-        shape,
-        length: a.flute_length * 1e-3,
-        ..deflect_core::machining::five_axis::Options::default()
-    }
-}
-
 /// The job with `--spin`: a constant spin, or the schedule the search finds (and what it
 /// found, with its wall time).
 fn spin(
@@ -451,7 +430,7 @@ impl Progress {
 /// part map and the summary.
 pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
     if t.program.is_multi_axis() {
-        return super::job_five_axis::five_axis_cmd(a, t, out);
+        return five_axis::five_axis_cmd(a, t, out);
     }
     let started = Instant::now();
     let setup = t.job.setup();

@@ -6,8 +6,8 @@ use std::fmt::Write as _;
 
 use deflect_core::machining::job::{self, Report};
 
-use super::job::JobTask;
-use super::job_files::OperationFigures;
+use super::files::OperationFigures;
+use super::task::JobTask;
 
 /// Which tool cuts each `T` of the program, and which spindle: the summary's words.
 fn tools_text(t: &JobTask) -> (String, Vec<serde_json::Value>) {

@@ -1,30 +1,23 @@
-//! `milling`: the hybrid compensation of Hähn and Weigold (sec. 2.2-2.6, 3). By default the
-//! paper's validation: deflect's test workpiece (or `--program`) cut by the flexible KR 300
-//! five ways ([`deflect_sim::scenes::milling::program`]); `--program groove` runs the straight
-//! groove with a prescribed force step ([`deflect_sim::scenes::milling::run`]) with the
-//! command line's feed, force, timing and noise settings. Prints the summary table and writes
-//! its files.
+//! What `milling` reads and checks before any work: the groove, or a program with its arm,
+//! setup and start joints.
 
 use std::path::Path;
 
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::Program;
+use deflect_core::machining::five_axis::Options;
 use deflect_core::machining::job::{Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
-use deflect_sim::SimError;
-use deflect_sim::scenes::milling::program;
-use deflect_sim::scenes::milling::program_output;
-use deflect_sim::scenes::milling::{self, MillingArm, output, part_map};
+use deflect_sim::scenes::milling::{MillingArm, program};
 use nalgebra::{Isometry3, Translation3, UnitQuaternion, Vector2, Vector3};
 
-use super::inputs::{apt_tools, load_arm, program_and_cutters, tool_and_material};
 use crate::cli::{CliError, MillingArgs};
-use deflect_core::machining::five_axis::Options;
+use crate::commands::inputs::{apt_tools, load_arm, program_and_cutters, tool_and_material};
 
 /// deflect's test workpiece after the paper's (grooves, a ramp, a circular pocket).
-const TEST_WORKPIECE: &str = include_str!("../../../../data/test_workpiece.nc");
+const TEST_WORKPIECE: &str = include_str!("../../../../../data/test_workpiece.nc");
 /// Its stock [mm]: XMIN, YMIN, XMAX, YMAX.
 const TEST_STOCK_MM: [f64; 4] = [0.0, 0.0, 140.0, 130.0];
 
@@ -168,7 +161,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         ),
         Some(_) => return Err(CliError::Usage("--placement: expected 6 values".into())),
         None if program.is_multi_axis() => {
-            let [x, y, z, r, p, w] = super::job::KR300_FIVE_AXIS_PLACEMENT;
+            let [x, y, z, r, p, w] = crate::commands::job::KR300_FIVE_AXIS_PLACEMENT;
             Isometry3::from_parts(
                 Translation3::new(x, y, z),
                 UnitQuaternion::from_euler_angles(r, p, w),
@@ -208,114 +201,4 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         tools,
         shape,
     })))
-}
-
-/// The options the command line sets.
-fn options(a: &MillingArgs) -> milling::MillingOptions {
-    let mut opts = milling::MillingOptions::default();
-    let dir = nalgebra::Vector3::from(opts.force).normalize();
-    opts.force = (dir * a.force).into();
-    opts.feed = a.feed * 1e-3;
-    opts.cut = a.cut;
-    opts.cycle = a.cycle_ms * 1e-3;
-    opts.force_rise = a.rise_ms * 1e-3;
-    opts.estimate_lead = a.lead_ms * 1e-3;
-    opts.estimate_error = a.estimate_error;
-    opts.seed = a.seed;
-    opts.id_poses = a.id_poses;
-    opts.program_dt = a.step_ms * 1e-3;
-    opts.program_substeps = a.substeps;
-    opts.spindle_mass = a.spindle_mass;
-    opts.link_inertia = !a.no_link_inertia;
-    opts.jobs = a.jobs;
-    opts
-}
-
-/// The `milling` command (arguments checked by [`MillingArgs::check`], inputs by [`load`]).
-pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<(), SimError> {
-    let opts = options(a);
-    let MillingInput::Program(p) = input else {
-        let r = milling::milling(&opts)?;
-        let table = output::table(&r);
-        put!("{table}");
-        output::write_all(out, &r)?;
-        say!(
-            "wrote {}/milling_summary.{{txt,csv,json}}, milling.mcap, milling_error.png, milling_stiffness.png",
-            out.display()
-        );
-        return Ok(());
-    };
-    let ProgramInput {
-        program,
-        name,
-        setup,
-        q0,
-        arm,
-        tools,
-        shape,
-    } = p.as_ref();
-    // An arm of the user's is identified at its start joints (the KR 300 at the paper's
-    // milling pose, as in the groove scenario).
-    let opts = if a.urdf.is_none() {
-        opts
-    } else {
-        milling::MillingOptions {
-            q0: q0.clone(),
-            ..opts
-        }
-    };
-    if program.is_multi_axis() {
-        let options = Options {
-            shape: *shape,
-            ..Options::default()
-        };
-        return super::milling_five_axis::run_and_write(
-            &opts,
-            p.as_ref(),
-            tools.as_ref(),
-            &options,
-            out,
-        );
-    }
-    let r = program::milling_program(&opts, arm, program, setup, q0)?;
-    let text = program_output::table(name, &r);
-    put!("{text}");
-    let write = |file: &str, body: &str| {
-        std::fs::write(out.join(file), body)
-            .map_err(|e| SimError::file(&out.join(file), "write", e))
-    };
-    write("milling_summary.txt", &text)?;
-    write(
-        "milling_summary.json",
-        &serde_json::to_string_pretty(&program_output::json(name, &r))
-            .map_err(|e| SimError::new(e.to_string()))?,
-    )?;
-    write("milling_samples.csv", &program_output::csv(&r))?;
-    program_output::write_mcap(&out.join("milling.mcap"), name, &r)?;
-    for run in &r.runs {
-        let e = &run.part_error;
-        let label = format!(
-            "{}: floors max {:.3} mm, RMS {:.3} mm; walls {:.0} mm^2 left, {:.0} overcut",
-            run.mode.label(),
-            e.floor.max * 1e3,
-            e.floor.rms * 1e3,
-            e.material_left * 1e6,
-            e.overcut * 1e6
-        );
-        part_map::plot_part_deviation(
-            &out.join(format!("milling_part_{}.png", run.mode.label())),
-            &format!(
-                "{name}, {} in rapier: the part's height above the nominal one",
-                r.robot
-            ),
-            &r.offline.nominal,
-            &[(&label, &run.part)],
-            setup.stock.top,
-        )?;
-    }
-    say!(
-        "wrote {}/milling_summary.{{txt,json}}, milling_samples.csv, milling.mcap, milling_part_<run>.png",
-        out.display()
-    );
-    Ok(())
 }
