@@ -17,13 +17,12 @@
 //!
 //! Shared by the scenes: the flexible arm built from any URDF ([`urdf_arm`], for milling and
 //! serial), the MCAP writer ([`mcap_log`]), the plot style ([`plot_style`]), rapier helpers
-//! ([`rapier_util`]), seeded noise ([`noise`]) and the parallel job runner ([`jobs`]). Gravity,
+//! ([`rapier_util`]), seeded noise ([`noise`]) and the worker threads for independent runs ([`workers`]). Gravity,
 //! where a scene has it, is deflect-core's [`deflect_core::units::GRAVITY_Z_DOWN`].
 #![deny(missing_docs)]
 // No input may kill the process: errors are returned, never panicked (tests may unwrap).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
 
-pub mod jobs;
 pub mod mcap_log;
 pub mod noise;
 pub mod npz_stream;
@@ -31,6 +30,7 @@ pub mod plot_style;
 pub mod rapier_util;
 pub mod scenes;
 pub mod urdf_arm;
+pub mod workers;
 
 use core::fmt;
 use std::path::Path;

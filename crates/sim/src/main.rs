@@ -18,7 +18,6 @@ use std::sync::Mutex;
 use clap::Parser;
 
 use cli::{Cli, CliError, Command, ReproduceArgs};
-use commands::{atlas, contour, fit, job, milling, place, reproduce, run, serial, static_test};
 
 /// The first panic's message, recorded by the panic hook for the one-line report.
 static PANIC: Mutex<Option<String>> = Mutex::new(None);
@@ -36,75 +35,26 @@ fn install_panic_hook() {
     }));
 }
 
-/// Checks, loads the inputs, prepares the output directory, then runs the command.
+/// Checks the flags, then drives the command through its spine ([`commands::Cmd`]: the
+/// inputs loaded and checked, the output directory prepared, the run).
 fn execute(cli: &Cli) -> Result<(), CliError> {
     let default = Command::Reproduce(ReproduceArgs::default());
     let command = cli.command.as_ref().unwrap_or(&default);
-    let out = &cli.out;
     command.check()?;
-    if let Command::Job(a) = command
-        && let Some(path) = &a.explain
-    {
-        return job::explain(a, path);
-    }
-    let fit_input = match command {
-        Command::Fit { input: Some(p), .. } => Some(fit::load_input(p)?),
-        _ => None,
-    };
-    let map = match command {
-        Command::Run(a) => a.map.as_deref().map(run::load_map).transpose()?,
-        _ => None,
-    };
-    let arm = match command {
-        Command::Serial(a) => Some(serial::load(a)?),
-        _ => None,
-    };
-    let atlas_task = match command {
-        Command::Atlas(a) => Some(atlas::load(a)?),
-        _ => None,
-    };
-    let milling_input = match command {
-        Command::Milling(a) => Some(milling::load(a)?),
-        _ => None,
-    };
-    let job_task = match command {
-        Command::Job(a) => Some(job::load(a)?),
-        _ => None,
-    };
-    let place_task = match command {
-        Command::Place(a) => Some(place::load(a)?),
-        _ => None,
-    };
-    commands::prepare_out(out)?;
+    let out = &cli.out;
     match command {
-        Command::Reproduce(a) => reproduce::reproduce(a, out),
-        Command::StaticTest { mechanism } => static_test::static_test(*mechanism, out),
-        Command::Fit { mechanism, .. } => fit::fit_cmd(*mechanism, fit_input, out),
-        Command::Run(a) => run::run_one(a, map, out),
-        Command::Serial(a) => match arm {
-            Some(arm) => serial::serial_cmd(a, arm, out),
-            None => Err(deflect_sim::SimError::new("serial: inputs not loaded")),
-        },
-        Command::Milling(a) => match &milling_input {
-            Some(i) => milling::milling_cmd(a, i, out),
-            None => Err(deflect_sim::SimError::new("milling: inputs not loaded")),
-        },
-        Command::Contour(a) => contour::contour_cmd(a, out),
-        Command::Atlas(a) => match &atlas_task {
-            Some(t) => atlas::atlas_cmd(a, t, out),
-            None => Err(deflect_sim::SimError::new("atlas: inputs not loaded")),
-        },
-        Command::Job(a) => match &job_task {
-            Some(t) => job::job_cmd(a, t, out),
-            None => Err(deflect_sim::SimError::new("job: inputs not loaded")),
-        },
-        Command::Place(a) => match &place_task {
-            Some(t) => place::place_cmd(a, t, out),
-            None => Err(deflect_sim::SimError::new("place: inputs not loaded")),
-        },
-        Command::Delta(a) => commands::delta::delta_cmd(a, out),
+        Command::Reproduce(a) => commands::execute(a, out),
+        Command::StaticTest(a) => commands::execute(a, out),
+        Command::Fit(a) => commands::execute(a, out),
+        Command::Run(a) => commands::execute(a, out),
+        Command::Milling(a) => commands::execute(a, out),
+        Command::Contour(a) => commands::execute(a, out),
+        Command::Serial(a) => commands::execute(a, out),
+        Command::Atlas(a) => commands::execute(a, out),
+        Command::Job(a) => commands::execute(a, out),
+        Command::Place(a) => commands::execute(a, out),
+        Command::Delta(a) => commands::execute(a, out),
     }
-    .map_err(CliError::from)
 }
 
 /// `msg` on one line: line breaks (from a dependency's message) become "; ".

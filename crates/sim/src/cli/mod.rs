@@ -70,7 +70,7 @@ pub use contour::ContourArgs;
 pub use delta::DeltaArgs;
 pub use job::{JobArgs, SpinArg};
 pub use milling::MillingArgs;
-pub use parallel::{Correction, Mech, ReproduceArgs, RunArgs};
+pub use parallel::{Correction, FitArgs, ReproduceArgs, RunArgs, StaticTestArgs};
 pub use place::PlaceArgs;
 pub use range::*;
 pub use serial::{ModelArg, SerialArgs, TaskArg};
@@ -101,23 +101,10 @@ pub enum Command {
     Reproduce(ReproduceArgs),
     /// Simulated static tests (15 nodes x 2 axes x 49..245 N), written as CSV (columns
     /// x_mm, y_mm, force_axis, force_N, dx_mm, dy_mm).
-    StaticTest {
-        /// Mechanism.
-        #[arg(long, value_enum, default_value_t = Mech::Oc)]
-        mechanism: Mech,
-    },
+    StaticTest(StaticTestArgs),
     /// Fits a compliance map from a static-test CSV (or runs the static tests first) and
     /// reports its held-out prediction error.
-    Fit {
-        /// Mechanism (for fresh static tests and the held-out tests).
-        #[arg(long, value_enum, default_value_t = Mech::Oc)]
-        mechanism: Mech,
-        /// Static-test CSV written by `static-test` (columns x_mm, y_mm, force_axis, force_N,
-        /// dx_mm, dy_mm; the older header x, y, force_axis, force, dx, dy is read in mm and N);
-        /// a regular file of at most 16 MiB.
-        #[arg(long)]
-        input: Option<PathBuf>,
-    },
+    Fit(FitArgs),
     /// One motion on one configuration, uncorrected and/or corrected; writes an MCAP log.
     Run(RunArgs),
     /// Milling scenario for the online force-based compensation (Hähn & Weigold): their
@@ -175,7 +162,7 @@ impl Command {
     pub fn check(&self) -> Result<(), CliError> {
         match self {
             Self::Reproduce(a) => a.check(),
-            Self::StaticTest { .. } | Self::Fit { .. } => Ok(()),
+            Self::StaticTest(_) | Self::Fit(_) => Ok(()),
             Self::Run(a) => a.check(),
             Self::Milling(a) => a.check(),
             Self::Contour(a) => a.check(),

@@ -169,3 +169,24 @@ pub enum Correction {
     // Both.
     Both,
 }
+
+/// `static-test`'s flags.
+#[derive(clap::Args, Debug)]
+pub struct StaticTestArgs {
+    /// Mechanism.
+    #[arg(long, value_enum, default_value_t = Mech::Oc)]
+    pub mechanism: Mech,
+}
+
+/// `fit`'s flags.
+#[derive(clap::Args, Debug)]
+pub struct FitArgs {
+    /// Mechanism (for fresh static tests and the held-out tests).
+    #[arg(long, value_enum, default_value_t = Mech::Oc)]
+    pub mechanism: Mech,
+    /// Static-test CSV written by `static-test` (columns x_mm, y_mm, force_axis, force_N,
+    /// dx_mm, dy_mm; the older header x, y, force_axis, force, dx, dy is read in mm and N);
+    /// a regular file of at most 16 MiB.
+    #[arg(long)]
+    pub input: Option<PathBuf>,
+}

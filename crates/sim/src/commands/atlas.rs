@@ -1,17 +1,18 @@
 //! `atlas`: the workspace compliance atlas of [`deflect_sim::scenes::serial::atlas`] on the built-in KR 300
 //! or on the user's URDF and stiffness file. [`load`] reads and checks everything before any
-//! work; [`atlas_cmd`] runs, prints the summary and writes `atlas.npz` and `atlas.png`.
+//! work; [`Cmd::run`] runs, prints the summary and writes `atlas.npz` and `atlas.png`.
 
 use std::path::Path;
 use std::time::Instant;
 
 use deflect_core::posture::Reach;
 use deflect_sim::SimError;
-use deflect_sim::jobs::progress;
 use deflect_sim::scenes::serial::atlas::{self, AtlasTask};
 use deflect_sim::urdf_arm::KR300_Q0;
+use deflect_sim::workers::progress;
 use nalgebra::Vector3;
 
+use super::Cmd;
 use super::inputs::load_robot;
 use super::stdout;
 use crate::cli::{AtlasArgs, CliError};
@@ -74,7 +75,7 @@ pub fn load(a: &AtlasArgs) -> Result<AtlasTask, CliError> {
 }
 
 /// Runs the atlas and writes its files.
-pub fn atlas_cmd(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimError> {
+fn run(a: &AtlasArgs, task: &AtlasTask, out: &Path) -> Result<(), SimError> {
     let t0 = Instant::now();
     let bar = progress(task.xs.len(), "atlas rows");
     let points = atlas::compute(task, a.jobs, &bar)?;
@@ -149,4 +150,16 @@ fn unreachable_summary(points: &[atlas::AtlasPoint]) -> String {
         }
     }
     text
+}
+
+impl Cmd for AtlasArgs {
+    type Input = AtlasTask;
+
+    fn load(&self) -> Result<AtlasTask, CliError> {
+        load(self)
+    }
+
+    fn run(&self, input: AtlasTask, out: &Path) -> Result<(), SimError> {
+        run(self, &input, out)
+    }
 }

@@ -9,10 +9,11 @@ use std::time::Instant;
 use deflect_sim::SimError;
 use deflect_sim::scenes::contour::{self, output};
 
-use crate::cli::ContourArgs;
+use super::Cmd;
+use crate::cli::{CliError, ContourArgs};
 
 /// The `contour` command (arguments checked by [`ContourArgs::check`]).
-pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
+fn run(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
     let mut opts = contour::TraceOptions {
         step: a.step_mm * 1e-3,
         target_force: a.target_force,
@@ -45,4 +46,16 @@ pub fn contour_cmd(a: &ContourArgs, out: &Path) -> Result<(), SimError> {
         out.display()
     );
     Ok(())
+}
+
+impl Cmd for ContourArgs {
+    type Input = ();
+
+    fn load(&self) -> Result<(), CliError> {
+        Ok(())
+    }
+
+    fn run(&self, (): (), out: &Path) -> Result<(), SimError> {
+        run(self, out)
+    }
 }

@@ -8,7 +8,8 @@ use deflect_core::io::map_json;
 use deflect_sim::SimError;
 use deflect_sim::scenes::delta::{self, DeltaOptions, DeltaResult};
 
-use crate::cli::DeltaArgs;
+use super::Cmd;
+use crate::cli::{CliError, DeltaArgs};
 
 /// The options the command line sets.
 pub fn options(a: &DeltaArgs) -> DeltaOptions {
@@ -88,7 +89,7 @@ pub fn table(r: &DeltaResult) -> String {
 
 /// The `delta` command: runs, prints the table, writes delta_summary.{txt,json},
 /// delta_map.json (the fitted map, format_version 2) and delta_samples.csv.
-pub fn delta_cmd(a: &DeltaArgs, out: &Path) -> Result<(), SimError> {
+fn run(a: &DeltaArgs, out: &Path) -> Result<(), SimError> {
     let r = delta::delta(&options(a))?;
     let text = table(&r);
     put!("{text}");
@@ -137,4 +138,16 @@ pub fn delta_cmd(a: &DeltaArgs, out: &Path) -> Result<(), SimError> {
         out.display()
     );
     Ok(())
+}
+
+impl Cmd for DeltaArgs {
+    type Input = ();
+
+    fn load(&self) -> Result<(), CliError> {
+        Ok(())
+    }
+
+    fn run(&self, (): (), out: &Path) -> Result<(), SimError> {
+        run(self, out)
+    }
 }

@@ -12,9 +12,10 @@ use deflect_sim::scenes::parallel::params::{Head, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, StaticOptions};
 use deflect_sim::{SimError, write_file};
 
-use super::calibrate::calibrate_all;
+use super::Cmd;
+use super::calibrate_all;
 use super::inputs::{input_file, load_error};
-use crate::cli::{CliError, Mech};
+use crate::cli::{CliError, FitArgs};
 
 /// What `fit --input` expects.
 const INPUT: &str = "static-test CSV written by `static-test` (columns x_mm, y_mm, force_axis, \
@@ -103,8 +104,8 @@ pub fn fit_csv(path: &Path) -> Result<ComplianceMap, deflect_core::LoadError> {
 
 /// The `fit` command: the map of `mech` fitted from `--input` (`input`, loaded by
 /// [`load_input`]) or from fresh static tests, written to `out`.
-pub fn fit_cmd(mech: Mech, input: Option<ComplianceMap>, out: &Path) -> Result<(), SimError> {
-    let constraint = mech.constraint();
+fn run(a: &FitArgs, input: Option<ComplianceMap>, out: &Path) -> Result<(), SimError> {
+    let constraint = a.mechanism.constraint();
     let map = match input {
         None => calibrate_all(&[constraint], out)?
             .pop()
@@ -138,4 +139,16 @@ pub fn fit_cmd(mech: Mech, input: Option<ComplianceMap>, out: &Path) -> Result<(
         out.display()
     );
     Ok(())
+}
+
+impl Cmd for FitArgs {
+    type Input = Option<ComplianceMap>;
+
+    fn load(&self) -> Result<Option<ComplianceMap>, CliError> {
+        self.input.as_deref().map(load_input).transpose()
+    }
+
+    fn run(&self, input: Option<ComplianceMap>, out: &Path) -> Result<(), SimError> {
+        run(self, input, out)
+    }
 }

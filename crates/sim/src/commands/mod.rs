@@ -6,7 +6,10 @@
 use std::fmt;
 use std::path::Path;
 
+use deflect_core::compliance_map::ComplianceMap;
 use deflect_sim::SimError;
+use deflect_sim::scenes::parallel::calibrate;
+use deflect_sim::scenes::parallel::params::Constraint;
 
 use crate::cli::CliError;
 
@@ -26,7 +29,6 @@ macro_rules! put {
 }
 
 pub mod atlas;
-pub mod calibrate;
 pub mod contour;
 pub mod delta;
 pub mod fit;
@@ -39,6 +41,34 @@ pub mod run;
 pub mod serial;
 pub mod static_test;
 
+/// One command's spine: [`Cmd::load`] reads and checks every input before any work, the
+/// output directory is then created and probed (when the command writes into it), and
+/// [`Cmd::run`] runs the scenario, prints its table and writes its files. Every command
+/// implements it on its flags and [`execute`] drives it, after the flags' ranges are checked
+/// ([`crate::cli::Command::check`]).
+pub trait Cmd {
+    /// What the command reads and checks before any work.
+    type Input;
+    /// Reads and checks the inputs: a usage error naming the flag, or a failure naming the
+    /// file.
+    fn load(&self) -> Result<Self::Input, CliError>;
+    /// Whether the run writes into `--out` (`job --explain` only prints).
+    fn writes(&self, _input: &Self::Input) -> bool {
+        true
+    }
+    /// Runs the command on its checked inputs, writing into `out`.
+    fn run(&self, input: Self::Input, out: &Path) -> Result<(), SimError>;
+}
+
+/// `load`, then the output directory, then `run` ([`Cmd`]).
+pub fn execute<C: Cmd>(command: &C, out: &Path) -> Result<(), CliError> {
+    let input = command.load()?;
+    if command.writes(&input) {
+        prepare_out(out)?;
+    }
+    command.run(input, out).map_err(CliError::from)
+}
+
 /// Writes `args` to stdout; an error if stdout is closed or fails.
 pub fn stdout(args: fmt::Arguments<'_>) -> Result<(), SimError> {
     use std::io::Write;
@@ -46,6 +76,20 @@ pub fn stdout(args: fmt::Arguments<'_>) -> Result<(), SimError> {
         .lock()
         .write_fmt(args)
         .map_err(|e| SimError::new(format!("cannot write to standard output: {e}")))
+}
+
+/// The parallel robot's calibration ([`calibrate::calibrate_all`]) for `constraints`, its
+/// summaries printed in order: the maps.
+pub fn calibrate_all(
+    constraints: &[Constraint],
+    out: &Path,
+) -> Result<Vec<(Constraint, ComplianceMap)>, SimError> {
+    let mut maps = Vec::new();
+    for (c, map, text) in calibrate::calibrate_all(constraints, out)? {
+        say!("{text}");
+        maps.push((c, map));
+    }
+    Ok(maps)
 }
 
 /// Creates the output directory `out` if missing and checks that it takes files, before any

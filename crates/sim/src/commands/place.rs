@@ -12,6 +12,7 @@ use deflect_core::machining::spin::SpinOptions;
 use deflect_sim::SimError;
 use deflect_sim::scenes::serial::atlas::{HeatMap, heat_map};
 
+use super::Cmd;
 use super::job::{self, JobTask};
 use super::stdout;
 use crate::cli::{CliError, PlaceArgs, SpinArg};
@@ -84,7 +85,7 @@ pub fn load(a: &PlaceArgs) -> Result<PlaceTask, CliError> {
 }
 
 /// Runs the search, prints the best placement, writes the heat map and the summary.
-pub fn place_cmd(a: &PlaceArgs, t: &PlaceTask, out: &Path) -> Result<(), SimError> {
+fn run(a: &PlaceArgs, t: &PlaceTask, out: &Path) -> Result<(), SimError> {
     let started = Instant::now();
     let threads = a.job.threads;
     let found = placement::search(&t.bx, a.refine, |ps: &[[f64; 4]]| -> Result<_, SimError> {
@@ -206,4 +207,16 @@ pub fn place_cmd(a: &PlaceArgs, t: &PlaceTask, out: &Path) -> Result<(), SimErro
         "{text}outputs in {}: place.png, place_summary.{{txt,json}}\n",
         out.display()
     ))
+}
+
+impl Cmd for PlaceArgs {
+    type Input = PlaceTask;
+
+    fn load(&self) -> Result<PlaceTask, CliError> {
+        load(self)
+    }
+
+    fn run(&self, input: PlaceTask, out: &Path) -> Result<(), SimError> {
+        run(self, &input, out)
+    }
 }

@@ -7,14 +7,15 @@ use std::path::Path;
 use std::time::Instant;
 
 use deflect_core::compliance_map::ComplianceMap;
-use deflect_sim::jobs::{parallel_map, progress};
 use deflect_sim::scenes::parallel::params::{Constraint, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, Motion, RunOptions, RunResult, configurations};
 use deflect_sim::scenes::parallel::{output, report};
+use deflect_sim::workers::{parallel_map, progress};
 use deflect_sim::{SimError, write_file};
 
-use super::calibrate::calibrate_all;
-use crate::cli::ReproduceArgs;
+use super::Cmd;
+use super::calibrate_all;
+use crate::cli::{CliError, ReproduceArgs};
 
 /// One run of the sweep.
 struct Job {
@@ -50,7 +51,7 @@ fn run_jobs(
 }
 
 /// The `reproduce` command.
-pub fn reproduce(args: &ReproduceArgs, out: &Path) -> Result<(), SimError> {
+fn run(args: &ReproduceArgs, out: &Path) -> Result<(), SimError> {
     let t0 = Instant::now();
     let maps = calibrate_all(&[Constraint::Oc, Constraint::Nc], out)?;
     let t_static = t0.elapsed().as_secs_f64();
@@ -166,4 +167,16 @@ fn write_outputs(runs: &[RunResult], out: &Path, table: &str) -> Result<(), SimE
         )?;
     }
     Ok(())
+}
+
+impl Cmd for ReproduceArgs {
+    type Input = ();
+
+    fn load(&self) -> Result<(), CliError> {
+        Ok(())
+    }
+
+    fn run(&self, (): (), out: &Path) -> Result<(), SimError> {
+        run(self, out)
+    }
 }

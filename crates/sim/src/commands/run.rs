@@ -12,7 +12,8 @@ use deflect_sim::scenes::parallel::params::RobotParams;
 use deflect_sim::scenes::parallel::run::{self, RunOptions, RunResult};
 use deflect_sim::{SimError, write_file};
 
-use super::calibrate::calibrate_all;
+use super::Cmd;
+use super::calibrate_all;
 use super::inputs::{input_file, load_error};
 use crate::cli::{CliError, Correction, RunArgs};
 
@@ -70,7 +71,7 @@ pub fn load_map(path: &Path) -> Result<LoadedMap, CliError> {
 }
 
 /// The `run` command; `map` is the loaded `--map`, if given.
-pub fn run_one(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
+fn run(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
     if let (Some(m), Some(p)) = (&map, &args.map) {
         say!(
             "--map {}: {}, {} x {} nodes",
@@ -209,7 +210,7 @@ mod tests {
         let units = dir.join("units.csv");
         let text = static_table().replacen(
             "x,y,force_axis,force,dx,dy",
-            super::super::calibrate::STATIC_HEADER,
+            deflect_sim::scenes::parallel::calibrate::STATIC_HEADER,
             1,
         );
         std::fs::write(&units, text).unwrap();
@@ -226,5 +227,17 @@ mod tests {
         assert_eq!(unit, deflect_core::units::LengthUnit::Metre);
         assert!(super::super::fit::unit_header("x,y,force_axis,force,dx,dy").is_none());
         let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+impl Cmd for RunArgs {
+    type Input = Option<LoadedMap>;
+
+    fn load(&self) -> Result<Option<LoadedMap>, CliError> {
+        self.map.as_deref().map(load_map).transpose()
+    }
+
+    fn run(&self, input: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
+        run(self, input, out)
     }
 }

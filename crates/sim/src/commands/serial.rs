@@ -1,6 +1,6 @@
 //! `serial`: the serial testbed of [`deflect_sim::scenes::serial`] on the built-in KR 300 or
 //! on the user's URDF and stiffness file. [`load`] reads and checks everything before any
-//! work (files, chain, start pose, motion reach); [`serial_cmd`] runs, prints the table and
+//! work (files, chain, start pose, motion reach); [`Cmd::run`] runs, prints the table and
 //! writes the files.
 
 use std::path::Path;
@@ -14,6 +14,7 @@ use deflect_sim::scenes::serial::{self, MotionParams, SerialOptions, output};
 use deflect_sim::urdf_arm::{ArmSpec, KR300_Q0, ServoParams};
 use nalgebra::{Matrix3, Vector3};
 
+use super::Cmd;
 use super::inputs::{ArmFiles, load_arm};
 use crate::cli::{CliError, ModelArg, SerialArgs, TaskArg};
 
@@ -243,7 +244,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
 }
 
 /// The `serial` command (arguments checked by [`SerialArgs::check`], inputs by [`load`]).
-pub fn serial_cmd(a: &SerialArgs, input: SerialInput, out: &Path) -> Result<(), SimError> {
+fn run(a: &SerialArgs, input: SerialInput, out: &Path) -> Result<(), SimError> {
     let r = serial::serial(&input.spec, &input.options, a.jobs)?;
     put!("{}", output::table(&r));
     let n = output::write_all(out, &r)?;
@@ -252,4 +253,16 @@ pub fn serial_cmd(a: &SerialArgs, input: SerialInput, out: &Path) -> Result<(), 
         out.display()
     );
     Ok(())
+}
+
+impl Cmd for SerialArgs {
+    type Input = SerialInput;
+
+    fn load(&self) -> Result<SerialInput, CliError> {
+        load(self)
+    }
+
+    fn run(&self, input: SerialInput, out: &Path) -> Result<(), SimError> {
+        run(self, input, out)
+    }
 }

@@ -4,16 +4,18 @@
 
 use std::path::Path;
 
-use deflect_sim::jobs::progress;
 use deflect_sim::scenes::parallel::params::{Head, RobotParams};
 use deflect_sim::scenes::parallel::run::{self, StaticOptions};
+use deflect_sim::workers::progress;
 use deflect_sim::{SimError, write_file};
 
-use super::calibrate::static_csv;
-use crate::cli::Mech;
+use super::Cmd;
+use crate::cli::{CliError, StaticTestArgs};
+use deflect_sim::scenes::parallel::calibrate::static_csv;
 
 /// The `static-test` command.
-pub fn static_test(mechanism: Mech, out: &Path) -> Result<(), SimError> {
+fn run(a: &StaticTestArgs, out: &Path) -> Result<(), SimError> {
+    let mechanism = a.mechanism;
     let params = RobotParams::new(mechanism.constraint(), Head::Upper);
     let pb = progress(30, "static");
     let r = run::static_tests(&params, &StaticOptions::default(), || pb.inc(1))?;
@@ -32,4 +34,16 @@ pub fn static_test(mechanism: Mech, out: &Path) -> Result<(), SimError> {
         rms
     );
     Ok(())
+}
+
+impl Cmd for StaticTestArgs {
+    type Input = ();
+
+    fn load(&self) -> Result<(), CliError> {
+        Ok(())
+    }
+
+    fn run(&self, (): (), out: &Path) -> Result<(), SimError> {
+        run(self, out)
+    }
 }

@@ -1,6 +1,6 @@
 //! `job`: a machining job offline (deflect-core's `machining::job`) on the built-in KR 300 or
 //! the user's arm. [`load`] reads and checks the program, the arm, the placement and the
-//! stock before any work; [`job_cmd`] runs the pass, prints the summary and writes the
+//! stock before any work; [`Cmd::run`] runs the pass, prints the summary and writes the
 //! compensated program, the samples, the part's heat map and the summary files.
 
 use std::fmt::Write as _;
@@ -29,7 +29,7 @@ mod five_axis;
 mod summary;
 mod task;
 
-use super::stdout;
+use super::{Cmd, stdout};
 use crate::cli::{CliError, JobArgs, SpinArg};
 use files::{FileOptions, JobFiles};
 use summary::summary;
@@ -428,7 +428,7 @@ impl Progress {
 
 /// Runs the pass, streaming its samples to the files on a writer thread, then writes the
 /// part map and the summary.
-pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
+fn run(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
     if t.program.is_multi_axis() {
         return five_axis::five_axis_cmd(a, t, out);
     }
@@ -547,4 +547,28 @@ pub fn job_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         out.display(),
         names.join(", ")
     ))
+}
+
+/// `job`: with `--explain` the program's word report only (nothing read but the program,
+/// nothing written); otherwise the job.
+impl Cmd for JobArgs {
+    type Input = Option<JobTask>;
+
+    fn load(&self) -> Result<Option<JobTask>, CliError> {
+        match &self.explain {
+            Some(path) => explain(self, path).map(|()| None),
+            None => load(self).map(Some),
+        }
+    }
+
+    fn writes(&self, input: &Option<JobTask>) -> bool {
+        input.is_some()
+    }
+
+    fn run(&self, input: Option<JobTask>, out: &Path) -> Result<(), SimError> {
+        match input {
+            Some(task) => run(self, &task, out),
+            None => Ok(()),
+        }
+    }
 }

@@ -13,7 +13,8 @@ use deflect_sim::scenes::milling::program;
 use deflect_sim::scenes::milling::program_output;
 use deflect_sim::scenes::milling::{self, output, part_map};
 
-use crate::cli::MillingArgs;
+use super::Cmd;
+use crate::cli::{CliError, MillingArgs};
 
 mod five_axis;
 mod input;
@@ -43,7 +44,7 @@ fn options(a: &MillingArgs) -> milling::MillingOptions {
 }
 
 /// The `milling` command (arguments checked by [`MillingArgs::check`], inputs by [`load`]).
-pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<(), SimError> {
+fn run(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<(), SimError> {
     let opts = options(a);
     let MillingInput::Program(p) = input else {
         let r = milling::milling(&opts)?;
@@ -123,4 +124,16 @@ pub fn milling_cmd(a: &MillingArgs, input: &MillingInput, out: &Path) -> Result<
         out.display()
     );
     Ok(())
+}
+
+impl Cmd for MillingArgs {
+    type Input = MillingInput;
+
+    fn load(&self) -> Result<MillingInput, CliError> {
+        load(self)
+    }
+
+    fn run(&self, input: MillingInput, out: &Path) -> Result<(), SimError> {
+        run(self, &input, out)
+    }
 }

@@ -14,8 +14,8 @@ use super::arm::{ArmParams, ArmSim};
 use super::objects::{ObjectSpec, Outline, v2};
 use super::{DT, err};
 use crate::SimError;
-use crate::jobs::parallel_map;
 use crate::noise::Noise;
+use crate::workers::parallel_map;
 
 /// Settings of a trace.
 #[derive(Debug, Clone, Serialize)]

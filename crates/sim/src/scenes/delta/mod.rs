@@ -147,7 +147,7 @@ pub fn static_tests(opts: &DeltaOptions) -> Result<Vec<GridMeasurement>, SimErro
             }
         }
     }
-    let readings = crate::jobs::parallel_map(&nodes, opts.jobs, |p| {
+    let readings = crate::workers::parallel_map(&nodes, opts.jobs, |p| {
         let mut out = Vec::with_capacity(6);
         for k in 0..3 {
             for sign in [-1.0, 1.0] {
@@ -266,7 +266,7 @@ pub fn delta(opts: &DeltaOptions) -> Result<DeltaResult, SimError> {
     let map = fit_grid(names, &readings, &fit_options)
         .map_err(|e| SimError::new(format!("Delta map fit: {e}")))?;
     let runs =
-        crate::jobs::parallel_map(&[false, true], opts.jobs, |&c| run(opts, c.then_some(&map)))?
+        crate::workers::parallel_map(&[false, true], opts.jobs, |&c| run(opts, c.then_some(&map)))?
             .into_iter()
             .collect::<Result<Vec<_>, _>>()?;
     Ok(DeltaResult {

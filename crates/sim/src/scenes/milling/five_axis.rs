@@ -81,7 +81,7 @@ pub fn milling_five_axis(
     let offline = five_axis::run(&job, program, seed, options)
         .map_err(|e| SimError::new(format!("five-axis pass: {e}")))?;
     let run_opts = super::program::run_options(opts);
-    let runs = crate::jobs::parallel_map(&MODES, opts.jobs, |&mode| {
+    let runs = crate::workers::parallel_map(&MODES, opts.jobs, |&mode| {
         run(arm, &run_opts, &job, &offline, mode, options)
     })?
     .into_iter()

@@ -196,7 +196,7 @@ pub fn identify_stiffness(
         .take(opts.id_poses.clamp(1, 3))
         .collect();
     let indexed: Vec<(usize, &Vec<f64>)> = qs.iter().enumerate().collect();
-    let readings = crate::jobs::parallel_map(&indexed, jobs, |&(i, q)| {
+    let readings = crate::workers::parallel_map(&indexed, jobs, |&(i, q)| {
         static_tests(arm, opts, q, opts.seed ^ (0x1D + i as u64))
     })?
     .into_iter()

@@ -549,7 +549,7 @@ pub fn milling_program(
         model: &model,
         calibration: &calibration,
     };
-    let runs = crate::jobs::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
+    let runs = crate::workers::parallel_map(&ProgramMode::ALL, opts.jobs, |&mode| {
         run_program(arm, &run_opts, &inputs, mode)
     })?
     .into_iter()

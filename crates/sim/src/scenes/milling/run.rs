@@ -289,7 +289,7 @@ pub fn milling(opts: &MillingOptions) -> Result<MillingResult, SimError> {
         Mode::Pilot,
         Mode::Uncalibrated,
     ];
-    let runs = crate::jobs::parallel_map(&modes, opts.jobs, |&mode| {
+    let runs = crate::workers::parallel_map(&modes, opts.jobs, |&mode| {
         run(&arm, opts, mode, &model, &calibration)
     })?
     .into_iter()

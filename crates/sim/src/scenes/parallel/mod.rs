@@ -8,6 +8,7 @@
 //! [`report`] as the paper's figures, [`output`] as tables, logs and plots).
 
 pub mod analysis;
+pub mod calibrate;
 pub mod output;
 pub mod params;
 pub mod report;

@@ -19,8 +19,8 @@ use ndarray::{Array1, Array2};
 use plotters::prelude::*;
 
 use crate::SimError;
-use crate::jobs::parallel_map;
 use crate::plot_style::{CHART, Entry, LEGEND_FONT, canvas, figure, new_chart, perr, present};
+use crate::workers::parallel_map;
 
 /// What to map.
 #[derive(Debug, Clone)]

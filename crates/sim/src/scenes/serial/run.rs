@@ -179,7 +179,7 @@ pub fn static_check(
         .fold(f64::INFINITY, f64::min);
     let scale = (k_min / 5000.0).min(1.0);
     let loads: Vec<usize> = (0..6).collect();
-    let errors = crate::jobs::parallel_map(&loads, jobs, |&k| {
+    let errors = crate::workers::parallel_map(&loads, jobs, |&k| {
         let mut w = Vector6::zeros();
         if let Some(x) = w.get_mut(k) {
             *x = scale * if k < 3 { 100.0 } else { 20.0 };
@@ -371,7 +371,7 @@ pub fn serial(spec: &ArmSpec, opts: &SerialOptions, jobs: usize) -> Result<Seria
         .into_iter()
         .flat_map(|p| [(p, false), (p, true)])
         .collect();
-    let runs = crate::jobs::parallel_map(&cases, jobs, |&(p, c)| run(spec, opts, p, c))?
+    let runs = crate::workers::parallel_map(&cases, jobs, |&(p, c)| run(spec, opts, p, c))?
         .into_iter()
         .collect::<Result<Vec<_>, _>>()?;
     let wall_seconds = start.elapsed().as_secs_f64();

@@ -1,15 +1,16 @@
 //! Calibration of the parallel robot as the paper does it (Paksoy, Dede and Kiper (2025),
 //! sec. 3.1-3.2, Eq. 9-14): simulated static tests, the fitted compliance map and its
-//! held-out error, one thread per mechanism. Shared by `reproduce`, `run` and `fit`.
+//! held-out error, one thread per mechanism; what the `reproduce`, `run`, `fit` and
+//! `static-test` commands share.
 
 use std::path::Path;
 
+use super::params::{Constraint, Head, RobotParams};
+use super::run::{self, StaticOptions, StaticReading};
+use crate::workers::{parallel_map, progress};
+use crate::{SimError, write_file};
 use deflect_core::compliance_map::ComplianceMap;
 use deflect_core::io::map_json;
-use deflect_sim::jobs::{parallel_map, progress};
-use deflect_sim::scenes::parallel::params::{Constraint, Head, RobotParams};
-use deflect_sim::scenes::parallel::run::{self, StaticOptions, StaticReading};
-use deflect_sim::{SimError, write_file};
 use indicatif::ProgressBar;
 
 /// The header of the static-test CSV: units in the column names.
@@ -103,19 +104,19 @@ fn calibrate(
     Ok((map, text))
 }
 
-/// [`calibrate`] for several mechanisms, one thread each; prints the summaries in order.
+/// [`calibrate`] for several mechanisms, one thread each: per mechanism, in order, its map
+/// and its summary text (for the command to print).
 pub fn calibrate_all(
     constraints: &[Constraint],
     out: &Path,
-) -> Result<Vec<(Constraint, ComplianceMap)>, SimError> {
+) -> Result<Vec<(Constraint, ComplianceMap, String)>, SimError> {
     let pb = progress(31 * constraints.len(), "static tests");
     let results = parallel_map(constraints, constraints.len(), |c| calibrate(*c, out, &pb))?;
     pb.finish_and_clear();
     let mut maps = Vec::new();
     for (c, r) in constraints.iter().zip(results) {
         let (map, text) = r?;
-        say!("{text}");
-        maps.push((*c, map));
+        maps.push((*c, map, text));
     }
     Ok(maps)
 }
