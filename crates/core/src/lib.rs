@@ -77,6 +77,7 @@ pub mod controller;
 pub mod dalembert;
 pub mod drivetrain;
 pub mod error;
+pub mod geometry;
 mod golden;
 #[cfg(feature = "std")]
 pub mod identification;

@@ -7,9 +7,20 @@
 //!
 //! Layout: `boundary` (panic containment, pointer and string checks), [`status`] (the
 //! codes and the one mapping from deflect-core's build, load and tick errors), then one
-//! module per concept: [`robot`], [`map`], [`motion`], [`pose_motion`], [`dalembert`]
-//! ([`dalembert::parallel`], [`dalembert::serial`]), [`compensation`]. Each
-//! handle wraps deflect-core's `Model` and `Data`; validation is deflect-core's.
+//! module per concept, each handle wrapping deflect-core's `Model` and `Data` (validation is
+//! deflect-core's):
+//!
+//! | module | handle | what |
+//! |---|---|---|
+//! | [`robot`] | `DeflectSerialRobot` | a serial arm's VJM: deflection, compliance, joint correction |
+//! | [`map`] | `DeflectComplianceMap` | the 2-D compliance map of static tests and its query |
+//! | [`grid_map`] | `DeflectGridMap` | the N-D (1-4 axes) compliance map and its query |
+//! | [`motion`] | `DeflectTrajectory2` | jerk-limited point-to-point and polyline motions |
+//! | [`pose_motion`] | `DeflectPoseMotion` | motions in pose (position and orientation) |
+//! | [`dalembert::parallel`] | `DeflectParallelRobot2`, `DeflectDalembert` | the five-bar and its D'Alembert corrector |
+//! | [`dalembert::serial`] | `DeflectSerialDalembert` | a serial arm's 6-D D'Alembert corrector |
+//! | [`dalembert::delta`] | `DeflectDelta`, `DeflectDeltaCorrector` | the Delta robot and its D'Alembert corrector |
+//! | [`compensation`] | `DeflectCompensator` | online force-based compensation (filters, pilot control) |
 //!
 //! Conventions of the API:
 //!

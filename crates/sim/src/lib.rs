@@ -1,24 +1,24 @@
 //! `deflect-sim`: a rapier3d-f64 testbed for the models of deflect-core, and the project's
 //! main command.
 //!
-//! The scenes ([`scenes`]), one folder per domain:
+//! The scenes ([`scenes`]), one folder per domain, and the command of `deflect-sim` that runs
+//! each:
 //!
-//! * [`scenes::parallel`]: the D'Alembert trajectory correction of Paksoy, Dede and Kiper
-//!   (2025) on the paper's 2-DoF planar parallel robot, from simulated static tests and a
-//!   fitted compliance map to the paper's evaluation (Appendix C).
-//! * [`scenes::milling`]: the online force-based compensation of Hähn and Weigold (sec.
-//!   2.2-2.6) on the flexible KR 300 R2500.
-//! * [`scenes::serial`]: any serial arm from a URDF and a stiffness file as a flexible arm and
-//!   the 6-D D'Alembert corrector for serial arms at high acceleration on it; the
-//!   stiffness-optimal posture over a workspace ([`scenes::serial::atlas`]).
-//! * [`scenes::contour`]: force-feedback contour tracing and shape recovery ("Shape recovery
-//!   from robot contour tracking with force feedback", Eq. 10 and 21) by a 2R arm with
-//!   compliant, backlashed joints.
+//! | scene | what | command |
+//! |---|---|---|
+//! | [`scenes::parallel`] | the D'Alembert trajectory correction of Paksoy, Dede and Kiper (2025) on the paper's 2-DoF five-bar: simulated static tests, the fitted compliance map ([`scenes::parallel::calibrate`]), the paper's evaluation (Appendix C) | `reproduce`, `static-test`, `fit`, `run` |
+//! | [`scenes::delta`] | the Delta robot's D'Alembert correction at 5-10 g | `delta` |
+//! | [`scenes::serial`] | any serial arm from a URDF and a stiffness file as a flexible arm, the 6-D D'Alembert corrector on it; the stiffness-optimal posture over a workspace ([`scenes::serial::atlas`]) | `serial`, `atlas` |
+//! | [`scenes::milling`] | robot machining after Hähn and Weigold (sec. 2.2-2.6) on the flexible KR 300 R2500: the groove, any CAM program's offline, Cartesian, hybrid, axis-specific and combined (inertial) compensation, five-axis programs, the part maps | `milling` |
+//! | [`scenes::contour`] | force-feedback contour tracing and shape recovery ("Shape recovery from robot contour tracking with force feedback", Eq. 10 and 21) by a 2R arm with compliant, backlashed joints | `contour` |
+//! | (deflect-core's machining job) | a CAM program's offline pass on any arm, 2.5-D or five-axis, streamed; the compensated program for the controller (G-code, KRL, RAPID, URScript); the placement search | `job`, `place` |
 //!
 //! Shared by the scenes: the flexible arm built from any URDF ([`urdf_arm`], for milling and
-//! serial), the MCAP writer ([`mcap_log`]), the plot style ([`plot_style`]), rapier helpers
-//! ([`rapier_util`]), seeded noise ([`noise`]) and the worker threads for independent runs ([`workers`]). Gravity,
-//! where a scene has it, is deflect-core's [`deflect_core::units::GRAVITY_Z_DOWN`].
+//! serial), the MCAP writer ([`mcap_log`]) and the streamed NumPy archive ([`npz_stream`]),
+//! the summary files and figures ([`summary`]), the plot style ([`plot_style`]), rapier
+//! helpers and the 2 kHz servo step ([`rapier_util`]), seeded noise
+//! ([`noise`]) and the worker threads for independent runs ([`workers`]). Gravity, where a
+//! scene has it, is deflect-core's [`deflect_core::units::GRAVITY_Z_DOWN`].
 #![deny(missing_docs)]
 // No input may kill the process: errors are returned, never panicked (tests may unwrap).
 #![deny(clippy::unwrap_used, clippy::expect_used, clippy::panic)]
@@ -29,6 +29,7 @@ pub mod npz_stream;
 pub mod plot_style;
 pub mod rapier_util;
 pub mod scenes;
+pub mod summary;
 pub mod urdf_arm;
 pub mod workers;
 

@@ -8,6 +8,9 @@ use rapier3d_f64::prelude::*;
 
 use crate::SimError;
 
+/// The servo step of the scenes \[s\]: the 2 kHz of Paksoy, Dede and Kiper's controller.
+pub const SERVO_DT: f64 = 1.0 / 2000.0;
+
 /// Index of the rotation about the joint frame's x axis among a generic joint's six
 /// coordinates (`LinX, LinY, LinZ, AngX, AngY, AngZ`).
 pub const ANG_X: usize = 3;

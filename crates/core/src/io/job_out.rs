@@ -22,7 +22,7 @@ use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use crate::contour::shape::distance_to_segment;
+use crate::geometry::distance_to_segment;
 use crate::error::LoadError;
 use crate::machining::job::{JobSample, Report};
 use crate::machining::{Motion, Program};

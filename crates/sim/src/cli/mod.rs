@@ -2,8 +2,9 @@
 //! their conversions to the library's types; the documented range of every numeric flag
 //! ([`Range`], shown in its `--help`) and the checks of the arguments before any work
 //! ([`Command::check`]); the two kinds of errors and their exit codes ([`CliError`]). Each
-//! subcommand's arguments have their file: `parallel` (`reproduce`, `run`), `milling`,
-//! `contour`, `serial`, `atlas`, `job`.
+//! subcommand's arguments have their file: `parallel` (`reproduce`, `static-test`, `fit`,
+//! `run`), `milling`, `contour`, `serial`, `atlas`, `job` (with `tool`, the flags it shares
+//! with `milling`), `place`, `delta`.
 //!
 //! The ranges keep every accepted command within a few minutes of run time and a few hundred
 //! MB of memory. Release build, measured on 2 cores: `milling` (the 16-body KR 300) at its
@@ -81,8 +82,12 @@ pub use tool::ToolArgs;
 #[command(
     name = "deflect-sim",
     version,
-    about = "Simulated reproduction of the D'Alembert trajectory correction (Paksoy et al.) on a \
-             rapier3d-f64 model of the 2-DoF parallel robot. Without a subcommand: reproduce."
+    about = "deflect's testbed in rapier3d-f64: the D'Alembert trajectory correction (Paksoy et \
+             al.) on the five-bar (reproduce, static-test, fit, run), the Delta (delta) and serial \
+             arms (serial); robot machining after Hähn and Weigold: online and hybrid compensation \
+             on the flexible KR 300 (milling), machining jobs from CAM programs, 2.5-D and \
+             five-axis (job), the workpiece's placement (place), the compliance atlas (atlas); \
+             force-feedback contour tracing (contour). Without a subcommand: reproduce."
 )]
 pub struct Cli {
     // The scenario; `reproduce` if none.

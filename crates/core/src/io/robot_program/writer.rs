@@ -11,7 +11,7 @@ use super::{
     Command, Language, ORIENTATION_LEVER, ProgramError, ProgramFile, ProgramOptions, Target, csv,
     krl, rapid, urscript,
 };
-use crate::contour::shape::distance_to_segment;
+use crate::geometry::distance_to_segment;
 use crate::io::decimate::{Decimator, Kept};
 use crate::machining::job::JobSample;
 use crate::vjm::Data;

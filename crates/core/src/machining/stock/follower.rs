@@ -4,7 +4,7 @@
 use nalgebra::Vector3;
 
 use super::{Cutter, Removal, ZMap};
-use crate::contour::shape::distance_to_segment;
+use crate::geometry::distance_to_segment;
 use crate::error::{TickError, check_finite};
 
 /// How far a [`Follower`] may leave cells above the exact sweep \[m\]: 1e-8 m, the pose

@@ -14,8 +14,7 @@ use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update
 use crate::plot_style::{
     ChartStyle, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, present,
 };
-use crate::scenes::parallel::output::write_summary;
-use crate::scenes::parallel::report::reduction;
+use crate::summary::{reduction, write_summary};
 
 /// The summary table: shape errors raw vs compensated, forces, contact losses.
 pub fn table(runs: &[ContourRun]) -> String {

@@ -5,7 +5,7 @@ use nalgebra::Vector3;
 use serde::Serialize;
 
 use super::sensor::SensorParams;
-use crate::scenes::parallel::params::DT;
+use crate::rapier_util::SERVO_DT as DT;
 use crate::urdf_arm::KR300_Q0;
 
 /// Largest physics step of the program runs \[s\]: 1 ms, twice the groove scenario's; the step

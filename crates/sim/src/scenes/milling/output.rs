@@ -13,7 +13,7 @@ use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
     present,
 };
-use crate::scenes::parallel::output::write_summary;
+use crate::summary::write_summary;
 
 /// The summary table printed on stdout and written to `milling_summary.txt`.
 pub fn table(r: &MillingResult) -> String {

@@ -104,8 +104,8 @@ fn calibrate(
     Ok((map, text))
 }
 
-/// [`calibrate`] for several mechanisms, one thread each: per mechanism, in order, its map
-/// and its summary text (for the command to print).
+/// The calibration of each of several mechanisms, one thread each: per mechanism, in order,
+/// its map and its summary text (for the command to print).
 pub fn calibrate_all(
     constraints: &[Constraint],
     out: &Path,

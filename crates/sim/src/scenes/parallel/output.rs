@@ -13,7 +13,8 @@ use crate::plot_style::{
     line, new_chart, padded_range, perr, present,
 };
 use crate::scenes::parallel::run::{Motion, RunResult};
-use crate::{SimError, write_file};
+use crate::SimError;
+pub use crate::summary::write_summary;
 
 /// Topics written for each run, as `/<scenario>/<run>/<topic>` (`crates/sim/README.md`).
 pub const TOPICS: [&str; 7] = [
@@ -157,24 +158,6 @@ pub fn summary_csv(runs: &[RunResult]) -> String {
         );
     }
     s
-}
-
-/// Writes `<stem>.txt`, `<stem>.csv` and `<stem>.json` (pretty JSON of `json`) into `out`.
-pub fn write_summary<T: serde::Serialize + ?Sized>(
-    out: &Path,
-    stem: &str,
-    txt: &str,
-    csv: &str,
-    json: &T,
-) -> Result<(), SimError> {
-    write_file(&out.join(format!("{stem}.txt")), "the summary table", txt)?;
-    write_file(&out.join(format!("{stem}.csv")), "the summary CSV", csv)?;
-    write_file(
-        &out.join(format!("{stem}.json")),
-        "the summary JSON",
-        serde_json::to_string_pretty(json)?,
-    )?;
-    Ok(())
 }
 
 /// Deviation \[m\] of `p` across the polyline `pts`: its signed distance from the line of

@@ -9,7 +9,7 @@ use nalgebra::{Matrix2, Matrix3, Vector2, Vector3};
 use crate::SimError;
 
 /// Simulation step \[s\]: the paper's 2 kHz servo rate.
-pub const DT: f64 = 1.0 / 2000.0;
+pub const DT: f64 = crate::rapier_util::SERVO_DT;
 /// Link length \[m\] (section 4.1).
 pub const LINK: f64 = 0.150;
 /// Half width |A0O| = |BC| \[m\].

@@ -4,6 +4,7 @@
 use std::fmt::Write as _;
 
 use crate::scenes::parallel::run::{Motion, RunResult};
+pub use crate::summary::reduction;
 
 fn find<'a>(
     runs: &'a [RunResult],
@@ -31,11 +32,6 @@ fn g_levels(runs: &[RunResult]) -> Vec<u8> {
     g.sort_unstable();
     g.dedup();
     g
-}
-
-/// Reduction in percent from `a` to `b`.
-pub fn reduction(a: f64, b: f64) -> f64 {
-    if a > 0.0 { 100.0 * (a - b) / a } else { 0.0 }
 }
 
 /// The per-motion tables and the 5 g reduction table.

@@ -14,8 +14,7 @@ use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, padded_range,
     present,
 };
-use crate::scenes::parallel::output::write_summary;
-use crate::scenes::parallel::report::reduction;
+use crate::summary::{reduction, write_summary};
 
 fn run_label(r: &SerialRun) -> String {
     format!(
