@@ -7,13 +7,13 @@ use std::path::Path;
 use plotters::prelude::*;
 use serde_json::json;
 
+use crate::SimError;
 use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, poses_in_frame, scene_update};
 use crate::plot_style::{
     CHART, Entry, Role, Swatch, canvas, color, config_role, config_words, draw_legend, figure,
     line, new_chart, padded_range, perr, present,
 };
 use crate::scenes::parallel::run::{Motion, RunResult};
-use crate::SimError;
 pub use crate::summary::write_summary;
 
 /// Topics written for each run, as `/<scenario>/<run>/<topic>` (`crates/sim/README.md`).
