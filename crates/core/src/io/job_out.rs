@@ -22,8 +22,8 @@ use std::path::Path;
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use crate::geometry::distance_to_segment;
 use crate::error::LoadError;
+use crate::geometry::distance_to_segment;
 use crate::machining::job::{JobSample, Report};
 use crate::machining::{Motion, Program};
 

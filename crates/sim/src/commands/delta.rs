@@ -6,8 +6,8 @@ use std::path::Path;
 
 use deflect_core::io::map_json;
 use deflect_sim::SimError;
-use deflect_sim::scenes::delta::{self, DeltaOptions};
 use deflect_sim::scenes::delta::output::table;
+use deflect_sim::scenes::delta::{self, DeltaOptions};
 
 use super::Cmd;
 use crate::cli::{CliError, DeltaArgs};

@@ -155,6 +155,18 @@ fn run(args: &RunArgs, map: Option<LoadedMap>, out: &Path) -> Result<(), SimErro
     Ok(())
 }
 
+impl Cmd for RunArgs {
+    type Input = Option<LoadedMap>;
+
+    fn load(&self) -> Result<Option<LoadedMap>, CliError> {
+        self.map.as_deref().map(load_map).transpose()
+    }
+
+    fn run(&self, input: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
+        run(self, input, out)
+    }
+}
+
 #[cfg(test)]
 #[allow(clippy::unwrap_used)]
 mod tests {
@@ -227,17 +239,5 @@ mod tests {
         assert_eq!(unit, deflect_core::units::LengthUnit::Metre);
         assert!(super::super::fit::unit_header("x,y,force_axis,force,dx,dy").is_none());
         let _ = std::fs::remove_dir_all(&dir);
-    }
-}
-
-impl Cmd for RunArgs {
-    type Input = Option<LoadedMap>;
-
-    fn load(&self) -> Result<Option<LoadedMap>, CliError> {
-        self.map.as_deref().map(load_map).transpose()
-    }
-
-    fn run(&self, input: Option<LoadedMap>, out: &Path) -> Result<(), SimError> {
-        run(self, input, out)
     }
 }

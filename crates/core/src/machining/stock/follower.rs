@@ -4,8 +4,8 @@
 use nalgebra::Vector3;
 
 use super::{Cutter, Removal, ZMap};
-use crate::geometry::distance_to_segment;
 use crate::error::{TickError, check_finite};
+use crate::geometry::distance_to_segment;
 
 /// How far a [`Follower`] may leave cells above the exact sweep \[m\]: 1e-8 m, the pose
 /// IK's position tolerance.
