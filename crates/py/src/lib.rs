@@ -30,6 +30,7 @@ mod field;
 mod five_axis;
 mod grid_map;
 mod identification;
+mod job_args;
 mod kinematics;
 mod machining;
 mod machining_job;

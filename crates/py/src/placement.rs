@@ -14,8 +14,9 @@ use pyo3::types::PyBytes;
 use crate::InputError;
 use crate::arrays::{matrix, vector};
 use crate::errors::{build_err, job_err};
+use crate::job_args::Spin;
 use crate::machining::GcodeProgram;
-use crate::machining_job::{MachiningJob, Spin};
+use crate::machining_job::MachiningJob;
 
 /// A placement search's problem: a `MachiningJob` (its arm, tool, stock and spin setting:
 /// `spin="keep"` scores each placement with the seed's spin, `spin="optimize"` with the

@@ -4,7 +4,8 @@
 //! * Topics `/<scenario>/<run>/<quantity>`; every run's log time starts at 0 (its first
 //!   sample), runs are overlaid and told apart by their topic prefix.
 //! * Schema names `deflect.<Type>` ([`Kind`]), the same field set wherever they appear, SI
-//!   units in every numeric field, declared in the property's `description`.
+//!   units in every numeric field, declared in the property's `description` (the schemas
+//!   in the private `schema`).
 //! * Foxglove's well-known schemas for the 3D panel: `foxglove.PosesInFrame` (the TCP pose,
 //!   every sample) and `foxglove.SceneUpdate` (desired and actual paths as lines, one message
 //!   at t = 0), frame `base`.
@@ -19,6 +20,8 @@ use mcap::records::{MessageHeader, Metadata};
 use serde_json::{Value, json};
 
 use crate::SimError;
+
+mod schema;
 
 /// The frame of every position and pose: the robot's base frame.
 pub const FRAME: &str = "base";
@@ -96,45 +99,6 @@ pub const KINDS: [Kind; 12] = [
     Kind::SceneUpdate,
 ];
 
-fn num(unit: &str) -> Value {
-    json!({"type": "number", "description": unit})
-}
-
-/// The JSON schema of a `{sec, nsec}` timestamp.
-fn time_schema() -> Value {
-    json!({"type": "object", "title": "time", "properties": {
-        "sec": {"type": "integer", "minimum": 0, "description": "s"},
-        "nsec": {"type": "integer", "minimum": 0, "maximum": 999_999_999, "description": "ns"}}})
-}
-
-fn vec3_schema(unit: &str) -> Value {
-    json!({"type": "object", "properties": {"x": num(unit), "y": num(unit), "z": num(unit)}})
-}
-
-fn color_schema() -> Value {
-    let c = num("1 (0 to 1)");
-    json!({"type": "object", "properties": {"r": c, "g": c, "b": c, "a": c}})
-}
-
-fn foxglove_pose_schema() -> Value {
-    json!({"type": "object", "properties": {
-        "position": vec3_schema("m"),
-        "orientation": {"type": "object", "properties": {
-            "x": num("1"), "y": num("1"), "z": num("1"), "w": num("1")}}}})
-}
-
-/// A `deflect.<Type>` schema: `timestamp`, `run` and `fields` (name, unit).
-fn deflect_schema(title: &str, fields: &[(&str, Value)]) -> Value {
-    let mut props = json!({
-        "timestamp": time_schema(),
-        "run": {"type": "string", "description": "the run's name (its topic prefix)"},
-    });
-    for (f, v) in fields {
-        props[*f] = v.clone();
-    }
-    json!({"title": title, "type": "object", "properties": props})
-}
-
 impl Kind {
     /// The schema name: `deflect.<Type>` or `foxglove.<Type>`.
     pub fn name(self) -> &'static str {
@@ -156,109 +120,19 @@ impl Kind {
 
     /// The JSON schema (root an object; units in the descriptions).
     pub fn schema(self) -> Value {
-        let xyz = |u: &str| vec![("x", num(u)), ("y", num(u)), ("z", num(u))];
-        let force = || vec![("fx", num("N")), ("fy", num("N")), ("fz", num("N"))];
-        let rad_array = |what: &str| {
-            json!({"type": "array", "items": {"type": "number", "description": "rad"},
-                   "description": format!("rad, {what}, one per joint")})
-        };
         match self {
-            Self::Point => deflect_schema("point [m], base frame", &xyz("m")),
-            Self::Pose => {
-                let mut f = xyz("m");
-                for q in ["qx", "qy", "qz", "qw"] {
-                    f.push((q, num("1 (unit quaternion)")));
-                }
-                deflect_schema("pose, base frame", &f)
-            }
-            Self::Force => deflect_schema("force [N], base frame", &force()),
-            Self::Wrench => {
-                let mut f = force();
-                for m in ["mx", "my", "mz"] {
-                    f.push((m, num("N m")));
-                }
-                deflect_schema("wrench [N, N m]", &f)
-            }
-            Self::Displacement => {
-                let mut f = vec![("dx", num("m")), ("dy", num("m")), ("dz", num("m"))];
-                for r in ["rx", "ry", "rz"] {
-                    f.push((r, num("rad (rotation vector)")));
-                }
-                deflect_schema("small 6-D displacement [m, rad], base frame", &f)
-            }
-            Self::JointState => deflect_schema(
-                "joint angles [rad]",
-                &[
-                    ("command", rad_array("commanded")),
-                    ("motor", rad_array("motor side")),
-                    ("link", rad_array("link side")),
-                ],
-            ),
-            Self::PathError => deflect_schema(
-                "distance of the tool point from the desired path [m]",
-                &[("distance", num("m"))],
-            ),
-            Self::PilotControl => deflect_schema(
-                "pilot control of the force estimate",
-                &[(
-                    "weight",
-                    num("1 (0: measured force only, 1: estimate only)"),
-                )],
-            ),
-            Self::TracerState => deflect_schema(
-                "state of the contour tracer",
-                &[(
-                    "state",
-                    json!({"type": "string", "description": "tracer phase"}),
-                )],
-            ),
-            Self::Engagement => deflect_schema(
-                "engagement of the cutter with the material",
-                &[
-                    ("depth", num("m (axial depth, 0 in air)")),
-                    (
-                        "entry_angle",
-                        num("rad (first engaged immersion angle, clockwise from +y, feed +x)"),
-                    ),
-                    ("exit_angle", num("rad (last engaged angle)")),
-                    (
-                        "arcs",
-                        json!({"type": "integer", "minimum": 0,
-                                   "description": "1 (number of engaged arcs)"}),
-                    ),
-                ],
-            ),
-            Self::PosesInFrame => json!({
-                "title": "foxglove.PosesInFrame", "type": "object", "properties": {
-                    "timestamp": time_schema(),
-                    "frame_id": {"type": "string"},
-                    "poses": {"type": "array", "items": foxglove_pose_schema()}}}),
-            Self::SceneUpdate => {
-                let line = json!({"type": "object", "properties": {
-                    "type": {"type": "integer", "description": "0 LINE_STRIP, 1 LINE_LOOP, 2 LINE_LIST"},
-                    "pose": foxglove_pose_schema(),
-                    "thickness": num("px (scale_invariant) or m"),
-                    "scale_invariant": {"type": "boolean"},
-                    "points": {"type": "array", "items": vec3_schema("m")},
-                    "color": color_schema(),
-                    "colors": {"type": "array", "items": color_schema()},
-                    "indices": {"type": "array", "items": {"type": "integer", "minimum": 0}}}});
-                let empty = json!({"type": "array", "items": {"type": "object"}});
-                let entity = json!({"type": "object", "properties": {
-                    "timestamp": time_schema(),
-                    "frame_id": {"type": "string"},
-                    "id": {"type": "string"},
-                    "lifetime": {"type": "object", "properties": {
-                        "sec": {"type": "integer", "description": "s"},
-                        "nsec": {"type": "integer", "description": "ns"}}},
-                    "frame_locked": {"type": "boolean"},
-                    "metadata": empty, "arrows": empty, "cubes": empty, "spheres": empty,
-                    "cylinders": empty, "triangles": empty, "texts": empty, "models": empty,
-                    "lines": {"type": "array", "items": line}}});
-                json!({"title": "foxglove.SceneUpdate", "type": "object", "properties": {
-                    "deletions": {"type": "array", "items": {"type": "object"}},
-                    "entities": {"type": "array", "items": entity}}})
-            }
+            Self::Point => schema::point(),
+            Self::Pose => schema::pose(),
+            Self::Force => schema::force(),
+            Self::Wrench => schema::wrench(),
+            Self::Displacement => schema::displacement(),
+            Self::JointState => schema::joint_state(),
+            Self::PathError => schema::path_error(),
+            Self::PilotControl => schema::pilot_control(),
+            Self::TracerState => schema::tracer_state(),
+            Self::Engagement => schema::engagement(),
+            Self::PosesInFrame => schema::poses_in_frame(),
+            Self::SceneUpdate => schema::scene_update(),
         }
     }
 }

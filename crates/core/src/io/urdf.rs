@@ -150,6 +150,16 @@ pub fn from_path(
     from_str(&urdf, &stiffness, base_link, tip_link)
 }
 
+/// Child link -> its joint, with the set of link names and the set of joint names.
+type TreeIndex<'a> = (
+    HashSet<&'a str>,
+    HashSet<&'a str>,
+    HashMap<&'a str, &'a urdf_rs::Joint>,
+);
+
+/// A virtual joint resolved to (link, frame in the link, label).
+type Placed = (String, Isometry3<f64>, String);
+
 /// Assembles a serial robot from a parsed URDF and virtual-joint specs, validating both.
 pub fn assemble(
     robot: &urdf_rs::Robot,
@@ -157,6 +167,41 @@ pub fn assemble(
     base_link: Option<&str>,
     tip_link: &str,
 ) -> Result<SerialRobot, LoadError> {
+    let (links, joint_names, parent_joint) = index_tree(robot)?;
+    check_single_root(robot, &parent_joint)?;
+    check_chain_ends(&links, base_link, tip_link)?;
+    let (base, path) = chain_path(&parent_joint, base_link, tip_link)?;
+    let base = base.to_string();
+
+    // Links on the chain, in order: the base, then each joint's child.
+    let chain_links: Vec<&str> = core::iter::once(base.as_str())
+        .chain(path.iter().map(|j| j.child.link.as_str()))
+        .collect();
+    let placed = place_springs(springs, &links, &joint_names, &chain_links, &path)?;
+
+    let mut b = ModelBuilder::new();
+    let mut names = Vec::new();
+    let mut limits = Vec::new();
+    let mut spring_names = Vec::new();
+    b = add_link_springs(b, robot, &placed, springs, &mut spring_names, &base)?;
+    for j in &path {
+        b = add_chain_joint(b, j, &mut names, &mut limits)?;
+        b = add_link_springs(b, robot, &placed, springs, &mut spring_names, &j.child.link)?;
+    }
+    Ok(SerialRobot {
+        model: b.build()?,
+        joint_names: names,
+        joint_limits: limits,
+        spring_names,
+        base_link: base,
+        tip_link: tip_link.to_string(),
+        controller: None,
+    })
+}
+
+/// Indexes the URDF tree (link names, joint names, child link -> joint), refusing
+/// duplicate names, joints naming unknown links and links with two parents.
+fn index_tree(robot: &urdf_rs::Robot) -> Result<TreeIndex<'_>, LoadError> {
     let mut links = HashSet::new();
     for l in &robot.links {
         if !links.insert(l.name.as_str()) {
@@ -190,6 +235,14 @@ pub fn assemble(
             });
         }
     }
+    Ok((links, joint_names, parent_joint))
+}
+
+/// Refuses a URDF with more than one root link, naming (up to 8 of) them.
+fn check_single_root(
+    robot: &urdf_rs::Robot,
+    parent_joint: &HashMap<&str, &urdf_rs::Joint>,
+) -> Result<(), LoadError> {
     // The URDF specification asks for one tree: a second root is a link nothing attaches,
     // left over or misspelt, and which of them is the base would be a guess.
     let mut roots: Vec<&str> = robot
@@ -211,6 +264,15 @@ pub fn assemble(
             ),
         });
     }
+    Ok(())
+}
+
+/// Refuses a tip link (or base link) the URDF does not have.
+fn check_chain_ends(
+    links: &HashSet<&str>,
+    base_link: Option<&str>,
+    tip_link: &str,
+) -> Result<(), LoadError> {
     if !links.contains(tip_link) {
         return Err(LoadError::UnknownLink {
             link: tip_link.to_string(),
@@ -225,6 +287,16 @@ pub fn assemble(
             referenced_by: "base_link".to_string(),
         });
     }
+    Ok(())
+}
+
+/// The chain's base link and its joints from base to tip, walked from the tip up to
+/// `base_link` (or the root), refusing cycles and a base the tip does not hang from.
+fn chain_path<'a>(
+    parent_joint: &HashMap<&'a str, &'a urdf_rs::Joint>,
+    base_link: Option<&str>,
+    tip_link: &'a str,
+) -> Result<(&'a str, Vec<&'a urdf_rs::Joint>), LoadError> {
     // Walk from the tip to the base (or the root).
     let mut path: Vec<&urdf_rs::Joint> = Vec::new();
     let mut visited = HashSet::new();
@@ -254,15 +326,20 @@ pub fn assemble(
             }
         }
     }
-    let base = link.to_string();
     path.reverse();
+    Ok((link, path))
+}
 
-    // Links on the chain, in order: the base, then each joint's child.
-    let chain_links: Vec<&str> = core::iter::once(base.as_str())
-        .chain(path.iter().map(|j| j.child.link.as_str()))
-        .collect();
-    // Every spring resolved to (link, frame in the link, label).
-    let mut placed: Vec<(String, Isometry3<f64>, String)> = Vec::with_capacity(springs.len());
+/// Resolves every virtual joint of the stiffness file to (link, frame in the link, label),
+/// in file order.
+fn place_springs(
+    springs: &[VirtualJointSpec],
+    links: &HashSet<&str>,
+    joint_names: &HashSet<&str>,
+    chain_links: &[&str],
+    path: &[&urdf_rs::Joint],
+) -> Result<Vec<Placed>, LoadError> {
+    let mut placed: Vec<Placed> = Vec::with_capacity(springs.len());
     for (entry, s) in springs.iter().enumerate() {
         let (link, frame, label) = match (&s.link, &s.joint) {
             (Some(link), _) => {
@@ -283,41 +360,7 @@ pub fn assemble(
                 )?;
                 (link.clone(), frame, label)
             }
-            (None, Some(joint)) => {
-                let label = format!("virtual_joint #{entry} at joint '{joint}'");
-                let Some(j) = path.iter().find(|j| j.name == *joint) else {
-                    return Err(LoadError::UnknownJoint {
-                        joint: joint.clone(),
-                        referenced_by: if joint_names.contains(joint.as_str()) {
-                            format!("{label} (the joint is not on the base-to-tip chain)")
-                        } else {
-                            label
-                        },
-                    });
-                };
-                if !matches!(
-                    j.joint_type,
-                    urdf_rs::JointType::Revolute
-                        | urdf_rs::JointType::Continuous
-                        | urdf_rs::JointType::Prismatic
-                ) {
-                    return Err(LoadError::UnsupportedJoint {
-                        joint: joint.clone(),
-                        kind: format!(
-                            "{} (a spring at a joint needs a moving joint's axis)",
-                            format!("{:?}", j.joint_type).to_lowercase()
-                        ),
-                    });
-                }
-                let axis = Vector3::from(j.axis.xyz.0);
-                let n = axis.norm();
-                if !(n.is_finite() && n > 0.0) {
-                    return Err(LoadError::ZeroAxis {
-                        joint: joint.clone(),
-                    });
-                }
-                (j.child.link.clone(), joint_spring_frame(&(axis / n)), label)
-            }
+            (None, Some(joint)) => place_at_joint(entry, joint, joint_names, path)?,
             (None, None) => {
                 return Err(LoadError::InvalidValue {
                     element: format!("virtual_joint #{entry}"),
@@ -329,106 +372,152 @@ pub fn assemble(
         };
         placed.push((link, frame, label));
     }
+    Ok(placed)
+}
 
-    let mut b = ModelBuilder::new();
-    let mut names = Vec::new();
-    let mut limits = Vec::new();
-    let mut spring_names = Vec::new();
-    let mut add_springs = |mut b: ModelBuilder, link: &str| -> Result<ModelBuilder, LoadError> {
-        let mut n_on_link = 0usize;
-        for ((on, frame, label), s) in placed.iter().zip(springs) {
-            if on != link {
-                continue;
-            }
-            if let Some((axis, &value)) =
-                s.k.iter()
-                    .enumerate()
-                    .find(|(_, v)| !crate::vjm::valid_stiffness(**v))
-            {
-                return Err(LoadError::NonPositiveStiffness {
-                    element: label.clone(),
-                    axis,
-                    value,
-                });
-            }
-            b = b.spring_at(*frame, s.k)?;
-            spring_names.push(match &s.joint {
-                Some(joint) => joint.clone(),
-                None if n_on_link == 0 => link.to_string(),
-                None => format!("{link}#{n_on_link}"),
-            });
-            n_on_link += 1;
-        }
-        // The link's mass after its springs: they are the link's compliance (bearings,
-        // drive, structure), and the link moves with them.
-        if let Some(l) = robot.links.iter().find(|l| l.name == link) {
-            b = link_mass(b, l)?;
-        }
-        Ok(b)
-    };
-    b = add_springs(b, &base)?;
-    for j in &path {
-        if j.mimic.is_some() {
-            return Err(LoadError::UnsupportedJoint {
-                joint: j.name.clone(),
-                kind: "mimic".to_string(),
-            });
-        }
-        b = b.fixed(pose(
-            &j.origin.xyz.0,
-            &j.origin.rpy.0,
-            &format!("joint '{}'", j.name),
-        )?)?;
-        let axis = Vector3::from(j.axis.xyz.0);
-        let moving = matches!(
-            j.joint_type,
-            urdf_rs::JointType::Revolute
-                | urdf_rs::JointType::Continuous
-                | urdf_rs::JointType::Prismatic
-        );
-        if moving {
-            let n = axis.norm();
-            if !(n.is_finite() && n > 0.0) {
-                return Err(LoadError::ZeroAxis {
-                    joint: j.name.clone(),
-                });
-            }
-            let (lo, hi) = match j.joint_type {
-                urdf_rs::JointType::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
-                _ => (j.limit.lower, j.limit.upper),
-            };
-            // urdf-rs gives a revolute or prismatic joint without `<limit>` the limits
-            // (0, 0); the URDF specification requires the element, and a joint that cannot
-            // move is not a joint: refuse both.
-            if lo.is_nan() || hi.is_nan() || lo >= hi {
-                return Err(LoadError::InvalidLimit {
-                    joint: j.name.clone(),
-                    lower: lo,
-                    upper: hi,
-                });
-            }
-            b = if j.joint_type == urdf_rs::JointType::Prismatic {
-                b.prismatic(axis)?
+/// Resolves virtual joint #`entry`, placed at `joint`, to its child link and the frame
+/// along the joint's axis; the joint must be a moving one on the chain.
+fn place_at_joint(
+    entry: usize,
+    joint: &String,
+    joint_names: &HashSet<&str>,
+    path: &[&urdf_rs::Joint],
+) -> Result<Placed, LoadError> {
+    let label = format!("virtual_joint #{entry} at joint '{joint}'");
+    let Some(j) = path.iter().find(|j| j.name == *joint) else {
+        return Err(LoadError::UnknownJoint {
+            joint: joint.clone(),
+            referenced_by: if joint_names.contains(joint.as_str()) {
+                format!("{label} (the joint is not on the base-to-tip chain)")
             } else {
-                b.revolute(axis)?
-            };
-            names.push(j.name.clone());
-            limits.push((lo, hi));
-        } else if j.joint_type != urdf_rs::JointType::Fixed {
-            return Err(LoadError::UnsupportedJoint {
-                joint: j.name.clone(),
-                kind: format!("{:?}", j.joint_type).to_lowercase(),
+                label
+            },
+        });
+    };
+    if !matches!(
+        j.joint_type,
+        urdf_rs::JointType::Revolute
+            | urdf_rs::JointType::Continuous
+            | urdf_rs::JointType::Prismatic
+    ) {
+        return Err(LoadError::UnsupportedJoint {
+            joint: joint.clone(),
+            kind: format!(
+                "{} (a spring at a joint needs a moving joint's axis)",
+                format!("{:?}", j.joint_type).to_lowercase()
+            ),
+        });
+    }
+    let axis = Vector3::from(j.axis.xyz.0);
+    let n = axis.norm();
+    if !(n.is_finite() && n > 0.0) {
+        return Err(LoadError::ZeroAxis {
+            joint: joint.clone(),
+        });
+    }
+    Ok((j.child.link.clone(), joint_spring_frame(&(axis / n)), label))
+}
+
+/// Adds the springs placed on `link` (in file order, naming each) and then the link's mass.
+fn add_link_springs(
+    mut b: ModelBuilder,
+    robot: &urdf_rs::Robot,
+    placed: &[Placed],
+    springs: &[VirtualJointSpec],
+    spring_names: &mut Vec<String>,
+    link: &str,
+) -> Result<ModelBuilder, LoadError> {
+    let mut n_on_link = 0usize;
+    for ((on, frame, label), s) in placed.iter().zip(springs) {
+        if on != link {
+            continue;
+        }
+        if let Some((axis, &value)) =
+            s.k.iter()
+                .enumerate()
+                .find(|(_, v)| !crate::vjm::valid_stiffness(**v))
+        {
+            return Err(LoadError::NonPositiveStiffness {
+                element: label.clone(),
+                axis,
+                value,
             });
         }
-        b = add_springs(b, &j.child.link)?;
+        b = b.spring_at(*frame, s.k)?;
+        spring_names.push(match &s.joint {
+            Some(joint) => joint.clone(),
+            None if n_on_link == 0 => link.to_string(),
+            None => format!("{link}#{n_on_link}"),
+        });
+        n_on_link += 1;
     }
-    Ok(SerialRobot {
-        model: b.build()?,
-        joint_names: names,
-        joint_limits: limits,
-        spring_names,
-        base_link: base,
-        tip_link: tip_link.to_string(),
-        controller: None,
-    })
+    // The link's mass after its springs: they are the link's compliance (bearings,
+    // drive, structure), and the link moves with them.
+    if let Some(l) = robot.links.iter().find(|l| l.name == link) {
+        b = link_mass(b, l)?;
+    }
+    Ok(b)
+}
+
+/// Adds one chain joint: its fixed origin, then (for a moving joint) its axis, recording
+/// its name and limits \[rad or m\]; refuses mimic and unsupported joints.
+fn add_chain_joint(
+    mut b: ModelBuilder,
+    j: &urdf_rs::Joint,
+    names: &mut Vec<String>,
+    limits: &mut Vec<(f64, f64)>,
+) -> Result<ModelBuilder, LoadError> {
+    if j.mimic.is_some() {
+        return Err(LoadError::UnsupportedJoint {
+            joint: j.name.clone(),
+            kind: "mimic".to_string(),
+        });
+    }
+    b = b.fixed(pose(
+        &j.origin.xyz.0,
+        &j.origin.rpy.0,
+        &format!("joint '{}'", j.name),
+    )?)?;
+    let axis = Vector3::from(j.axis.xyz.0);
+    let moving = matches!(
+        j.joint_type,
+        urdf_rs::JointType::Revolute
+            | urdf_rs::JointType::Continuous
+            | urdf_rs::JointType::Prismatic
+    );
+    if moving {
+        let n = axis.norm();
+        if !(n.is_finite() && n > 0.0) {
+            return Err(LoadError::ZeroAxis {
+                joint: j.name.clone(),
+            });
+        }
+        let (lo, hi) = match j.joint_type {
+            urdf_rs::JointType::Continuous => (f64::NEG_INFINITY, f64::INFINITY),
+            _ => (j.limit.lower, j.limit.upper),
+        };
+        // urdf-rs gives a revolute or prismatic joint without `<limit>` the limits
+        // (0, 0); the URDF specification requires the element, and a joint that cannot
+        // move is not a joint: refuse both.
+        if lo.is_nan() || hi.is_nan() || lo >= hi {
+            return Err(LoadError::InvalidLimit {
+                joint: j.name.clone(),
+                lower: lo,
+                upper: hi,
+            });
+        }
+        b = if j.joint_type == urdf_rs::JointType::Prismatic {
+            b.prismatic(axis)?
+        } else {
+            b.revolute(axis)?
+        };
+        names.push(j.name.clone());
+        limits.push((lo, hi));
+    } else if j.joint_type != urdf_rs::JointType::Fixed {
+        return Err(LoadError::UnsupportedJoint {
+            joint: j.name.clone(),
+            kind: format!("{:?}", j.joint_type).to_lowercase(),
+        });
+    }
+    Ok(b)
 }

@@ -141,6 +141,76 @@ fn tick_dict<'py>(py: Python<'py>, t: &serial::Tick, dof: usize) -> PyResult<Bou
     Ok(d)
 }
 
+/// The deflection model named `model` (`'exact'` or `'linearized'`).
+fn deflection_model(model: &str) -> PyResult<Deflection> {
+    match model {
+        "exact" => Ok(Deflection::Exact),
+        "linearized" => Ok(Deflection::Linearized),
+        other => Err(InputError::new_err(format!(
+            "model = '{other}': expected 'exact' or 'linearized'"
+        ))),
+    }
+}
+
+/// `joint_limits=`: a (dof, 2) array of (lower, upper) \[rad or m\], else the robot's.
+fn joint_limits_arg(
+    joint_limits: Option<&Bound<'_, PyAny>>,
+    robot_limits: &[(f64, f64)],
+    dof: usize,
+) -> PyResult<Vec<(f64, f64)>> {
+    Ok(match joint_limits {
+        None => robot_limits.to_vec(),
+        Some(l) => {
+            let m = matrix(l, "joint_limits", Some(dof), Some(2))?;
+            m.as_array()
+                .rows()
+                .into_iter()
+                .map(|r| {
+                    let at = |k: usize| r.get(k).copied().unwrap_or(f64::NAN);
+                    (at(0), at(1))
+                })
+                .collect()
+        }
+    })
+}
+
+/// `seed=`: the IK's start joints \[rad or m\], `dof` finite values, if given.
+fn seed_arg(seed: Option<&Bound<'_, PyAny>>, dof: usize) -> PyResult<Option<Vec<f64>>> {
+    Ok(match seed {
+        Some(s) => {
+            let q = vector(s, "seed", dof)?;
+            if let Some(i) = q.iter().position(|v| !v.is_finite()) {
+                return Err(InputError::new_err(format!("seed[{i}] is not finite")));
+            }
+            Some(q)
+        }
+        None => None,
+    })
+}
+
+/// `task=`: the IK's task by name; `'auto'` the largest the arm has at the seed (else by
+/// its joint count).
+fn task_arg(task: &str, seed: Option<&[f64]>, chain: &deflect_core::vjm::Model) -> PyResult<Task> {
+    let dof = chain.dof();
+    Ok(match (task, seed) {
+        ("auto", Some(q)) => largest_task(chain, &mut deflect_core::vjm::Data::new(chain), q)
+            .map_err(|e| tick_err_at(format_args!("task='auto' at the seed"), e))?,
+        ("auto", None) => Task::for_dof(dof),
+        (task, _) => match task {
+            "pose" => Task::POSE,
+            "position_and_axis" => Task::POSITION_AND_AXIS,
+            "position_and_spin" => Task::POSITION_AND_SPIN,
+            "position" => Task::POSITION,
+            other => {
+                return Err(InputError::new_err(format!(
+                    "task = '{other}': expected 'auto', 'pose', 'position_and_axis', \
+                     'position_and_spin' or 'position'"
+                )));
+            }
+        },
+    })
+}
+
 #[pymethods]
 impl SerialDalembertCorrector {
     #[new]
@@ -166,56 +236,10 @@ impl SerialDalembertCorrector {
         let chain = robot.inner.model.clone();
         let dof = chain.dof();
         let payload = payload(mass, com, inertia)?;
-        let deflection = match model {
-            "exact" => Deflection::Exact,
-            "linearized" => Deflection::Linearized,
-            other => {
-                return Err(InputError::new_err(format!(
-                    "model = '{other}': expected 'exact' or 'linearized'"
-                )));
-            }
-        };
-        let limits: Vec<(f64, f64)> = match joint_limits {
-            None => robot.inner.joint_limits.clone(),
-            Some(l) => {
-                let m = matrix(l, "joint_limits", Some(dof), Some(2))?;
-                m.as_array()
-                    .rows()
-                    .into_iter()
-                    .map(|r| {
-                        let at = |k: usize| r.get(k).copied().unwrap_or(f64::NAN);
-                        (at(0), at(1))
-                    })
-                    .collect()
-            }
-        };
-        let seed = match seed {
-            Some(s) => {
-                let q = vector(s, "seed", dof)?;
-                if let Some(i) = q.iter().position(|v| !v.is_finite()) {
-                    return Err(InputError::new_err(format!("seed[{i}] is not finite")));
-                }
-                Some(q)
-            }
-            None => None,
-        };
-        let task = match (task, &seed) {
-            ("auto", Some(q)) => largest_task(&chain, &mut deflect_core::vjm::Data::new(&chain), q)
-                .map_err(|e| tick_err_at(format_args!("task='auto' at the seed"), e))?,
-            ("auto", None) => Task::for_dof(dof),
-            (task, _) => match task {
-                "pose" => Task::POSE,
-                "position_and_axis" => Task::POSITION_AND_AXIS,
-                "position_and_spin" => Task::POSITION_AND_SPIN,
-                "position" => Task::POSITION,
-                other => {
-                    return Err(InputError::new_err(format!(
-                        "task = '{other}': expected 'auto', 'pose', 'position_and_axis', \
-                     'position_and_spin' or 'position'"
-                    )));
-                }
-            },
-        };
+        let deflection = deflection_model(model)?;
+        let limits = joint_limits_arg(joint_limits, &robot.inner.joint_limits, dof)?;
+        let seed = seed_arg(seed, dof)?;
+        let task = task_arg(task, seed.as_deref(), &chain)?;
         let ik = PoseIkOptions {
             max_iterations,
             position_tolerance,

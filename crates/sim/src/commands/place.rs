@@ -7,7 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 use std::time::Instant;
 
-use deflect_core::machining::placement::{self, PlacementBox, Problem};
+use deflect_core::machining::placement::{self, PlacementBox, Problem, Search};
 use deflect_core::machining::spin::SpinOptions;
 use deflect_sim::SimError;
 use deflect_sim::scenes::serial::atlas::{HeatMap, heat_map};
@@ -138,6 +138,45 @@ fn run(a: &PlaceArgs, t: &PlaceTask, out: &Path) -> Result<(), SimError> {
         at_job.rms * 1e3,
         at_job.max * 1e3
     );
+    plot_grid(t, &found, out)?;
+    let json = serde_json::json!({
+        "program": t.task.program_name,
+        "robot": t.task.robot_name,
+        "spin_optimised": optimise,
+        "measure": spin.measure.name(),
+        "box_min": t.bx.min, "box_max": t.bx.max, "steps": t.bx.steps,
+        "refine": a.refine,
+        "evaluations": found.evaluations,
+        "wall_time_s": wall,
+        "threads": threads,
+        "best": {"x_m": best[0], "y_m": best[1], "z_m": best[2], "yaw_rad": best[3],
+                 "rms_m": score.rms, "max_m": score.max},
+        "job_placement": {"rms_m": at_job.rms, "max_m": at_job.max},
+        "grid": found.grid.iter().map(|(p, s)| serde_json::json!({
+            "x_m": p[0], "y_m": p[1], "z_m": p[2], "yaw_rad": p[3],
+            "rms_m": if s.feasible() { Some(s.rms) } else { None },
+            "max_m": if s.feasible() { Some(s.max) } else { None },
+            "line": s.line,
+        })).collect::<Vec<_>>(),
+    });
+    let write = |name: &str, body: &str| {
+        deflect_core::io::job_out::write(out.join(name), body)
+            .map_err(|e| SimError::new(e.to_string()))
+    };
+    write("place_summary.txt", &text)?;
+    write(
+        "place_summary.json",
+        &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
+    )?;
+    stdout(format_args!(
+        "{text}outputs in {}: place.png, place_summary.{{txt,json}}\n",
+        out.display()
+    ))
+}
+
+/// Plots the grid's heat map to `place.png`: per x-y cell the best RMS deflection \[mm\] over
+/// z and yaw.
+fn plot_grid(t: &PlaceTask, found: &Search, out: &Path) -> Result<(), SimError> {
     let [nx, ny, _, _] = t.bx.steps;
     let grid = t.bx.grid();
     let (xs, ys): (Vec<f64>, Vec<f64>) = (
@@ -174,39 +213,7 @@ fn run(a: &PlaceArgs, t: &PlaceTask, out: &Path) -> Result<(), SimError> {
             ),
         },
     )?;
-    let json = serde_json::json!({
-        "program": t.task.program_name,
-        "robot": t.task.robot_name,
-        "spin_optimised": optimise,
-        "measure": spin.measure.name(),
-        "box_min": t.bx.min, "box_max": t.bx.max, "steps": t.bx.steps,
-        "refine": a.refine,
-        "evaluations": found.evaluations,
-        "wall_time_s": wall,
-        "threads": threads,
-        "best": {"x_m": best[0], "y_m": best[1], "z_m": best[2], "yaw_rad": best[3],
-                 "rms_m": score.rms, "max_m": score.max},
-        "job_placement": {"rms_m": at_job.rms, "max_m": at_job.max},
-        "grid": found.grid.iter().map(|(p, s)| serde_json::json!({
-            "x_m": p[0], "y_m": p[1], "z_m": p[2], "yaw_rad": p[3],
-            "rms_m": if s.feasible() { Some(s.rms) } else { None },
-            "max_m": if s.feasible() { Some(s.max) } else { None },
-            "line": s.line,
-        })).collect::<Vec<_>>(),
-    });
-    let write = |name: &str, body: &str| {
-        deflect_core::io::job_out::write(out.join(name), body)
-            .map_err(|e| SimError::new(e.to_string()))
-    };
-    write("place_summary.txt", &text)?;
-    write(
-        "place_summary.json",
-        &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
-    )?;
-    stdout(format_args!(
-        "{text}outputs in {}: place.png, place_summary.{{txt,json}}\n",
-        out.display()
-    ))
+    Ok(())
 }
 
 impl Cmd for PlaceArgs {

@@ -139,30 +139,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
         (None, true) => 1.0,
         (None, false) => (reach / 3.0).clamp(0.05, 3.0),
     };
-    let q0 = match (&a.q0, builtin) {
-        (Some(q), _) => q.clone(),
-        (None, true) => KR300_Q0.to_vec(),
-        (None, false) => dexterous_pose(&spec, reach).ok_or_else(|| {
-            CliError::Usage(format!(
-                "--q0: no non-singular start pose found on the grid for {urdf_name}; give one"
-            ))
-        })?,
-    };
-    if q0.len() != dof {
-        return Err(CliError::Usage(format!(
-            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
-            q0.len(),
-            spec.robot.joint_names.join(", ")
-        )));
-    }
-    for (k, (&q, &(lo, hi))) in q0.iter().zip(&spec.robot.joint_limits).enumerate() {
-        if q < lo || q > hi {
-            return Err(CliError::Usage(format!(
-                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
-                spec.robot.joint_names.get(k).map_or("?", String::as_str)
-            )));
-        }
-    }
+    let q0 = start_joints(a, &spec, builtin, reach, &urdf_name)?;
     let task = match a.task {
         TaskArg::Pose => Task::POSE,
         TaskArg::PositionAndAxis => Task::POSITION_AND_AXIS,
@@ -181,30 +158,7 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
             task.rank()
         )));
     }
-    let links_mass: f64 = spec.bodies.iter().map(|b| b.inertia.mass).sum();
-    let mass = match (a.payload_mass, builtin) {
-        (Some(m), _) => m,
-        (None, true) => 150.0,
-        // 10 % of the links, to two significant digits (0.03 kg on a hobby arm).
-        (None, false) if links_mass > 0.0 => {
-            let m = 0.1 * links_mass;
-            let unit = 10f64.powf(m.log10().floor() - 1.0);
-            (m / unit).round() * unit
-        }
-        (None, false) => {
-            return Err(CliError::Usage(format!(
-                "--payload-mass: {urdf_name} has no link masses to take 10 % of; give the \
-                 payload mass [kg]"
-            )));
-        }
-    };
-    // A cube of aluminium centred on the tool axis, half a side beyond the flange.
-    let side = (mass / PAYLOAD_DENSITY).cbrt();
-    let payload = Payload {
-        mass,
-        com: Vector3::new(0.0, 0.0, 0.5 * side),
-        inertia: Matrix3::from_diagonal_element(mass * side * side / 6.0),
-    };
+    let payload = payload(a, &spec, builtin, &urdf_name)?;
     let options = SerialOptions {
         robot: if builtin {
             "KR 300 R2500".to_string()
@@ -241,6 +195,77 @@ pub fn load(a: &SerialArgs) -> Result<SerialInput, CliError> {
         ))
     })?;
     Ok(SerialInput { spec, options })
+}
+
+/// The start joints \[rad or m\]: `--q0`, the KR 300's, or the grid's most dexterous pose;
+/// checked against the arm's joints and limits.
+fn start_joints(
+    a: &SerialArgs,
+    spec: &ArmSpec,
+    builtin: bool,
+    reach: f64,
+    urdf_name: &str,
+) -> Result<Vec<f64>, CliError> {
+    let dof = spec.robot.model.dof();
+    let q0 = match (&a.q0, builtin) {
+        (Some(q), _) => q.clone(),
+        (None, true) => KR300_Q0.to_vec(),
+        (None, false) => dexterous_pose(spec, reach).ok_or_else(|| {
+            CliError::Usage(format!(
+                "--q0: no non-singular start pose found on the grid for {urdf_name}; give one"
+            ))
+        })?,
+    };
+    if q0.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
+            q0.len(),
+            spec.robot.joint_names.join(", ")
+        )));
+    }
+    for (k, (&q, &(lo, hi))) in q0.iter().zip(&spec.robot.joint_limits).enumerate() {
+        if q < lo || q > hi {
+            return Err(CliError::Usage(format!(
+                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
+                spec.robot.joint_names.get(k).map_or("?", String::as_str)
+            )));
+        }
+    }
+    Ok(q0)
+}
+
+/// The payload: `--payload-mass` \[kg\] (the KR 300's 150 kg, else 10 % of the links) as a
+/// cube of aluminium on the tool axis.
+fn payload(
+    a: &SerialArgs,
+    spec: &ArmSpec,
+    builtin: bool,
+    urdf_name: &str,
+) -> Result<Payload, CliError> {
+    let links_mass: f64 = spec.bodies.iter().map(|b| b.inertia.mass).sum();
+    let mass = match (a.payload_mass, builtin) {
+        (Some(m), _) => m,
+        (None, true) => 150.0,
+        // 10 % of the links, to two significant digits (0.03 kg on a hobby arm).
+        (None, false) if links_mass > 0.0 => {
+            let m = 0.1 * links_mass;
+            let unit = 10f64.powf(m.log10().floor() - 1.0);
+            (m / unit).round() * unit
+        }
+        (None, false) => {
+            return Err(CliError::Usage(format!(
+                "--payload-mass: {urdf_name} has no link masses to take 10 % of; give the \
+                 payload mass [kg]"
+            )));
+        }
+    };
+    // A cube of aluminium centred on the tool axis, half a side beyond the flange.
+    let side = (mass / PAYLOAD_DENSITY).cbrt();
+    Ok(Payload {
+        mass,
+        com: Vector3::new(0.0, 0.0, 0.5 * side),
+        inertia: Matrix3::from_diagonal_element(mass * side * side / 6.0),
+    })
 }
 
 /// The `serial` command (arguments checked by [`SerialArgs::check`], inputs by [`load`]).

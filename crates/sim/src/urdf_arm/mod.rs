@@ -1,7 +1,9 @@
 //! A flexible serial arm from any URDF and stiffness file, in rapier: the description
 //! ([`spec`]: bodies, attachments, lumped link masses) and the simulated arm ([`sim`]: spring
-//! joints for the virtual joints, servo motors with drive springs for the actuated joints).
+//! joints for the virtual joints, servo motors with drive springs for the actuated joints;
+//! its rapier multibody built by the private `build`).
 
+mod build;
 pub mod sim;
 pub mod spec;
 

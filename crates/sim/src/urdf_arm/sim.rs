@@ -27,12 +27,13 @@
 
 use deflect_core::dalembert::serial::Payload;
 use deflect_core::vjm::Vector6;
-use nalgebra::{Isometry3, Matrix3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, Vector3};
 use rapier3d_f64::prelude::*;
 
-use super::spec::{ArmSpec, Inertia, Piece, RIGID};
+use super::build::{Chain, ChainParams, build_chain};
+use super::spec::{ArmSpec, Piece, RIGID};
 use crate::SimError;
-use crate::rapier_util::{ANG_X, ANG_Y, ANG_Z, LIN_X, new_world, pose_na, set_spring};
+use crate::rapier_util::{ANG_X, LIN_X, pose_na, set_spring};
 
 /// A rigid axis among a virtual joint's three free rotations gets this many times the joint's
 /// stiffest finite stiffness.
@@ -127,35 +128,6 @@ impl core::fmt::Debug for FlexSerialArm {
     }
 }
 
-fn to_pose(iso: &Isometry3<f64>) -> Pose {
-    let t = iso.translation.vector;
-    let q = iso.rotation;
-    Pose::from_parts(
-        Vector::new(t.x, t.y, t.z),
-        Rotation::from_xyzw(q.i, q.j, q.k, q.w),
-    )
-}
-
-fn mass_properties(i: &Inertia) -> MassProperties {
-    let m = &i.inertia;
-    let cols = [
-        m[(0, 0)],
-        m[(1, 0)],
-        m[(2, 0)],
-        m[(0, 1)],
-        m[(1, 1)],
-        m[(2, 1)],
-        m[(0, 2)],
-        m[(1, 2)],
-        m[(2, 2)],
-    ];
-    MassProperties::with_inertia_matrix(
-        Vector::new(i.com.x, i.com.y, i.com.z),
-        i.mass,
-        Matrix::from_cols_array(&cols),
-    )
-}
-
 impl FlexSerialArm {
     /// The arm of `spec` at rest at joints `q0` \[rad\], carrying `payload` (TCP frame), with
     /// `servo` settings. `damping_scale` multiplies every damping (> 1 to settle static tests
@@ -207,182 +179,24 @@ impl FlexSerialArm {
                 "servo settings: substeps must be at least 1, got 0",
             ));
         }
-        let mut world = new_world(Vector::ZERO, servo.dt);
-        world.integration_parameters.num_solver_iterations = servo.substeps;
-        let mut parent = world.insert_body(RigidBodyBuilder::fixed());
-        let mut at = Isometry3::identity();
-        let (mut bodies, mut joints, mut actuated, mut axes, mut spring_bodies) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
-        let last = spec.bodies.len().saturating_sub(1);
-        let mut qi = 0usize;
-        for (index, b) in spec.bodies.iter().enumerate() {
-            let mut inertia = b.inertia;
-            if index == last
-                && let Some(p) = payload
-            {
-                inertia.add(
-                    &Inertia {
-                        mass: p.mass,
-                        com: p.com,
-                        inertia: p.inertia,
-                    },
-                    &spec.tcp,
-                );
-            }
-            if inertia.mass <= 0.0 {
-                let m = filler;
-                inertia = Inertia {
-                    mass: m,
-                    com: Vector3::zeros(),
-                    inertia: Matrix3::identity() * (0.4 * m * 0.05 * 0.05),
-                };
-            }
-            let (frame1, frame2, locked, springs) = match &b.piece {
-                Piece::Revolute { axis, .. } => {
-                    let q = q0.get(qi).copied().unwrap_or(0.0);
-                    qi += 1;
-                    let align = UnitQuaternion::rotation_between(&Vector3::x(), axis)
-                        .unwrap_or_else(|| {
-                            UnitQuaternion::from_axis_angle(
-                                &Vector3::z_axis(),
-                                core::f64::consts::PI,
-                            )
-                        });
-                    let align = Isometry3::from_parts(Translation3::identity(), align);
-                    let turn = Isometry3::from_parts(
-                        Translation3::identity(),
-                        UnitQuaternion::from_axis_angle(axis, q),
-                    );
-                    actuated.push(index);
-                    axes.push(axis.into_inner());
-                    (
-                        b.attach * turn * align,
-                        align,
-                        JointAxesMask::LIN_AXES | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z,
-                        vec![(ANG_X, k_drive, 0.0)],
-                    )
-                }
-                Piece::Spring { k, .. } => {
-                    spring_bodies.push((index, b.attach));
-                    let finite: Vec<usize> = (0..3).filter(|&a| k[a] < RIGID).collect();
-                    let stiffest = finite.iter().map(|&a| k[a]).fold(0.0f64, f64::max);
-                    let names = [ANG_X, ANG_Y, ANG_Z];
-                    let (locked, springs) = if finite.len() == 1 {
-                        let a = finite.first().copied().unwrap_or(0);
-                        let lock = [
-                            JointAxesMask::ANG_X,
-                            JointAxesMask::ANG_Y,
-                            JointAxesMask::ANG_Z,
-                        ]
-                        .iter()
-                        .enumerate()
-                        .filter(|(i, _)| *i != a)
-                        .fold(JointAxesMask::LIN_AXES, |m, (_, x)| m | *x);
-                        (lock, vec![(names[a], k[a], servo.beta * k[a])])
-                    } else {
-                        let springs = (0..3)
-                            .map(|a| {
-                                let ka = if k[a] < RIGID {
-                                    k[a]
-                                } else {
-                                    STIFF_RATIO * stiffest
-                                };
-                                (names[a], ka, servo.beta * ka)
-                            })
-                            .collect();
-                        (JointAxesMask::LIN_AXES, springs)
-                    };
-                    (b.attach, Isometry3::identity(), locked, springs)
-                }
-                Piece::Prismatic { axis, .. } => {
-                    let q = q0.get(qi).copied().unwrap_or(0.0);
-                    qi += 1;
-                    let align = UnitQuaternion::rotation_between(&Vector3::x(), axis)
-                        .unwrap_or_else(|| {
-                            UnitQuaternion::from_axis_angle(
-                                &Vector3::z_axis(),
-                                core::f64::consts::PI,
-                            )
-                        });
-                    let align = Isometry3::from_parts(Translation3::identity(), align);
-                    let slide = Isometry3::from_parts(
-                        Translation3::from(axis.into_inner() * q),
-                        UnitQuaternion::identity(),
-                    );
-                    actuated.push(index);
-                    axes.push(axis.into_inner());
-                    (
-                        b.attach * slide * align,
-                        align,
-                        JointAxesMask::LIN_Y
-                            | JointAxesMask::LIN_Z
-                            | JointAxesMask::ANG_X
-                            | JointAxesMask::ANG_Y
-                            | JointAxesMask::ANG_Z,
-                        vec![(LIN_X, k_drive, 0.0)],
-                    )
-                }
-            };
-            at *= match &b.piece {
-                Piece::Revolute { axis, .. } => {
-                    b.attach
-                        * Isometry3::from_parts(
-                            Translation3::identity(),
-                            UnitQuaternion::from_axis_angle(
-                                axis,
-                                q0.get(qi.saturating_sub(1)).copied().unwrap_or(0.0),
-                            ),
-                        )
-                }
-                Piece::Prismatic { axis, .. } => {
-                    b.attach
-                        * Translation3::from(
-                            axis.into_inner()
-                                * q0.get(qi.saturating_sub(1)).copied().unwrap_or(0.0),
-                        )
-                }
-                Piece::Spring { .. } => b.attach,
-            };
-            let body = world.insert_body(
-                RigidBodyBuilder::dynamic()
-                    .pose(to_pose(&at))
-                    .additional_mass_properties(mass_properties(&inertia))
-                    .can_sleep(false),
-            );
-            let joint = GenericJointBuilder::new(locked)
-                .local_frame1(to_pose(&frame1))
-                .local_frame2(to_pose(&frame2))
-                .contacts_enabled(false)
-                .build();
-            let h = world
-                .insert_multibody_joint(parent, body, joint)
-                .ok_or_else(|| {
-                    SimError::new(format!("rapier refused the joint of body {index}"))
-                })?;
-            for (axis, stiffness, _) in &springs {
-                set_spring(&mut world, h, *axis, *stiffness, 0.0);
-            }
-            // Per-DOF damping: the joint's free DOFs are its last ones so far, in axis order.
-            if let Some((mb, _)) = world.multibody_joints.get_mut(h) {
-                let n = mb.damping_mut().len();
-                let dampings: Vec<f64> = springs
-                    .iter()
-                    .map(|(_, _, c)| match &b.piece {
-                        // The drive's damping `c (w_link - w_motor)`: the link part is
-                        // implicit here, the motor part an explicit torque ([`Self::apply`]).
-                        Piece::Revolute { .. } | Piece::Prismatic { .. } => c_drive,
-                        Piece::Spring { .. } => *c * damping_scale,
-                    })
-                    .collect();
-                let start = n.saturating_sub(dampings.len());
-                for (d, c) in mb.damping_mut().iter_mut().skip(start).zip(&dampings) {
-                    *d = *c;
-                }
-            }
-            bodies.push(body);
-            joints.push(h);
-            parent = body;
-        }
+        let params = ChainParams {
+            k_drive,
+            c_drive,
+            beta: servo.beta,
+            damping_scale,
+            filler,
+            stiff_ratio: STIFF_RATIO,
+            dt: servo.dt,
+            substeps: servo.substeps,
+        };
+        let Chain {
+            world,
+            bodies,
+            joints,
+            actuated,
+            axes,
+            springs: spring_bodies,
+        } = build_chain(spec, q0, payload, &params)?;
         let motors = q0
             .iter()
             .map(|&angle| Motor { angle, speed: 0.0 })

@@ -156,14 +156,46 @@ pub fn arm_spec(
     let springs = stiffness::from_str(stiffness_text)?;
     let links: HashMap<&str, &urdf_rs::Link> =
         parsed.links.iter().map(|l| (l.name.as_str(), l)).collect();
+    let (path, base) = chain_path(&parsed, base_link, tip_link);
+    let mut chain = Lumping {
+        links,
+        on_link: springs_by_link(&springs, &parsed)?,
+        bodies: Vec::new(),
+        base_inertia: Inertia::zero(),
+        offset: Isometry3::identity(),
+    };
+    chain.add_link(base);
+    for j in &path {
+        chain.offset *= pose(&j.origin.xyz.0, &j.origin.rpy.0);
+        if let Some(body) = joint_body(j, chain.offset)? {
+            chain.bodies.push(body);
+            chain.offset = Isometry3::identity();
+        }
+        chain.add_link(&j.child.link);
+    }
+    Ok(ArmSpec {
+        bodies: chain.bodies,
+        tcp: chain.offset,
+        robot,
+        base_mass: chain.base_inertia.mass,
+    })
+}
+
+/// A spring of a link: its frame in the link, stiffnesses \[N m/rad\] and name.
+type Spring = (Isometry3<f64>, [f64; 3], String);
+
+/// The URDF joints on the path base -> tip, base first, and the base link (deflect-core has
+/// checked that the path exists).
+fn chain_path<'a>(
+    parsed: &'a urdf_rs::Robot,
+    base_link: Option<&str>,
+    tip_link: &'a str,
+) -> (Vec<&'a urdf_rs::Joint>, &'a str) {
     let by_child: HashMap<&str, &urdf_rs::Joint> = parsed
         .joints
         .iter()
         .map(|j| (j.child.link.as_str(), j))
         .collect();
-    let joints_by_name: HashMap<&str, &urdf_rs::Joint> =
-        parsed.joints.iter().map(|j| (j.name.as_str(), j)).collect();
-    // The path base -> tip (deflect-core has checked that it exists).
     let mut path = Vec::new();
     let mut link = tip_link;
     while Some(link) != base_link {
@@ -176,12 +208,18 @@ pub fn arm_spec(
         }
     }
     path.reverse();
-    let base = link;
+    (path, link)
+}
 
-    // The springs of each link, in file order, as (frame in the link, k, name).
-    type Spring = (Isometry3<f64>, [f64; 3], String);
+/// The springs of each link, in file order (a joint's spring on the joint's child link).
+fn springs_by_link(
+    springs: &[stiffness::VirtualJointSpec],
+    parsed: &urdf_rs::Robot,
+) -> Result<HashMap<String, Vec<Spring>>, SimError> {
+    let joints_by_name: HashMap<&str, &urdf_rs::Joint> =
+        parsed.joints.iter().map(|j| (j.name.as_str(), j)).collect();
     let mut on_link: HashMap<String, Vec<Spring>> = HashMap::new();
-    for s in &springs {
+    for s in springs {
         let (link, frame, name) = match (&s.link, &s.joint) {
             (Some(l), _) => (
                 l.clone(),
@@ -203,90 +241,76 @@ pub fn arm_spec(
         };
         on_link.entry(link).or_default().push((frame, s.k, name));
     }
+    Ok(on_link)
+}
 
-    let mut bodies: Vec<Body> = Vec::new();
-    let mut base_inertia = Inertia::zero();
-    // Pose of the current virtual-joint-model frame in the current body's frame.
-    let mut offset = Isometry3::identity();
-    let add_link = |bodies: &mut Vec<Body>,
-                    base_inertia: &mut Inertia,
-                    name: &str,
-                    offset: &mut Isometry3<f64>|
-     -> Result<(), SimError> {
-        // Its springs first (each a new body), then its mass on the last body.
-        for (frame, k, label) in on_link.get(name).map(Vec::as_slice).unwrap_or(&[]) {
+/// The chain being built: the bodies so far, the links lumped on the fixed base, and the
+/// pose of the current virtual-joint-model frame in the current body's frame.
+struct Lumping<'a> {
+    links: HashMap<&'a str, &'a urdf_rs::Link>,
+    on_link: HashMap<String, Vec<Spring>>,
+    bodies: Vec<Body>,
+    base_inertia: Inertia,
+    offset: Isometry3<f64>,
+}
+
+impl Lumping<'_> {
+    /// Adds the link `name`: its springs first (each a new body), then its mass on the last
+    /// body (or the base).
+    fn add_link(&mut self, name: &str) {
+        for (frame, k, label) in self.on_link.get(name).map(Vec::as_slice).unwrap_or(&[]) {
             if k.iter().all(|v| *v >= RIGID) {
                 continue;
             }
-            bodies.push(Body {
+            self.bodies.push(Body {
                 piece: Piece::Spring {
                     name: label.clone(),
                     k: *k,
                 },
-                attach: *offset * frame,
+                attach: self.offset * frame,
                 inertia: Inertia::zero(),
                 links: Vec::new(),
             });
-            *offset = frame.inverse();
+            self.offset = frame.inverse();
         }
-        if let Some(l) = links.get(name) {
+        if let Some(l) = self.links.get(name) {
             let li = link_inertia(l);
-            match bodies.last_mut() {
+            match self.bodies.last_mut() {
                 Some(b) => {
-                    b.inertia.add(&li, offset);
+                    b.inertia.add(&li, &self.offset);
                     b.links.push(name.to_string());
                 }
-                None => base_inertia.add(&li, offset),
+                None => self.base_inertia.add(&li, &self.offset),
             }
         }
-        Ok(())
-    };
-    add_link(&mut bodies, &mut base_inertia, base, &mut offset)?;
-    for j in &path {
-        offset *= pose(&j.origin.xyz.0, &j.origin.rpy.0);
-        match j.joint_type {
-            urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous => {
-                let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
-                bodies.push(Body {
-                    piece: Piece::Revolute {
-                        name: j.name.clone(),
-                        axis,
-                    },
-                    attach: offset,
-                    inertia: Inertia::zero(),
-                    links: Vec::new(),
-                });
-                offset = Isometry3::identity();
-            }
-            urdf_rs::JointType::Prismatic => {
-                let axis = Unit::new_normalize(Vector3::from(j.axis.xyz.0));
-                bodies.push(Body {
-                    piece: Piece::Prismatic {
-                        name: j.name.clone(),
-                        axis,
-                    },
-                    attach: offset,
-                    inertia: Inertia::zero(),
-                    links: Vec::new(),
-                });
-                offset = Isometry3::identity();
-            }
-            urdf_rs::JointType::Fixed => {}
-            ref other => {
-                return Err(SimError::new(format!(
-                    "joint '{}': the testbed builds revolute, continuous, prismatic and fixed \
-                     joints only, not {}",
-                    j.name,
-                    format!("{other:?}").to_lowercase()
-                )));
-            }
-        }
-        add_link(&mut bodies, &mut base_inertia, &j.child.link, &mut offset)?;
     }
-    Ok(ArmSpec {
-        bodies,
-        tcp: offset,
-        robot,
-        base_mass: base_inertia.mass,
-    })
+}
+
+/// The body an actuated URDF joint starts, attached at `attach`; none for a fixed joint.
+fn joint_body(j: &urdf_rs::Joint, attach: Isometry3<f64>) -> Result<Option<Body>, SimError> {
+    let piece = match j.joint_type {
+        urdf_rs::JointType::Revolute | urdf_rs::JointType::Continuous => Piece::Revolute {
+            name: j.name.clone(),
+            axis: Unit::new_normalize(Vector3::from(j.axis.xyz.0)),
+        },
+        urdf_rs::JointType::Prismatic => Piece::Prismatic {
+            name: j.name.clone(),
+            axis: Unit::new_normalize(Vector3::from(j.axis.xyz.0)),
+        },
+        urdf_rs::JointType::Fixed => return Ok(None),
+        ref other => {
+            return Err(SimError::new(format!(
+                "joint '{}': the testbed builds revolute, continuous, prismatic and fixed \
+                 joints only, not {}",
+                j.name,
+                format!("{other:?}").to_lowercase()
+            )));
+        }
+    };
+    Ok(Some(Body {
+        piece,
+        attach,
+        inertia: Inertia::zero(),
+        links: Vec::new(),
+    }))
 }

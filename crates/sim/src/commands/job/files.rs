@@ -128,17 +128,11 @@ fn create(path: &Path) -> Result<BufWriter<File>, SimError> {
         .map_err(|e| SimError::file(path, "create", e))
 }
 
-impl<'p> JobFiles<'p> {
-    /// Opens every file (the archive's parts, the MCAP log, the G-code, the CSV if asked).
-    pub fn create(
-        program: &'p Program,
-        target: Target<'p>,
-        o: &FileOptions,
-    ) -> Result<Self, SimError> {
-        let mut npz = NpzStream::create(&o.out.join("job_samples.npz"))?;
-        let dof = o.dof;
+impl Arrays {
+    /// Declares the archive's arrays in `npz` (`dof` joints wide for `q`).
+    fn declare(npz: &mut NpzStream, dof: usize) -> Result<Self, SimError> {
         let mut a = |name: &str, dtype: Dtype, width: usize| npz.array(name, dtype, width);
-        let arrays = Arrays {
+        Ok(Self {
             time: a("time", Dtype::F64, 0)?,
             line: a("line", Dtype::I64, 0)?,
             tool: a("tool", Dtype::I64, 0)?,
@@ -159,40 +153,95 @@ impl<'p> JobFiles<'p> {
             speed: a("speed", Dtype::F64, 0)?,
             engagement: a("engagement", Dtype::F64, 3)?,
             coupling_residual: a("coupling_residual", Dtype::F64, 2)?,
-        };
-        let mcap_path = o.out.join("job.mcap");
-        let mut mcap = McapLog::create(&mcap_path)?;
-        let channel = |run: &str, quantity: &str, kind: Kind, log: &mut McapLog| {
-            log.channel(&format!("/job/{run}/"), quantity, kind)
-        };
-        for (run, what) in [
-            ("nominal", "the tool on the program, on the nominal stock"),
-            ("uncompensated", "the arm at the program's rigid joints"),
-            ("compensated", "the arm at the compensated joints"),
+        })
+    }
+}
+
+/// Opens the MCAP log at `path`: every run's metadata, then the channels.
+fn open_mcap(path: &Path, o: &FileOptions) -> Result<(McapLog, Channels), SimError> {
+    let mut mcap = McapLog::create(path)?;
+    let channel = |run: &str, quantity: &str, kind: Kind, log: &mut McapLog| {
+        log.channel(&format!("/job/{run}/"), quantity, kind)
+    };
+    for (run, what) in [
+        ("nominal", "the tool on the program, on the nominal stock"),
+        ("uncompensated", "the arm at the program's rigid joints"),
+        ("compensated", "the arm at the compensated joints"),
+    ] {
+        mcap.run_metadata(&RunInfo {
+            scenario: "job".into(),
+            run: run.into(),
+            robot: o.robot.clone(),
+            motion: "the program, sampled at the controller rate".into(),
+            acceleration: "the path's jerk-limited profile".into(),
+            correction: what.into(),
+            options: serde_json::json!({"rate_hz": o.rate_hz, "log_rate_hz": o.log_rate}),
+        })?;
+    }
+    let channels = Channels {
+        force: [
+            channel("nominal", "force", Kind::Force, &mut mcap)?,
+            channel("uncompensated", "force", Kind::Force, &mut mcap)?,
+            channel("compensated", "force", Kind::Force, &mut mcap)?,
+        ],
+        error: [
+            channel("uncompensated", "path_error", Kind::PathError, &mut mcap)?,
+            channel("compensated", "path_error", Kind::PathError, &mut mcap)?,
+        ],
+        deflection: channel("nominal", "deflection", Kind::Displacement, &mut mcap)?,
+        engagement: channel("nominal", "engagement", Kind::Engagement, &mut mcap)?,
+    };
+    Ok((mcap, channels))
+}
+
+/// The robot programs being written, each with its path.
+type RobotPrograms<'p> = Vec<(String, RobotProgram<'p, BufWriter<File>>)>;
+
+/// Opens the robot programs of `--robot-program` (the Cartesian command, then the joints),
+/// each path (and its companion file's) added to `paths`.
+fn open_robot_programs<'p>(
+    target: Target<'p>,
+    o: &FileOptions,
+    paths: &mut Vec<PathBuf>,
+) -> Result<RobotPrograms<'p>, SimError> {
+    let mut robot_programs = Vec::new();
+    if let Some(language) = o.robot_program {
+        for (command, name) in [
+            (Command::Cartesian, "job_program"),
+            (Command::Joints, "job_program_joints"),
         ] {
-            mcap.run_metadata(&RunInfo {
-                scenario: "job".into(),
-                run: run.into(),
-                robot: o.robot.clone(),
-                motion: "the program, sampled at the controller rate".into(),
-                acceleration: "the path's jerk-limited profile".into(),
-                correction: what.into(),
-                options: serde_json::json!({"rate_hz": o.rate_hz, "log_rate_hz": o.log_rate}),
-            })?;
+            let options = ProgramOptions {
+                name: name.to_string(),
+                tolerance: o.tolerance,
+                ..ProgramOptions::new(language, command)
+            };
+            let path = o.out.join(format!("{name}.{}", language.extension()));
+            let w = RobotProgram::new(create(&path)?, target, &options)
+                .map_err(|e| SimError::new(format!("--robot-program {}: {e}", language.name())))?;
+            if let Some(f) = w.companion() {
+                let p = o.out.join(&f.name);
+                std::fs::write(&p, &f.text).map_err(|e| SimError::file(&p, "write", e))?;
+                paths.push(p);
+            }
+            paths.push(path.clone());
+            robot_programs.push((path.display().to_string(), w));
         }
-        let channels = Channels {
-            force: [
-                channel("nominal", "force", Kind::Force, &mut mcap)?,
-                channel("uncompensated", "force", Kind::Force, &mut mcap)?,
-                channel("compensated", "force", Kind::Force, &mut mcap)?,
-            ],
-            error: [
-                channel("uncompensated", "path_error", Kind::PathError, &mut mcap)?,
-                channel("compensated", "path_error", Kind::PathError, &mut mcap)?,
-            ],
-            deflection: channel("nominal", "deflection", Kind::Displacement, &mut mcap)?,
-            engagement: channel("nominal", "engagement", Kind::Engagement, &mut mcap)?,
-        };
+    }
+    Ok(robot_programs)
+}
+
+impl<'p> JobFiles<'p> {
+    /// Opens every file (the archive's parts, the MCAP log, the G-code, the CSV if asked).
+    pub fn create(
+        program: &'p Program,
+        target: Target<'p>,
+        o: &FileOptions,
+    ) -> Result<Self, SimError> {
+        let mut npz = NpzStream::create(&o.out.join("job_samples.npz"))?;
+        let dof = o.dof;
+        let arrays = Arrays::declare(&mut npz, dof)?;
+        let mcap_path = o.out.join("job.mcap");
+        let (mcap, channels) = open_mcap(&mcap_path, o)?;
         let log_every = if o.log_rate > 0.0 {
             (o.rate_hz / o.log_rate).round().max(1.0) as usize
         } else {
@@ -210,30 +259,7 @@ impl<'p> JobFiles<'p> {
             }
             None => None,
         };
-        let mut robot_programs = Vec::new();
-        if let Some(language) = o.robot_program {
-            for (command, name) in [
-                (Command::Cartesian, "job_program"),
-                (Command::Joints, "job_program_joints"),
-            ] {
-                let options = ProgramOptions {
-                    name: name.to_string(),
-                    tolerance: o.tolerance,
-                    ..ProgramOptions::new(language, command)
-                };
-                let path = o.out.join(format!("{name}.{}", language.extension()));
-                let w = RobotProgram::new(create(&path)?, target, &options).map_err(|e| {
-                    SimError::new(format!("--robot-program {}: {e}", language.name()))
-                })?;
-                if let Some(f) = w.companion() {
-                    let p = o.out.join(&f.name);
-                    std::fs::write(&p, &f.text).map_err(|e| SimError::file(&p, "write", e))?;
-                    paths.push(p);
-                }
-                paths.push(path.clone());
-                robot_programs.push((path.display().to_string(), w));
-            }
-        }
+        let robot_programs = open_robot_programs(target, o, &mut paths)?;
         Ok(Self {
             program,
             dof,

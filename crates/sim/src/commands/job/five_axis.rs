@@ -108,11 +108,66 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
     let (su, sc) = (DeviationStats::of(&pu), DeviationStats::of(&pc));
     let mu = SurfaceMesh::new(pu, cell).map_err(fail)?;
     let mc = SurfaceMesh::new(pc, cell).map_err(fail)?;
+    let mut files = write_meshes(out, &mu, &mc)?;
+    plot_view(t, out, [(&su, &mu), (&sc, &mc)])?;
+    files.push("part_view.png".into());
+    let write = |name: &str, text: &str| {
+        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
+    };
+    write("five_axis_samples.csv", &samples_csv(&r))?;
+    files.push("five_axis_samples.csv".into());
+    let wall = started.elapsed().as_secs_f64();
+    let cutting = r.samples.iter().filter(|s| s.bands > 0).count();
+    let n = r.samples.len();
+    let text = summary_text(
+        t,
+        &Figures {
+            r: &r,
+            n,
+            cutting,
+            wall,
+            pass,
+            tool: [&eu, &ec],
+            part: [(&su, missing_u), (&sc, missing_c)],
+        },
+    );
+    let summary = json!({
+        "program": t.program_name,
+        "robot": t.robot_name,
+        "samples": n,
+        "cutting_samples": cutting,
+        "rate_hz": r.rate_hz,
+        "ray_updates": r.ray_updates,
+        "wall_s": wall,
+        "samples_per_second": n as f64 / pass.max(1e-9),
+        "cell_mm": cell * 1e3,
+        "tool": {
+            "uncompensated": tool_figures(&eu),
+            "compensated": tool_figures(&ec),
+        },
+        "part": {
+            "uncompensated": fu,
+            "compensated": fc,
+            "unmatched_points": [missing_u, missing_c],
+        },
+        "rapid_volume_mm3": r.rapid_volume * 1e9,
+    });
+    write("five_axis_summary.txt", &text)?;
+    write(
+        "five_axis_summary.json",
+        &serde_json::to_string_pretty(&summary).map_err(|e| SimError::new(e.to_string()))?,
+    )?;
+    stdout(format_args!(
+        "{text}outputs in {}: {}, five_axis_summary.{{txt,json}}\n",
+        out.display(),
+        files.join(", ")
+    ))
+}
+
+/// Writes the predicted parts' PLY meshes (uncompensated, compensated); their file names.
+fn write_meshes(out: &Path, mu: &SurfaceMesh, mc: &SurfaceMesh) -> Result<Vec<String>, SimError> {
     let mut files = Vec::new();
-    for (name, mesh) in [
-        ("part_uncompensated.ply", &mu),
-        ("part_compensated.ply", &mc),
-    ] {
+    for (name, mesh) in [("part_uncompensated.ply", mu), ("part_compensated.ply", mc)] {
         let path = out.join(name);
         let f = std::fs::File::create(&path)
             .map_err(|e| SimError::file(&path, "create the PLY mesh", e))?;
@@ -120,6 +175,16 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             .map_err(|e| SimError::file(&path, "write the PLY mesh", e))?;
         files.push(name.to_string());
     }
+    Ok(files)
+}
+
+/// Plots the machined surfaces' deviation along their normal (uncompensated, compensated,
+/// each with its statistics) to `part_view.png`.
+fn plot_view(
+    t: &JobTask,
+    out: &Path,
+    [(su, mu), (sc, mc)]: [(&DeviationStats, &SurfaceMesh); 2],
+) -> Result<(), SimError> {
     let short = Path::new(&t.program_name).file_name().map_or_else(
         || t.program_name.clone(),
         |n| n.to_string_lossy().into_owned(),
@@ -132,10 +197,7 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             s.rms * 1e3
         )
     };
-    let (lu, lc) = (
-        label("uncompensated", &su),
-        label("compensated offline", &sc),
-    );
+    let (lu, lc) = (label("uncompensated", su), label("compensated offline", sc));
     let png = out.join("part_view.png");
     part_view::plot_part_view(
         &png,
@@ -143,17 +205,37 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             "{short} on {}: the machined surface's deviation along its normal",
             t.robot_name
         ),
-        &[(&lu, &mu), (&lc, &mc)],
+        &[(&lu, mu), (&lc, mc)],
     )?;
-    files.push("part_view.png".into());
-    let write = |name: &str, text: &str| {
-        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
-    };
-    write("five_axis_samples.csv", &samples_csv(&r))?;
-    files.push("five_axis_samples.csv".into());
-    let wall = started.elapsed().as_secs_f64();
-    let cutting = r.samples.iter().filter(|s| s.bands > 0).count();
-    let n = r.samples.len();
+    Ok(())
+}
+
+/// The pass's figures that the summary text reports.
+struct Figures<'a> {
+    r: &'a Report,
+    /// Samples, and those that cut.
+    n: usize,
+    cutting: usize,
+    /// Wall time of the whole command and of the pass \[s\].
+    wall: f64,
+    pass: f64,
+    /// The tool's errors, uncompensated and compensated.
+    tool: [&'a ToolErrors; 2],
+    /// The parts' deviation and unmatched points, uncompensated and compensated.
+    part: [(&'a DeviationStats, usize); 2],
+}
+
+/// The summary's text: the pass, the tool's and the part's errors, the spin and the rapids.
+fn summary_text(t: &JobTask, f: &Figures<'_>) -> String {
+    let Figures {
+        r,
+        n,
+        cutting,
+        wall,
+        pass,
+        tool: [eu, ec],
+        part: [(su, missing_u), (sc, missing_c)],
+    } = *f;
     let mut text = String::new();
     let _ = writeln!(
         text,
@@ -165,7 +247,7 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
         r.ray_updates,
         n as f64 / pass.max(1e-9)
     );
-    for (name, e) in [("uncompensated", &eu), ("compensated offline", &ec)] {
+    for (name, e) in [("uncompensated", eu), ("compensated offline", ec)] {
         let _ = writeln!(
             text,
             "  {name:<20} tool off the program: tip max {:.4} mm (line {}), RMS {:.4} mm; axis \
@@ -226,35 +308,5 @@ pub fn five_axis_cmd(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimErro
             r.rapid_volume * 1e9
         );
     }
-    let summary = json!({
-        "program": t.program_name,
-        "robot": t.robot_name,
-        "samples": n,
-        "cutting_samples": cutting,
-        "rate_hz": r.rate_hz,
-        "ray_updates": r.ray_updates,
-        "wall_s": wall,
-        "samples_per_second": n as f64 / pass.max(1e-9),
-        "cell_mm": cell * 1e3,
-        "tool": {
-            "uncompensated": tool_figures(&eu),
-            "compensated": tool_figures(&ec),
-        },
-        "part": {
-            "uncompensated": fu,
-            "compensated": fc,
-            "unmatched_points": [missing_u, missing_c],
-        },
-        "rapid_volume_mm3": r.rapid_volume * 1e9,
-    });
-    write("five_axis_summary.txt", &text)?;
-    write(
-        "five_axis_summary.json",
-        &serde_json::to_string_pretty(&summary).map_err(|e| SimError::new(e.to_string()))?,
-    )?;
-    stdout(format_args!(
-        "{text}outputs in {}: {}, five_axis_summary.{{txt,json}}\n",
-        out.display(),
-        files.join(", ")
-    ))
+    text
 }

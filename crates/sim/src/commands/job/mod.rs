@@ -4,9 +4,10 @@
 //! compensated program, the samples, the part's heat map and the summary files.
 
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+use deflect_core::io::apt::AptCutter;
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::io::tool_table::{self, TblOptions};
 use deflect_core::io::{job_out, points_csv};
@@ -15,6 +16,7 @@ use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::job::{self, Job, Setup, Stock};
 use deflect_core::machining::path::PathOptions;
 use deflect_core::machining::spin::{self, LoadPath, SpinOptions, SpinPlan, SpinSchedule};
+use deflect_core::machining::tools::ToolTable;
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
 use deflect_sim::SimError;
@@ -26,12 +28,14 @@ use super::inputs::{
 };
 mod files;
 mod five_axis;
+mod stream;
 mod summary;
 mod task;
 
 use super::{Cmd, stdout};
 use crate::cli::{CliError, JobArgs, SpinArg};
 use files::{FileOptions, JobFiles};
+use stream::stream_pass;
 use summary::summary;
 pub use task::JobTask;
 use task::five_axis_options;
@@ -109,25 +113,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         dialect: a.dialect.dialect(),
         ..GcodeOptions::default()
     };
-    let mut cutters = Vec::new();
-    let (program, program_name) = match (&a.program, &a.points) {
-        (Some(p), _) => {
-            let (program, c) = program_and_cutters("--program", p, &options)?;
-            cutters = c;
-            (program, p.display().to_string())
-        }
-        (None, Some(p)) => {
-            let text = read_text("--points", p, "tool points CSV")?;
-            let program = points_csv::from_str(&text, &options)
-                .map_err(|e| CliError::Failure(format!("--points {}: {e}", p.display())))?;
-            (program, p.display().to_string())
-        }
-        (None, None) => (
-            gcode::from_str(DEFAULT_PROGRAM, &options)
-                .map_err(|e| CliError::Failure(format!("built-in program: {e}")))?,
-            "data/groove_and_pocket.nc (built in)".to_string(),
-        ),
-    };
+    let (program, program_name, cutters) = job_program(a, &options)?;
     let loaded = load_robot(
         a.urdf.as_deref(),
         a.stiffness.as_deref(),
@@ -147,6 +133,94 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             loaded.name
         )));
     }
+    let placement = placement(a, &program)?;
+    let (min, max) = stock_corners(a, &program, &program_name)?;
+    let (tool, coefficients) = tool_and_material(&a.tool)?;
+    let table = tool_table(a, &program, &program_name, &cutters)?;
+    // A cutter before any LOADTL is the tool the program starts with (T0): the setup's.
+    let first = cutters.iter().rev().find(|c| c.tool == 0);
+    let tool = match first {
+        Some(c) => Tool::new(c.diameter, tool.flutes, tool.helix).map_err(|e| {
+            CliError::Failure(format!("{program_name} line {}: CUTTER: {e}", c.line))
+        })?,
+        None => tool,
+    };
+    let shape = first.map_or(a.shape.0, |c| c.shape);
+    let cell_mm = cell_mm(a, table.as_ref(), &program);
+    let setup = Setup {
+        placement,
+        tool_orientation: Setup::tool_down(),
+        tool,
+        coefficients,
+        stock: Stock {
+            min,
+            max,
+            top: a.top * 1e-3,
+            cell: cell_mm * 1e-3,
+        },
+        path: PathOptions {
+            rate_hz: a.rate,
+            acceleration: a.acceleration,
+            jerk: a.jerk,
+            rapid_speed: a.rapid_speed,
+            ..PathOptions::default()
+        },
+        ik: PoseIkOptions::default(),
+        hand_spindle: a.spindle_rpm.map(|rpm| rpm / 60.0),
+        rapid_skim: a.rapid_skim * 1e-3,
+    };
+    let mut job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
+        .map_err(|e| CliError::Usage(format!("--stock/--cell and the job's settings: {e}")))?;
+    if let Some(t) = table {
+        job = job.with_tools(t);
+    }
+    if let Some(c) = robot.controller {
+        job = job.with_controller(c);
+    }
+    check_robot_program(a, &job, &loaded.name)?;
+    let five = program.is_multi_axis().then(|| five_axis_options(a, shape));
+    let (job, spin) = spin(a, job, &program, &program_name, &seed, five.as_ref())?;
+    Ok(JobTask {
+        job,
+        program,
+        program_name,
+        robot_name: loaded.name,
+        seed,
+        spin,
+        shape,
+    })
+}
+
+/// The program (`--program`, `--points` or the built-in one), its name and its APT cutters.
+fn job_program(
+    a: &JobArgs,
+    options: &GcodeOptions,
+) -> Result<(Program, String, Vec<AptCutter>), CliError> {
+    let mut cutters = Vec::new();
+    let (program, program_name) = match (&a.program, &a.points) {
+        (Some(p), _) => {
+            let (program, c) = program_and_cutters("--program", p, options)?;
+            cutters = c;
+            (program, p.display().to_string())
+        }
+        (None, Some(p)) => {
+            let text = read_text("--points", p, "tool points CSV")?;
+            let program = points_csv::from_str(&text, options)
+                .map_err(|e| CliError::Failure(format!("--points {}: {e}", p.display())))?;
+            (program, p.display().to_string())
+        }
+        (None, None) => (
+            gcode::from_str(DEFAULT_PROGRAM, options)
+                .map_err(|e| CliError::Failure(format!("built-in program: {e}")))?,
+            "data/groove_and_pocket.nc (built in)".to_string(),
+        ),
+    };
+    Ok((program, program_name, cutters))
+}
+
+/// The workpiece frame in the base frame (`--placement` x y z \[m\], roll pitch yaw \[rad\],
+/// else the KR 300's default for the program).
+fn placement(a: &JobArgs, program: &Program) -> Result<Isometry3<f64>, CliError> {
     let p = a.placement.clone().unwrap_or(if program.is_multi_axis() {
         KR300_FIVE_AXIS_PLACEMENT.to_vec()
     } else {
@@ -158,24 +232,41 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             p.len()
         )));
     };
-    let placement = Isometry3::from_parts(
+    Ok(Isometry3::from_parts(
         Translation3::new(*x, *y, *z),
         UnitQuaternion::from_euler_angles(*roll, *pitch, *yaw),
-    );
+    ))
+}
+
+/// The stock's corners (x, y) \[m\]: `--stock` \[mm\], else around the program's feed moves.
+fn stock_corners(
+    a: &JobArgs,
+    program: &Program,
+    program_name: &str,
+) -> Result<(Vector2<f64>, Vector2<f64>), CliError> {
     let radius = 0.5e-3 * a.tool.diameter;
-    let (min, max) = match &a.stock {
+    Ok(match &a.stock {
         Some(s) => match s.as_slice() {
             [x0, y0, x1, y1] => (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3),
             _ => return Err(CliError::Usage("--stock: expected 4 values".into())),
         },
-        None => Stock::around(&program, radius).ok_or_else(|| {
+        None => Stock::around(program, radius).ok_or_else(|| {
             CliError::Failure(format!(
                 "{program_name}: no feed move (G1-G3) to size the stock from; give --stock"
             ))
         })?,
-    };
-    let (tool, coefficients) = tool_and_material(&a.tool)?;
-    let table = match &a.tools {
+    })
+}
+
+/// The tool table: `--tools` (checked to have every tool the program cuts with), else the
+/// program's APT cutters (none when it names none).
+fn tool_table(
+    a: &JobArgs,
+    program: &Program,
+    program_name: &str,
+    cutters: &[AptCutter],
+) -> Result<Option<ToolTable>, CliError> {
+    Ok(match &a.tools {
         Some(path) => {
             let o = TblOptions {
                 units: LengthUnit::Millimetre,
@@ -218,23 +309,18 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
                 a.tool.helix.to_radians(),
                 a.flute_length * 1e-3,
             ),
-            &cutters,
-            &program_name,
+            cutters,
+            program_name,
         )?,
-    };
-    // A cutter before any LOADTL is the tool the program starts with (T0): the setup's.
-    let first = cutters.iter().rev().find(|c| c.tool == 0);
-    let tool = match first {
-        Some(c) => Tool::new(c.diameter, tool.flutes, tool.helix).map_err(|e| {
-            CliError::Failure(format!("{program_name} line {}: CUTTER: {e}", c.line))
-        })?,
-        None => tool,
-    };
-    let shape = first.map_or(a.shape.0, |c| c.shape);
+    })
+}
+
+/// The z-map's cell \[mm\]: `--cell`, else resolving the smallest cutting tool.
+fn cell_mm(a: &JobArgs, table: Option<&ToolTable>, program: &Program) -> f64 {
     // The z-map resolves the smallest cutting tool: a twelfth of its diameter, within
     // [0.1, 0.5] mm (finer cells for small tools keep the force's sensitivity to the tool's
     // position what the cutter, not the grid, makes it).
-    let smallest = match &table {
+    let smallest = match table {
         Some(t) => t
             .tools()
             .iter()
@@ -248,7 +334,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             .fold(f64::INFINITY, f64::min),
         None => a.tool.diameter,
     };
-    let cell_mm = a.cell.unwrap_or_else(|| {
+    a.cell.unwrap_or_else(|| {
         if smallest.is_finite() {
             // At least 0.1 mm, but never past half the smallest radius (a tool below 0.4 mm),
             // which the job refuses.
@@ -256,38 +342,11 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
         } else {
             0.5
         }
-    });
-    let setup = Setup {
-        placement,
-        tool_orientation: Setup::tool_down(),
-        tool,
-        coefficients,
-        stock: Stock {
-            min,
-            max,
-            top: a.top * 1e-3,
-            cell: cell_mm * 1e-3,
-        },
-        path: PathOptions {
-            rate_hz: a.rate,
-            acceleration: a.acceleration,
-            jerk: a.jerk,
-            rapid_speed: a.rapid_speed,
-            ..PathOptions::default()
-        },
-        ik: PoseIkOptions::default(),
-        hand_spindle: a.spindle_rpm.map(|rpm| rpm / 60.0),
-        rapid_skim: a.rapid_skim * 1e-3,
-    };
-    let mut job = Job::new(robot.model.clone(), &robot.joint_limits, setup)
-        .map_err(|e| CliError::Usage(format!("--stock/--cell and the job's settings: {e}")))?;
-    if let Some(t) = table {
-        job = job.with_tools(t);
-    }
-    if let Some(c) = robot.controller {
-        job = job.with_controller(c);
-    }
-    // A robot program its controller does not run is refused before any work.
+    })
+}
+
+/// Refuses a robot program (`--robot-program`) its controller does not run, before any work.
+fn check_robot_program(a: &JobArgs, job: &Job, robot_name: &str) -> Result<(), CliError> {
     if let Some(vendor) = a.robot_program.and_then(|k| k.language().vendor()) {
         let language = a
             .robot_program
@@ -298,14 +357,14 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
                 return Err(CliError::Usage(format!(
                     "--robot-program {language}: {} has no controller convention ([controller] \
                      with vendor = \"{}\" in its stiffness file)",
-                    loaded.name,
+                    robot_name,
                     vendor.name()
                 )));
             }
             Some(c) if c.vendor != vendor => {
                 return Err(CliError::Usage(format!(
                     "--robot-program {language}: {}'s controller convention is {}'s ({})",
-                    loaded.name,
+                    robot_name,
                     c.vendor.name(),
                     c.vendor.language()
                 )));
@@ -313,17 +372,7 @@ pub fn load(a: &JobArgs) -> Result<JobTask, CliError> {
             Some(_) => {}
         }
     }
-    let five = program.is_multi_axis().then(|| five_axis_options(a, shape));
-    let (job, spin) = spin(a, job, &program, &program_name, &seed, five.as_ref())?;
-    Ok(JobTask {
-        job,
-        program,
-        program_name,
-        robot_name: loaded.name,
-        seed,
-        spin,
-        shape,
-    })
+    Ok(())
 }
 
 /// The job with `--spin`: a constant spin, or the schedule the search finds (and what it
@@ -380,52 +429,6 @@ fn spin(
     }
 }
 
-/// A progress bar over the program's duration \[s\] with its ETA on stderr: drawn once the
-/// job has run a second, never when stderr is not a terminal or under CI.
-struct Progress {
-    bar: indicatif::ProgressBar,
-    started: Instant,
-    shown: bool,
-    allowed: bool,
-}
-
-impl Progress {
-    fn new(duration: f64) -> Self {
-        use std::io::IsTerminal;
-        let allowed = std::io::stderr().is_terminal()
-            && !std::env::var("CI").is_ok_and(|v| !v.is_empty() && v != "false" && v != "0");
-        let bar = indicatif::ProgressBar::with_draw_target(
-            Some((duration * 1e3).ceil().max(1.0) as u64),
-            indicatif::ProgressDrawTarget::hidden(),
-        );
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{msg} [{bar:40}] {percent:>3}% of the program, {elapsed_precise} (ETA {eta})",
-        ) {
-            bar.set_style(style.progress_chars("=> "));
-        }
-        bar.set_message("job");
-        Self {
-            bar,
-            started: Instant::now(),
-            shown: false,
-            allowed,
-        }
-    }
-
-    fn at(&mut self, time: f64) {
-        if self.allowed && !self.shown && self.started.elapsed().as_secs_f64() > 1.0 {
-            self.shown = true;
-            self.bar
-                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
-        self.bar.set_position((time * 1e3) as u64);
-    }
-
-    fn done(&self) {
-        self.bar.finish_and_clear();
-    }
-}
-
 /// Runs the pass, streaming its samples to the files on a writer thread, then writes the
 /// part map and the summary.
 fn run(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
@@ -457,48 +460,35 @@ fn run(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         rapid_speed: setup.path.rapid_speed,
     };
     let files = JobFiles::create(&t.program, target, &options)?;
-    let mut progress = Progress::new(duration);
-    let run_options = job::RunOptions {
-        threads: a.threads,
-        ..job::RunOptions::default()
-    };
-    let (report, written) = std::thread::scope(|scope| {
-        // Two chunks in flight at most: the writer's memory is bounded too.
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<job::JobSample>>(2);
-        let writer = scope.spawn(move || -> Result<_, SimError> {
-            let mut files = files;
-            for chunk in rx {
-                files.write(&chunk)?;
-            }
-            files.finish()
-        });
-        let mut sink = |chunk: &[job::JobSample]| -> Result<(), SimError> {
-            if let Some(last) = chunk.last() {
-                progress.at(last.path.time);
-            }
-            tx.send(chunk.to_vec())
-                .map_err(|_| SimError::new("the file writer stopped"))
-        };
-        let run = job::run_streaming(&t.job, &t.program, &t.seed, &run_options, &mut sink);
-        // The last sender gone, the writer's loop ends.
-        drop(tx);
-        let written = writer
-            .join()
-            .map_err(|_| SimError::new("the file writer panicked"))?;
-        match (run, written) {
-            (Ok(r), Ok(w)) => Ok((r, w)),
-            // The writer's own error says more than the run's "writer stopped".
-            (_, Err(e)) => Err(e),
-            (Err(job::RunError::Job(e)), _) => {
-                Err(SimError::new(format!("{}: {e}", t.program_name)))
-            }
-            (Err(job::RunError::Sink(e)), _) => Err(e),
-        }
-    })?;
-    progress.done();
+    let (report, written) = stream_pass(a, t, files, duration)?;
     let (ops, paths) = written;
     let wall = started.elapsed().as_secs_f64();
     let r = report;
+    let png = plot_part(t, &r, out)?;
+    let (text, json) = summary(t, &r, &ops, wall, a.threads);
+    let write = |name: &str, text: &str| {
+        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
+    };
+    write("job_summary.txt", &text)?;
+    write(
+        "job_summary.json",
+        &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
+    )?;
+    let names: Vec<String> = paths
+        .iter()
+        .chain([&png])
+        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    stdout(format_args!(
+        "{text}outputs in {}: {}, job_summary.{{txt,json}}\n",
+        out.display(),
+        names.join(", ")
+    ))
+}
+
+/// Plots the part's deviation, uncompensated and compensated, to `job_part.png`.
+fn plot_part(t: &JobTask, r: &job::Report, out: &Path) -> Result<PathBuf, SimError> {
+    let setup = t.job.setup();
     let png = out.join("job_part.png");
     let label = |name: &str, part| {
         let s = r.surface_error(part);
@@ -528,25 +518,7 @@ fn run(a: &JobArgs, t: &JobTask, out: &Path) -> Result<(), SimError> {
         &[(&lu, &r.uncompensated), (&lc, &r.compensated)],
         setup.stock.top,
     )?;
-    let (text, json) = summary(t, &r, &ops, wall, a.threads);
-    let write = |name: &str, text: &str| {
-        job_out::write(out.join(name), text).map_err(|e| SimError::new(e.to_string()))
-    };
-    write("job_summary.txt", &text)?;
-    write(
-        "job_summary.json",
-        &serde_json::to_string_pretty(&json).map_err(|e| SimError::new(e.to_string()))?,
-    )?;
-    let names: Vec<String> = paths
-        .iter()
-        .chain([&png])
-        .filter_map(|p| p.file_name().map(|n| n.to_string_lossy().into_owned()))
-        .collect();
-    stdout(format_args!(
-        "{text}outputs in {}: {}, job_summary.{{txt,json}}\n",
-        out.display(),
-        names.join(", ")
-    ))
+    Ok(png)
 }
 
 /// `job`: with `--explain` the program's word report only (nothing read but the program,

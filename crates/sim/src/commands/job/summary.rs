@@ -161,6 +161,87 @@ pub(crate) fn summary(
     let duration = sm.duration();
     let fmax = sm.max_force();
     let cell = t.job.setup().stock.cell;
+    let mut text = header_text(t, r, wall, threads);
+    let (tools, tools_json) = tools_text(t);
+    let _ = writeln!(text, "{tools}");
+    if let Some(c) = r.rapid_contact {
+        let _ = writeln!(
+            text,
+            "rapids in the stock: the deepest {:.3} mm at line {} (t = {:.2} s), within --rapid-skim \
+             {:.3} mm",
+            c.depth * 1e3,
+            c.line,
+            c.time,
+            t.job.setup().rapid_skim * 1e3
+        );
+    }
+    let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
+    let spin_json = spin_text(t, &mut text);
+    operations_text(ops, &mut text);
+    let lines = r.line_forces();
+    let mut top: Vec<_> = lines.iter().filter(|l| l.max > 0.0).collect();
+    top.sort_by(|a, b| b.max.total_cmp(&a.max));
+    top.truncate(10);
+    top_lines_text(&top, &mut text);
+    let mut off: Vec<_> = lines.iter().filter(|l| l.deviation.is_some()).collect();
+    off.sort_by(|a, b| b.error_compensated.total_cmp(&a.error_compensated));
+    let tol = job::PREDICTION_TOLERANCE;
+    deviating_text(&off, r, pc.max, &mut text);
+    let _ = writeln!(text);
+    for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
+        let _ = writeln!(
+            text,
+            "{label:<13}  path error max {:.4} mm, RMS {:.4} mm; part floors max {:.4} mm, \
+             RMS {:.4} mm; walls {:.1} mm^2 left, {:.1} mm^2 overcut",
+            p.max * 1e3,
+            p.rms * 1e3,
+            s.floor.max * 1e3,
+            s.floor.rms * 1e3,
+            s.material_left * 1e6,
+            s.overcut * 1e6
+        );
+    }
+    let json = serde_json::json!({
+        "program": t.program_name,
+        "robot": t.robot_name,
+        "samples": sm.samples(),
+        "rate_hz": r.rate_hz,
+        "duration_s": duration,
+        "wall_time_s": wall,
+        "threads": threads,
+        "cell_m": cell,
+        "cell_updates": r.cell_updates,
+        "plunge_samples": r.plunge_samples,
+        "max_force_n": fmax,
+        "tools": tools_json,
+        "rapid_contact": r.rapid_contact.map(|c| serde_json::json!({
+            "line": c.line, "time_s": c.time, "depth_m": c.depth,
+        })),
+        "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
+        "spin": spin_json,
+        "operations": ops.iter().map(|o| serde_json::json!({
+            "name": o.name, "line": o.line, "tool": o.tool, "samples": o.samples,
+            "start_s": o.start, "end_s": o.end, "max_force_n": o.max_force,
+            "mean_force_n": o.sum_force / o.samples.max(1) as f64,
+            "path_error_uncompensated_m": o.error_uncompensated,
+            "path_error_compensated_m": o.error_compensated,
+            "deviating_samples": o.deviating,
+        })).collect::<Vec<_>>(),
+        "top_lines": top.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
+        "deviating_lines": off.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
+        "prediction_tolerance_m": tol,
+        "coupling_residual_max_m": sm.max_residual(),
+        "uncompensated": stats_json(pu, su),
+        "compensated": stats_json(pc, sc),
+    });
+    (text, json)
+}
+
+/// The summary's first line: the program, the arm, the samples and the pass's speed.
+fn header_text(t: &JobTask, r: &Report, wall: f64, threads: usize) -> String {
+    let sm = &r.summary;
+    let duration = sm.duration();
+    let cell = t.job.setup().stock.cell;
     let mut text = String::new();
     let _ = writeln!(
         text,
@@ -177,21 +258,11 @@ pub(crate) fn summary(
         cell * 1e3,
         r.plunge_samples
     );
-    let (tools, tools_json) = tools_text(t);
-    let _ = writeln!(text, "{tools}");
-    if let Some(c) = r.rapid_contact {
-        let _ = writeln!(
-            text,
-            "rapids in the stock: the deepest {:.3} mm at line {} (t = {:.2} s), within --rapid-skim \
-             {:.3} mm",
-            c.depth * 1e3,
-            c.line,
-            c.time,
-            t.job.setup().rapid_skim * 1e3
-        );
-    }
-    let _ = writeln!(text, "largest force on the tool: {fmax:.1} N");
-    let spin_json = spin_text(t, &mut text);
+    text
+}
+
+/// The table of the program's operations: time, force and path error max \[mm\].
+fn operations_text(ops: &[OperationFigures], text: &mut String) {
     let _ = writeln!(
         text,
         "\noperations ({}): path error max [mm] uncompensated -> compensated",
@@ -225,17 +296,17 @@ pub(crate) fn summary(
             o.error_compensated * 1e3
         );
     }
-    let lines = r.line_forces();
-    let mut top: Vec<_> = lines.iter().filter(|l| l.max > 0.0).collect();
-    top.sort_by(|a, b| b.max.total_cmp(&a.max));
-    top.truncate(10);
+}
+
+/// The table of the ten program lines of largest force.
+fn top_lines_text(top: &[&job::LineSummary], text: &mut String) {
     let _ = writeln!(text, "\nthe ten program lines of largest force");
     let _ = writeln!(
         text,
         "{:>6}  {:>7}  {:>12}  {:>11}  {:>22}",
         "line", "samples", "mean |F| [N]", "max |F| [N]", "path error max [mm] u/c"
     );
-    for l in &top {
+    for l in top {
         let _ = writeln!(
             text,
             "{:>6}  {:>7}  {:>12.1}  {:>11.1}  {:>11.4} / {:.6}",
@@ -247,8 +318,12 @@ pub(crate) fn summary(
             l.error_compensated * 1e3
         );
     }
-    let mut off: Vec<_> = lines.iter().filter(|l| l.deviation.is_some()).collect();
-    off.sort_by(|a, b| b.error_compensated.total_cmp(&a.error_compensated));
+}
+
+/// Whether the compensated prediction stays within the tolerance on every line (its largest
+/// path error `pc_max` \[m\]), else the worst lines and why.
+fn deviating_text(off: &[&job::LineSummary], r: &Report, pc_max: f64, text: &mut String) {
+    let sm = &r.summary;
     let tol = job::PREDICTION_TOLERANCE;
     if off.is_empty() {
         let _ = writeln!(
@@ -256,7 +331,7 @@ pub(crate) fn summary(
             "\nthe compensated prediction stays within {:.0} um of the program on every line \
              (largest {:.2e} mm; coupling residual at most {:.1e} m)",
             tol * 1e6,
-            pc.max * 1e3,
+            pc_max * 1e3,
             sm.max_residual()[1]
         );
     } else {
@@ -288,69 +363,25 @@ pub(crate) fn summary(
             );
         }
     }
-    let _ = writeln!(text);
-    for (label, p, s) in [("uncompensated", pu, su), ("compensated", pc, sc)] {
-        let _ = writeln!(
-            text,
-            "{label:<13}  path error max {:.4} mm, RMS {:.4} mm; part floors max {:.4} mm, \
-             RMS {:.4} mm; walls {:.1} mm^2 left, {:.1} mm^2 overcut",
-            p.max * 1e3,
-            p.rms * 1e3,
-            s.floor.max * 1e3,
-            s.floor.rms * 1e3,
-            s.material_left * 1e6,
-            s.overcut * 1e6
-        );
-    }
-    let stats = |p: job::ErrorStats, s: job::SurfaceError| {
-        serde_json::json!({
-            "path_error_max_m": p.max, "path_error_rms_m": p.rms,
-            "floor_error_max_m": s.floor.max, "floor_error_rms_m": s.floor.rms,
-            "material_left_m2": s.material_left, "overcut_m2": s.overcut,
-        })
-    };
-    let line_json = |l: &job::LineSummary| {
-        serde_json::json!({
-            "line": l.line, "samples": l.samples,
-            "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
-            "path_error_uncompensated_m": l.error_uncompensated,
-            "path_error_compensated_m": l.error_compensated,
-            "coupling_residual_m": l.residual,
-            "deviation": l.deviation.map(job::Deviation::name),
-        })
-    };
-    let json = serde_json::json!({
-        "program": t.program_name,
-        "robot": t.robot_name,
-        "samples": sm.samples(),
-        "rate_hz": r.rate_hz,
-        "duration_s": duration,
-        "wall_time_s": wall,
-        "threads": threads,
-        "cell_m": cell,
-        "cell_updates": r.cell_updates,
-        "plunge_samples": r.plunge_samples,
-        "max_force_n": fmax,
-        "tools": tools_json,
-        "rapid_contact": r.rapid_contact.map(|c| serde_json::json!({
-            "line": c.line, "time_s": c.time, "depth_m": c.depth,
-        })),
-        "hand_spindle_rpm": t.job.setup().hand_spindle.map(|v| v * 60.0),
-        "spin": spin_json,
-        "operations": ops.iter().map(|o| serde_json::json!({
-            "name": o.name, "line": o.line, "tool": o.tool, "samples": o.samples,
-            "start_s": o.start, "end_s": o.end, "max_force_n": o.max_force,
-            "mean_force_n": o.sum_force / o.samples.max(1) as f64,
-            "path_error_uncompensated_m": o.error_uncompensated,
-            "path_error_compensated_m": o.error_compensated,
-            "deviating_samples": o.deviating,
-        })).collect::<Vec<_>>(),
-        "top_lines": top.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
-        "deviating_lines": off.iter().map(|l| line_json(l)).collect::<Vec<_>>(),
-        "prediction_tolerance_m": tol,
-        "coupling_residual_max_m": sm.max_residual(),
-        "uncompensated": stats(pu, su),
-        "compensated": stats(pc, sc),
-    });
-    (text, json)
+}
+
+/// A prediction's path and part errors, as JSON \[m, m^2\].
+fn stats_json(p: job::ErrorStats, s: job::SurfaceError) -> serde_json::Value {
+    serde_json::json!({
+        "path_error_max_m": p.max, "path_error_rms_m": p.rms,
+        "floor_error_max_m": s.floor.max, "floor_error_rms_m": s.floor.rms,
+        "material_left_m2": s.material_left, "overcut_m2": s.overcut,
+    })
+}
+
+/// A program line's figures, as JSON \[N, m\].
+fn line_json(l: &job::LineSummary) -> serde_json::Value {
+    serde_json::json!({
+        "line": l.line, "samples": l.samples,
+        "mean_force_n": [l.mean.x, l.mean.y, l.mean.z], "max_force_n": l.max,
+        "path_error_uncompensated_m": l.error_uncompensated,
+        "path_error_compensated_m": l.error_compensated,
+        "coupling_residual_m": l.residual,
+        "deviation": l.deviation.map(job::Deviation::name),
+    })
 }

@@ -83,24 +83,10 @@ pub fn run_and_write(
         );
         let mesh = SurfaceMesh::new(points, cell).map_err(|e| SimError::new(e.to_string()))?;
         let path = out.join(format!("milling_part_{}.ply", run.mode.label()));
-        let f = std::fs::File::create(&path)
-            .map_err(|e| SimError::file(&path, "create the PLY mesh", e))?;
-        ply::write(&mesh, ply::Format::Binary, std::io::BufWriter::new(f))
-            .map_err(|e| SimError::file(&path, "write the PLY mesh", e))?;
+        write_ply(&path, &mesh)?;
         meshes.push((label, mesh));
     }
-    let panels: Vec<(&str, &SurfaceMesh)> = meshes.iter().map(|(l, m)| (l.as_str(), m)).collect();
-    let short = Path::new(&p.name)
-        .file_name()
-        .map_or_else(|| p.name.clone(), |n| n.to_string_lossy().into_owned());
-    part_view::plot_part_view(
-        &out.join("milling_part_view.png"),
-        &format!(
-            "{short}, {} in rapier: the machined surface along its normal",
-            r.robot
-        ),
-        &panels,
-    )?;
+    plot_view(p, &r.robot, &meshes, out)?;
     let write = |name: &str, body: &str| {
         job_out::write(out.join(name), body).map_err(|e| SimError::new(e.to_string()))
     };
@@ -120,4 +106,35 @@ pub fn run_and_write(
         "{text}wrote {}/milling_summary.{{txt,json}}, milling_part_<mode>.ply, milling_part_view.png\n",
         out.display()
     ))
+}
+
+/// Writes `mesh` to `path` as a binary PLY.
+fn write_ply(path: &Path, mesh: &SurfaceMesh) -> Result<(), SimError> {
+    let f =
+        std::fs::File::create(path).map_err(|e| SimError::file(path, "create the PLY mesh", e))?;
+    ply::write(mesh, ply::Format::Binary, std::io::BufWriter::new(f))
+        .map_err(|e| SimError::file(path, "write the PLY mesh", e))?;
+    Ok(())
+}
+
+/// Plots the runs' machined surfaces (`meshes`, with their labels) to `milling_part_view.png`.
+fn plot_view(
+    p: &ProgramInput,
+    robot: &str,
+    meshes: &[(String, SurfaceMesh)],
+    out: &Path,
+) -> Result<(), SimError> {
+    let panels: Vec<(&str, &SurfaceMesh)> = meshes.iter().map(|(l, m)| (l.as_str(), m)).collect();
+    let short = Path::new(&p.name)
+        .file_name()
+        .map_or_else(|| p.name.clone(), |n| n.to_string_lossy().into_owned());
+    part_view::plot_part_view(
+        &out.join("milling_part_view.png"),
+        &format!(
+            "{short}, {} in rapier: the machined surface along its normal",
+            robot
+        ),
+        &panels,
+    )?;
+    Ok(())
 }

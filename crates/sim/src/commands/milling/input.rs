@@ -3,11 +3,15 @@
 
 use std::path::Path;
 
+use deflect_core::SerialRobot;
+use deflect_core::io::apt::AptCutter;
 use deflect_core::io::gcode::{self, GcodeOptions};
 use deflect_core::machining::Program;
+use deflect_core::machining::cutting::Tool;
 use deflect_core::machining::five_axis::Options;
 use deflect_core::machining::job::{Setup, Stock};
 use deflect_core::machining::path::PathOptions;
+use deflect_core::machining::profile::ToolShape;
 use deflect_core::mechanism::PoseIkOptions;
 use deflect_core::units::LengthUnit;
 use deflect_sim::scenes::milling::{MillingArm, program};
@@ -77,16 +81,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         ),
     };
     let (tool, coefficients) = tool_and_material(&a.tool)?;
-    // A five-axis program's cutters: before any LOADTL the setup's tool, after one a table.
-    let first = cutters.iter().rev().find(|c| c.tool == 0);
-    let tool = match first {
-        Some(c) => deflect_core::machining::cutting::Tool::new(c.diameter, tool.flutes, tool.helix)
-            .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?,
-        None => tool,
-    };
-    let shape = first.map_or(deflect_core::machining::profile::ToolShape::Flat, |c| {
-        c.shape
-    });
+    let (tool, shape) = setup_tool(tool, &cutters, &name)?;
     let tools = apt_tools(
         (
             a.tool.flutes,
@@ -111,22 +106,7 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
             files.urdf_name, files.tip
         )));
     }
-    let q0 = a.q0.clone().unwrap_or(program::PROGRAM_SEED.to_vec());
-    if q0.len() != dof {
-        return Err(CliError::Usage(format!(
-            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
-            q0.len(),
-            robot.joint_names.join(", ")
-        )));
-    }
-    for (k, (&q, &(lo, hi))) in q0.iter().zip(&robot.joint_limits).enumerate() {
-        if q < lo || q > hi {
-            return Err(CliError::Usage(format!(
-                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
-                robot.joint_names.get(k).map_or("?", String::as_str)
-            )));
-        }
-    }
+    let q0 = start_joints(a, robot)?;
     let arm_name = if files.builtin {
         "KR 300 R2500".to_string()
     } else {
@@ -134,41 +114,8 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
     };
     let arm = MillingArm::from_spec(&arm_name, files.spec, &files.parsed, &files.tip)
         .map_err(|e| CliError::Failure(format!("{}: {}", files.urdf_name, e.0)))?;
-    let (min, max) = match (&a.stock, builtin) {
-        (Some(_), _) | (None, true) => {
-            let s = a.stock.as_deref().unwrap_or(&TEST_STOCK_MM);
-            match s {
-                [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => {
-                    (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3)
-                }
-                _ => {
-                    return Err(CliError::Usage(format!(
-                        "--stock {s:?}: expected XMIN < XMAX and YMIN < YMAX [mm]"
-                    )));
-                }
-            }
-        }
-        (None, false) => Stock::around(&program, tool.diameter / 2.0).ok_or_else(|| {
-            CliError::Failure(format!(
-                "{name}: no feed move (G1-G3) to size the stock from; give --stock"
-            ))
-        })?,
-    };
-    let placement = match a.placement.as_deref() {
-        Some([x, y, z, r, p, w]) => Isometry3::from_parts(
-            Translation3::new(*x, *y, *z),
-            UnitQuaternion::from_euler_angles(*r, *p, *w),
-        ),
-        Some(_) => return Err(CliError::Usage("--placement: expected 6 values".into())),
-        None if program.is_multi_axis() => {
-            let [x, y, z, r, p, w] = crate::commands::job::KR300_FIVE_AXIS_PLACEMENT;
-            Isometry3::from_parts(
-                Translation3::new(x, y, z),
-                UnitQuaternion::from_euler_angles(r, p, w),
-            )
-        }
-        None => program::kr300_placement(),
-    };
+    let (min, max) = stock_corners(a, builtin, &program, tool.diameter, &name)?;
+    let placement = placement(a, &program)?;
     let setup = Setup {
         placement,
         tool_orientation: Setup::tool_down(),
@@ -201,4 +148,95 @@ pub fn load(a: &MillingArgs) -> Result<MillingInput, CliError> {
         tools,
         shape,
     })))
+}
+
+/// The start joints (`--q0`, else the program seed) \[rad\], checked against the arm's
+/// joints and limits.
+fn start_joints(a: &MillingArgs, robot: &SerialRobot) -> Result<Vec<f64>, CliError> {
+    let dof = robot.model.dof();
+    let q0 = a.q0.clone().unwrap_or(program::PROGRAM_SEED.to_vec());
+    if q0.len() != dof {
+        return Err(CliError::Usage(format!(
+            "--q0: {} values given; expected {dof} (one per actuated joint of {})",
+            q0.len(),
+            robot.joint_names.join(", ")
+        )));
+    }
+    for (k, (&q, &(lo, hi))) in q0.iter().zip(&robot.joint_limits).enumerate() {
+        if q < lo || q > hi {
+            return Err(CliError::Usage(format!(
+                "--q0: joint {k} ({}) is {q} rad: outside its limits [{lo}, {hi}] rad",
+                robot.joint_names.get(k).map_or("?", String::as_str)
+            )));
+        }
+    }
+    Ok(q0)
+}
+
+/// The stock's corners (x, y) \[m\]: `--stock` \[mm\] (or the test workpiece's), else around
+/// the program's feed moves with a tool of `tool_diameter` \[m\].
+fn stock_corners(
+    a: &MillingArgs,
+    builtin: bool,
+    program: &Program,
+    tool_diameter: f64,
+    name: &str,
+) -> Result<(Vector2<f64>, Vector2<f64>), CliError> {
+    Ok(match (&a.stock, builtin) {
+        (Some(_), _) | (None, true) => {
+            let s = a.stock.as_deref().unwrap_or(&TEST_STOCK_MM);
+            match s {
+                [x0, y0, x1, y1] if x1 > x0 && y1 > y0 => {
+                    (Vector2::new(*x0, *y0) * 1e-3, Vector2::new(*x1, *y1) * 1e-3)
+                }
+                _ => {
+                    return Err(CliError::Usage(format!(
+                        "--stock {s:?}: expected XMIN < XMAX and YMIN < YMAX [mm]"
+                    )));
+                }
+            }
+        }
+        (None, false) => Stock::around(program, tool_diameter / 2.0).ok_or_else(|| {
+            CliError::Failure(format!(
+                "{name}: no feed move (G1-G3) to size the stock from; give --stock"
+            ))
+        })?,
+    })
+}
+
+/// The workpiece frame in the base frame: `--placement` x y z \[m\] roll pitch yaw \[rad\],
+/// else the KR 300's default for the program.
+fn placement(a: &MillingArgs, program: &Program) -> Result<Isometry3<f64>, CliError> {
+    Ok(match a.placement.as_deref() {
+        Some([x, y, z, r, p, w]) => Isometry3::from_parts(
+            Translation3::new(*x, *y, *z),
+            UnitQuaternion::from_euler_angles(*r, *p, *w),
+        ),
+        Some(_) => return Err(CliError::Usage("--placement: expected 6 values".into())),
+        None if program.is_multi_axis() => {
+            let [x, y, z, r, p, w] = crate::commands::job::KR300_FIVE_AXIS_PLACEMENT;
+            Isometry3::from_parts(
+                Translation3::new(x, y, z),
+                UnitQuaternion::from_euler_angles(r, p, w),
+            )
+        }
+        None => program::kr300_placement(),
+    })
+}
+
+/// The setup's tool and its end: a five-axis program's cutters before any LOADTL are the
+/// setup's tool (after one, a table), else `tool` (flat).
+fn setup_tool(
+    tool: Tool,
+    cutters: &[AptCutter],
+    name: &str,
+) -> Result<(Tool, ToolShape), CliError> {
+    let first = cutters.iter().rev().find(|c| c.tool == 0);
+    let tool = match first {
+        Some(c) => Tool::new(c.diameter, tool.flutes, tool.helix)
+            .map_err(|e| CliError::Failure(format!("{name} line {}: CUTTER: {e}", c.line)))?,
+        None => tool,
+    };
+    let shape = first.map_or(ToolShape::Flat, |c| c.shape);
+    Ok((tool, shape))
 }

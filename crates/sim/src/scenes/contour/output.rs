@@ -12,7 +12,8 @@ use super::{ContourRun, Sample, TraceOptions};
 use crate::SimError;
 use crate::mcap_log::{self, IDENTITY, Kind, Line, McapLog, RunInfo, scene_update};
 use crate::plot_style::{
-    ChartStyle, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart, present,
+    Area, ChartStyle, Entry, Role, Swatch, canvas, color, draw_legend, figure, line, new_chart,
+    present,
 };
 use crate::summary::{reduction, write_summary};
 
@@ -289,13 +290,27 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     let (plot, legend) = figure(&root, &title, 20, &entries)?;
     let (pw, _) = plot.dim_in_pixel();
     let (left, right) = plot.split_horizontally(pw * 45 / 100);
+    plot_contour(left, outline, &raw, &comp)?;
+    plot_distances(right, r, &raw, &comp)?;
+    draw_legend(&legend, &entries)?;
+    present(&root, path)?;
+    Ok(())
+}
+
+/// The left panel: the true outline and the raw and compensated contours \[mm\], equal scales.
+fn plot_contour(
+    left: Area<'_>,
+    outline: Vec<(f64, f64)>,
+    raw: &[(f64, f64)],
+    comp: &[(f64, f64)],
+) -> Result<(), SimError> {
     let (mut x0, mut x1, mut y0, mut y1) = (
         f64::INFINITY,
         f64::NEG_INFINITY,
         f64::INFINITY,
         f64::NEG_INFINITY,
     );
-    for (x, y) in outline.iter().chain(&raw).chain(&comp) {
+    for (x, y) in outline.iter().chain(raw).chain(comp) {
         x0 = x0.min(*x);
         x1 = x1.max(*x);
         y0 = y0.min(*y);
@@ -331,12 +346,22 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     )?;
     for (pts, role) in [
         (outline, Role::Desired),
-        (raw.clone(), Role::Uncorrected),
-        (comp.clone(), Role::Corrected),
+        (raw.to_vec(), Role::Uncorrected),
+        (comp.to_vec(), Role::Corrected),
     ] {
         line(&mut chart, pts, color(role), 2, false)?;
     }
+    Ok(())
+}
 
+/// The right panel: the signed distance \[mm\] of each recorded point (raw, compensated) to
+/// the outline.
+fn plot_distances(
+    right: Area<'_>,
+    r: &ContourRun,
+    raw: &[(f64, f64)],
+    comp: &[(f64, f64)],
+) -> Result<(), SimError> {
     let dist = |pts: &[(f64, f64)]| -> Vec<(f64, f64)> {
         pts.iter()
             .enumerate()
@@ -348,7 +373,7 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
             })
             .collect()
     };
-    let (draw, dcomp) = (dist(&raw), dist(&comp));
+    let (draw, dcomp) = (dist(raw), dist(comp));
     let lim = draw
         .iter()
         .chain(&dcomp)
@@ -377,8 +402,6 @@ pub fn plot_run(path: &Path, r: &ContourRun) -> Result<(), SimError> {
     for (pts, role) in [(draw, Role::Uncorrected), (dcomp, Role::Corrected)] {
         line(&mut chart, pts, color(role), 2, false)?;
     }
-    draw_legend(&legend, &entries)?;
-    present(&root, path)?;
     Ok(())
 }
 

@@ -187,12 +187,7 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
     let arm = &opts.arm;
     let drive = arm.drive_train()?;
     let mut data = drivetrain::Data::new(&drive);
-    let mut cfg = TracerConfig::new(opts.step, opts.contact_force, opts.jam_force);
-    cfg.target_force = opts.target_force;
-    cfg.approach_step = opts.approach_step;
-    cfg.direction = TraceDirection::CounterClockwise;
-    cfg.max_steps = opts.max_steps;
-    cfg.bias_samples = opts.bias_samples.max(1);
+    let cfg = tracer_config(opts);
     let start = v2(&object.start);
     let mut q_cmd = arm.ik(&start);
     let k0 = cartesian_stiffness_xy(&drive, &mut data, &q_cmd).map_err(err)?;
@@ -200,11 +195,7 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
     let mut tracer_data = contour::Data::new(&tracer);
     let mut sim = ArmSim::new(arm, &q_cmd, opts.k_contact, opts.c_contact)?;
     let mut noise = Noise::new(opts.seed ^ 0x5EED_C0DE);
-    let bias = v2(&opts.bias);
-    let objects = [&object.outline];
-    let n_ramp = ((opts.ramp / DT).round() as usize).max(1);
-    let n_settle = (opts.settle / DT).round() as usize;
-    let n_avg = ((opts.average / DT).round() as usize).clamp(1, n_ramp + n_settle);
+    let (objects, settle) = ([&object.outline], Settle::new(opts));
     let mut cmd = start;
     let mut q_prev = q_cmd;
     let mut samples = Vec::new();
@@ -214,34 +205,15 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
     let mut steps = 0;
     let state = loop {
         steps += 1;
-        // Move the motors to the command on a cosine ramp, then hold and settle.
-        let total = n_ramp + n_settle;
-        let (mut f_true, mut f_sensed) = (Vector2::zeros(), Vector2::zeros());
-        for k in 0..total {
-            let (q, w) = if k < n_ramp {
-                let s = (k + 1) as f64 / n_ramp as f64;
-                let blend = 0.5 * (1.0 - (core::f64::consts::PI * s).cos());
-                let rate = 0.5 * core::f64::consts::PI * (core::f64::consts::PI * s).sin()
-                    / (n_ramp as f64 * DT);
-                (
-                    [
-                        q_prev[0] + (q_cmd[0] - q_prev[0]) * blend,
-                        q_prev[1] + (q_cmd[1] - q_prev[1]) * blend,
-                    ],
-                    [(q_cmd[0] - q_prev[0]) * rate, (q_cmd[1] - q_prev[1]) * rate],
-                )
-            } else {
-                (q_cmd, [0.0; 2])
-            };
-            let f = sim.step(&q, &w, &objects);
-            t += DT;
-            if k + n_avg >= total {
-                f_true += f;
-                f_sensed += f + bias + Vector2::new(noise.gauss(), noise.gauss()) * opts.noise;
-            }
-        }
-        f_true /= n_avg as f64;
-        f_sensed /= n_avg as f64;
+        // Ramp the motors to the command, hold and settle.
+        let (f_true, f_sensed) = move_and_settle(
+            &mut sim,
+            &mut noise,
+            (q_prev, q_cmd),
+            &objects,
+            &settle,
+            &mut t,
+        );
         max_force = max_force.max(f_true.norm());
         let (q_link, _) = sim.link_state();
         let tool_actual = arm.fk(&q_link);
@@ -266,10 +238,7 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
             compensated: None,
         };
         if out.contact {
-            let p_raw = arm.fk(&q_motor);
-            let w = Vector6::new(out.force.x, out.force.y, 0.0, 0.0, 0.0, 0.0);
-            let c = drivetrain::step(&drive, &mut data, &q_motor, &w).map_err(err)?;
-            let p_comp = arm.fk(&[c.q[0], c.q[1]]);
+            let (p_raw, p_comp) = recover(arm, &drive, &mut data, &q_motor, &out.force)?;
             sample.raw = Some(arr(&p_raw));
             sample.compensated = Some(arr(&p_comp));
             raw.push(p_raw);
@@ -312,6 +281,102 @@ pub fn trace(object: &ObjectSpec, opts: &TraceOptions) -> Result<ContourRun, Sim
         wall: wall.elapsed().as_secs_f64(),
         samples,
     })
+}
+
+/// The tracer's settings from the trace's.
+fn tracer_config(opts: &TraceOptions) -> TracerConfig {
+    let mut cfg = TracerConfig::new(opts.step, opts.contact_force, opts.jam_force);
+    cfg.target_force = opts.target_force;
+    cfg.approach_step = opts.approach_step;
+    cfg.direction = TraceDirection::CounterClockwise;
+    cfg.max_steps = opts.max_steps;
+    cfg.bias_samples = opts.bias_samples.max(1);
+    cfg
+}
+
+/// How a command is driven: ramp, settle and averaging ticks, the sensor's bias \[N\] and
+/// noise \[N\].
+struct Settle {
+    n_ramp: usize,
+    n_settle: usize,
+    n_avg: usize,
+    bias: Vector2<f64>,
+    noise: f64,
+}
+
+impl Settle {
+    /// The ticks of the trace's ramp, settle and averaging times \[s\], and its sensor.
+    fn new(opts: &TraceOptions) -> Self {
+        let bias = v2(&opts.bias);
+        let n_ramp = ((opts.ramp / DT).round() as usize).max(1);
+        let n_settle = (opts.settle / DT).round() as usize;
+        let n_avg = ((opts.average / DT).round() as usize).clamp(1, n_ramp + n_settle);
+        Self {
+            n_ramp,
+            n_settle,
+            n_avg,
+            bias,
+            noise: opts.noise,
+        }
+    }
+}
+
+/// Moves the motors from `q_prev` to `q_cmd` \[rad\] on a cosine ramp, then holds and
+/// settles (advancing `t` \[s\]); the true and sensed contact forces \[N\] averaged over the
+/// last ticks.
+fn move_and_settle(
+    sim: &mut ArmSim,
+    noise: &mut Noise,
+    (q_prev, q_cmd): ([f64; 2], [f64; 2]),
+    objects: &[&Outline],
+    how: &Settle,
+    t: &mut f64,
+) -> (Vector2<f64>, Vector2<f64>) {
+    let (n_ramp, n_avg) = (how.n_ramp, how.n_avg);
+    let total = n_ramp + how.n_settle;
+    let (mut f_true, mut f_sensed) = (Vector2::zeros(), Vector2::zeros());
+    for k in 0..total {
+        let (q, w) = if k < n_ramp {
+            let s = (k + 1) as f64 / n_ramp as f64;
+            let blend = 0.5 * (1.0 - (core::f64::consts::PI * s).cos());
+            let rate = 0.5 * core::f64::consts::PI * (core::f64::consts::PI * s).sin()
+                / (n_ramp as f64 * DT);
+            (
+                [
+                    q_prev[0] + (q_cmd[0] - q_prev[0]) * blend,
+                    q_prev[1] + (q_cmd[1] - q_prev[1]) * blend,
+                ],
+                [(q_cmd[0] - q_prev[0]) * rate, (q_cmd[1] - q_prev[1]) * rate],
+            )
+        } else {
+            (q_cmd, [0.0; 2])
+        };
+        let f = sim.step(&q, &w, objects);
+        *t += DT;
+        if k + n_avg >= total {
+            f_true += f;
+            f_sensed += f + how.bias + Vector2::new(noise.gauss(), noise.gauss()) * how.noise;
+        }
+    }
+    f_true /= n_avg as f64;
+    f_sensed /= n_avg as f64;
+    (f_true, f_sensed)
+}
+
+/// The tool point recovered from the motor readings `q_motor` \[rad\] under the contact
+/// `force` \[N\]: raw (their forward kinematics) and compensated (Eq. 10).
+fn recover(
+    arm: &ArmParams,
+    drive: &drivetrain::Model,
+    data: &mut drivetrain::Data,
+    q_motor: &[f64; 2],
+    force: &Vector2<f64>,
+) -> Result<(Vector2<f64>, Vector2<f64>), SimError> {
+    let p_raw = arm.fk(q_motor);
+    let w = Vector6::new(force.x, force.y, 0.0, 0.0, 0.0, 0.0);
+    let c = drivetrain::step(drive, data, q_motor, &w).map_err(err)?;
+    let p_comp = arm.fk(&[c.q[0], c.q[1]]);
+    Ok((p_raw, p_comp))
 }
 
 /// Traces every object on up to `jobs` worker threads ([`parallel_map`]); results in the

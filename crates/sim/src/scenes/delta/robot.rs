@@ -175,6 +175,137 @@ fn set_arm_damping(world: &mut PhysicsWorld, arms: &[RigidBodyHandle; 3], c: f64
     }
 }
 
+/// Inserts the three arms, each on its drive joint at its angle `q` \[rad\]; their bodies,
+/// drive joints and elbows \[m\].
+fn insert_arms(
+    world: &mut PhysicsWorld,
+    params: &DeltaParams,
+    base: RigidBodyHandle,
+    q: &Vector3<f64>,
+) -> Result<ArmBodies, SimError> {
+    let delta = params.delta;
+    let l_arm = delta.arm();
+    let arm_props = MassProperties::new(
+        Vector::new(0.6 * l_arm, 0.0, 0.0),
+        params.arm_mass,
+        Vector::new(
+            1e-3,
+            params.arm_mass * l_arm * l_arm / 12.0,
+            params.arm_mass * l_arm * l_arm / 12.0,
+        ),
+    );
+    let mut arms = [base; 3];
+    let mut drives = Vec::with_capacity(3);
+    let mut elbows = [Vector3::zeros(); 3];
+    for (i, theta) in q.iter().enumerate() {
+        let frame = arm_frame(&delta, i, *theta);
+        let arm = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .pose(to_pose(&frame))
+                .additional_mass_properties(arm_props)
+                .can_sleep(false),
+        );
+        let joint = GenericJointBuilder::new(REVOLUTE_Y)
+            .local_frame1(to_pose(&frame))
+            .local_frame2(Pose::IDENTITY)
+            .contacts_enabled(false)
+            .build();
+        drives.push(
+            world
+                .insert_multibody_joint(base, arm, joint)
+                .ok_or_else(|| SimError::new("Delta arm joint rejected"))?,
+        );
+        if let (Some(a), Some(e)) = (arms.get_mut(i), elbows.get_mut(i)) {
+            *a = arm;
+            *e = (frame * nalgebra::Point3::new(l_arm, 0.0, 0.0)).coords;
+        }
+    }
+    Ok((arms, drives, elbows))
+}
+
+/// Inserts the platform (with the payload) at `start` \[m\], free to translate only.
+fn insert_platform(
+    world: &mut PhysicsWorld,
+    params: &DeltaParams,
+    base: RigidBodyHandle,
+    start: &Vector3<f64>,
+) -> Result<RigidBodyHandle, SimError> {
+    let platform_mass = params.platform_mass + params.payload_mass;
+    let platform = world.insert_body(
+        RigidBodyBuilder::dynamic()
+            .pose(to_pose(&Isometry3::translation(start.x, start.y, start.z)))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                platform_mass,
+                Vector::new(2e-3, 2e-3, 3e-3),
+            ))
+            .can_sleep(false),
+    );
+    let slide = GenericJointBuilder::new(JointAxesMask::ANG_AXES)
+        .local_frame1(to_pose(&Isometry3::translation(start.x, start.y, start.z)))
+        .local_frame2(Pose::IDENTITY)
+        .contacts_enabled(false)
+        .build();
+    world
+        .insert_multibody_joint(base, platform, slide)
+        .ok_or_else(|| SimError::new("Delta platform joint rejected"))?;
+    Ok(platform)
+}
+
+/// Inserts the forearms: rods from the `arms`' `elbows` to the platform joints, ball-jointed
+/// at both ends.
+fn insert_forearms(
+    world: &mut PhysicsWorld,
+    params: &DeltaParams,
+    start: &Vector3<f64>,
+    (arms, elbows): (&[RigidBodyHandle; 3], [Vector3<f64>; 3]),
+    platform: RigidBodyHandle,
+) {
+    let delta = params.delta;
+    let l_arm = delta.arm();
+    let l = delta.forearm();
+    let m_f = params.forearm_mass;
+    let rod = MassProperties::new(
+        Vector::new(0.5 * l, 0.0, 0.0),
+        m_f,
+        Vector::new(1e-4, m_f * l * l / 12.0, m_f * l * l / 12.0),
+    );
+    for (i, (arm, elbow)) in arms.iter().zip(elbows).enumerate() {
+        let joint_at = start + radial(i) * delta.platform_radius();
+        let d = (joint_at - elbow) / l;
+        let frame = Isometry3::from_parts(Translation3::from(elbow), x_onto(&d));
+        let body = world.insert_body(
+            RigidBodyBuilder::dynamic()
+                .pose(to_pose(&frame))
+                .additional_mass_properties(rod)
+                .angular_damping(0.5)
+                .can_sleep(false),
+        );
+        // Elbow: the arm's (L, 0, 0) to the rod's origin.
+        let at_elbow = GenericJointBuilder::new(JointAxesMask::LIN_AXES)
+            .local_frame1(to_pose(&Isometry3::translation(l_arm, 0.0, 0.0)))
+            .local_frame2(Pose::IDENTITY)
+            .contacts_enabled(false)
+            .build();
+        world.insert_impulse_joint(*arm, body, at_elbow);
+        // Platform joint: the rod's (l, 0, 0) to r u_i on the platform.
+        let local = radial(i) * delta.platform_radius();
+        let at_platform = GenericJointBuilder::new(JointAxesMask::LIN_AXES)
+            .local_frame1(to_pose(&Isometry3::translation(l, 0.0, 0.0)))
+            .local_frame2(to_pose(&Isometry3::translation(local.x, local.y, local.z)))
+            .contacts_enabled(false)
+            .build();
+        world.insert_impulse_joint(body, platform, at_platform);
+    }
+}
+
+/// The arms' bodies, their drive joints and their elbows \[m\].
+type ArmBodies = (
+    [RigidBodyHandle; 3],
+    Vec<MultibodyJointHandle>,
+    [Vector3<f64>; 3],
+);
+
 impl DeltaSim {
     /// The Delta at rest with its platform centre at `start` \[m\].
     pub fn new(params: DeltaParams, start: &Vector3<f64>) -> Result<Self, SimError> {
@@ -184,96 +315,9 @@ impl DeltaSim {
         world.integration_parameters.num_solver_iterations = 4;
         world.integration_parameters.num_internal_pgs_iterations = 4;
         let base = world.insert_body(RigidBodyBuilder::fixed());
-        let l_arm = delta.arm();
-        let arm_props = MassProperties::new(
-            Vector::new(0.6 * l_arm, 0.0, 0.0),
-            params.arm_mass,
-            Vector::new(
-                1e-3,
-                params.arm_mass * l_arm * l_arm / 12.0,
-                params.arm_mass * l_arm * l_arm / 12.0,
-            ),
-        );
-        let mut arms = [base; 3];
-        let mut drives = Vec::with_capacity(3);
-        let mut elbows = [Vector3::zeros(); 3];
-        for (i, theta) in q.iter().enumerate() {
-            let frame = arm_frame(&delta, i, *theta);
-            let arm = world.insert_body(
-                RigidBodyBuilder::dynamic()
-                    .pose(to_pose(&frame))
-                    .additional_mass_properties(arm_props)
-                    .can_sleep(false),
-            );
-            let joint = GenericJointBuilder::new(REVOLUTE_Y)
-                .local_frame1(to_pose(&frame))
-                .local_frame2(Pose::IDENTITY)
-                .contacts_enabled(false)
-                .build();
-            drives.push(
-                world
-                    .insert_multibody_joint(base, arm, joint)
-                    .ok_or_else(|| SimError::new("Delta arm joint rejected"))?,
-            );
-            if let (Some(a), Some(e)) = (arms.get_mut(i), elbows.get_mut(i)) {
-                *a = arm;
-                *e = (frame * nalgebra::Point3::new(l_arm, 0.0, 0.0)).coords;
-            }
-        }
-        let platform_mass = params.platform_mass + params.payload_mass;
-        let platform = world.insert_body(
-            RigidBodyBuilder::dynamic()
-                .pose(to_pose(&Isometry3::translation(start.x, start.y, start.z)))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    platform_mass,
-                    Vector::new(2e-3, 2e-3, 3e-3),
-                ))
-                .can_sleep(false),
-        );
-        let slide = GenericJointBuilder::new(JointAxesMask::ANG_AXES)
-            .local_frame1(to_pose(&Isometry3::translation(start.x, start.y, start.z)))
-            .local_frame2(Pose::IDENTITY)
-            .contacts_enabled(false)
-            .build();
-        world
-            .insert_multibody_joint(base, platform, slide)
-            .ok_or_else(|| SimError::new("Delta platform joint rejected"))?;
-        // Forearms: rods from the elbows to the platform joints, ball-jointed at both ends.
-        let l = delta.forearm();
-        let m_f = params.forearm_mass;
-        let rod = MassProperties::new(
-            Vector::new(0.5 * l, 0.0, 0.0),
-            m_f,
-            Vector::new(1e-4, m_f * l * l / 12.0, m_f * l * l / 12.0),
-        );
-        for (i, (arm, elbow)) in arms.iter().zip(elbows).enumerate() {
-            let joint_at = start + radial(i) * delta.platform_radius();
-            let d = (joint_at - elbow) / l;
-            let frame = Isometry3::from_parts(Translation3::from(elbow), x_onto(&d));
-            let body = world.insert_body(
-                RigidBodyBuilder::dynamic()
-                    .pose(to_pose(&frame))
-                    .additional_mass_properties(rod)
-                    .angular_damping(0.5)
-                    .can_sleep(false),
-            );
-            // Elbow: the arm's (L, 0, 0) to the rod's origin.
-            let at_elbow = GenericJointBuilder::new(JointAxesMask::LIN_AXES)
-                .local_frame1(to_pose(&Isometry3::translation(l_arm, 0.0, 0.0)))
-                .local_frame2(Pose::IDENTITY)
-                .contacts_enabled(false)
-                .build();
-            world.insert_impulse_joint(*arm, body, at_elbow);
-            // Platform joint: the rod's (l, 0, 0) to r u_i on the platform.
-            let local = radial(i) * delta.platform_radius();
-            let at_platform = GenericJointBuilder::new(JointAxesMask::LIN_AXES)
-                .local_frame1(to_pose(&Isometry3::translation(l, 0.0, 0.0)))
-                .local_frame2(to_pose(&Isometry3::translation(local.x, local.y, local.z)))
-                .contacts_enabled(false)
-                .build();
-            world.insert_impulse_joint(body, platform, at_platform);
-        }
+        let (arms, drives, elbows) = insert_arms(&mut world, &params, base, &q)?;
+        let platform = insert_platform(&mut world, &params, base, start)?;
+        insert_forearms(&mut world, &params, start, (&arms, elbows), platform);
         let w = 2.0 * core::f64::consts::PI * params.bandwidth_hz;
         let kp = params.kp_ratio * params.k_drive;
         let j_motor = kp / (w * w);

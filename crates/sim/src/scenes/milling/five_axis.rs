@@ -8,6 +8,7 @@
 //! compared with the program's along the surface's normal. The online compensator's
 //! projection (normal to the feed, Hähn and Weigold 2020, Eq. 10-11) is 2.5-D and is not run.
 
+use deflect_core::machining::cutting::Coefficients;
 use deflect_core::machining::dexel::Dexels;
 use deflect_core::machining::five_axis::{self, CutterModel, Options, Report};
 use deflect_core::machining::job::{Job, Setup};
@@ -160,14 +161,7 @@ fn run(
     for (k, s) in offline.samples.iter().enumerate() {
         let next = offline.samples.get(k + 1).unwrap_or(s);
         let (q_a, q_b) = (joints(s), joints(next));
-        let c = match cutters.iter().find(|(t, _)| *t == s.path.tool) {
-            Some((_, c)) => *c,
-            None => {
-                let c = cutter(job, s.path.tool, options)?;
-                cutters.push((s.path.tool, c));
-                c
-            }
-        };
+        let c = cutter_of(&mut cutters, job, s.path.tool, options)?;
         let (tip, axis) = pose(&sim);
         if s.bands > 0 {
             let e = (tip - s.path.position).norm();
@@ -184,16 +178,7 @@ fn run(
             .cut(&c.solid, &from, &from_axis, &tip, &axis)
             .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
         prev = Some((tip, axis));
-        let spindle = match (s.path.spindle, setup.hand_spindle) {
-            (0.0, Some(hand)) => hand,
-            (v, _) => v,
-        };
-        let teeth = spindle.abs() * f64::from(c.tool.flutes);
-        let fz = if s.path.feed_move && teeth > 0.0 {
-            s.path.speed / teeth
-        } else {
-            0.0
-        };
+        let fz = feed_per_tooth(s, setup, &c);
         for j in 0..sub {
             let u = j as f64 / sub as f64;
             let q_prev = q_cmd.clone();
@@ -207,29 +192,8 @@ fn run(
                 .collect();
             // The force where the tool is and as it is tilted, on this run's stock.
             let (tip, axis) = pose(&sim);
-            let mut w = Vector6::zeros();
-            if fz > 0.0
-                && let Some(frame) = five_axis::frame(&axis, &s.path.direction)
-            {
-                let nb = part
-                    .engagement(
-                        &c.solid,
-                        &tip,
-                        &frame,
-                        options.slices,
-                        options.angles,
-                        &mut bands,
-                    )
-                    .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
-                if nb > 0 {
-                    let engaged = bands.get(..nb).unwrap_or(&[]);
-                    let coefficients = &setup.coefficients;
-                    let dir = &s.path.direction;
-                    w = five_axis::edge_wrench(coefficients, &c, &frame, engaged, &axis, dir, fz)
-                        .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?
-                        .1;
-                }
-            }
+            let on = (&part, &c, &mut bands);
+            let w = process_wrench(on, (&tip, &axis), s, fz, &setup.coefficients, options)?;
             let w_base = rotate(&to_base.rotation, &w);
             sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w_base));
         }
@@ -241,4 +205,64 @@ fn run(
         max_axis,
         part,
     })
+}
+
+/// The cutter model of tool `number`, built once and kept in `cutters`.
+fn cutter_of(
+    cutters: &mut Vec<(u32, CutterModel)>,
+    job: &Job,
+    number: u32,
+    options: &Options,
+) -> Result<CutterModel, SimError> {
+    Ok(match cutters.iter().find(|(t, _)| *t == number) {
+        Some((_, c)) => *c,
+        None => {
+            let c = cutter(job, number, options)?;
+            cutters.push((number, c));
+            c
+        }
+    })
+}
+
+/// The sample's feed per tooth \[m\] (the hand spindle where the program's is off; 0 off a
+/// feed move or with the spindle stopped).
+fn feed_per_tooth(s: &five_axis::Sample, setup: &Setup, c: &CutterModel) -> f64 {
+    let spindle = match (s.path.spindle, setup.hand_spindle) {
+        (0.0, Some(hand)) => hand,
+        (v, _) => v,
+    };
+    let teeth = spindle.abs() * f64::from(c.tool.flutes);
+    if s.path.feed_move && teeth > 0.0 {
+        s.path.speed / teeth
+    } else {
+        0.0
+    }
+}
+
+/// The process wrench \[N, N m\] (workpiece frame) on cutter `c` at `tip` with `axis` \[m\]
+/// in the run's stock `part`, feeding `fz` \[m\] per tooth: zero out of the material.
+fn process_wrench(
+    (part, c, bands): (&Dexels, &CutterModel, &mut [Band; MAX_BANDS]),
+    (tip, axis): (&Vector3<f64>, &Vector3<f64>),
+    s: &five_axis::Sample,
+    fz: f64,
+    coefficients: &Coefficients,
+    options: &Options,
+) -> Result<Vector6, SimError> {
+    let mut w = Vector6::zeros();
+    if fz > 0.0
+        && let Some(frame) = five_axis::frame(axis, &s.path.direction)
+    {
+        let nb = part
+            .engagement(&c.solid, tip, &frame, options.slices, options.angles, bands)
+            .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
+        if nb > 0 {
+            let engaged = bands.get(..nb).unwrap_or(&[]);
+            let dir = &s.path.direction;
+            w = five_axis::edge_wrench(coefficients, c, &frame, engaged, axis, dir, fz)
+                .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?
+                .1;
+        }
+    }
+    Ok(w)
 }

@@ -20,11 +20,13 @@
 //!   identified values.
 //! * [`output`]: summary table, CSV, JSON, MCAP log and plots.
 //! * [`program`]: the paper's validation on a machining program (engagement where the
-//!   simulated tool is; uncompensated, offline, Cartesian, hybrid, axis-specific).
+//!   simulated tool is; uncompensated, offline, Cartesian, hybrid, axis-specific); the
+//!   parts of its control cycle in the private `cycle`.
 //! * [`program_output`]: the program scenario's table, JSON, CSV and MCAP log.
 //! * [`part_map`]: the machined part against the nominal one as a heat map (Fig. 10-13).
 
 pub mod arm;
+mod cycle;
 pub mod five_axis;
 pub mod identification;
 pub mod options;

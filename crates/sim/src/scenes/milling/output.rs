@@ -63,6 +63,23 @@ pub fn table(r: &MillingResult) -> String {
             m.exit_max_mm
         );
     }
+    stiffness_table(r, &mut s);
+    sensor_table(r, &mut s);
+    let _ = writeln!(
+        s,
+        "\n{:.1} s simulated ({} steps of {} ms) in {:.2} s wall clock, identification included",
+        r.sim_seconds,
+        (r.sim_seconds / o.dt).round(),
+        o.dt * 1e3,
+        r.wall_seconds
+    );
+    s
+}
+
+/// The stiffness identification's rows: each spring axis's true and identified stiffness
+/// \[kN m/rad\] from frame pairs and from the TCP.
+fn stiffness_table(r: &MillingResult, s: &mut String) {
+    let o = &r.options;
     let _ = writeln!(
         s,
         "\nstiffness identification ({} N and {} N m static loads in rapier, {} poses) \
@@ -103,6 +120,11 @@ pub fn table(r: &MillingResult) -> String {
             pct(e.k_tcp, e.k_true)
         );
     }
+}
+
+/// The sensor identification's rows: force and moment offsets, weight and centre of gravity,
+/// true and identified.
+fn sensor_table(r: &MillingResult, s: &mut String) {
     let c = &r.sensor;
     let _ = writeln!(
         s,
@@ -133,15 +155,6 @@ pub fn table(r: &MillingResult) -> String {
         v(&c.center_of_gravity.0, 1e3),
         v(&c.center_of_gravity.1, 1e3)
     );
-    let _ = writeln!(
-        s,
-        "\n{:.1} s simulated ({} steps of {} ms) in {:.2} s wall clock, identification included",
-        r.sim_seconds,
-        (r.sim_seconds / o.dt).round(),
-        o.dt * 1e3,
-        r.wall_seconds
-    );
-    s
 }
 
 /// CSV: one row per run (errors), then one row per joint (identification).

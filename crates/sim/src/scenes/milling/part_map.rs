@@ -13,7 +13,7 @@ use deflect_core::machining::stock::ZMap;
 use plotters::prelude::*;
 
 use crate::SimError;
-use crate::plot_style::{CHART, LEGEND_FONT, canvas, figure, new_chart, perr, present};
+use crate::plot_style::{Area, CHART, LEGEND_FONT, canvas, figure, new_chart, perr, present};
 
 /// Most blocks drawn along an axis: larger grids are drawn in blocks of cells, each showing
 /// its cell of largest deviation.
@@ -153,7 +153,12 @@ pub fn plot_part_deviation(
         }
         chart.draw_series(cells).map_err(perr)?;
     }
-    // The colour bar.
+    draw_color_bar(&side, limit)?;
+    present(&root, path)
+}
+
+/// The colour bar of the deviation scale, `limit` \[m\] at its ends, and the uncut swatch.
+fn draw_color_bar(side: &Area<'_>, limit: f64) -> Result<(), SimError> {
     let (x0, y0, w, h) = (16, 60, 22, 300);
     for i in 0..h {
         let t = 1.0 - 2.0 * f64::from(i) / f64::from(h - 1);
@@ -180,7 +185,7 @@ pub fn plot_part_deviation(
     .map_err(perr)?;
     side.draw(&Text::new("uncut", (x0 + w + 6, y0 + h + 21), font))
         .map_err(perr)?;
-    present(&root, path)
+    Ok(())
 }
 
 /// About how many characters of a sans-serif font of `px` pixels fit in `width` pixels.

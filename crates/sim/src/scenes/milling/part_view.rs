@@ -14,7 +14,7 @@ use plotters::prelude::*;
 
 use super::part_map::{deviation_color, wrap};
 use crate::SimError;
-use crate::plot_style::{LEGEND_FONT, canvas, figure, perr, present};
+use crate::plot_style::{Area, LEGEND_FONT, canvas, figure, perr, present};
 
 /// The view: right, up and towards-the-viewer directions (workpiece frame).
 fn view() -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
@@ -130,7 +130,12 @@ pub fn plot_part_view(
                 .map_err(perr)?;
         }
     }
-    // The colour bar.
+    draw_color_bar(&side, limit)?;
+    present(&root, path)
+}
+
+/// The colour bar of the deviation scale, `limit` \[m\] at its ends.
+fn draw_color_bar(side: &Area<'_>, limit: f64) -> Result<(), SimError> {
     let (x0, y0, bw, bh) = (16, 70, 22, 300);
     for i in 0..bh {
         let t = 1.0 - 2.0 * f64::from(i) / f64::from(bh - 1);
@@ -154,5 +159,5 @@ pub fn plot_part_view(
         side.draw(&Text::new(label, (x0 + bw + 6, y0 + dy - 7), font.clone()))
             .map_err(perr)?;
     }
-    present(&root, path)
+    Ok(())
 }

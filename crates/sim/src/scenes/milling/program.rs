@@ -17,15 +17,14 @@
 //! feed-forward is zero and the combined run is the hybrid one bit for bit.
 
 use deflect_core::compensation::{self, CompensatorConfig, CorrectionOutput, SensorCalibration};
-use deflect_core::machining::chip::ChipModel;
-use deflect_core::machining::engagement;
 use deflect_core::machining::job::{self, Job, Report, SurfaceError};
-use deflect_core::machining::stock::{Cutter, ZMap};
+use deflect_core::machining::stock::ZMap;
 use deflect_core::vjm::{Model, Vector6};
-use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
+use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector3};
 use serde::Serialize;
 
 use super::arm::MillingArm;
+use super::cycle::{CycleInputs, RunStock, correct, servo_command};
 use super::options::MillingOptions;
 use crate::SimError;
 use crate::noise::Noise;
@@ -222,13 +221,8 @@ pub fn run_program(
     inputs: &RunInputs<'_>,
     mode: ProgramMode,
 ) -> Result<ProgramRun, SimError> {
-    let RunInputs {
-        job,
-        offline,
-        feedforward,
-        model,
-        calibration,
-    } = *inputs;
+    let (job, offline, feedforward) = (inputs.job, inputs.offline, inputs.feedforward);
+    let (model, calibration) = (inputs.model, inputs.calibration);
     let setup = job.setup();
     let (to_base, to_work) = (setup.placement, setup.placement.inverse());
     let dof = arm.dof();
@@ -240,33 +234,9 @@ pub fn run_program(
     let truth = opts.sensor.calibration(arm.sensor_to_tcp);
     let spindle = spindle(arm, opts);
     let mut sim = arm.sim(&q_start, 1.0, (opts.dt, opts.substeps), spindle.as_ref())?;
-    let mut comp = match mode {
-        ProgramMode::Uncompensated | ProgramMode::Offline => None,
-        ProgramMode::Cartesian
-        | ProgramMode::Hybrid
-        | ProgramMode::AxisSpecific
-        | ProgramMode::Combined => {
-            let mut cfg = CompensatorConfig::paper(1.0 / offline.rate_hz, *calibration);
-            cfg.pilot = (mode != ProgramMode::Cartesian).then_some(opts.pilot);
-            if mode == ProgramMode::AxisSpecific {
-                cfg.output = CorrectionOutput::Joint;
-            }
-            let c = compensation::Model::new(model.clone(), cfg)
-                .map_err(|e| SimError::new(format!("compensator: {e}")))?;
-            let d = compensation::Data::new(&c);
-            Some((c, d))
-        }
-    };
+    let mut comp = compensator(mode, offline.rate_hz, opts, model, calibration)?;
     let pilot = offline.pilot_wrenches(opts.estimate_lead);
-    let st = &setup.stock;
-    let mut part = ZMap::new(st.min, st.max, st.top, st.cell)
-        .map_err(|e| SimError::new(format!("stock: {e}")))?;
-    let cutter = Cutter::Flat {
-        radius: 0.5 * setup.tool.diameter,
-    };
-    let probes = engagement::Probes::new(cutter.radius(), st.cell);
-    let chip_model = ChipModel::new(&setup.coefficients, &setup.tool, probes.count());
-    let mut chip = engagement::Chip::default();
+    let mut stock = RunStock::new(setup)?;
     let mut noise = Noise::new(opts.seed);
     let dt = opts.dt;
     let cycle = 1.0 / offline.rate_hz;
@@ -274,28 +244,15 @@ pub fn run_program(
     let mut ik = arm.ik_data(&q_start);
     let mut queue: std::collections::VecDeque<Vec<f64>> =
         std::iter::repeat_n(vec![0.0; dof], opts.delay_cycles).collect();
-    let mut lagged = vec![0.0; dof];
+    let mut lag = vec![0.0; dof];
     let alpha = dt / (opts.servo_tau + dt);
     let mut dq_target = vec![0.0; dof];
     let mut q_cmd = q_start.clone();
-    let mut tip_prev: Option<Vector3<f64>> = None;
     let mut force_w = Vector3::zeros();
     let mut engaged: Option<(f64, [f64; 2], usize)> = None;
     let mut samples = Vec::with_capacity(offline.samples.len());
     let mut cutting = Vec::with_capacity(offline.samples.len());
-    let joints = |k: usize, s: &job::JobSample| -> Vec<f64> {
-        let q = if mode == ProgramMode::Offline {
-            &s.q_commanded
-        } else {
-            &s.q
-        };
-        match (mode, feedforward.get(k)) {
-            (ProgramMode::Combined, Some(ff)) => {
-                q.iter().zip(ff).take(dof).map(|(a, b)| a + b).collect()
-            }
-            _ => q.iter().take(dof).copied().collect(),
-        }
-    };
+    let joints = |k: usize, s: &job::JobSample| run_joints(mode, feedforward.get(k), dof, s);
     for (k, s) in offline.samples.iter().enumerate() {
         let (kn, next) = offline.samples.get(k + 1).map_or((k, s), |n| (k + 1, n));
         let (q_a, q_b) = (joints(k, s), joints(kn, next));
@@ -306,100 +263,130 @@ pub fn run_program(
         let tcp = sim.tcp_pose().translation.vector;
         let tip = (to_work * Point3::from(tcp)).coords;
         let f_base = to_base.rotation * force_w;
-        let reading = opts.sensor.reading(
-            &truth,
-            &arm.sensor_pose(&sim),
-            &tcp,
-            &f_base,
-            &mut noise,
-            1.0,
-        );
-        let d = tip - p_nom;
-        let across = d - s.path.direction * d.dot(&s.path.direction);
-        samples.push(ProgramSample {
-            t: s.path.time,
-            line: s.path.line,
-            nominal: p_nom.into(),
-            actual: tip.into(),
-            force: force_w.into(),
-            depth: engaged.map_or(0.0, |e| e.0),
-            angles: engaged.map_or([0.0; 2], |e| e.1),
-            arcs: engaged.map_or(0, |e| e.2),
-            error_mm: across.norm() * 1e3,
-        });
+        let sensor = arm.sensor_pose(&sim);
+        let reading = opts
+            .sensor
+            .reading(&truth, &sensor, &tcp, &f_base, &mut noise, 1.0);
+        samples.push(program_sample(s, &tip, &force_w, engaged));
         cutting.push(s.path.feed_move && !s.contact.arcs().is_empty());
-        if let Some((c, data)) = comp.as_mut() {
+        if let Some(compensator) = comp.as_mut() {
             let est = pilot.get(k).copied().unwrap_or_else(Vector6::zeros);
-            let out = compensation::step(c, data, &q_cmd, &reading, Some(&est), &v_nom)
-                .map_err(|e| SimError::new(format!("compensator step: {e}")))?;
-            if mode == ProgramMode::AxisSpecific {
-                for (dst, src) in dq_target.iter_mut().zip(out.dq.iter()) {
-                    *dst = *src;
-                }
-            } else {
-                let dp: Vector3<f64> = out.correction.fixed_rows::<3>(0).into_owned();
-                let dr: Vector3<f64> = out.correction.fixed_rows::<3>(3).into_owned();
-                let nominal = to_base
-                    * Isometry3::from_parts(Translation3::from(p_nom), setup.tool_orientation);
-                let target = Isometry3::from_parts(
-                    Translation3::from(nominal.translation.vector + dp),
-                    UnitQuaternion::from_scaled_axis(dr) * nominal.rotation,
-                );
-                let q_target = arm.ik(&mut ik, &target)?;
-                for ((d, a), b) in dq_target.iter_mut().zip(&q_target).zip(&q_a) {
-                    *d = a - b;
-                }
-            }
+            let cx = CycleInputs {
+                joint_output: mode == ProgramMode::AxisSpecific,
+                q_cmd: &q_cmd,
+                reading: &reading,
+                estimate: &est,
+                v_nom: &v_nom,
+                nominal: (to_base, p_nom, setup.tool_orientation),
+                q_a: &q_a,
+            };
+            correct(compensator, &cx, (arm, &mut ik), &mut dq_target)?;
         }
         queue.push_back(dq_target.clone());
         let dq_servo = queue.pop_front().unwrap_or_else(|| vec![0.0; dof]);
         let fz = job::feed_per_tooth(setup, &s.path);
         for j in 0..sub {
             let u = j as f64 / sub as f64;
-            let q_prev = q_cmd.clone();
-            for ((((l, m), d), a), b) in lagged
-                .iter_mut()
-                .zip(&mut q_cmd)
-                .zip(&dq_servo)
-                .zip(&q_a)
-                .zip(&q_b)
-            {
-                *l += alpha * (d - *l);
-                *m = a + (b - a) * u + *l;
-            }
-            let qd: Vec<f64> = q_cmd
-                .iter()
-                .zip(&q_prev)
-                .map(|(a, b)| (a - b) / dt)
-                .collect();
+            let qd = servo_command(
+                &mut q_cmd,
+                &mut lag,
+                &dq_servo,
+                (&q_a, &q_b),
+                alpha,
+                (u, dt),
+            );
             // The force where the tool is: the engagement on this run's stock at the
             // simulated tip, then the cut to it.
             let tip = (to_work * Point3::from(sim.tcp_pose().translation.vector)).coords;
-            engagement::read(&part, &probes, &tip, &s.path.direction, false, &mut chip);
-            let contact = chip.contact();
-            let (f, w) = job::chip_wrench(&chip_model, &chip, &s.path.direction, fz, false)
-                .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
-            force_w = f;
-            engaged = contact
-                .span()
-                .map(|a| (a.depth, [a.entry, a.exit], contact.arcs().len()));
-            let _ = part
-                .cut(&cutter, &tip_prev.unwrap_or(tip), &tip)
-                .map_err(|e| SimError::new(format!("program line {}: {e}", s.path.line)))?;
-            tip_prev = Some(tip);
+            let w;
+            (force_w, w, engaged) = stock.step(&tip, &s.path, fz)?;
             let w_base = rotate(&to_base.rotation, &w);
             sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w_base));
         }
     }
-    let cuts = cuts(offline, cutter.radius());
-    let part_error = offline.surface_error(&part);
+    let cuts = cuts(offline, stock.cutter.radius());
+    let part_error = offline.surface_error(&stock.part);
     Ok(ProgramRun {
         mode,
         metrics: metrics(&samples, &cuts, &cutting),
-        part,
+        part: stock.part,
         part_error,
         samples,
     })
+}
+
+/// The joints \[rad\] a run of `mode` follows at sample `s`: the pass's rigid joints, its
+/// compensated ones (offline), or the rigid ones plus the inertial feed-forward `ff`
+/// (combined).
+fn run_joints(
+    mode: ProgramMode,
+    ff: Option<&[f64; deflect_core::vjm::MAX_DOF]>,
+    dof: usize,
+    s: &job::JobSample,
+) -> Vec<f64> {
+    let q = if mode == ProgramMode::Offline {
+        &s.q_commanded
+    } else {
+        &s.q
+    };
+    match (mode, ff) {
+        (ProgramMode::Combined, Some(ff)) => {
+            q.iter().zip(ff).take(dof).map(|(a, b)| a + b).collect()
+        }
+        _ => q.iter().take(dof).copied().collect(),
+    }
+}
+
+/// The compensator of `mode` at the pass's rate `rate_hz` (none uncompensated or offline),
+/// with the identified `model` and the sensor's `calibration`.
+fn compensator(
+    mode: ProgramMode,
+    rate_hz: f64,
+    opts: &MillingOptions,
+    model: &Model,
+    calibration: &SensorCalibration,
+) -> Result<Option<(compensation::Model, compensation::Data)>, SimError> {
+    Ok(match mode {
+        ProgramMode::Uncompensated | ProgramMode::Offline => None,
+        ProgramMode::Cartesian
+        | ProgramMode::Hybrid
+        | ProgramMode::AxisSpecific
+        | ProgramMode::Combined => {
+            let mut cfg = CompensatorConfig::paper(1.0 / rate_hz, *calibration);
+            cfg.pilot = (mode != ProgramMode::Cartesian).then_some(opts.pilot);
+            if mode == ProgramMode::AxisSpecific {
+                cfg.output = CorrectionOutput::Joint;
+            }
+            let c = compensation::Model::new(model.clone(), cfg)
+                .map_err(|e| SimError::new(format!("compensator: {e}")))?;
+            let d = compensation::Data::new(&c);
+            Some((c, d))
+        }
+    })
+}
+
+/// The cycle's log entry: where the tool is (`tip`, workpiece frame \[m\]) against the
+/// program, the force on it \[N\] and its engagement.
+fn program_sample(
+    s: &job::JobSample,
+    tip: &Vector3<f64>,
+    force_w: &Vector3<f64>,
+    engaged: Option<(f64, [f64; 2], usize)>,
+) -> ProgramSample {
+    let p_nom = s.path.position;
+    let d = tip - p_nom;
+    let across = d - s.path.direction * d.dot(&s.path.direction);
+    ProgramSample {
+        t: s.path.time,
+        line: s.path.line,
+        nominal: p_nom.into(),
+        actual: (*tip).into(),
+        force: (*force_w).into(),
+        depth: engaged.map_or(0.0, |e| e.0),
+        angles: engaged.map_or([0.0; 2], |e| e.1),
+        arcs: engaged.map_or(0, |e| e.2),
+        error_mm: across.norm() * 1e3,
+    }
 }
 
 /// The spindle the simulated arm carries ([`MillingOptions::spindle_mass`]): a point mass

@@ -139,22 +139,15 @@ fn metrics(opts: &MillingOptions, samples: &[Sample]) -> Metrics {
     }
 }
 
-/// One run of the groove with `mode` on `arm`, the compensator using `model` (identified
-/// stiffnesses) and `calibration` (identified sensor).
-pub fn run(
-    arm: &MillingArm,
-    opts: &MillingOptions,
+/// The compensator of `mode` (none uncompensated), with the identified `model` and the
+/// sensor's `calibration` (the default one for [`Mode::Uncalibrated`]).
+fn compensator(
     mode: Mode,
+    opts: &MillingOptions,
     model: &Model,
     calibration: &SensorCalibration,
-) -> Result<Run, SimError> {
-    let truth = opts.sensor.calibration(arm.sensor_to_tcp);
-    let start_pose = arm.forward(&opts.q0)?;
-    let start = start_pose.translation.vector;
-    let pose_at =
-        |p: &Vector3<f64>| Isometry3::from_parts(Translation3::from(*p), start_pose.rotation);
-    let mut sim = arm.sim(&opts.q0, 1.0, (opts.dt, opts.substeps), None)?;
-    let mut comp = match mode {
+) -> Result<Option<(compensation::Model, compensation::Data)>, SimError> {
+    Ok(match mode {
         Mode::Uncompensated => None,
         Mode::Cartesian | Mode::Pilot | Mode::Uncalibrated => {
             let cal = if mode == Mode::Uncalibrated {
@@ -172,7 +165,53 @@ pub fn run(
             let data = compensation::Data::new(&comp);
             Some((comp, data))
         }
-    };
+    })
+}
+
+/// One physics step's joint command: the nominal joints `qn` plus the servo's offset lagging
+/// behind the correction `dq_servo` \[rad\]; its rate \[rad/s\] over `dt` \[s\].
+fn servo_command(
+    q_cmd: &mut [f64],
+    lagged: &mut [f64],
+    (dq_servo, qn): (&[f64], &[f64]),
+    alpha: f64,
+    dt: f64,
+) -> Vec<f64> {
+    let q_prev = q_cmd.to_vec();
+    for (((l, m), d), n) in lagged
+        .iter_mut()
+        .zip(q_cmd.iter_mut())
+        .zip(dq_servo)
+        .zip(qn)
+    {
+        *l += alpha * (d - *l);
+        *m = n + *l;
+    }
+    // Velocity feed-forward from the command's backward difference; the feed is slow
+    // and the corrections smooth, so no acceleration feed-forward.
+    q_cmd
+        .iter()
+        .zip(&q_prev)
+        .map(|(a, b)| (a - b) / dt)
+        .collect()
+}
+
+/// One run of the groove with `mode` on `arm`, the compensator using `model` (identified
+/// stiffnesses) and `calibration` (identified sensor).
+pub fn run(
+    arm: &MillingArm,
+    opts: &MillingOptions,
+    mode: Mode,
+    model: &Model,
+    calibration: &SensorCalibration,
+) -> Result<Run, SimError> {
+    let truth = opts.sensor.calibration(arm.sensor_to_tcp);
+    let start_pose = arm.forward(&opts.q0)?;
+    let start = start_pose.translation.vector;
+    let pose_at =
+        |p: &Vector3<f64>| Isometry3::from_parts(Translation3::from(*p), start_pose.rotation);
+    let mut sim = arm.sim(&opts.q0, 1.0, (opts.dt, opts.substeps), None)?;
+    let mut comp = compensator(mode, opts, model, calibration)?;
     let mut noise = Noise::new(opts.seed);
     let dt = opts.dt;
     let dof = arm.dof();
@@ -244,18 +283,7 @@ pub fn run(
             let ts = step_index as f64 * dt;
             let (p, _) = opts.nominal(&start, ts);
             let qn = arm.ik(&mut ik_nominal, &pose_at(&p))?;
-            let q_prev = q_cmd.clone();
-            for (((l, m), d), n) in lagged.iter_mut().zip(&mut q_cmd).zip(&dq_servo).zip(&qn) {
-                *l += alpha * (d - *l);
-                *m = n + *l;
-            }
-            // Velocity feed-forward from the command's backward difference; the feed is slow
-            // and the corrections smooth, so no acceleration feed-forward.
-            let qd: Vec<f64> = q_cmd
-                .iter()
-                .zip(&q_prev)
-                .map(|(a, b)| (a - b) / dt)
-                .collect();
+            let qd = servo_command(&mut q_cmd, &mut lagged, (&dq_servo, &qn), alpha, dt);
             let f = opts.process_force(ts);
             let w = Vector6::new(f.x, f.y, f.z, 0.0, 0.0, 0.0);
             sim.step_servo(&q_cmd, &qd, &vec![0.0; dof], Some(&w));

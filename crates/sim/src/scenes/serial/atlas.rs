@@ -19,7 +19,9 @@ use ndarray::{Array1, Array2};
 use plotters::prelude::*;
 
 use crate::SimError;
-use crate::plot_style::{CHART, Entry, LEGEND_FONT, canvas, figure, new_chart, perr, present};
+use crate::plot_style::{
+    Area, CHART, Entry, LEGEND_FONT, canvas, figure, new_chart, perr, present,
+};
 use crate::workers::parallel_map;
 
 /// What to map.
@@ -350,6 +352,12 @@ pub fn heat_map(path: &Path, m: &HeatMap<'_>) -> Result<(), SimError> {
                 .map_err(perr)?;
         }
     }
+    draw_color_bar(&side, m.bar, (lo, span))?;
+    present(&root, path)
+}
+
+/// The colour bar of `bar` from `lo` over `span` \[mm\], and the unreachable and best swatches.
+fn draw_color_bar(side: &Area<'_>, bar: &str, (lo, span): (f64, f64)) -> Result<(), SimError> {
     // The colour bar: 200 px high, ticks at the ends and the middle.
     let (x0, y0, w, h) = (16, 40, 22, 240);
     for i in 0..h {
@@ -361,7 +369,7 @@ pub fn heat_map(path: &Path, m: &HeatMap<'_>) -> Result<(), SimError> {
         .map_err(perr)?;
     }
     let font = ("sans-serif", LEGEND_FONT).into_font().color(&BLACK);
-    side.draw(&Text::new(m.bar, (x0, y0 - 24), font.clone()))
+    side.draw(&Text::new(bar, (x0, y0 - 24), font.clone()))
         .map_err(perr)?;
     for (t, dy) in [(1.0, 0), (0.5, h / 2), (0.0, h - 1)] {
         // Three decimals: micrometres.
@@ -391,7 +399,7 @@ pub fn heat_map(path: &Path, m: &HeatMap<'_>) -> Result<(), SimError> {
         font,
     ))
     .map_err(perr)?;
-    present(&root, path)
+    Ok(())
 }
 
 #[cfg(test)]

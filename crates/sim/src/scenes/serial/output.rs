@@ -111,6 +111,20 @@ pub fn table(r: &SerialResult) -> String {
             m.correction_max_mm
         );
     }
+    reduction_table(r, &mut s);
+    let _ = writeln!(
+        s,
+        "\n{:.2} s simulated (steps of {} ms) in {:.2} s wall clock ({:.2}x real time)",
+        r.sim_seconds,
+        o.servo.dt * 1e3,
+        r.wall_seconds,
+        r.sim_seconds / r.wall_seconds.max(f64::MIN_POSITIVE)
+    );
+    s
+}
+
+/// The reduction of each error by the correction \[%\], per path.
+fn reduction_table(r: &SerialResult, s: &mut String) {
     let _ = writeln!(s, "\nreduction by the correction [%]");
     let _ = writeln!(s, "path   | path max | path RMS | rot max | rot RMS");
     for path in [PathKind::Line, PathKind::Circle] {
@@ -127,15 +141,6 @@ pub fn table(r: &SerialResult) -> String {
             );
         }
     }
-    let _ = writeln!(
-        s,
-        "\n{:.2} s simulated (steps of {} ms) in {:.2} s wall clock ({:.2}x real time)",
-        r.sim_seconds,
-        o.servo.dt * 1e3,
-        r.wall_seconds,
-        r.sim_seconds / r.wall_seconds.max(f64::MIN_POSITIVE)
-    );
-    s
 }
 
 /// CSV: one row per run, SI-suffixed columns.
@@ -288,34 +293,6 @@ pub fn write_mcap(path: &Path, r: &SerialResult) -> Result<usize, SimError> {
 /// uncorrected / corrected, solid line, dashed circle; the legend in a column on the right.
 pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
     let root = canvas(path, (1250, 900))?;
-    let start = |run: &SerialRun| {
-        let p = run.samples.first().map(|s| s.desired).unwrap_or_default();
-        super::run::pose_of(&p)
-    };
-    let series = |run: &SerialRun, rot: bool| -> Vec<(f64, f64)> {
-        let s0 = start(run);
-        run.samples
-            .iter()
-            .filter(|s| s.active)
-            .map(|s| {
-                let (a, d) = (
-                    super::run::pose_of(&s.actual),
-                    super::run::pose_of(&s.desired),
-                );
-                let v = if rot {
-                    a.rotation.angle_to(&d.rotation) * 1e3
-                } else {
-                    super::motion::path_distance(
-                        run.path,
-                        &s0,
-                        &r.options.motion,
-                        &a.translation.vector,
-                    ) * 1e3
-                };
-                (s.t, v)
-            })
-            .collect()
-    };
     let order = [
         (PathKind::Line, false),
         (PathKind::Line, true),
@@ -323,19 +300,10 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
         (PathKind::Circle, true),
     ];
     let runs: Vec<&SerialRun> = order.iter().filter_map(|&(p, c)| find(r, p, c)).collect();
-    let style = |run: &SerialRun| {
-        let role = if run.corrected {
-            Role::Corrected
-        } else {
-            Role::Uncorrected
-        };
-        let dashed = run.path == PathKind::Circle;
-        (role, dashed)
-    };
     let entries: Vec<Entry> = runs
         .iter()
         .map(|run| {
-            let (role, dashed) = style(run);
+            let (role, dashed) = run_style(run);
             let m = &run.metrics;
             Entry::new(
                 format!(
@@ -363,7 +331,7 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
     let (_, h) = plot.dim_in_pixel();
     let (top, bottom) = plot.split_vertically(h / 2);
     for (area, rot) in [(&top, false), (&bottom, true)] {
-        let all: Vec<Vec<(f64, f64)>> = runs.iter().map(|x| series(x, rot)).collect();
+        let all: Vec<Vec<(f64, f64)>> = runs.iter().map(|x| error_series(r, x, rot)).collect();
         let ymax = all.iter().flatten().map(|p| p.1).fold(1e-3, f64::max) * 1.06;
         let x = padded_range(all.iter().flatten().map(|p| p.0), 0.01, 0.01);
         let (caption, unit) = if rot {
@@ -382,13 +350,55 @@ pub fn plot(path: &Path, r: &SerialResult) -> Result<(), SimError> {
             ("time since the motion start [s]", unit),
         )?;
         for (run, pts) in runs.iter().zip(all) {
-            let (role, dashed) = style(run);
+            let (role, dashed) = run_style(run);
             line(&mut chart, pts, color(role), 2, dashed)?;
         }
     }
     draw_legend(&legend, &entries)?;
     present(&root, path)?;
     Ok(())
+}
+
+/// A run's error against time over its motion \[s, mm\] (`rot`: the orientation error
+/// \[s, mrad\]).
+fn error_series(r: &SerialResult, run: &SerialRun, rot: bool) -> Vec<(f64, f64)> {
+    let start = |run: &SerialRun| {
+        let p = run.samples.first().map(|s| s.desired).unwrap_or_default();
+        super::run::pose_of(&p)
+    };
+    let s0 = start(run);
+    run.samples
+        .iter()
+        .filter(|s| s.active)
+        .map(|s| {
+            let (a, d) = (
+                super::run::pose_of(&s.actual),
+                super::run::pose_of(&s.desired),
+            );
+            let v = if rot {
+                a.rotation.angle_to(&d.rotation) * 1e3
+            } else {
+                super::motion::path_distance(
+                    run.path,
+                    &s0,
+                    &r.options.motion,
+                    &a.translation.vector,
+                ) * 1e3
+            };
+            (s.t, v)
+        })
+        .collect()
+}
+
+/// A run's line: its role (corrected or not) and whether dashed (the circle).
+fn run_style(run: &SerialRun) -> (Role, bool) {
+    let role = if run.corrected {
+        Role::Corrected
+    } else {
+        Role::Uncorrected
+    };
+    let dashed = run.path == PathKind::Circle;
+    (role, dashed)
 }
 
 /// Writes `serial_summary.{txt,csv,json}`, `serial.mcap` and `serial.png` into `out`.
