@@ -79,8 +79,9 @@ mod offline;
 mod predict;
 mod setup;
 mod streaming;
+mod warm;
 
-pub(crate) use predict::Warm;
+pub(crate) use warm::Warm;
 
 pub use inertia::Inertia;
 pub use nominal::{NominalSample, nominal_pass};

@@ -33,9 +33,11 @@ use crate::error::{BuildError, TickError, check_finite};
 mod cutter;
 mod follower;
 mod pass;
+mod rows;
 pub use cutter::{Cutter, Removal};
 pub use follower::{FOLLOW_TOLERANCE, Follower, MAX_HELD, Step};
 use pass::Pass;
+use rows::Rows;
 
 /// Most cells of one z-map: 2^24 (16.8 million, 134 MB of heights; a 1 m x 1 m stock at
 /// 0.25 mm). [`BuildError::Budget`] past it.
@@ -271,6 +273,8 @@ impl ZMap {
         matches!(cutter, Cutter::Flat { .. }) && (to.xy() - from.xy()).norm() < self.cell
     }
 
+    /// Sweeps `cutter` from `from` to `to` \[m\] (see [`Self::cut`]); `after` for a followed
+    /// step, which visits the crescent only where it may ([`Self::crescent`]).
     fn sweep(
         &mut self,
         cutter: &Cutter,
@@ -296,26 +300,8 @@ impl ZMap {
         // A step shorter than a cell: every cell it reaches lies within r + cell of an end.
         let short = (to.xy() - from.xy()).norm() < cell;
         let crescent = after && self.crescent(cutter, from, to);
-        // The cells whose centres can lie within r of the move.
-        let lo = from.xy().inf(&to.xy()) - Vector2::repeat(r + 0.5 * cell) - self.origin;
-        let hi = from.xy().sup(&to.xy()) + Vector2::repeat(r + 0.5 * cell) - self.origin;
-        let index = |v: f64, n: usize| -> usize {
-            let k = ComplexField::floor(v / cell - 0.5);
-            if k <= 0.0 {
-                0
-            } else if k >= n as f64 {
-                n
-            } else {
-                k as usize
-            }
-        };
+        let (i0, i1, j0, j1) = self.window(from, to, r);
         let (nx, origin) = (self.nx, self.origin);
-        let i1 = index(hi.x, nx).saturating_add(2).min(nx);
-        let i0 = index(lo.x, nx).min(i1);
-        let (j0, j1) = (
-            index(lo.y, self.ny),
-            index(hi.y, self.ny).saturating_add(2).min(self.ny),
-        );
         let pass = Pass {
             cutter,
             from,
@@ -333,122 +319,51 @@ impl ZMap {
             area: cell * cell,
         };
         let mut removal = Removal::default();
-        // Centre column of x (m) rounded up / down.
-        // Per row a few of these: a product, not a division (the row's set-up is a third of a
-        // small step's sweep).
-        let inv_cell = 1.0 / cell;
-        let above = |x: f64| -floor_of(-((x - origin.x) * inv_cell - 0.5));
-        let below = |x: f64| floor_of((x - origin.x) * inv_cell - 0.5);
-        let clamp = |k: f64| k.clamp(i0 as f64, i1 as f64) as usize;
-        // The crescent's half-plane ahead of `from`: x > from.x - (y - from.y) by / bx.
-        let (bx, by) = (to.x - from.x, to.y - from.y);
-        let slope = if bx != 0.0 { by / bx } else { 0.0 };
+        let rows = Rows::new(&pass, cell, origin.x, i0, i1);
         for j in j0..j1 {
             let cy = origin.y + (j as f64 + 0.5) * cell;
             let Some(row) = self.heights.get_mut(j * nx..(j + 1) * nx) else {
                 continue;
             };
-            if !crescent {
-                if short {
-                    // Within r + cell of either end: the hull of the two discs' chords.
-                    let reach = r + cell;
-                    let core = (r - 0.5 * cell).max(0.0);
-                    let core_chord = |p: &Vector3<f64>| {
-                        let dy = cy - p.y;
-                        let inner = core * core - dy * dy;
-                        // 1e-9 m inside, as the crescent's exclusion: rounding stays out.
-                        (inner > 0.0).then(|| {
-                            let w = ComplexField::sqrt(inner) - 1.0e-9;
-                            (p.x - w, p.x + w)
-                        })
-                    };
-                    let chord = |p: &Vector3<f64>| {
-                        let dy = cy - p.y;
-                        (dy.abs() <= reach).then(|| {
-                            let w = ComplexField::sqrt(reach * reach - dy * dy);
-                            (p.x - w, p.x + w)
-                        })
-                    };
-                    let (a, b) = match (chord(from), chord(to)) {
-                        (Some(f), Some(t)) => (f.0.min(t.0), f.1.max(t.1)),
-                        (Some(c), None) | (None, Some(c)) => c,
-                        (None, None) => continue,
-                    };
-                    let (a, b) = (clamp(above(a)), clamp(below(b) + 1.0));
-                    // A flat end's cells within `R - cell / 2` of both ends (inside its
-                    // rim's band all along the move) go to the lower end: one comparison
-                    // each instead of the cell's search.
-                    let (ca, cb) = match (cutter, core_chord(from), core_chord(to)) {
-                        (Cutter::Flat { .. }, Some(f), Some(t)) => (
-                            clamp(above(f.0.max(t.0))).max(a).min(b),
-                            clamp(below(f.1.min(t.1)) + 1.0).max(a).min(b),
-                        ),
-                        _ => (b, b),
-                    };
-                    if ca >= cb {
-                        pass.row(row, a, b, cy, origin.x, cell, &mut removal);
-                    } else {
-                        pass.row(row, a, ca, cy, origin.x, cell, &mut removal);
-                        pass.floor(row, ca, cb, &mut removal);
-                        pass.row(row, cb, b, cy, origin.x, cell, &mut removal);
-                    }
-                } else {
-                    pass.row(row, i0, i1, cy, origin.x, cell, &mut removal);
-                }
-                continue;
-            }
-            // The disc at `to` grown by a cell (so the sliver of the capsule between the
-            // discs is inside), minus the cells strictly inside the disc at `from`.
-            let reach = r + cell;
-            let dy = cy - to.y;
-            if dy.abs() > reach {
-                continue;
-            }
-            let w = ComplexField::sqrt(reach * reach - dy * dy);
-            let (a, b) = (clamp(above(to.x - w)), clamp(below(to.x + w) + 1.0));
-            let df = cy - from.y;
-            // Only cells ahead of `from` along the move: one behind it has `from` for its
-            // closest point, as it had at the end of the last move, and keeps its height to
-            // the descent the follower allows.
-            let (ha, hb) = if bx > 0.0 {
-                (clamp(above(from.x - df * slope)), i1)
-            } else if bx < 0.0 {
-                (i0, clamp(below(from.x - df * slope) + 1.0))
-            } else if df * by > 0.0 {
-                (i0, i1)
+            if crescent {
+                rows.crescent(row, cy, &mut removal);
+            } else if short {
+                rows.short(row, cy, &mut removal);
             } else {
-                continue;
-            };
-            let (a, b) = (a.max(ha), b.min(hb));
-            if a >= b {
-                continue;
-            }
-            // Cells fully under the disc at `from` (inside its rim's band) are at or below it.
-            let core = (r - 0.5 * cell).max(0.0);
-            let inner = core * core - df * df;
-            if inner <= 0.0 {
-                pass.row(row, a, b, cy, origin.x, cell, &mut removal);
-                continue;
-            }
-            let wf = ComplexField::sqrt(inner) - 1.0e-9;
-            let (ea, eb) = (clamp(above(from.x - wf)), clamp(below(from.x + wf) + 1.0));
-            if ea >= eb {
-                pass.row(row, a, b, cy, origin.x, cell, &mut removal);
-            } else {
-                pass.row(row, a, ea.max(a).min(b), cy, origin.x, cell, &mut removal);
-                pass.row(row, eb.max(a).min(b), b, cy, origin.x, cell, &mut removal);
+                rows.whole(row, cy, &mut removal);
             }
         }
         Ok(removal)
     }
-}
 
-/// The floor of `x` without a libm call (`x` within +-2^52; else `x`).
-#[inline]
-fn floor_of(x: f64) -> f64 {
-    if x.is_nan() || x.abs() >= 4.0e15 {
-        return x;
+    /// The cells whose centres can lie within `r` \[m\] of the move from `from` to `to`:
+    /// columns `[i0, i1)` and rows `[j0, j1)`, clamped to the grid.
+    fn window(
+        &self,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+        r: f64,
+    ) -> (usize, usize, usize, usize) {
+        let cell = self.cell;
+        let lo = from.xy().inf(&to.xy()) - Vector2::repeat(r + 0.5 * cell) - self.origin;
+        let hi = from.xy().sup(&to.xy()) + Vector2::repeat(r + 0.5 * cell) - self.origin;
+        let index = |v: f64, n: usize| -> usize {
+            let k = ComplexField::floor(v / cell - 0.5);
+            if k <= 0.0 {
+                0
+            } else if k >= n as f64 {
+                n
+            } else {
+                k as usize
+            }
+        };
+        let nx = self.nx;
+        let i1 = index(hi.x, nx).saturating_add(2).min(nx);
+        let i0 = index(lo.x, nx).min(i1);
+        let (j0, j1) = (
+            index(lo.y, self.ny),
+            index(hi.y, self.ny).saturating_add(2).min(self.ny),
+        );
+        (i0, i1, j0, j1)
     }
-    let t = x as i64 as f64;
-    if t > x { t - 1.0 } else { t }
 }

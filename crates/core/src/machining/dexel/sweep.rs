@@ -157,19 +157,108 @@ pub(super) fn hit(
     lo: f64,
     hi: f64,
 ) -> Option<(f64, f64)> {
-    let mut e = Vector3::zeros();
-    if let Some(x) = e.get_mut(d) {
-        *x = 1.0;
+    let ray = RaySweep::new(tool, origin, d, from, to, axis);
+    let (t0, t1) = ray.t_range(lo, hi)?;
+    let (tm, fm) = golden(t0, t1, GOLDEN, &|t| ray.gap(t));
+    if fm.is_nan() || fm > 0.0 {
+        return None;
     }
-    let step = to - from;
-    // z(t, s) = alpha + beta t - gamma s along the axis.
-    let alpha = (origin - from).dot(axis);
-    let beta = e.dot(axis);
-    let gamma = step.dot(axis);
-    let h = tool.length;
-    // The s-range where 0 <= z <= h at `t`, within [0, 1].
-    let s_range = |t: f64| -> Option<(f64, f64)> {
-        let z0 = alpha + beta * t;
+    let a = if ray.gap(t0) <= 0.0 {
+        t0
+    } else {
+        ray.edge(tm, t0)
+    };
+    let b = if ray.gap(t1) <= 0.0 {
+        t1
+    } else {
+        ray.edge(tm, t1)
+    };
+    (b > a).then_some((a, b))
+}
+
+/// One ray against one straight sweep: the coefficients [`hit`]'s search reads, in plain
+/// f64 (this is the inner loop, thousands of evaluations per ray, and nalgebra's small
+/// vectors are slow unoptimised). `t` is the ray's coordinate (m), `s` the fraction of the
+/// move (0 at `from`, 1 at `to`).
+struct RaySweep<'a> {
+    tool: &'a DexelTool,
+    /// z(t, s) = alpha + beta t - gamma s along the axis (m).
+    alpha: f64,
+    beta: f64,
+    gamma: f64,
+    /// The tool's length (m).
+    h: f64,
+    /// |w|^2 of w = (origin - from) + t e - s step is
+    /// q0 + t^2 + s^2 dd + 2 (t qe - s qd - t s ed).
+    q0: f64,
+    qe: f64,
+    qd: f64,
+    ed: f64,
+    dd: f64,
+    /// The tool's corner radius (m).
+    corner: f64,
+    /// Whether the tool is a ball end (corner = radius).
+    ball: bool,
+    /// The s^2 coefficient of the squared distance from the axis, dd - gamma^2.
+    quad_a: f64,
+}
+
+impl<'a> RaySweep<'a> {
+    /// The coefficients for the ray through `origin` along coordinate `d`.
+    #[inline]
+    fn new(
+        tool: &'a DexelTool,
+        origin: &Vector3<f64>,
+        d: usize,
+        from: &Vector3<f64>,
+        to: &Vector3<f64>,
+        axis: &Vector3<f64>,
+    ) -> Self {
+        let mut e = Vector3::zeros();
+        if let Some(x) = e.get_mut(d) {
+            *x = 1.0;
+        }
+        let step = to - from;
+        let alpha = (origin - from).dot(axis);
+        let beta = e.dot(axis);
+        let gamma = step.dot(axis);
+        let h = tool.length;
+        let o = origin - from;
+        let (q0, qe, qd) = (o.norm_squared(), at(&o, d), o.dot(&step));
+        let (ed, dd) = (at(&step, d), step.norm_squared());
+        // The distance from the axis squared, rho^2(s) = q - z^2 = A s^2 + B s + C at `t`: its
+        // minimiser is the minimiser of f wherever it lies on the tool's cylinder (z >= the
+        // corner radius, everywhere for a flat end), since there f = rho - R and elsewhere
+        // f >= rho - R (the radius is at most R). A ball end is the points within R of the
+        // axis segment from the ball's centre up (inside the slab), so the distance to that
+        // segment minus R has the same sign as f and its minimum over the move is the smaller
+        // of two quadratics' on their stretches (above the centre: rho^2; below: the squared
+        // distance to the centre). Only a bull-nose's corner needs the search.
+        let corner = tool.corner;
+        let ball = (tool.radius - corner).abs() <= 1e-12 * tool.radius;
+        let quad_a = dd - gamma * gamma;
+        Self {
+            tool,
+            alpha,
+            beta,
+            gamma,
+            h,
+            q0,
+            qe,
+            qd,
+            ed,
+            dd,
+            corner,
+            ball,
+            quad_a,
+        }
+    }
+
+    /// The s-range where 0 <= z <= h at `t`, within [0, 1].
+    #[inline]
+    fn s_range(&self, t: f64) -> Option<(f64, f64)> {
+        let (gamma, h) = (self.gamma, self.h);
+        let z0 = self.alpha + self.beta * t;
         let (mut a, mut b) = (0.0f64, 1.0f64);
         if gamma.abs() < 1e-300 {
             return (z0 >= 0.0 && z0 <= h).then_some((a, b));
@@ -179,112 +268,123 @@ pub(super) fn hit(
         a = a.max(p.min(q));
         b = b.min(p.max(q));
         (a <= b).then_some((a, b))
-    };
-    // |w|^2 of w = (origin - from) + t e - s step as a quadratic in (t, s), in plain f64: this
-    // is the inner loop (thousands of evaluations per ray), and nalgebra's small vectors are
-    // slow unoptimised.
-    let o = origin - from;
-    let (q0, qe, qd) = (o.norm_squared(), at(&o, d), o.dot(&step));
-    let (ed, dd) = (at(&step, d), step.norm_squared());
-    let f = |t: f64, s: f64| {
-        let q = q0 + t * t + s * s * dd + 2.0 * (t * qe - s * qd - t * s * ed);
-        let z = alpha + beta * t - gamma * s;
-        ComplexField::sqrt((q - z * z).max(0.0)) - tool.radius_at(z.clamp(0.0, h))
-    };
-    // The distance from the axis squared, rho^2(s) = q - z^2 = A s^2 + B s + C at `t`: its
-    // minimiser is the minimiser of f wherever it lies on the tool's cylinder (z >= the
-    // corner radius, everywhere for a flat end), since there f = rho - R and elsewhere
-    // f >= rho - R (the radius is at most R). A ball end is the points within R of the axis
-    // segment from the ball's centre up (inside the slab), so the distance to that segment
-    // minus R has the same sign as f and its minimum over the move is the smaller of two
-    // quadratics' on their stretches (above the centre: rho^2; below: the squared distance to
-    // the centre). Only a bull-nose's corner needs the search.
-    let corner = tool.corner;
-    let ball = (tool.radius - corner).abs() <= 1e-12 * tool.radius;
-    let quad_a = dd - gamma * gamma;
-    // The least of A s^2 + B s + C on [a, b] (A >= 0), as sqrt(max(., 0)).
-    let least = |qa: f64, qb: f64, qc: f64, a: f64, b: f64| {
-        let at = |s: f64| ComplexField::sqrt((qa * s * s + qb * s + qc).max(0.0));
-        if qa > 1e-300 {
-            at((-qb / (2.0 * qa)).clamp(a, b))
+    }
+
+    /// The signed distance (m) of the point at (t, s) from the tool's surface at its height:
+    /// negative inside.
+    #[inline]
+    fn f(&self, t: f64, s: f64) -> f64 {
+        let q =
+            self.q0 + t * t + s * s * self.dd + 2.0 * (t * self.qe - s * self.qd - t * s * self.ed);
+        let z = self.alpha + self.beta * t - self.gamma * s;
+        ComplexField::sqrt((q - z * z).max(0.0)) - self.tool.radius_at(z.clamp(0.0, self.h))
+    }
+
+    /// The least over the move of the signed distance from the tool at the ray's `t` (m;
+    /// infinite where no part of the move's slab reaches it).
+    #[inline]
+    fn gap(&self, t: f64) -> f64 {
+        match self.s_range(t) {
+            Some((a, b)) => {
+                let z0 = self.alpha + self.beta * t;
+                let quad_b = 2.0 * (-self.qd - t * self.ed) + 2.0 * self.gamma * z0;
+                let q_t = self.q0 + t * t + 2.0 * t * self.qe;
+                if self.ball {
+                    return self.ball_gap(t, (a, b), z0, quad_b, q_t);
+                }
+                self.corner_gap(t, (a, b), z0, quad_b)
+            }
+            None => f64::INFINITY,
+        }
+    }
+
+    /// [`Self::gap`] for a ball end on the move's stretch `(a, b)`: the smaller of the two
+    /// quadratics' least (above the ball's centre: the distance from the axis; below: from
+    /// the centre), less the radius. `z0` is z at s = 0, `quad_b` the s coefficient of
+    /// rho^2, `q_t` |w|^2 at s = 0.
+    #[inline]
+    fn ball_gap(&self, t: f64, (a, b): (f64, f64), z0: f64, quad_b: f64, q_t: f64) -> f64 {
+        let (gamma, corner) = (self.gamma, self.corner);
+        // Where z = z0 - gamma s passes the centre's height R.
+        let (mut cyl, mut sph) = ((a, b), (a, b));
+        if gamma.abs() > 1e-300 {
+            // Not clamped into [a, b]: a stretch the split leaves empty stays empty
+            // (a clamped one would read the cylinder at a point below the centre).
+            let split = (z0 - corner) / gamma;
+            if gamma > 0.0 {
+                cyl.1 = cyl.1.min(split);
+                sph.0 = sph.0.max(split);
+            } else {
+                cyl.0 = cyl.0.max(split);
+                sph.1 = sph.1.min(split);
+            }
+        } else if z0 >= corner {
+            sph = (1.0, 0.0);
         } else {
-            at(a).min(at(b))
+            cyl = (1.0, 0.0);
         }
-    };
-    let g = |t: f64| match s_range(t) {
-        Some((a, b)) => {
-            let z0 = alpha + beta * t;
-            let quad_b = 2.0 * (-qd - t * ed) + 2.0 * gamma * z0;
-            let q_t = q0 + t * t + 2.0 * t * qe;
-            if ball {
-                // Where z = z0 - gamma s passes the centre's height R.
-                let (mut cyl, mut sph) = ((a, b), (a, b));
-                if gamma.abs() > 1e-300 {
-                    // Not clamped into [a, b]: a stretch the split leaves empty stays empty
-                    // (a clamped one would read the cylinder at a point below the centre).
-                    let split = (z0 - corner) / gamma;
-                    if gamma > 0.0 {
-                        cyl.1 = cyl.1.min(split);
-                        sph.0 = sph.0.max(split);
-                    } else {
-                        cyl.0 = cyl.0.max(split);
-                        sph.1 = sph.1.min(split);
-                    }
-                } else if z0 >= corner {
-                    sph = (1.0, 0.0);
-                } else {
-                    cyl = (1.0, 0.0);
-                }
-                let mut best = f64::INFINITY;
-                if cyl.0 <= cyl.1 {
-                    best = best.min(least(quad_a, quad_b, q_t - z0 * z0, cyl.0, cyl.1));
-                }
-                if sph.0 <= sph.1 {
-                    let (qb, qc) = (
-                        2.0 * (-qd - t * ed) + 2.0 * corner * gamma,
-                        q_t - 2.0 * corner * z0 + corner * corner,
-                    );
-                    best = best.min(least(dd, qb, qc, sph.0, sph.1));
-                }
-                return best - tool.radius;
-            }
-            let rho2 = |s: f64| quad_a * s * s + quad_b * s;
-            let s_min = if quad_a > 1e-300 {
-                (-quad_b / (2.0 * quad_a)).clamp(a, b)
-            } else if rho2(a) <= rho2(b) {
-                a
-            } else {
-                b
-            };
-            if z0 - gamma * s_min >= corner {
-                f(t, s_min)
-            } else {
-                golden(a, b, GOLDEN_MOVE, &|s| f(t, s)).1
-            }
+        let mut best = f64::INFINITY;
+        if cyl.0 <= cyl.1 {
+            best = best.min(least(self.quad_a, quad_b, q_t - z0 * z0, cyl.0, cyl.1));
         }
-        None => f64::INFINITY,
-    };
-    // The t-range where some s keeps the slab: 0 <= alpha + beta t - gamma s <= h for an s
-    // in [0, 1], i.e. alpha + beta t in [min(0, gamma), h + max(0, gamma)].
-    let (zlo, zhi) = (gamma.min(0.0), h + gamma.max(0.0));
-    let (mut t0, mut t1) = (lo, hi);
-    if beta.abs() > 1e-300 {
-        let (p, q) = ((zlo - alpha) / beta, (zhi - alpha) / beta);
-        t0 = t0.max(p.min(q));
-        t1 = t1.min(p.max(q));
-    } else if alpha < zlo || alpha > zhi {
-        return None;
+        if sph.0 <= sph.1 {
+            let (qb, qc) = (
+                2.0 * (-self.qd - t * self.ed) + 2.0 * corner * gamma,
+                q_t - 2.0 * corner * z0 + corner * corner,
+            );
+            best = best.min(least(self.dd, qb, qc, sph.0, sph.1));
+        }
+        best - self.tool.radius
     }
-    if t0 >= t1 {
-        return None;
+
+    /// [`Self::gap`] for a flat or bull-nose end on the move's stretch `(a, b)`: f at the
+    /// minimiser of the distance from the axis when that lies on the cylinder, else a
+    /// golden-section search over the move.
+    #[inline]
+    fn corner_gap(&self, t: f64, (a, b): (f64, f64), z0: f64, quad_b: f64) -> f64 {
+        let quad_a = self.quad_a;
+        let rho2 = |s: f64| quad_a * s * s + quad_b * s;
+        let s_min = if quad_a > 1e-300 {
+            (-quad_b / (2.0 * quad_a)).clamp(a, b)
+        } else if rho2(a) <= rho2(b) {
+            a
+        } else {
+            b
+        };
+        if z0 - self.gamma * s_min >= self.corner {
+            self.f(t, s_min)
+        } else {
+            golden(a, b, GOLDEN_MOVE, &|s| self.f(t, s)).1
+        }
     }
-    let (tm, fm) = golden(t0, t1, GOLDEN, &g);
-    if fm.is_nan() || fm > 0.0 {
-        return None;
+
+    /// The t-range (m) within `[lo, hi]` where some s keeps the slab: 0 <= alpha + beta t -
+    /// gamma s <= h for an s in [0, 1], i.e. alpha + beta t in [min(0, gamma), h + max(0,
+    /// gamma)]; `None` when empty.
+    #[inline]
+    fn t_range(&self, lo: f64, hi: f64) -> Option<(f64, f64)> {
+        let (alpha, beta, gamma) = (self.alpha, self.beta, self.gamma);
+        let (zlo, zhi) = (gamma.min(0.0), self.h + gamma.max(0.0));
+        let (mut t0, mut t1) = (lo, hi);
+        if beta.abs() > 1e-300 {
+            let (p, q) = ((zlo - alpha) / beta, (zhi - alpha) / beta);
+            t0 = t0.max(p.min(q));
+            t1 = t1.min(p.max(q));
+        } else if alpha < zlo || alpha > zhi {
+            return None;
+        }
+        if t0 >= t1 {
+            return None;
+        }
+        Some((t0, t1))
     }
-    // The zero of g between an inside point (g <= 0) and an outside one: regula falsi with
-    // the Illinois modification (the retained end's value halved), bracket kept.
-    let edge = |inside: f64, outside: f64| {
+
+    /// The zero of [`Self::gap`] between an inside point (gap <= 0) and an outside one:
+    /// regula falsi with the Illinois modification (the retained end's value halved),
+    /// bracket kept.
+    #[inline]
+    fn edge(&self, inside: f64, outside: f64) -> f64 {
+        let g = |t: f64| self.gap(t);
         let (mut a, mut b) = (inside, outside);
         let (mut fa, mut fb) = (g(a), g(b));
         if !fb.is_finite() {
@@ -337,8 +437,16 @@ pub(super) fn hit(
             }
         }
         0.5 * (a + b)
-    };
-    let a = if g(t0) <= 0.0 { t0 } else { edge(tm, t0) };
-    let b = if g(t1) <= 0.0 { t1 } else { edge(tm, t1) };
-    (b > a).then_some((a, b))
+    }
+}
+
+/// The least of A s^2 + B s + C on [a, b] (A >= 0), as sqrt(max(., 0)).
+#[inline]
+fn least(qa: f64, qb: f64, qc: f64, a: f64, b: f64) -> f64 {
+    let at = |s: f64| ComplexField::sqrt((qa * s * s + qb * s + qc).max(0.0));
+    if qa > 1e-300 {
+        at((-qb / (2.0 * qa)).clamp(a, b))
+    } else {
+        at(a).min(at(b))
+    }
 }

@@ -10,9 +10,10 @@ use nalgebra::{Isometry3, Matrix3, Matrix6, Point3, Translation3, Vector3};
 
 use super::inertia::{self, Motion};
 use super::nominal::Sample;
+use super::warm::Warm;
 use super::{
     COUPLING_TOLERANCE, Job, MAX_COUPLING_ITERATIONS, RunOptions, ToolModels, chip_wrench,
-    engagement, in_limits, rotate,
+    engagement, rotate,
 };
 use crate::error::{JobError, TickError};
 use crate::machining::Program;
@@ -20,7 +21,6 @@ use crate::machining::engagement::Chip;
 use crate::machining::path;
 use crate::machining::spin::{Cursor, SpinSchedule};
 use crate::machining::stock::{Follower, ZMap};
-use crate::mechanism::pose_ik;
 use crate::vjm::{self, Data, Load, MAX_DOF, Vector6};
 
 /// A correction of the linear coupling step \[m\] past which the arm's deflection is
@@ -365,10 +365,22 @@ impl<'a> Arm<'a> {
                 index: 0,
             });
         };
-        let (mut t, mut y, mut force) = (bt, by, bf);
-        // Slow or diverging (the force changes faster with the position than the arm holds
-        // the tool): Newton's method on g(t) = phi(t) - t, its Jacobian by differences,
-        // with backtracking on |g|.
+        self.newton(n, qs, &mut c, (bt, by, bf))
+    }
+
+    /// The coupling's second phase, for a fixed point the plain steps approach slowly or not
+    /// at all (the force changes faster with the position than the arm holds the tool):
+    /// Newton's method on g(t) = phi(t) - t from the best `(point, image, force)` so far,
+    /// its Jacobian by differences, with backtracking on |g|. Returns the tip, the force
+    /// there and the residual \[m\].
+    #[inline]
+    fn newton(
+        &mut self,
+        n: &Sample,
+        qs: &[f64],
+        c: &mut Coupling,
+        (mut t, mut y, mut force): (Vector3<f64>, Vector3<f64>, Vector3<f64>),
+    ) -> Result<(Vector3<f64>, Vector3<f64>, f64), TickError> {
         let mut g = y - t;
         while c.evaluations + 4 <= MAX_COUPLING_ITERATIONS {
             let mut jac = Matrix3::identity() * -1.0;
@@ -377,7 +389,7 @@ impl<'a> Arm<'a> {
                 if let Some(v) = te.get_mut(axis) {
                     *v += NEWTON_STEP;
                 }
-                let (ye, _) = self.phi(n, qs, &te, &mut c)?;
+                let (ye, _) = self.phi(n, qs, &te, c)?;
                 let column = (ye - te - g) / NEWTON_STEP;
                 jac.set_column(axis, &column);
             }
@@ -388,7 +400,7 @@ impl<'a> Arm<'a> {
             let mut moved = false;
             while c.evaluations < MAX_COUPLING_ITERATIONS {
                 let tn = t + step * lambda;
-                let (yn, fnew) = self.phi(n, qs, &tn, &mut c)?;
+                let (yn, fnew) = self.phi(n, qs, &tn, c)?;
                 let gn = yn - tn;
                 if gn.norm() < g.norm() {
                     (t, y, force, g) = (tn, yn, fnew, gn);
@@ -456,98 +468,6 @@ impl<'a> Arm<'a> {
         crate::error::check_output("predicted tip", tip.as_slice())?;
         Ok((tip, f))
     }
-}
-
-/// Pose IK warm-started along a path: from the joints the last two solutions extrapolate to
-/// (from the last one's if that fails), the first from the seed.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Warm {
-    /// The last solution (the seed before the first) \[rad or m\].
-    pub q: [f64; MAX_DOF],
-    q_before: Option<[f64; MAX_DOF]>,
-    /// Whether `q` is a sample's solution (not the seed): only then does the next sample
-    /// extrapolate from it (a seed far from the first pose would throw the guess off).
-    solved: bool,
-}
-
-impl Warm {
-    /// Starting from `seed` (at most [`MAX_DOF`] joints).
-    pub fn new(seed: &[f64]) -> Self {
-        let mut q = [0.0; MAX_DOF];
-        for (d, s) in q.iter_mut().zip(seed) {
-            *d = *s;
-        }
-        Self {
-            q,
-            q_before: None,
-            solved: false,
-        }
-    }
-
-    /// The next solve's first guess: the last two solutions extrapolated (the last one, or
-    /// the seed, before there are two).
-    pub fn seed(&self, dof: usize) -> [f64; MAX_DOF] {
-        let mut seed = self.q;
-        if let Some(before) = self.q_before {
-            for ((s, q), b) in seed.iter_mut().zip(self.q).zip(before).take(dof) {
-                *s = 2.0 * q - b;
-            }
-        }
-        seed
-    }
-
-    /// The joints at which the arm of `job` (rigid, or loaded by `wrench` as `load` says)
-    /// puts its TCP on `target` (base frame), checked against the job's joint limits.
-    pub fn solve(
-        &mut self,
-        job: &Job,
-        data: &mut Data,
-        target: &Isometry3<f64>,
-        wrench: &Vector6,
-        load: Load<'_>,
-    ) -> Result<(), TickError> {
-        let dof = job.model.dof();
-        let seed = self.seed(dof);
-        let solve = |data: &mut Data, seed: &[f64; MAX_DOF]| {
-            loaded_ik(job, data, target, seed, (wrench, load))
-        };
-        let q = match solve(data, &seed) {
-            Ok(q) => q,
-            Err(_) if self.q_before.is_some() => solve(data, &self.q)?,
-            Err(e) => return Err(e),
-        };
-        self.q_before = self.solved.then_some(self.q);
-        self.solved = true;
-        self.q = q;
-        in_limits(self.q.get(..dof).unwrap_or(&[]), &job.limits)
-    }
-
-    /// [`Self::solve`] again from the last solution (a load that changed with it), in its
-    /// place: the history the next guess extrapolates is kept.
-    pub fn refine(
-        &mut self,
-        job: &Job,
-        data: &mut Data,
-        target: &Isometry3<f64>,
-        wrench: &Vector6,
-        load: Load<'_>,
-    ) -> Result<(), TickError> {
-        self.q = loaded_ik(job, data, target, &self.q, (wrench, load))?;
-        in_limits(self.q.get(..job.model.dof()).unwrap_or(&[]), &job.limits)
-    }
-}
-
-/// The pose IK of `job`'s arm onto `target` from `seed`, loaded by `wrench` as `load` says.
-fn loaded_ik(
-    job: &Job,
-    data: &mut Data,
-    target: &Isometry3<f64>,
-    seed: &[f64; MAX_DOF],
-    (wrench, load): (&Vector6, Load<'_>),
-) -> Result<[f64; MAX_DOF], TickError> {
-    let dof = job.model.dof();
-    let seed = seed.get(..dof).unwrap_or(&[]);
-    Ok(pose_ik(&job.model, data, target, seed, wrench, load, &job.setup.ik)?.q)
 }
 
 /// The state of one sample's coupling: the wrench and tip of the last exact deflection, the

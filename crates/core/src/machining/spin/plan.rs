@@ -7,7 +7,7 @@ use alloc::vec::Vec;
 
 use nalgebra::{Isometry3, Matrix3, SMatrix, Translation3};
 
-use super::loads::{Load, LoadPath};
+use super::loads::{Load, LoadPath, Station};
 use super::{SpinCost, SpinOptions, SpinPlan, SpinSchedule};
 use crate::error::{BuildError, JobError, TickError};
 use crate::machining::job::Job;
@@ -94,7 +94,24 @@ struct Solver<'a> {
     last_error: Option<TickError>,
 }
 
-impl Solver<'_> {
+impl<'a> Solver<'a> {
+    /// The solver for `job`'s arm (of `dof` joints) with the workpiece at `placement`, its
+    /// pose IK held to `options`' singularity margin.
+    fn new(job: &'a Job, placement: &Isometry3<f64>, options: &'a SpinOptions, dof: usize) -> Self {
+        let mut ik = job.setup().ik;
+        ik.min_sigma = options.min_sigma;
+        Self {
+            job,
+            placement: *placement,
+            options,
+            ik,
+            data: Data::new(job.model()),
+            dof,
+            refused: 0,
+            last_error: None,
+        }
+    }
+
     /// The joints of spin `theta` at `position` from `seed`, if they hold (limits less the
     /// margin, the singularity margin, within the joint step of `seed` unless it is the
     /// user's seed: a branch hint, not a neighbour).
@@ -156,6 +173,26 @@ impl Solver<'_> {
             return None;
         }
         Some(q)
+    }
+
+    /// The joints of spin `theta` at station `st` from `seed` (see [`Self::joints`]) and
+    /// their deflection map, if they hold; the failure kept in `last_error` otherwise.
+    #[inline]
+    fn node(
+        &mut self,
+        st: &Station,
+        theta: f64,
+        seed: &[f64; MAX_DOF],
+        neighbour: bool,
+    ) -> Option<([f64; MAX_DOF], SMatrix<f64, 3, 6>)> {
+        self.joints(&st.position, &st.axis, theta, seed, neighbour)
+            .and_then(|q| match self.map(&q) {
+                Ok(a) => Some((q, a)),
+                Err(e) => {
+                    self.last_error = Some(e);
+                    None
+                }
+            })
     }
 
     /// The deflection map of joints `q`: `A` (3 x 6) with `dp = A w`, workpiece frame.
@@ -264,17 +301,7 @@ pub fn plan_at(
     optimise: bool,
 ) -> Result<SpinPlan, JobError> {
     options.validate()?;
-    if loads.step != options.step
-        || loads.per_metre != options.per_metre
-        || loads.per_second != options.per_second
-    {
-        return Err(BuildError::InvalidParameter {
-            what: "spin loads (built for another candidate step or rate bounds)",
-            value: loads.step,
-            expected: "the options' step and rates",
-        }
-        .into());
-    }
+    check_loads(loads, options)?;
     let dof = job.model().dof();
     crate::machining::job::check_seed(job, seed)?;
     let job = &*job.at_seed(seed)?;
@@ -283,81 +310,174 @@ pub fn plan_at(
     } else {
         vec![0.0]
     };
-    let k = candidates.len();
-    let center = k / 2;
     let stations = loads.stations();
     let n = stations.len();
-    let mut ik = job.setup().ik;
-    ik.min_sigma = options.min_sigma;
-    let mut solver = Solver {
-        job,
-        placement: *placement,
-        options,
-        ik,
-        data: Data::new(job.model()),
-        dof,
-        refused: 0,
-        last_error: None,
-    };
+    let mut solver = Solver::new(job, placement, options, dof);
     let mut user_seed = [0.0; MAX_DOF];
     for (d, s) in user_seed.iter_mut().zip(seed) {
         *d = *s;
     }
-    let mut prev = vec![Node::default(); k];
-    let mut cur = vec![Node::default(); k];
-    let mut parent: Vec<u16> = Vec::new();
-    let mut node_max: Vec<f32> = Vec::new();
-    if parent.try_reserve_exact(n * k).is_err() || node_max.try_reserve_exact(n * k).is_err() {
-        return Err(BuildError::Budget {
-            what: "spin search nodes (the allocation was refused)",
-            budget: "MAX_STATIONS",
-            limit: super::MAX_STATIONS,
-            requested: n,
-        }
-        .into());
-    }
-    let mut columns = vec![
-        Column {
-            sum: 0.0,
-            max: 0.0,
-            ok: true,
-        };
-        k
-    ];
-    let solve_order = order(k);
+    let mut search = Search::new(candidates, n)?;
     let mut budget_prev = 0.0;
     for (i, st) in stations.iter().enumerate() {
-        let (before, after) = loads.around(i);
-        for &(j, towards) in &solve_order {
-            let theta = candidates.get(j).copied().unwrap_or(0.0);
-            let from_prev = prev.get(j).filter(|p| i > 0 && p.ok).map(|p| p.q);
+        search.solve(&mut solver, i, st, loads.around(i), &user_seed);
+        // The steps the budget since the last station allows.
+        let steps = if i == 0 {
+            0
+        } else {
+            nalgebra::ComplexField::floor(((st.budget - budget_prev) / options.step) + 1e-9)
+                .clamp(0.0, search.k() as f64) as usize
+        };
+        budget_prev = st.budget;
+        search.link(i, steps, options.max_joint_step, dof);
+        if search.cur.iter().all(|c| !c.value.is_finite()) {
+            return Err(JobError::AtLine {
+                line: st.line,
+                time: st.time,
+                error: solver.last_error.unwrap_or(TickError::InvalidArgument {
+                    what: "spin: no candidate linked to the station before",
+                    value: st.time,
+                }),
+            });
+        }
+        core::mem::swap(&mut search.prev, &mut search.cur);
+    }
+    let end = search.end();
+    let (spins, largest) = search.backtrack(end.1, n);
+    let loaded = loads.loads.len().max(1) as f64;
+    let rms = |sum: f64| nalgebra::ComplexField::sqrt(sum / loaded);
+    let best_constant = search.best_constant(&rms);
+    let seed_cost = search
+        .columns
+        .get(search.center)
+        .filter(|c| c.ok)
+        .map(|c| SpinCost {
+            rms: rms(c.sum),
+            max: c.max,
+        });
+    let budgets = stations.iter().map(|s| s.budget).collect();
+    Ok(SpinPlan {
+        schedule: SpinSchedule::new(budgets, spins, options.per_metre, options.per_second)?,
+        optimised: SpinCost {
+            rms: rms(end.0),
+            max: largest,
+        },
+        seed: seed_cost,
+        best_constant,
+        candidates: search.candidates,
+        stations: n,
+        refused: solver.refused,
+        measure: options.measure,
+    })
+}
+
+/// Refuses `loads` built for another candidate step or other rate bounds than `options`'.
+fn check_loads(loads: &LoadPath, options: &SpinOptions) -> Result<(), BuildError> {
+    if loads.step != options.step
+        || loads.per_metre != options.per_metre
+        || loads.per_second != options.per_second
+    {
+        return Err(BuildError::InvalidParameter {
+            what: "spin loads (built for another candidate step or rate bounds)",
+            value: loads.step,
+            expected: "the options' step and rates",
+        });
+    }
+    Ok(())
+}
+
+/// The search's state over the stations: the candidate spins \[rad\] and their solve order,
+/// the nodes of the station before and of this one, each node's predecessor and largest
+/// measure (station-major, a row of candidates per station), and the constant spins.
+struct Search {
+    candidates: Vec<f64>,
+    /// The seed's spin's index in `candidates`.
+    center: usize,
+    solve_order: Vec<(usize, Option<usize>)>,
+    prev: Vec<Node>,
+    cur: Vec<Node>,
+    parent: Vec<u16>,
+    node_max: Vec<f32>,
+    columns: Vec<Column>,
+}
+
+impl Search {
+    /// The state for `n` stations of `candidates` ([`BuildError::Budget`] when the nodes'
+    /// allocation is refused).
+    fn new(candidates: Vec<f64>, n: usize) -> Result<Self, BuildError> {
+        let k = candidates.len();
+        let center = k / 2;
+        let prev = vec![Node::default(); k];
+        let cur = vec![Node::default(); k];
+        let mut parent: Vec<u16> = Vec::new();
+        let mut node_max: Vec<f32> = Vec::new();
+        if parent.try_reserve_exact(n * k).is_err() || node_max.try_reserve_exact(n * k).is_err() {
+            return Err(BuildError::Budget {
+                what: "spin search nodes (the allocation was refused)",
+                budget: "MAX_STATIONS",
+                limit: super::MAX_STATIONS,
+                requested: n,
+            });
+        }
+        let columns = vec![
+            Column {
+                sum: 0.0,
+                max: 0.0,
+                ok: true,
+            };
+            k
+        ];
+        let solve_order = order(k);
+        Ok(Self {
+            candidates,
+            center,
+            solve_order,
+            prev,
+            cur,
+            parent,
+            node_max,
+            columns,
+        })
+    }
+
+    /// How many candidate spins.
+    #[inline]
+    fn k(&self) -> usize {
+        self.candidates.len()
+    }
+
+    /// Station `i`'s nodes (at `st`, its loads before and after) solved into `cur` in the
+    /// solve order, each from the station before's node of its spin, else its neighbour
+    /// towards the seed's spin, else (the first station's seed spin) the user's `seed`.
+    #[inline]
+    fn solve(
+        &mut self,
+        solver: &mut Solver<'_>,
+        i: usize,
+        st: &Station,
+        (before, after): (&[Load], &[Load]),
+        user_seed: &[f64; MAX_DOF],
+    ) {
+        for &(j, towards) in &self.solve_order {
+            let theta = self.candidates.get(j).copied().unwrap_or(0.0);
+            let from_prev = self.prev.get(j).filter(|p| i > 0 && p.ok).map(|p| p.q);
             let from_neighbour = towards
-                .and_then(|nb| cur.get(nb))
+                .and_then(|nb| self.cur.get(nb))
                 .filter(|c| c.ok)
                 .map(|c| c.q);
-            let start = match (from_prev, from_neighbour, i, j == center) {
+            let start = match (from_prev, from_neighbour, i, j == self.center) {
                 (Some(q), _, _, _) | (None, Some(q), _, _) => Some((q, true)),
-                (None, None, 0, true) => Some((user_seed, false)),
+                (None, None, 0, true) => Some((*user_seed, false)),
                 _ => None,
             };
-            let node = start
-                .and_then(|(s, neighbour)| {
-                    solver.joints(&st.position, &st.axis, theta, &s, neighbour)
-                })
-                .and_then(|q| match solver.map(&q) {
-                    Ok(a) => Some((q, a)),
-                    Err(e) => {
-                        solver.last_error = Some(e);
-                        None
-                    }
-                });
-            let Some(slot) = cur.get_mut(j) else {
+            let node = start.and_then(|(s, neighbour)| solver.node(st, theta, &s, neighbour));
+            let Some(slot) = self.cur.get_mut(j) else {
                 continue;
             };
             *slot = Node::default();
             match node {
                 Some((q, a)) => {
-                    let (c, m) = cost(options, &a, before, after);
+                    let (c, m) = cost(solver.options, &a, before, after);
                     *slot = Node {
                         q,
                         ok: true,
@@ -369,100 +489,88 @@ pub fn plan_at(
                 None => solver.refused += 1,
             }
         }
-        // The steps the budget since the last station allows.
-        let steps = if i == 0 {
-            0
-        } else {
-            nalgebra::ComplexField::floor(((st.budget - budget_prev) / options.step) + 1e-9)
-                .clamp(0.0, k as f64) as usize
-        };
-        budget_prev = st.budget;
+    }
+
+    /// Station `i`'s nodes linked to the station before's (at most `steps` candidates away,
+    /// joints within `max_step`), their largest measures kept and the constant spins
+    /// extended.
+    #[inline]
+    fn link(&mut self, i: usize, steps: usize, max_step: f64, dof: usize) {
         link(
-            &mut cur,
-            &prev,
+            &mut self.cur,
+            &self.prev,
             i == 0,
             steps,
-            options.max_joint_step,
+            max_step,
             dof,
-            &mut parent,
+            &mut self.parent,
         );
-        for ((node, column), p) in cur.iter().zip(columns.iter_mut()).zip(&prev) {
-            node_max.push(node.max as f32);
+        for ((node, column), p) in self.cur.iter().zip(self.columns.iter_mut()).zip(&self.prev) {
+            self.node_max.push(node.max as f32);
             // The constant spin: every node holds, linked to the one before.
-            let linked = i == 0 || (p.ok && gap(&node.q, &p.q, dof) <= options.max_joint_step);
+            let linked = i == 0 || (p.ok && gap(&node.q, &p.q, dof) <= max_step);
             column.ok = column.ok && node.ok && linked;
             column.sum += node.cost;
             column.max = column.max.max(node.max);
         }
-        if cur.iter().all(|c| !c.value.is_finite()) {
-            return Err(JobError::AtLine {
-                line: st.line,
-                time: st.time,
-                error: solver.last_error.unwrap_or(TickError::InvalidArgument {
-                    what: "spin: no candidate linked to the station before",
-                    value: st.time,
-                }),
-            });
-        }
-        core::mem::swap(&mut prev, &mut cur);
     }
-    // The end: the least cost, the smallest spin on a tie.
-    let mut end = (f64::INFINITY, center);
-    for (j, node) in prev.iter().enumerate() {
-        let v = node.value;
-        if less(v, end.0) || (!less(end.0, v) && j.abs_diff(center) < end.1.abs_diff(center)) {
-            end = (v, j);
-        }
-    }
-    let mut spins = vec![0.0; n];
-    let mut largest = 0.0f64;
-    let mut j = end.1;
-    for (i, spin) in spins.iter_mut().enumerate().rev() {
-        *spin = candidates.get(j).copied().unwrap_or(0.0);
-        largest = largest.max(f64::from(node_max.get(i * k + j).copied().unwrap_or(0.0)));
-        j = usize::from(parent.get(i * k + j).copied().unwrap_or(0));
-    }
-    let loaded = loads.loads.len().max(1) as f64;
-    let rms = |sum: f64| nalgebra::ComplexField::sqrt(sum / loaded);
-    let best_constant = columns
-        .iter()
-        .zip(&candidates)
-        .enumerate()
-        .filter(|(_, (c, _))| c.ok)
-        .min_by(|(a, (ca, _)), (b, (cb, _))| {
-            if less(ca.sum, cb.sum) {
-                core::cmp::Ordering::Less
-            } else if less(cb.sum, ca.sum) {
-                core::cmp::Ordering::Greater
-            } else {
-                a.abs_diff(center).cmp(&b.abs_diff(center))
+
+    /// The end of the path (the last station's nodes, in `prev` after the swap): the least
+    /// cost and its candidate, the smallest spin on a tie.
+    fn end(&self) -> (f64, usize) {
+        let center = self.center;
+        let mut end = (f64::INFINITY, center);
+        for (j, node) in self.prev.iter().enumerate() {
+            let v = node.value;
+            if less(v, end.0) || (!less(end.0, v) && j.abs_diff(center) < end.1.abs_diff(center)) {
+                end = (v, j);
             }
-        })
-        .map(|(_, (c, angle))| {
-            (
-                *angle,
-                SpinCost {
-                    rms: rms(c.sum),
-                    max: c.max,
-                },
-            )
-        });
-    let seed_cost = columns.get(center).filter(|c| c.ok).map(|c| SpinCost {
-        rms: rms(c.sum),
-        max: c.max,
-    });
-    let budgets = stations.iter().map(|s| s.budget).collect();
-    Ok(SpinPlan {
-        schedule: SpinSchedule::new(budgets, spins, options.per_metre, options.per_second)?,
-        optimised: SpinCost {
-            rms: rms(end.0),
-            max: largest,
-        },
-        seed: seed_cost,
-        best_constant,
-        candidates,
-        stations: n,
-        refused: solver.refused,
-        measure: options.measure,
-    })
+        }
+        end
+    }
+
+    /// The spins \[rad\] of the `n` stations along the path ending at candidate `j`, and the
+    /// largest measure on it.
+    fn backtrack(&self, mut j: usize, n: usize) -> (Vec<f64>, f64) {
+        let k = self.k();
+        let mut spins = vec![0.0; n];
+        let mut largest = 0.0f64;
+        for (i, spin) in spins.iter_mut().enumerate().rev() {
+            *spin = self.candidates.get(j).copied().unwrap_or(0.0);
+            largest = largest.max(f64::from(
+                self.node_max.get(i * k + j).copied().unwrap_or(0.0),
+            ));
+            j = usize::from(self.parent.get(i * k + j).copied().unwrap_or(0));
+        }
+        (spins, largest)
+    }
+
+    /// The constant spin of least cost among those that hold throughout (the smallest spin
+    /// on a tie), with its cost (`rms` of a summed cost).
+    fn best_constant(&self, rms: &dyn Fn(f64) -> f64) -> Option<(f64, SpinCost)> {
+        let center = self.center;
+        self.columns
+            .iter()
+            .zip(&self.candidates)
+            .enumerate()
+            .filter(|(_, (c, _))| c.ok)
+            .min_by(|(a, (ca, _)), (b, (cb, _))| {
+                if less(ca.sum, cb.sum) {
+                    core::cmp::Ordering::Less
+                } else if less(cb.sum, ca.sum) {
+                    core::cmp::Ordering::Greater
+                } else {
+                    a.abs_diff(center).cmp(&b.abs_diff(center))
+                }
+            })
+            .map(|(_, (c, angle))| {
+                (
+                    *angle,
+                    SpinCost {
+                        rms: rms(c.sum),
+                        max: c.max,
+                    },
+                )
+            })
+    }
 }
