@@ -336,6 +336,48 @@ pub fn fit(
 ) -> Result<ComplianceMap, BuildError> {
     let (nf, nd) = (options.n_force, options.n_displacement);
     check_counts(nf, nd)?;
+    check_measurements(measurements, nf, nd)?;
+    let tol = options.position_tolerance;
+    let (cx, cy, nodes) = grid_of(measurements, tol)?;
+    let (nx, ny) = (cx.len(), cy.len());
+    let readings = Readings {
+        measurements,
+        nodes: &nodes,
+    };
+    let order = grouped_order(measurements.len(), |r| readings.key(r))?;
+    let block = nd * nf;
+    let mut fitter = Fitter {
+        readings,
+        order: &order,
+        cx: &cx,
+        cy: &cy,
+        nf,
+        nd,
+        slopes: vec![0.0; nx * ny * block],
+        offsets: vec![0.0; nx * ny * block],
+        pos: 0,
+    };
+    let mut stats = Vec::with_capacity(nx * ny);
+    for node in 0..nx * ny {
+        let nfit = fitter.node(node)?;
+        check_node_stats(&nfit)?;
+        stats.push(nfit);
+    }
+    let Fitter {
+        slopes, offsets, ..
+    } = fitter;
+    let mut map = ComplianceMap::new(cx, cy, nf, nd, slopes, offsets)?;
+    map.set_fit_stats(Some(stats));
+    Ok(map)
+}
+
+/// Checks the readings before any grouping: at most [`MAX_MEASUREMENTS`], finite positions,
+/// forces and first `nd` displacements, force axes below `nf`.
+fn check_measurements(
+    measurements: &[Measurement],
+    nf: usize,
+    nd: usize,
+) -> Result<(), BuildError> {
     if measurements.len() > MAX_MEASUREMENTS {
         return Err(BuildError::Budget {
             what: "measurements",
@@ -344,7 +386,6 @@ pub fn fit(
             requested: measurements.len(),
         });
     }
-    let tol = options.position_tolerance;
     for (row, m) in measurements.iter().enumerate() {
         for (column, v) in [("x", m.x), ("y", m.y), ("force", m.force)] {
             if !v.is_finite() {
@@ -368,27 +409,51 @@ pub fn fit(
             });
         }
     }
-    let (cx, cy, nodes) = grid_of(measurements, tol)?;
-    let (nx, ny) = (cx.len(), cy.len());
-    let node_of = |r: usize| nodes.get(r).copied().unwrap_or(0);
-    let key = |r: usize| {
-        let m = measurements.get(r);
+    Ok(())
+}
+
+/// The readings with each one's node `i * ny + j` (from [`grid_of`]).
+#[derive(Clone, Copy)]
+struct Readings<'a> {
+    measurements: &'a [Measurement],
+    nodes: &'a [usize],
+}
+
+impl Readings<'_> {
+    /// Reading `r`'s grouping key: (node, force axis, force \[N\]).
+    fn key(&self, r: usize) -> (usize, usize, f64) {
+        let m = self.measurements.get(r);
         (
-            node_of(r),
+            self.nodes.get(r).copied().unwrap_or(0),
             m.map_or(0, |m| m.force_axis),
             m.map_or(0.0, |m| m.force),
         )
-    };
-    let order = grouped_order(measurements.len(), key)?;
-    let block = nd * nf;
-    let mut slopes = vec![0.0; nx * ny * block];
-    let mut offsets = vec![0.0; nx * ny * block];
-    let mut stats = Vec::with_capacity(nx * ny);
-    let mut pos = 0usize;
-    for node in 0..nx * ny {
+    }
+}
+
+/// The fit node by node: the readings in [`grouped_order`], the grid lines \[m\], and the
+/// slopes and offsets filled at `node * nd * nf + d * nf + f`.
+struct Fitter<'a> {
+    readings: Readings<'a>,
+    order: &'a [usize],
+    cx: &'a [f64],
+    cy: &'a [f64],
+    nf: usize,
+    nd: usize,
+    slopes: Vec<f64>,
+    offsets: Vec<f64>,
+    /// The first entry of `order` not yet fitted.
+    pos: usize,
+}
+
+impl Fitter<'_> {
+    /// Fits the lines of node `node` (`i * ny + j`) for every force axis, its readings being
+    /// the next in `order`; returns its statistics.
+    fn node(&mut self, node: usize) -> Result<NodeFit, BuildError> {
+        let (nf, ny, block) = (self.nf, self.cy.len(), self.nd * self.nf);
         let (node_x, node_y) = (
-            cx.get(node / ny).copied().unwrap_or(f64::NAN),
-            cy.get(node % ny).copied().unwrap_or(f64::NAN),
+            self.cx.get(node / ny).copied().unwrap_or(f64::NAN),
+            self.cy.get(node % ny).copied().unwrap_or(f64::NAN),
         );
         let mut nfit = NodeFit {
             i: node / ny,
@@ -408,64 +473,74 @@ pub fn fit(
             samples: vec![0; nf],
         };
         for f in 0..nf {
-            let begin = pos;
-            while order
-                .get(pos)
-                .is_some_and(|r| key(*r).0 == node && key(*r).1 == f)
-            {
-                pos += 1;
-            }
-            let rows = order.get(begin..pos).unwrap_or(&[]);
-            if rows.len() < 2 {
-                return Err(BuildError::TooFewForceLevels {
-                    node_x,
-                    node_y,
-                    force_axis: f,
-                    levels: rows.len(),
-                });
-            }
-            let group: Vec<(f64, [f64; MAX_AXES])> = rows
-                .iter()
-                .filter_map(|r| measurements.get(*r))
-                .map(|m| (m.force, m.displacement))
-                .collect();
-            let (condition, lines) = fit_lines(&group, nd);
-            if let Some(slot) = nfit.condition.get_mut(f) {
-                *slot = condition;
-            }
-            if let Some(slot) = nfit.samples.get_mut(f) {
-                *slot = group.len();
-            }
-            for (d, line) in lines.iter().enumerate().take(nd) {
-                let idx = node * block + d * nf + f;
-                if let Some(s) = slopes.get_mut(idx) {
-                    *s = line.slope;
-                }
-                if let Some(o) = offsets.get_mut(idx) {
-                    *o = line.offset;
-                }
-                if let Some(l) = nfit.lines.get_mut(d * nf + f) {
-                    *l = *line;
-                }
-            }
+            self.axis(node, f, &mut nfit)?;
         }
-        // Sums of squares of huge (finite) forces or displacements overflow: refuse such a fit
-        // rather than return statistics of NaN or inf (JSON cannot hold them).
-        let mut values = nfit.condition.iter().copied().chain(
-            nfit.lines
-                .iter()
-                .flat_map(|l| [l.slope, l.offset, l.rms, l.r_squared]),
-        );
-        if let Some(index) = values.position(|v| !v.is_finite()) {
-            return Err(BuildError::NonFinite {
-                what: "fit statistics (condition, then slope, offset, rms, r_squared per \
-                       line) of a node: forces or displacements too large",
-                index,
+        Ok(nfit)
+    }
+
+    /// Fits the lines of node `node` under force axis `f` into the tables and `nfit`: at
+    /// least two force levels, the next readings in `order`.
+    fn axis(&mut self, node: usize, f: usize, nfit: &mut NodeFit) -> Result<(), BuildError> {
+        let (nf, nd, block) = (self.nf, self.nd, self.nd * self.nf);
+        let (order, readings) = (self.order, self.readings);
+        let begin = self.pos;
+        while order
+            .get(self.pos)
+            .is_some_and(|r| readings.key(*r).0 == node && readings.key(*r).1 == f)
+        {
+            self.pos += 1;
+        }
+        let rows = order.get(begin..self.pos).unwrap_or(&[]);
+        if rows.len() < 2 {
+            return Err(BuildError::TooFewForceLevels {
+                node_x: nfit.x,
+                node_y: nfit.y,
+                force_axis: f,
+                levels: rows.len(),
             });
         }
-        stats.push(nfit);
+        let group: Vec<(f64, [f64; MAX_AXES])> = rows
+            .iter()
+            .filter_map(|r| readings.measurements.get(*r))
+            .map(|m| (m.force, m.displacement))
+            .collect();
+        let (condition, lines) = fit_lines(&group, nd);
+        if let Some(slot) = nfit.condition.get_mut(f) {
+            *slot = condition;
+        }
+        if let Some(slot) = nfit.samples.get_mut(f) {
+            *slot = group.len();
+        }
+        for (d, line) in lines.iter().enumerate().take(nd) {
+            let idx = node * block + d * nf + f;
+            if let Some(s) = self.slopes.get_mut(idx) {
+                *s = line.slope;
+            }
+            if let Some(o) = self.offsets.get_mut(idx) {
+                *o = line.offset;
+            }
+            if let Some(l) = nfit.lines.get_mut(d * nf + f) {
+                *l = *line;
+            }
+        }
+        Ok(())
     }
-    let mut map = ComplianceMap::new(cx, cy, nf, nd, slopes, offsets)?;
-    map.set_fit_stats(Some(stats));
-    Ok(map)
+}
+
+/// Refuses a node whose statistics are not finite: sums of squares of huge (finite) forces or
+/// displacements overflow, and JSON cannot hold NaN or inf.
+fn check_node_stats(nfit: &NodeFit) -> Result<(), BuildError> {
+    let mut values = nfit.condition.iter().copied().chain(
+        nfit.lines
+            .iter()
+            .flat_map(|l| [l.slope, l.offset, l.rms, l.r_squared]),
+    );
+    if let Some(index) = values.position(|v| !v.is_finite()) {
+        return Err(BuildError::NonFinite {
+            what: "fit statistics (condition, then slope, offset, rms, r_squared per \
+                   line) of a node: forces or displacements too large",
+            index,
+        });
+    }
+    Ok(())
 }

@@ -301,20 +301,7 @@ pub fn pose_ik(
     options: &PoseIkOptions,
 ) -> Result<PoseIkSolution, TickError> {
     let dof = model.dof();
-    if seed.len() != dof {
-        return Err(TickError::WrongLength {
-            what: "seed",
-            expected: dof,
-            got: seed.len(),
-        });
-    }
-    check_finite("seed", seed)?;
-    check_finite("target translation", target.translation.vector.as_slice())?;
-    check_finite("target rotation", target.rotation.coords.as_slice())?;
-    let mut q = [0.0; MAX_DOF];
-    for (dst, &s) in q.iter_mut().zip(seed) {
-        *dst = s;
-    }
+    let mut q = checked_seed(dof, seed, target)?;
     let lambda2 = options.damping * options.damping;
     let full = options.task == Task::POSE;
     let mut iterations = 0;
@@ -332,18 +319,13 @@ pub fn pose_ik(
         let (jac, e, oe, free) = if full {
             (&data.jacobian, e6, er.norm(), 0.0)
         } else {
-            let er_t = pose.rotation.inverse() * er;
-            let (mut on, mut off) = (0.0, 0.0);
-            for (k, &c) in options.task.rotation.iter().enumerate() {
-                let v = er_t.get(k).copied().unwrap_or(0.0);
-                if c { on += v * v } else { off += v * v }
-            }
+            let (oe, free) = rotation_errors(&pose.rotation, &er, options.task);
             jt = task_jacobian(&data.jacobian, &pose.rotation, options.task, dof);
             (
                 &jt,
                 task_vector(&e6, &pose.rotation, options.task),
-                nalgebra::ComplexField::sqrt(on),
-                nalgebra::ComplexField::sqrt(off),
+                oe,
+                free,
             )
         };
         let jj = task_gram(jac, options.task, dof);
@@ -370,30 +352,90 @@ pub fn pose_ik(
                 residual: pe + oe,
             });
         }
-        let g = jj + Matrix6::identity() * lambda2;
-        let Some(chol) = g.cholesky() else {
-            return Err(TickError::Singular {
-                what: "joint Jacobian (pose IK)",
-                sigma_min: 0.0,
-            });
-        };
-        let y = chol.solve(&e);
-        let mut dq = jac.tr_mul(&y);
-        let n = dq.norm();
-        if !n.is_finite() {
-            return Err(TickError::NonFiniteOutput {
-                what: "pose IK step",
-                index: 0,
-            });
-        }
-        if n > options.max_step {
-            dq *= options.max_step / n;
-        }
+        let dq = damped_step(jac, &jj, &e, lambda2, options.max_step)?;
         for (qi, d) in q.iter_mut().zip(dq.iter()).take(dof) {
             *qi += d;
         }
         iterations += 1;
     }
+}
+
+/// The seed \[rad or m\] checked (length `dof`, finite, as the target) and copied into a
+/// joint vector (zero past the dof).
+#[inline]
+fn checked_seed(
+    dof: usize,
+    seed: &[f64],
+    target: &Isometry3<f64>,
+) -> Result<[f64; MAX_DOF], TickError> {
+    if seed.len() != dof {
+        return Err(TickError::WrongLength {
+            what: "seed",
+            expected: dof,
+            got: seed.len(),
+        });
+    }
+    check_finite("seed", seed)?;
+    check_finite("target translation", target.translation.vector.as_slice())?;
+    check_finite("target rotation", target.rotation.coords.as_slice())?;
+    let mut q = [0.0; MAX_DOF];
+    for (dst, &s) in q.iter_mut().zip(seed) {
+        *dst = s;
+    }
+    Ok(q)
+}
+
+/// The orientation error `er` \[rad\] (base frame) split in the TCP frame (`rotation` the
+/// TCP's) by `task`: the norms of its controlled and of its free components.
+#[inline]
+fn rotation_errors(
+    rotation: &nalgebra::UnitQuaternion<f64>,
+    er: &nalgebra::Vector3<f64>,
+    task: Task,
+) -> (f64, f64) {
+    let er_t = rotation.inverse() * er;
+    let (mut on, mut off) = (0.0, 0.0);
+    for (k, &c) in task.rotation.iter().enumerate() {
+        let v = er_t.get(k).copied().unwrap_or(0.0);
+        if c { on += v * v } else { off += v * v }
+    }
+    (
+        nalgebra::ComplexField::sqrt(on),
+        nalgebra::ComplexField::sqrt(off),
+    )
+}
+
+/// The damped least-squares step `dq = J^T (J J^T + lambda^2 I)^-1 e` \[rad or m\] for the
+/// task's Jacobian `jac`, its Gram matrix `jj` and error `e` \[m, rad\], clipped to the norm
+/// `max_step`.
+#[inline]
+fn damped_step(
+    jac: &nalgebra::SMatrix<f64, 6, MAX_DOF>,
+    jj: &Matrix6<f64>,
+    e: &Vector6,
+    lambda2: f64,
+    max_step: f64,
+) -> Result<nalgebra::SVector<f64, MAX_DOF>, TickError> {
+    let g = jj + Matrix6::identity() * lambda2;
+    let Some(chol) = g.cholesky() else {
+        return Err(TickError::Singular {
+            what: "joint Jacobian (pose IK)",
+            sigma_min: 0.0,
+        });
+    };
+    let y = chol.solve(e);
+    let mut dq = jac.tr_mul(&y);
+    let n = dq.norm();
+    if !n.is_finite() {
+        return Err(TickError::NonFiniteOutput {
+            what: "pose IK step",
+            index: 0,
+        });
+    }
+    if n > max_step {
+        dq *= max_step / n;
+    }
+    Ok(dq)
 }
 
 /// Smallest ratio of the smallest to the largest singular value of a task's Jacobian (position

@@ -170,6 +170,44 @@ pub fn equilibrium(
 ) -> Result<Equilibrium, TickError> {
     check_q(model, data, q)?;
     check_finite("wrench", wrench.as_slice())?;
+    check_options(options)?;
+    // The paper's solution is the start (and fills data.tcp with the rigid pose).
+    super::deflection(model, data, q, wrench, super::Load::Exact)?;
+    let rigid = data.tcp;
+    let mut x: Vec<f64> = data
+        .spring_angles
+        .iter()
+        .take(model.springs)
+        .flat_map(|a| a.iter().copied())
+        .collect();
+    let mut frames = vec![Isometry3::identity(); model.springs];
+    let problem = Problem { model, q, wrench };
+    let mut iterations = 0;
+    let mut g = problem.residual(&x, &mut frames);
+    loop {
+        let step_norm = problem.newton_step(&mut x, &g, &mut frames)?;
+        iterations += 1;
+        g = problem.residual(&x, &mut frames);
+        if step_norm <= options.tolerance {
+            break;
+        }
+        if iterations >= options.max_iterations {
+            return Err(TickError::NotConverged {
+                iterations,
+                residual: g.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+            });
+        }
+    }
+    let d = write_back(model, data, q, &x, &rigid, &mut frames)?;
+    Ok(Equilibrium {
+        deflection: d,
+        iterations,
+        residual: g.iter().fold(0.0f64, |a, v| a.max(v.abs())),
+    })
+}
+
+/// Checks the settings: 1..=64 iterations, a finite positive tolerance.
+fn check_options(options: &EquilibriumOptions) -> Result<(), TickError> {
     if options.max_iterations == 0 || options.max_iterations > 64 {
         return Err(TickError::InvalidArgument {
             what: "max_iterations (1..=64)",
@@ -182,70 +220,79 @@ pub fn equilibrium(
             value: options.tolerance,
         });
     }
-    // The paper's solution is the start (and fills data.tcp with the rigid pose).
-    super::deflection(model, data, q, wrench, super::Load::Exact)?;
-    let rigid = data.tcp;
-    let n = 3 * model.springs;
-    let mut x: Vec<f64> = data
-        .spring_angles
-        .iter()
-        .take(model.springs)
-        .flat_map(|a| a.iter().copied())
-        .collect();
-    let mut frames = vec![Isometry3::identity(); model.springs];
-    let residual_of = |x: &[f64], frames: &mut [Isometry3<f64>]| {
-        let r = spring_response(model, q, &as_angles(x), frames, wrench);
+    Ok(())
+}
+
+/// The equations Newton's method solves: the chain at joints `q` under `wrench`.
+struct Problem<'a> {
+    model: &'a Model,
+    q: &'a [f64],
+    wrench: &'a Vector6,
+}
+
+impl Problem<'_> {
+    /// The residual `theta - C (.) E^T M_s(theta)` \[rad\] at the flattened spring angles `x`
+    /// (`frames` is the workspace of [`deflected_frames`]).
+    fn residual(&self, x: &[f64], frames: &mut [Isometry3<f64>]) -> Vec<f64> {
+        let r = spring_response(self.model, self.q, &as_angles(x), frames, self.wrench);
         x.iter().zip(&r).map(|(a, b)| a - b).collect::<Vec<f64>>()
-    };
-    let mut iterations = 0;
-    let mut g = residual_of(&x, &mut frames);
-    loop {
-        let step_norm;
-        {
-            // Jacobian of g by central differences.
-            let mut jac = DMatrix::<f64>::zeros(n, n);
-            for j in 0..n {
-                // Angles are below 0.5 rad: a fixed step keeps the truncation error
-                // (h^2 times the third derivative) and the rounding error (eps / h) both
-                // near 1e-12 of the response.
-                let h = 1e-6;
-                let mut xp = x.clone();
-                let mut xm = x.clone();
-                if let (Some(p), Some(m)) = (xp.get_mut(j), xm.get_mut(j)) {
-                    *p += h;
-                    *m -= h;
-                }
-                let (gp, gm) = (residual_of(&xp, &mut frames), residual_of(&xm, &mut frames));
-                for (i, (a, b)) in gp.iter().zip(&gm).enumerate() {
-                    if let Some(slot) = jac.get_mut((i, j)) {
-                        *slot = (a - b) / (2.0 * h);
-                    }
-                }
-            }
-            let Some(dx) = jac.lu().solve(&DVector::from_column_slice(&g)) else {
-                return Err(TickError::Singular {
-                    what: "equilibrium Jacobian",
-                    sigma_min: 0.0,
-                });
-            };
-            step_norm = dx.amax();
-            for (xi, d) in x.iter_mut().zip(dx.iter()) {
-                *xi -= d;
-            }
-        }
-        iterations += 1;
-        g = residual_of(&x, &mut frames);
-        if step_norm <= options.tolerance {
-            break;
-        }
-        if iterations >= options.max_iterations {
-            return Err(TickError::NotConverged {
-                iterations,
-                residual: g.iter().fold(0.0f64, |a, v| a.max(v.abs())),
-            });
-        }
     }
-    let angles = as_angles(&x);
+
+    /// One Newton step on `x` from its residual `g` (Jacobian by central differences):
+    /// `x -= J^-1 g`; returns the step's largest entry \[rad\].
+    fn newton_step(
+        &self,
+        x: &mut [f64],
+        g: &[f64],
+        frames: &mut [Isometry3<f64>],
+    ) -> Result<f64, TickError> {
+        let n = 3 * self.model.springs;
+        // Jacobian of g by central differences.
+        let mut jac = DMatrix::<f64>::zeros(n, n);
+        for j in 0..n {
+            // Angles are below 0.5 rad: a fixed step keeps the truncation error
+            // (h^2 times the third derivative) and the rounding error (eps / h) both
+            // near 1e-12 of the response.
+            let h = 1e-6;
+            let mut xp = x.to_vec();
+            let mut xm = x.to_vec();
+            if let (Some(p), Some(m)) = (xp.get_mut(j), xm.get_mut(j)) {
+                *p += h;
+                *m -= h;
+            }
+            let (gp, gm) = (self.residual(&xp, frames), self.residual(&xm, frames));
+            for (i, (a, b)) in gp.iter().zip(&gm).enumerate() {
+                if let Some(slot) = jac.get_mut((i, j)) {
+                    *slot = (a - b) / (2.0 * h);
+                }
+            }
+        }
+        let Some(dx) = jac.lu().solve(&DVector::from_column_slice(g)) else {
+            return Err(TickError::Singular {
+                what: "equilibrium Jacobian",
+                sigma_min: 0.0,
+            });
+        };
+        let step_norm = dx.amax();
+        for (xi, d) in x.iter_mut().zip(dx.iter()) {
+            *xi -= d;
+        }
+        Ok(step_norm)
+    }
+}
+
+/// The equilibrium's spring angles `x` (flattened, \[rad\]) into `data` (the angles and the
+/// deflected TCP), checked against [`MAX_SPRING_ANGLE`]; returns the deflection `[dp; dr]`
+/// \[m, rad\] from the rigid TCP `rigid`.
+fn write_back(
+    model: &Model,
+    data: &mut Data,
+    q: &[f64],
+    x: &[f64],
+    rigid: &Isometry3<f64>,
+    frames: &mut [Isometry3<f64>],
+) -> Result<Vector6, TickError> {
+    let angles = as_angles(x);
     let largest = x.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     if largest > MAX_SPRING_ANGLE {
         return Err(TickError::InvalidArgument {
@@ -253,7 +300,7 @@ pub fn equilibrium(
             value: largest,
         });
     }
-    let tcp = deflected_frames(model, q, &angles, &mut frames);
+    let tcp = deflected_frames(model, q, &angles, frames);
     for (slot, a) in data.spring_angles.iter_mut().zip(&angles) {
         *slot = *a;
     }
@@ -262,9 +309,5 @@ pub fn equilibrium(
     let d = Vector6::new(dp.x, dp.y, dp.z, dr.x, dr.y, dr.z);
     check_output("deflection", d.as_slice())?;
     data.tcp_deflected = tcp;
-    Ok(Equilibrium {
-        deflection: d,
-        iterations,
-        residual: g.iter().fold(0.0f64, |a, v| a.max(v.abs())),
-    })
+    Ok(d)
 }

@@ -265,81 +265,7 @@ fn blocks_in<L: Lanes>(
         ) else {
             continue; // unreachable: chunks of four
         };
-        let q = fs.each_ref().map(|f| f.rotation.coords);
-        let o = fs.each_ref().map(|f| f.translation.vector);
-        let (qw, qx, qy, qz) = (
-            q.map(|v| v.w),
-            q.map(|v| v.x),
-            q.map(|v| v.y),
-            q.map(|v| v.z),
-        );
-        let (ox, oy, oz) = (o.map(|v| v.x), o.map(|v| v.y), o.map(|v| v.z));
-        let c0 = cs.each_ref().map(|c| c.x);
-        let c1 = cs.each_ref().map(|c| c.y);
-        let c2 = cs.each_ref().map(|c| c.z);
-        let (w, x, y, z) = (l.load(qw), l.load(qx), l.load(qy), l.load(qz));
-        let (c0, c1, c2) = (l.load(c0), l.load(c1), l.load(c2));
-        // Rotation matrix of the unit quaternion (columns: the spring's axes in world axes).
-        let two = l.splat(2.0);
-        let (ww_, xx, yy, zz) = (w * w, x * x, y * y, z * z);
-        let (xy, xz, yz) = (x * y, x * z, y * z);
-        let (wx, wy, wz) = (w * x, w * y, w * z);
-        let u = V4 {
-            x: ww_ + xx - yy - zz,
-            y: two * (xy + wz),
-            z: two * (xz - wy),
-        };
-        let v = V4 {
-            x: two * (xy - wz),
-            y: ww_ - xx + yy - zz,
-            z: two * (yz + wx),
-        };
-        let t = V4 {
-            x: two * (xz + wy),
-            y: two * (yz - wx),
-            z: ww_ - xx - yy + zz,
-        };
-        // A = R diag(c) R^T, six distinct entries.
-        let g = |i, j, k, l, m, n| c0 * i * j + c1 * k * l + c2 * m * n;
-        let a = [
-            g(u.x, u.x, v.x, v.x, t.x, t.x),
-            g(u.x, u.y, v.x, v.y, t.x, t.y),
-            g(u.x, u.z, v.x, v.z, t.x, t.z),
-            g(u.y, u.y, v.y, v.y, t.y, t.y),
-            g(u.y, u.z, v.y, v.z, t.y, t.z),
-            g(u.z, u.z, v.z, v.z, t.z, t.z),
-        ];
-        let r = V4 {
-            x: l.splat(p.x) - l.load(ox),
-            y: l.splat(p.y) - l.load(oy),
-            z: l.splat(p.z) - l.load(oz),
-        };
-        let [a0, a1, a2, a3, a4, a5] = a;
-        // B = S A (S = [r]x), column j = r x A_j.
-        let b0 = r.cross(V4 {
-            x: a0,
-            y: a1,
-            z: a2,
-        });
-        let b1 = r.cross(V4 {
-            x: a1,
-            y: a3,
-            z: a4,
-        });
-        let b2 = r.cross(V4 {
-            x: a2,
-            y: a4,
-            z: a5,
-        });
-        // S A S^T = -(S A) S: six entries.
-        let dv = [
-            b2.x * r.y - b1.x * r.z,
-            b0.x * r.z - b2.x * r.x,
-            b1.x * r.x - b0.x * r.y,
-            b0.y * r.z - b2.y * r.x,
-            b1.y * r.x - b0.y * r.y,
-            b1.z * r.x - b0.z * r.y,
-        ];
+        let Terms { dv, a, b } = chunk_terms(l, fs, cs, p);
         for (acc, d) in vv.iter_mut().zip(dv) {
             *acc = *acc + d;
         }
@@ -347,13 +273,125 @@ fn blocks_in<L: Lanes>(
             *acc = *acc + d;
         }
         // The translation-rotation block -B, row by row.
-        let b = [b0.x, b1.x, b2.x, b0.y, b1.y, b2.y, b0.z, b1.z, b2.z];
         for (acc, d) in vw.iter_mut().zip(b) {
             *acc = *acc - d;
         }
     }
     let total = |v| l.total(v);
     (vv.map(total), vw.map(total), ww.map(total))
+}
+
+/// One chunk's terms of the sums, four springs in the lanes.
+struct Terms<V> {
+    /// The six distinct entries of `S A S^T` \[m^2 rad / (N m)\].
+    dv: [V; 6],
+    /// The six distinct entries of `A = R diag(c) R^T` \[rad / (N m)\].
+    a: [V; 6],
+    /// `B = S A` row by row \[m rad / (N m)\].
+    b: [V; 9],
+}
+
+/// The [`Terms`] of four springs (frames `fs`, compliances `cs` \[rad / (N m)\]) for the TCP
+/// at `p` \[m\] (`S = [r]x`, `r` the lever from the spring to the TCP).
+#[inline(always)]
+fn chunk_terms<L: Lanes>(
+    l: L,
+    fs: &[Isometry3<f64>; 4],
+    cs: &[Vector3<f64>; 4],
+    p: &Vector3<f64>,
+) -> Terms<L::V> {
+    let q = fs.each_ref().map(|f| f.rotation.coords);
+    let o = fs.each_ref().map(|f| f.translation.vector);
+    let (qw, qx, qy, qz) = (
+        q.map(|v| v.w),
+        q.map(|v| v.x),
+        q.map(|v| v.y),
+        q.map(|v| v.z),
+    );
+    let (ox, oy, oz) = (o.map(|v| v.x), o.map(|v| v.y), o.map(|v| v.z));
+    let c0 = cs.each_ref().map(|c| c.x);
+    let c1 = cs.each_ref().map(|c| c.y);
+    let c2 = cs.each_ref().map(|c| c.z);
+    let (w, x, y, z) = (l.load(qw), l.load(qx), l.load(qy), l.load(qz));
+    let (c0, c1, c2) = (l.load(c0), l.load(c1), l.load(c2));
+    let [u, v, t] = rotation_columns(l, w, x, y, z);
+    // A = R diag(c) R^T, six distinct entries.
+    let g = |i, j, k, l, m, n| c0 * i * j + c1 * k * l + c2 * m * n;
+    let a = [
+        g(u.x, u.x, v.x, v.x, t.x, t.x),
+        g(u.x, u.y, v.x, v.y, t.x, t.y),
+        g(u.x, u.z, v.x, v.z, t.x, t.z),
+        g(u.y, u.y, v.y, v.y, t.y, t.y),
+        g(u.y, u.z, v.y, v.z, t.y, t.z),
+        g(u.z, u.z, v.z, v.z, t.z, t.z),
+    ];
+    let r = V4 {
+        x: l.splat(p.x) - l.load(ox),
+        y: l.splat(p.y) - l.load(oy),
+        z: l.splat(p.z) - l.load(oz),
+    };
+    let (dv, b) = lever_terms(r, a);
+    Terms { dv, a, b }
+}
+
+/// The rotation matrix of the unit quaternions `w + x i + y j + z k`, as its columns (the
+/// spring's axes in world axes, dimensionless).
+#[inline(always)]
+fn rotation_columns<L: Lanes>(l: L, w: L::V, x: L::V, y: L::V, z: L::V) -> [V4<L::V>; 3] {
+    let two = l.splat(2.0);
+    let (ww_, xx, yy, zz) = (w * w, x * x, y * y, z * z);
+    let (xy, xz, yz) = (x * y, x * z, y * z);
+    let (wx, wy, wz) = (w * x, w * y, w * z);
+    let u = V4 {
+        x: ww_ + xx - yy - zz,
+        y: two * (xy + wz),
+        z: two * (xz - wy),
+    };
+    let v = V4 {
+        x: two * (xy - wz),
+        y: ww_ - xx + yy - zz,
+        z: two * (yz + wx),
+    };
+    let t = V4 {
+        x: two * (xz + wy),
+        y: two * (yz - wx),
+        z: ww_ - xx - yy + zz,
+    };
+    [u, v, t]
+}
+
+/// The lever terms of a spring with compliance `a` (the six entries of the symmetric `A`)
+/// and lever `r` \[m\]: the six entries of `S A S^T` and the nine of `B = S A` row by row.
+#[inline(always)]
+fn lever_terms<V: Arith>(r: V4<V>, a: [V; 6]) -> ([V; 6], [V; 9]) {
+    let [a0, a1, a2, a3, a4, a5] = a;
+    // B = S A (S = [r]x), column j = r x A_j.
+    let b0 = r.cross(V4 {
+        x: a0,
+        y: a1,
+        z: a2,
+    });
+    let b1 = r.cross(V4 {
+        x: a1,
+        y: a3,
+        z: a4,
+    });
+    let b2 = r.cross(V4 {
+        x: a2,
+        y: a4,
+        z: a5,
+    });
+    // S A S^T = -(S A) S: six entries.
+    let dv = [
+        b2.x * r.y - b1.x * r.z,
+        b0.x * r.z - b2.x * r.x,
+        b1.x * r.x - b0.x * r.y,
+        b0.y * r.z - b2.y * r.x,
+        b1.y * r.x - b0.y * r.y,
+        b1.z * r.x - b0.z * r.y,
+    ];
+    let b = [b0.x, b1.x, b2.x, b0.y, b1.y, b2.y, b0.z, b1.z, b2.z];
+    (dv, b)
 }
 
 #[cfg(test)]

@@ -429,103 +429,8 @@ impl ModelBuilder {
 
     /// Finishes the model (and compiles it for the kernels).
     pub fn build(self) -> Result<Model, BuildError> {
-        let mut ops: heapless::Vec<Op, MAX_ELEMENTS> = heapless::Vec::new();
-        let capacity = BuildError::Capacity {
-            what: "elements",
-            capacity: MAX_ELEMENTS,
-            got: MAX_ELEMENTS + 1,
-        };
-        // A fixed transform waiting to be folded into the next joint.
-        let mut pending: Option<Isometry3<f64>> = None;
-        for e in &self.elements {
-            let op = match *e {
-                Element::Fixed(t) => {
-                    pending = Some(pending.map_or(t, |p| p * t));
-                    continue;
-                }
-                Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
-                    Op::Joint {
-                        pre: pending.take().unwrap_or_else(Isometry3::identity),
-                        axis,
-                        revolute: matches!(e, Element::Revolute { .. }),
-                        index,
-                    }
-                }
-                Element::Spring {
-                    compliance,
-                    index,
-                    offset,
-                } => {
-                    if let Some(p) = pending.take() {
-                        ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
-                    }
-                    Op::Spring {
-                        offset: (offset != Isometry3::identity()).then_some(offset),
-                        compliance,
-                        index,
-                    }
-                }
-                Element::Mass {
-                    mass,
-                    com,
-                    inertia,
-                    index,
-                } => {
-                    // Expressed in the frame before a pending fixed transform, so that the
-                    // transform still folds into the next joint.
-                    let p = pending.unwrap_or_else(Isometry3::identity);
-                    let r = p.rotation.to_rotation_matrix();
-                    Op::Mass {
-                        mass,
-                        com: p.transform_point(&com.into()).coords,
-                        inertia: r.matrix() * inertia * r.matrix().transpose(),
-                        index,
-                    }
-                }
-            };
-            ops.push(op).map_err(|_| capacity)?;
-        }
-        if let Some(p) = pending {
-            ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
-        }
-        // Springs and masses leave the rigid chain as it is: without them, the fixed
-        // transforms between two joints fold into one.
-        let mut tcp_chain: heapless::Vec<TcpStep, MAX_DOF> = heapless::Vec::new();
-        let mut pass: heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }> = heapless::Vec::new();
-        let mut tail = Isometry3::identity();
-        for e in &self.elements {
-            match *e {
-                Element::Fixed(t) => tail *= t,
-                Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
-                    let pre = core::mem::replace(&mut tail, Isometry3::identity());
-                    let step = TcpStep {
-                        pre_shape: Shape::of(&pre),
-                        pre,
-                        axis,
-                        kind: AxisKind::of(&axis),
-                        revolute: matches!(e, Element::Revolute { .. }),
-                        index,
-                    };
-                    pass.push(Pass::Joint(tcp_chain.len()))
-                        .map_err(|_| capacity)?;
-                    tcp_chain.push(step).map_err(|_| BuildError::Capacity {
-                        what: "joints",
-                        capacity: MAX_DOF,
-                        got: MAX_DOF + 1,
-                    })?;
-                }
-                Element::Spring { offset, index, .. } => {
-                    let local = tail * offset;
-                    pass.push(Pass::Spring {
-                        shape: Shape::of(&local),
-                        local,
-                        index,
-                    })
-                    .map_err(|_| capacity)?;
-                }
-                Element::Mass { .. } => {}
-            }
-        }
+        let ops = compile_ops(&self.elements)?;
+        let (tcp_chain, pass, tail) = compile_pass(&self.elements)?;
         let mut spring_compliance = [Vector3::zeros(); MAX_SPRINGS];
         for e in &self.elements {
             if let Element::Spring {
@@ -548,6 +453,123 @@ impl ModelBuilder {
             masses: self.masses,
         })
     }
+}
+
+/// The error of a compiled table past [`MAX_ELEMENTS`].
+const ELEMENTS_CAPACITY: BuildError = BuildError::Capacity {
+    what: "elements",
+    capacity: MAX_ELEMENTS,
+    got: MAX_ELEMENTS + 1,
+};
+
+/// The chain compiled for the kernels ([`Op`]): each fixed transform folded into the next
+/// joint, masses expressed before a pending one.
+fn compile_ops(elements: &[Element]) -> Result<heapless::Vec<Op, MAX_ELEMENTS>, BuildError> {
+    let mut ops: heapless::Vec<Op, MAX_ELEMENTS> = heapless::Vec::new();
+    let capacity = ELEMENTS_CAPACITY;
+    // A fixed transform waiting to be folded into the next joint.
+    let mut pending: Option<Isometry3<f64>> = None;
+    for e in elements {
+        let op = match *e {
+            Element::Fixed(t) => {
+                pending = Some(pending.map_or(t, |p| p * t));
+                continue;
+            }
+            Element::Revolute { axis, index } | Element::Prismatic { axis, index } => Op::Joint {
+                pre: pending.take().unwrap_or_else(Isometry3::identity),
+                axis,
+                revolute: matches!(e, Element::Revolute { .. }),
+                index,
+            },
+            Element::Spring {
+                compliance,
+                index,
+                offset,
+            } => {
+                if let Some(p) = pending.take() {
+                    ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
+                }
+                Op::Spring {
+                    offset: (offset != Isometry3::identity()).then_some(offset),
+                    compliance,
+                    index,
+                }
+            }
+            Element::Mass {
+                mass,
+                com,
+                inertia,
+                index,
+            } => {
+                // Expressed in the frame before a pending fixed transform, so that the
+                // transform still folds into the next joint.
+                let p = pending.unwrap_or_else(Isometry3::identity);
+                let r = p.rotation.to_rotation_matrix();
+                Op::Mass {
+                    mass,
+                    com: p.transform_point(&com.into()).coords,
+                    inertia: r.matrix() * inertia * r.matrix().transpose(),
+                    index,
+                }
+            }
+        };
+        ops.push(op).map_err(|_| capacity)?;
+    }
+    if let Some(p) = pending {
+        ops.push(Op::Fixed(p)).map_err(|_| capacity)?;
+    }
+    Ok(ops)
+}
+
+/// The rigid pass compiled ([`TcpStep`], [`Pass`]): the joints, the springs' frames relative
+/// to the frame after the joint before them, and the fixed transform after the last joint.
+type Compiled = (
+    heapless::Vec<TcpStep, MAX_DOF>,
+    heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }>,
+    Isometry3<f64>,
+);
+
+/// The rigid pass of the chain (see [`Compiled`]). Springs and masses leave the rigid chain
+/// as it is: without them, the fixed transforms between two joints fold into one.
+fn compile_pass(elements: &[Element]) -> Result<Compiled, BuildError> {
+    let capacity = ELEMENTS_CAPACITY;
+    let mut tcp_chain: heapless::Vec<TcpStep, MAX_DOF> = heapless::Vec::new();
+    let mut pass: heapless::Vec<Pass, { MAX_DOF + MAX_SPRINGS }> = heapless::Vec::new();
+    let mut tail = Isometry3::identity();
+    for e in elements {
+        match *e {
+            Element::Fixed(t) => tail *= t,
+            Element::Revolute { axis, index } | Element::Prismatic { axis, index } => {
+                let pre = core::mem::replace(&mut tail, Isometry3::identity());
+                let step = TcpStep {
+                    pre_shape: Shape::of(&pre),
+                    pre,
+                    axis,
+                    kind: AxisKind::of(&axis),
+                    revolute: matches!(e, Element::Revolute { .. }),
+                    index,
+                };
+                pass.push(Pass::Joint(tcp_chain.len()))
+                    .map_err(|_| capacity)?;
+                tcp_chain.push(step).map_err(|_| BuildError::Capacity {
+                    what: "joints",
+                    capacity: MAX_DOF,
+                    got: MAX_DOF + 1,
+                })?;
+            }
+            Element::Spring { offset, index, .. } => {
+                let local = tail * offset;
+                pass.push(Pass::Spring {
+                    shape: Shape::of(&local),
+                    local,
+                    index,
+                })
+                .map_err(|_| capacity)?;
+            }
+            Element::Mass { .. } => {}
+        }
+    }
+    Ok((tcp_chain, pass, tail))
 }
 
 /// A virtual-joint stiffness \[N m / rad\]: a normal positive number, or `+inf` (rigid).

@@ -15,7 +15,7 @@ use nalgebra::{Isometry3, Quaternion, UnitQuaternion};
 
 use super::data::check_q;
 use super::lanes::{LaneKernel, Lanes, V4, dispatch};
-use super::model::{MAX_SPRINGS, Pass};
+use super::model::{MAX_SPRINGS, Pass, TcpStep};
 use super::rotation::rotation_vector;
 use super::turns::{Frames4, Motion4, SERIES_ANGLE, splat3};
 use super::{Data, MAX_SPRING_ANGLE, Model, Vector6};
@@ -90,11 +90,19 @@ fn per_row<L: Lanes>(l: L, f: impl Fn(usize) -> f64) -> L::V {
     l.load([f(0), f(1), f(2), f(3)])
 }
 
-impl LaneKernel for Rows<'_> {
-    type Output = [[f64; 4]; 8];
+/// The lane constants of the kernel: `0` and `2` in every lane (`2` for the quaternion
+/// products), the zero vector and the identity motion.
+struct Consts<L: Lanes> {
+    zero: L::V,
+    two: L::V,
+    none: V4<L::V>,
+    identity: Motion4<L::V>,
+}
+
+impl<L: Lanes> Consts<L> {
+    /// The constants in the lanes `l`.
     #[inline(always)]
-    fn run<L: Lanes>(self, l: L) -> [[f64; 4]; 8] {
-        let Self { model, q, wrench } = self;
+    fn new(l: L) -> Self {
         let (zero, one, two) = (l.splat(0.0), l.splat(1.0), l.splat(2.0));
         let none = V4 {
             x: zero,
@@ -106,108 +114,24 @@ impl LaneKernel for Rows<'_> {
             u: none,
             t: none,
         };
-        // The rigid pass (`deflection::rigid_pass`), the springs' world frames kept as lanes.
-        let mut springs = [identity; MAX_SPRINGS];
-        let mut frame = identity;
-        for p in model.pass.iter() {
-            match p {
-                Pass::Joint(k) => {
-                    let Some(step) = model.tcp_chain.get(*k) else {
-                        continue; // unreachable: built together
-                    };
-                    frame = frame.then(splat_iso(l, &step.pre), two);
-                    let qi = |r: usize| {
-                        q.get(r)
-                            .and_then(|q| q.get(step.index))
-                            .copied()
-                            .unwrap_or(0.0)
-                    };
-                    let axis = step.axis.into_inner();
-                    if step.revolute {
-                        let half = [0, 1, 2, 3].map(|r| qi(r) * 0.5);
-                        let (s, c) = super::trig::sin_cos_lanes(l, half);
-                        let turn = Motion4 {
-                            w: c,
-                            u: V4 {
-                                x: l.splat(axis.x) * s,
-                                y: l.splat(axis.y) * s,
-                                z: l.splat(axis.z) * s,
-                            },
-                            t: none,
-                        };
-                        // The rotation only: `frame.rotation * turn`.
-                        let t = frame.t;
-                        frame = frame.then(turn, two);
-                        frame.t = t;
-                    } else {
-                        let rot = Frames4 {
-                            w: frame.w,
-                            u: frame.u,
-                            o: none,
-                        };
-                        let u = rot.world(splat3(l, &axis), two);
-                        let qi = per_row(l, qi);
-                        frame.t = V4 {
-                            x: frame.t.x + u.x * qi,
-                            y: frame.t.y + u.y * qi,
-                            z: frame.t.z + u.z * qi,
-                        };
-                    }
-                }
-                Pass::Spring { local, index, .. } => {
-                    if let Some(slot) = springs.get_mut(*index) {
-                        *slot = frame.then(splat_iso(l, local), two);
-                    }
-                }
-            }
+        Self {
+            zero,
+            two,
+            none,
+            identity,
         }
-        let tcp = frame.then(splat_iso(l, &model.tcp_tail), two);
-        // The springs (`turns::Springs` with the loads and the exact product), each row's
-        // spring k in lane r, the four runs of springs one after the other.
-        let p = tcp.t;
-        let column = |i: usize| per_row(l, |r| wrench.get(r).map_or(0.0, |w| w[i]));
-        let force = V4 {
-            x: column(0),
-            y: column(1),
-            z: column(2),
-        };
-        let moment = V4 {
-            x: column(3),
-            y: column(4),
-            z: column(5),
-        };
-        let n = model.springs;
-        let run = n.div_ceil(4);
-        let mut largest = zero;
-        let mut runs = [identity; 4];
-        // Step c turns spring g run + c of every run g: four independent products at once.
-        for c in 0..run {
-            for (g, acc) in runs.iter_mut().enumerate() {
-                let k = g * run + c;
-                let (Some(f), Some(cs)) = (springs.get(k), model.spring_compliance.get(k)) else {
-                    continue;
-                };
-                if k >= n {
-                    continue;
-                }
-                let frames = Frames4 {
-                    w: f.w,
-                    u: f.u,
-                    o: f.t,
-                };
-                let lever = V4 {
-                    x: p.x - frames.o.x,
-                    y: p.y - frames.o.y,
-                    z: p.z - frames.o.z,
-                };
-                let (_, a) = frames.loads(lever, force, moment, splat3(l, cs), two);
-                let big = l.max(l.max(l.abs(a.x), l.abs(a.y)), l.abs(a.z));
-                largest = l.max(largest, big);
-                *acc = acc.then(frames.turn(l, a, p, two), two);
-            }
-        }
-        let [r0, r1, r2, r3] = runs;
-        let total = r0.then(r1, two).then(r2.then(r3, two), two);
+    }
+}
+
+impl LaneKernel for Rows<'_> {
+    type Output = [[f64; 4]; 8];
+    #[inline(always)]
+    fn run<L: Lanes>(self, l: L) -> [[f64; 4]; 8] {
+        let Self { model, q, wrench } = self;
+        let consts = Consts::new(l);
+        let mut springs = [consts.identity; MAX_SPRINGS];
+        let tcp = rigid_pass(l, &consts, model, &q, &mut springs);
+        let (total, largest) = spring_turns(l, &consts, model, &springs, tcp.t, &wrench);
         let s = |v: L::V| l.store(v);
         let (w, u, t) = (total.w, total.u, total.t);
         [
@@ -221,6 +145,147 @@ impl LaneKernel for Rows<'_> {
             s(largest),
         ]
     }
+}
+
+/// The rigid pass (`deflection::rigid_pass`) of the four rows: the springs' world frames
+/// into `springs` (by spring index), kept as lanes, and the rigid TCP returned.
+#[inline(always)]
+fn rigid_pass<L: Lanes>(
+    l: L,
+    consts: &Consts<L>,
+    model: &Model,
+    q: &[&[f64]; ROWS],
+    springs: &mut [Motion4<L::V>; MAX_SPRINGS],
+) -> Motion4<L::V> {
+    let mut frame = consts.identity;
+    for p in model.pass.iter() {
+        match p {
+            Pass::Joint(k) => {
+                let Some(step) = model.tcp_chain.get(*k) else {
+                    continue; // unreachable: built together
+                };
+                frame = joint(l, consts, frame, step, q);
+            }
+            Pass::Spring { local, index, .. } => {
+                if let Some(slot) = springs.get_mut(*index) {
+                    *slot = frame.then(splat_iso(l, local), consts.two);
+                }
+            }
+        }
+    }
+    frame.then(splat_iso(l, &model.tcp_tail), consts.two)
+}
+
+/// One joint of the rigid pass: `frame` followed by the fixed transform before the joint and
+/// the joint's motion by each row's `q[r][step.index]` \[rad or m\].
+#[inline(always)]
+fn joint<L: Lanes>(
+    l: L,
+    consts: &Consts<L>,
+    frame: Motion4<L::V>,
+    step: &TcpStep,
+    q: &[&[f64]; ROWS],
+) -> Motion4<L::V> {
+    let (two, none) = (consts.two, consts.none);
+    let mut frame = frame.then(splat_iso(l, &step.pre), two);
+    let qi = |r: usize| {
+        q.get(r)
+            .and_then(|q| q.get(step.index))
+            .copied()
+            .unwrap_or(0.0)
+    };
+    let axis = step.axis.into_inner();
+    if step.revolute {
+        let half = [0, 1, 2, 3].map(|r| qi(r) * 0.5);
+        let (s, c) = super::trig::sin_cos_lanes(l, half);
+        let turn = Motion4 {
+            w: c,
+            u: V4 {
+                x: l.splat(axis.x) * s,
+                y: l.splat(axis.y) * s,
+                z: l.splat(axis.z) * s,
+            },
+            t: none,
+        };
+        // The rotation only: `frame.rotation * turn`.
+        let t = frame.t;
+        frame = frame.then(turn, two);
+        frame.t = t;
+    } else {
+        let rot = Frames4 {
+            w: frame.w,
+            u: frame.u,
+            o: none,
+        };
+        let u = rot.world(splat3(l, &axis), two);
+        let qi = per_row(l, qi);
+        frame.t = V4 {
+            x: frame.t.x + u.x * qi,
+            y: frame.t.y + u.y * qi,
+            z: frame.t.z + u.z * qi,
+        };
+    }
+    frame
+}
+
+/// The springs (`turns::Springs` with the loads and the exact product) of the frames
+/// `springs` about the rigid TCP at `p` \[m\] under the rows' wrenches \[N, N m\], each row's
+/// spring k in lane r, the four runs of springs one after the other: the product of the
+/// springs' turns and each row's largest elastic angle \[rad\].
+#[inline(always)]
+fn spring_turns<L: Lanes>(
+    l: L,
+    consts: &Consts<L>,
+    model: &Model,
+    springs: &[Motion4<L::V>; MAX_SPRINGS],
+    p: V4<L::V>,
+    wrench: &[&Vector6; ROWS],
+) -> (Motion4<L::V>, L::V) {
+    let two = consts.two;
+    let column = |i: usize| per_row(l, |r| wrench.get(r).map_or(0.0, |w| w[i]));
+    let force = V4 {
+        x: column(0),
+        y: column(1),
+        z: column(2),
+    };
+    let moment = V4 {
+        x: column(3),
+        y: column(4),
+        z: column(5),
+    };
+    let n = model.springs;
+    let run = n.div_ceil(4);
+    let mut largest = consts.zero;
+    let mut runs = [consts.identity; 4];
+    // Step c turns spring g run + c of every run g: four independent products at once.
+    for c in 0..run {
+        for (g, acc) in runs.iter_mut().enumerate() {
+            let k = g * run + c;
+            let (Some(f), Some(cs)) = (springs.get(k), model.spring_compliance.get(k)) else {
+                continue;
+            };
+            if k >= n {
+                continue;
+            }
+            let frames = Frames4 {
+                w: f.w,
+                u: f.u,
+                o: f.t,
+            };
+            let lever = V4 {
+                x: p.x - frames.o.x,
+                y: p.y - frames.o.y,
+                z: p.z - frames.o.z,
+            };
+            let (_, a) = frames.loads(lever, force, moment, splat3(l, cs), two);
+            let big = l.max(l.max(l.abs(a.x), l.abs(a.y)), l.abs(a.z));
+            largest = l.max(largest, big);
+            *acc = acc.then(frames.turn(l, a, p, two), two);
+        }
+    }
+    let [r0, r1, r2, r3] = runs;
+    let total = r0.then(r1, two).then(r2.then(r3, two), two);
+    (total, largest)
 }
 
 #[cfg(test)]
