@@ -17,19 +17,55 @@ pub(crate) struct Axis<'a> {
     pub inv_step: f64,
 }
 
+/// A grid axis as errors name it: the 2-D map's `x` and `y`, or axis `k` (0 to 3) of an N-D
+/// grid. The names are static strings because the errors carry `&'static str`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum AxisId {
+    /// The 2-D map's x axis.
+    X,
+    /// The 2-D map's y axis.
+    Y,
+    /// Axis `k` of an N-D grid, `k < MAX_GRID_DIMS` (the N-D grid needs `alloc`).
+    #[cfg_attr(not(feature = "alloc"), allow(dead_code))]
+    Grid(usize),
+}
+
+/// The N-D grid axes' names, then their node lists' names.
+const GRID_NAMES: [&str; 4] = ["axis 0", "axis 1", "axis 2", "axis 3"];
+const GRID_NODE_NAMES: [&str; 4] = [
+    "axis 0 nodes",
+    "axis 1 nodes",
+    "axis 2 nodes",
+    "axis 3 nodes",
+];
+
+impl AxisId {
+    /// The axis' name in errors ("x", "axis 2").
+    pub(crate) fn name(self) -> &'static str {
+        match self {
+            Self::X => "x",
+            Self::Y => "y",
+            Self::Grid(k) => GRID_NAMES.get(k).copied().unwrap_or("grid axis"),
+        }
+    }
+
+    /// The name of the axis' node list in errors ("x nodes", "axis 2 nodes").
+    fn nodes_name(self) -> &'static str {
+        match self {
+            Self::X => "x nodes",
+            Self::Y => "y nodes",
+            Self::Grid(k) => GRID_NODE_NAMES.get(k).copied().unwrap_or("grid axis nodes"),
+        }
+    }
+}
+
 /// Checks an axis (at least 2 nodes, finite, strictly increasing) and returns `1/step` when
 /// it is evenly spaced, else `0.0`.
-pub(crate) fn check_axis(axis: &'static str, nodes: &[f64]) -> Result<f64, BuildError> {
+pub(crate) fn check_axis(id: AxisId, nodes: &[f64]) -> Result<f64, BuildError> {
+    let axis = id.name();
     if nodes.len() < 2 {
         return Err(BuildError::TooFew {
-            what: match axis {
-                "x" => "x nodes",
-                "y" => "y nodes",
-                "axis 0" => "axis 0 nodes",
-                "axis 1" => "axis 1 nodes",
-                "axis 2" => "axis 2 nodes",
-                _ => "axis 3 nodes",
-            },
+            what: id.nodes_name(),
             needed: 2,
             got: nodes.len(),
         });

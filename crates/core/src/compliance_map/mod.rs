@@ -62,6 +62,8 @@ mod fit_stats;
 mod map;
 #[cfg(feature = "alloc")]
 mod nd;
+#[cfg(feature = "alloc")]
+mod nd_fit;
 
 #[cfg(feature = "alloc")]
 pub use cross_validation::{CrossValidation, HeldOutNode, HoldOutAxis, leave_one_node_out};
@@ -77,7 +79,9 @@ pub use interp::{BatchError, BatchSummary};
 #[cfg(feature = "alloc")]
 pub use map::ComplianceMap;
 #[cfg(feature = "alloc")]
-pub use nd::{GridMap, GridMeasurement, MAX_GRID_DIMS, MAX_GRID_NODES, fit_grid};
+pub use nd::{GridMap, MAX_GRID_DIMS, MAX_GRID_NODES};
+#[cfg(feature = "alloc")]
+pub use nd_fit::{GridMeasurement, fit_grid};
 pub use view::ComplianceMapView;
 
 use crate::error::{Placement, TickError};

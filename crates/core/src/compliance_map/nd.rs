@@ -18,10 +18,9 @@ use alloc::string::{String, ToString};
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::fit::{FitOptions, cluster, fit_lines, grouped_order};
-use super::grid::{Axis, Stencil, check_axis};
+use super::grid::{Axis, AxisId, Stencil, check_axis};
 use super::view::check_counts;
-use super::{ComplianceMap, MAX_AXES, MAX_MEASUREMENTS, QueryOptions};
+use super::{ComplianceMap, QueryOptions};
 use crate::error::{BuildError, Placement, TickError};
 
 /// Most grid dimensions of a [`GridMap`].
@@ -30,9 +29,6 @@ pub const MAX_GRID_DIMS: usize = 4;
 /// Most nodes of a [`GridMap`]: 2^20 (a 32^4 grid), 8 MiB of coefficients per force and
 /// displacement axis pair; a typed [`BuildError::Budget`] past it.
 pub const MAX_GRID_NODES: usize = 1 << 20;
-
-/// How axes are named in errors (the names a user gives are `String`s).
-const AXIS: [&str; MAX_GRID_DIMS] = ["axis 0", "axis 1", "axis 2", "axis 3"];
 
 /// A compliance map over a 1-4 dimensional rectilinear grid (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
@@ -91,8 +87,8 @@ impl GridMap {
         }
         let mut inv_steps = [0.0; MAX_GRID_DIMS];
         let mut nodes = 1usize;
-        for ((axis, nodes_k), inv) in AXIS.iter().zip(&axes).zip(inv_steps.iter_mut()) {
-            *inv = check_axis(axis, nodes_k)?;
+        for (k, (nodes_k, inv)) in axes.iter().zip(inv_steps.iter_mut()).enumerate() {
+            *inv = check_axis(AxisId::Grid(k), nodes_k)?;
             nodes = nodes.saturating_mul(nodes_k.len());
         }
         if nodes > MAX_GRID_NODES {
@@ -141,9 +137,13 @@ impl GridMap {
     pub fn from_map(map: &ComplianceMap) -> Self {
         let (x, y) = (map.x().to_vec(), map.y().to_vec());
         let mut inv_steps = [0.0; MAX_GRID_DIMS];
-        for (inv, nodes) in inv_steps.iter_mut().zip([&x, &y]) {
+        for ((inv, nodes), id) in inv_steps
+            .iter_mut()
+            .zip([&x, &y])
+            .zip([AxisId::X, AxisId::Y])
+        {
             // The map's axes were checked when it was built.
-            *inv = check_axis("x", nodes).unwrap_or(0.0);
+            *inv = check_axis(id, nodes).unwrap_or(0.0);
         }
         Self {
             strides: [y.len(), 1, 0, 0],
@@ -374,213 +374,4 @@ fn worse(a: Placement, b: Placement) -> Placement {
         Placement::Extrapolated => 2,
     };
     if rank(b) > rank(a) { b } else { a }
-}
-
-/// One static-test reading on an N-D grid: at node `point` (its first `dims` entries) a force
-/// `force` \[N\] (moment \[N m\]) along force axis `force_axis` only, and the measured
-/// `displacement` (first `n_displacement` entries \[m | rad\]).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct GridMeasurement {
-    /// Node coordinates; entries past the grid's dimensions are ignored.
-    pub point: [f64; MAX_GRID_DIMS],
-    /// Loaded force axis, `0..n_force`.
-    pub force_axis: usize,
-    /// Force level \[N\] (moment \[N m\]).
-    pub force: f64,
-    /// Measured displacement; the first `n_displacement` entries are used.
-    pub displacement: [f64; MAX_AXES],
-}
-
-impl GridMeasurement {
-    /// A reading at `point` (at most 4 coordinates; missing ones 0) with the displacement
-    /// copied from `displacement` (at most 6 entries).
-    pub fn new(point: &[f64], force_axis: usize, force: f64, displacement: &[f64]) -> Self {
-        let mut p = [0.0; MAX_GRID_DIMS];
-        p.iter_mut().zip(point).for_each(|(a, b)| *a = *b);
-        let mut d = [0.0; MAX_AXES];
-        d.iter_mut().zip(displacement).for_each(|(a, b)| *a = *b);
-        Self {
-            point: p,
-            force_axis,
-            force,
-            displacement: d,
-        }
-    }
-}
-
-/// Fits a grid map over `names.len()` axes (1..=4) from static tests, as [`super::fit()`]
-/// does in 2-D (Eq. 10-13): readings grouped by node (coordinates within
-/// `options.position_tolerance` share a grid line, every node of the grid of distinct
-/// coordinates needs readings) and by force axis; per node, force axis and displacement axis
-/// the least-squares line, each force axis keeping its intercept as its offset.
-///
-/// Errors name the reading (row and column) or the node: non-finite values, a force axis
-/// `>= n_force`, ambiguous coordinates, a missing node ([`BuildError::MissingGridNode`]), a
-/// repeated (node, axis, force), fewer than 2 force levels, past [`MAX_MEASUREMENTS`] or
-/// [`MAX_GRID_NODES`].
-pub fn fit_grid(
-    names: Vec<String>,
-    measurements: &[GridMeasurement],
-    options: &FitOptions,
-) -> Result<GridMap, BuildError> {
-    let (nf, nd) = (options.n_force, options.n_displacement);
-    check_counts(nf, nd)?;
-    let dims = names.len();
-    if dims == 0 || dims > MAX_GRID_DIMS {
-        return Err(BuildError::InvalidParameter {
-            what: "grid dimensions",
-            value: dims as f64,
-            expected: "1 to 4 axes",
-        });
-    }
-    if measurements.len() > MAX_MEASUREMENTS {
-        return Err(BuildError::Budget {
-            what: "measurements",
-            budget: "MAX_MEASUREMENTS",
-            limit: MAX_MEASUREMENTS,
-            requested: measurements.len(),
-        });
-    }
-    for (row, m) in measurements.iter().enumerate() {
-        for (column, v) in AXIS.iter().zip(&m.point).take(dims) {
-            if !v.is_finite() {
-                return Err(BuildError::NonFiniteMeasurement { row, column });
-            }
-        }
-        if !m.force.is_finite() {
-            return Err(BuildError::NonFiniteMeasurement {
-                row,
-                column: "force",
-            });
-        }
-        for (column, v) in super::fit::DISPLACEMENT_COLUMNS
-            .iter()
-            .zip(&m.displacement)
-            .take(nd)
-        {
-            if !v.is_finite() {
-                return Err(BuildError::NonFiniteMeasurement { row, column });
-            }
-        }
-        if m.force_axis >= nf {
-            return Err(BuildError::ForceAxisOutOfRange {
-                row,
-                force_axis: m.force_axis,
-                n_force: nf,
-            });
-        }
-    }
-    // Grid lines per axis and each reading's node.
-    let mut axes = Vec::with_capacity(dims);
-    let mut node_of = vec![0usize; measurements.len()];
-    for (k, axis) in AXIS.iter().enumerate().take(dims) {
-        let values: Vec<f64> = measurements
-            .iter()
-            .map(|m| m.point.get(k).copied().unwrap_or(0.0))
-            .collect();
-        let (centres, line_of) = cluster(&values, axis, options.position_tolerance)?;
-        for (n, l) in node_of.iter_mut().zip(&line_of) {
-            *n = n.saturating_mul(centres.len()).saturating_add(*l);
-        }
-        axes.push(centres);
-    }
-    let nodes: usize = axes.iter().map(Vec::len).product();
-    for (axis, a) in AXIS.iter().zip(&axes) {
-        if a.len() < 2 {
-            return Err(BuildError::TooFew {
-                what: axis,
-                needed: 2,
-                got: a.len(),
-            });
-        }
-    }
-    if nodes > MAX_GRID_NODES {
-        return Err(BuildError::Budget {
-            what: "grid nodes",
-            budget: "MAX_GRID_NODES",
-            limit: MAX_GRID_NODES,
-            requested: nodes,
-        });
-    }
-    let coordinates = |node: usize| {
-        let mut out = [0.0; MAX_GRID_DIMS];
-        let mut rest = node;
-        for k in (0..dims).rev() {
-            let len = axes.get(k).map_or(1, Vec::len).max(1);
-            if let Some(o) = out.get_mut(k) {
-                *o = axes
-                    .get(k)
-                    .and_then(|a| a.get(rest % len))
-                    .copied()
-                    .unwrap_or(0.0);
-            }
-            rest /= len;
-        }
-        out
-    };
-    let key = |r: usize| {
-        let m = measurements.get(r);
-        (
-            node_of.get(r).copied().unwrap_or(0),
-            m.map_or(0, |m| m.force_axis),
-            m.map_or(0.0, |m| m.force),
-        )
-    };
-    let order = grouped_order(measurements.len(), key)?;
-    let mut measured = vec![false; nodes];
-    for n in &node_of {
-        if let Some(m) = measured.get_mut(*n) {
-            *m = true;
-        }
-    }
-    if let Some(node) = measured.iter().position(|m| !*m) {
-        return Err(BuildError::MissingGridNode {
-            node: coordinates(node),
-            dims,
-        });
-    }
-    let block = nd * nf;
-    let mut slopes = vec![0.0; nodes * block];
-    let mut offsets = vec![0.0; nodes * block];
-    let mut pos = 0usize;
-    for node in 0..nodes {
-        for f in 0..nf {
-            let begin = pos;
-            while order
-                .get(pos)
-                .is_some_and(|r| key(*r).0 == node && key(*r).1 == f)
-            {
-                pos += 1;
-            }
-            let rows = order.get(begin..pos).unwrap_or(&[]);
-            if rows.len() < 2 {
-                return Err(BuildError::TooFewGridForceLevels {
-                    node: coordinates(node),
-                    dims,
-                    force_axis: f,
-                    levels: rows.len(),
-                });
-            }
-            let group: Vec<(f64, [f64; MAX_AXES])> = rows
-                .iter()
-                .filter_map(|r| measurements.get(*r))
-                .map(|m| (m.force, m.displacement))
-                .collect();
-            let (_, lines) = fit_lines(&group, nd);
-            for (d, line) in lines.iter().enumerate().take(nd) {
-                let idx = node * block + d * nf + f;
-                if let (Some(s), Some(o)) = (slopes.get_mut(idx), offsets.get_mut(idx)) {
-                    *s = line.slope;
-                    *o = line.offset;
-                }
-            }
-        }
-    }
-    if let Some(index) = slopes.iter().chain(&offsets).position(|v| !v.is_finite()) {
-        return Err(BuildError::NonFinite {
-            what: "fitted slopes then offsets: forces or displacements too large",
-            index,
-        });
-    }
-    GridMap::new(axes, names, nf, nd, slopes, offsets)
 }

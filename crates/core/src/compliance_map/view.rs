@@ -72,8 +72,8 @@ impl<'a> ComplianceMapView<'a> {
         offsets: &'a [f64],
     ) -> Result<Self, BuildError> {
         check_counts(n_force, n_displacement)?;
-        let xi = grid::check_axis("x", x)?;
-        let yi = grid::check_axis("y", y)?;
+        let xi = grid::check_axis(grid::AxisId::X, x)?;
+        let yi = grid::check_axis(grid::AxisId::Y, y)?;
         check_coefficients(x.len() * y.len(), n_force, n_displacement, slopes, offsets)?;
         Ok(Self {
             x: grid::Axis {
