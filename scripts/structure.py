@@ -29,7 +29,12 @@ MAX_FN_LINES = 100
 FN_CRATES = ["core", "sim", "py"]
 
 # Known exceptions, each with its reason: "path" or "path:function".
-EXCEPTIONS: dict[str, str] = {}
+EXCEPTIONS: dict[str, str] = {
+    "crates/core/src/error/build.rs:fmt": "Display of BuildError: one match arm per variant, "
+    "each a message; splitting it would scatter the messages of one type",
+    "crates/core/src/error/load.rs:fmt": "Display of LoadError: one match arm per variant, "
+    "each a message; splitting it would scatter the messages of one type",
+}
 
 ITEM = re.compile(
     r"^\s*(?:#\[[^\]]*\]\s*)*(?:pub(?:\s*\([^)]*\))?\s+)?(?:unsafe\s+|const\s+|async\s+|extern\s+\"C\"\s+)*"
