@@ -44,6 +44,9 @@ use crate::machining::{
 };
 use crate::units::LengthUnit;
 
+mod args;
+use args::{Arg, fault, numbers, parse_args, point_and_axis, word};
+
 /// How far from unit length a tool vector may be and be normalised: 1e-3 (a vector printed
 /// to 4 decimals is within 2e-4; one further off is not a tool vector but a typo).
 pub const AXIS_NORM_TOLERANCE: f64 = 1.0e-3;
@@ -74,22 +77,6 @@ pub struct AptProgram {
 /// Reads an APT / CL file (see the module docs).
 pub fn from_path(path: impl AsRef<Path>, options: &GcodeOptions) -> Result<AptProgram, LoadError> {
     from_str(&super::read_text_lossy(path.as_ref())?, options)
-}
-
-/// A fault at `line`, column 1: the statement.
-fn fault<T>(line: usize, message: impl Into<String>) -> Result<T, LoadError> {
-    Err(LoadError::Program {
-        line,
-        column: 1,
-        message: message.into(),
-    })
-}
-
-/// One argument: a number or a word (upper-cased).
-#[derive(Debug, Clone, PartialEq)]
-enum Arg {
-    Number(f64),
-    Word(String),
 }
 
 /// Reads APT text (see the module docs); `options.start` is where the tool is before the
@@ -573,58 +560,4 @@ fn unit_axis(line: usize, what: &str, i: f64, j: f64, k: f64) -> Result<Vector3<
         );
     }
     Ok(v / n)
-}
-
-/// The word at `i`, if that argument is one.
-fn word(args: &[Arg], i: usize) -> Option<String> {
-    match args.get(i) {
-        Some(Arg::Word(w)) => Some(w.clone()),
-        _ => None,
-    }
-}
-
-/// The first `N` arguments, numbers (more may follow).
-fn numbers<const N: usize>(line: usize, form: &str, args: &[Arg]) -> Result<[f64; N], LoadError> {
-    let mut out = [0.0; N];
-    for (i, o) in out.iter_mut().enumerate() {
-        match args.get(i) {
-            Some(Arg::Number(v)) => *o = *v,
-            _ => return fault(line, format!("{form} ({N} numbers)")),
-        }
-    }
-    Ok(out)
-}
-
-/// A point and, with 6 numbers, a tool vector (unnormalised): 3 or 6 numbers, nothing else.
-fn point_and_axis(
-    line: usize,
-    form: &str,
-    args: &[Arg],
-) -> Result<([f64; 3], Option<[f64; 3]>), LoadError> {
-    match args.len() {
-        3 => Ok((numbers::<3>(line, form, args)?, None)),
-        6 => {
-            let [x, y, z, i, j, k] = numbers::<6>(line, form, args)?;
-            Ok(([x, y, z], Some([i, j, k])))
-        }
-        n => fault(line, format!("{form} (3 or 6 numbers), got {n} values")),
-    }
-}
-
-/// Splits `a, b, c` into numbers and words.
-fn parse_args(line: usize, text: &str) -> Result<Vec<Arg>, LoadError> {
-    text.split(',')
-        .map(|t| t.trim())
-        .filter(|t| !t.is_empty())
-        .map(|t| {
-            if t.starts_with(|c: char| c.is_ascii_digit() || matches!(c, '-' | '+' | '.')) {
-                match t.parse::<f64>() {
-                    Ok(v) if v.is_finite() => Ok(Arg::Number(v)),
-                    _ => fault(line, format!("a finite number, got {t}")),
-                }
-            } else {
-                Ok(Arg::Word(t.to_ascii_uppercase()))
-            }
-        })
-        .collect()
 }

@@ -48,37 +48,12 @@ impl Machine {
                 "G18/G19 arcs in a rotated coordinate system (G10 L2 R) are not modelled",
             );
         }
-        // The centre words of the plane's first and second axes, and the one of its normal.
-        let (first, second, off) = match plane {
-            Plane::Xy => (b'i', b'j', b'k'),
-            Plane::Zx => (b'k', b'i', b'j'),
-            Plane::Yz => (b'j', b'k', b'i'),
-        };
+        let (first, second, off) = centre_letters(plane);
         self.off_plane_word(w, off, (first, second))?;
-        let radius_word = w.peek(b'r');
-        match (w.has(first) || w.has(second), radius_word.is_some()) {
-            (true, true) => {
-                return fault(
-                    w.column(b'r'),
-                    "either a centre (I, J, K) or a radius R on an arc, not both",
-                );
-            }
-            (false, false) => {
-                return fault(
-                    column,
-                    "an arc needs its centre (I, J, K in its plane) or its radius R",
-                );
-            }
-            _ => {}
-        }
+        let radius_word = centre_form(w, (first, second), column)?;
         let turns = turns(w)?;
         let (a, b, n) = plane.axes();
-        let in_plane = [b'x', b'y', b'z']
-            .iter()
-            .enumerate()
-            .any(|(k, l)| (k == a || k == b) && w.has(*l))
-            || w.has(b'@')
-            || w.has(b'^');
+        let in_plane = ends_in_plane(w, (a, b));
         let start = self.pos;
         let end_column = w.first_of(b"xyz@^").unwrap_or(column);
         let end = self.target(w)?;
@@ -88,32 +63,57 @@ impl Machine {
             end: Vector2::new(get(&end, a), get(&end, b)),
         };
         let centre = match radius_word {
-            Some(r) => {
-                if !in_plane {
-                    return fault(
-                        column,
-                        std::format!(
-                            "an R arc needs an end point in its plane ({})",
-                            plane.gcode()
-                        ),
-                    );
-                }
-                let r_column = w.column(b'r');
-                w.take(b'r');
-                self.radius_centre(&ends, r, clockwise, (column, r_column))?
-            }
+            Some(r) => self.r_word_centre(w, &ends, r, clockwise, in_plane, column)?,
             None => self.centre_words(w, &ends, (first, second), column)?,
         };
         let r1 = self.check_radii(&ends, &centre, radius_word.is_none(), (column, end_column))?;
-        let extra = f64::from(turns - 1) * core::f64::consts::TAU;
-        let base = sweep(&ends.start, &ends.end, &centre, clockwise);
-        let sweep = if clockwise {
-            base - extra
-        } else {
-            base + extra
-        };
+        let sweep = turned_sweep(&ends, &centre, clockwise, turns);
         let length = (r1 * sweep.abs()).hypot(get(&end, n) - get(&start, n));
         let feed = self.speed(w, length, column)?;
+        let c = self.centre_point(start, &centre, (a, b), column)?;
+        let motion = Motion::Arc {
+            plane,
+            center: c,
+            sweep,
+        };
+        self.emit(motion, end, feed, column)
+    }
+
+    /// The centre of an `R` arc, its `R` word taken: refused without an end point in the
+    /// plane (`in_plane`), else [`Self::radius_centre`] \[m\].
+    fn r_word_centre(
+        &self,
+        w: &mut Words,
+        ends: &Ends,
+        r: f64,
+        clockwise: bool,
+        in_plane: bool,
+        column: usize,
+    ) -> Result<Vector2<f64>, Fault> {
+        if !in_plane {
+            return fault(
+                column,
+                std::format!(
+                    "an R arc needs an end point in its plane ({})",
+                    self.plane.gcode()
+                ),
+            );
+        }
+        let r_column = w.column(b'r');
+        w.take(b'r');
+        self.radius_centre(ends, r, clockwise, (column, r_column))
+    }
+
+    /// The program-frame centre of the arc: `start` with its plane coordinates (`a`, `b`)
+    /// replaced by the in-plane `centre` \[m\], refused when its machine-frame point is
+    /// beyond [`MAX_COORDINATE`].
+    fn centre_point(
+        &self,
+        start: Vector3<f64>,
+        centre: &Vector2<f64>,
+        (a, b): (usize, usize),
+        column: usize,
+    ) -> Result<Vector3<f64>, Fault> {
         let mut c = start;
         if let Some(x) = c.get_mut(a) {
             *x = centre.x;
@@ -131,12 +131,7 @@ impl Machine {
                 std::format!("an arc centre within +-{MAX_COORDINATE} m, got {v} m"),
             );
         }
-        let motion = Motion::Arc {
-            plane,
-            center: c,
-            sweep,
-        };
-        self.emit(motion, end, feed, column)
+        Ok(c)
     }
 
     /// The centre word along the plane's normal: LinuxCNC refuses it, grbl ignores it.
@@ -286,6 +281,55 @@ fn turns(w: &mut Words) -> Result<u32, Fault> {
                 "a number of turns P in 1..={MAX_ARC_TURNS} (an integer) on an arc, got P{p}"
             ),
         ),
+    }
+}
+
+/// The centre words of the plane's first and second axes, and the one of its normal.
+fn centre_letters(plane: Plane) -> (u8, u8, u8) {
+    match plane {
+        Plane::Xy => (b'i', b'j', b'k'),
+        Plane::Zx => (b'k', b'i', b'j'),
+        Plane::Yz => (b'j', b'k', b'i'),
+    }
+}
+
+/// How the arc gives its centre: the `R` word (returned, program units) or the centre words
+/// `first`, `second` (`None`); refused with both or neither.
+fn centre_form(w: &Words, (first, second): (u8, u8), column: usize) -> Result<Option<f64>, Fault> {
+    let radius_word = w.peek(b'r');
+    match (w.has(first) || w.has(second), radius_word.is_some()) {
+        (true, true) => fault(
+            w.column(b'r'),
+            "either a centre (I, J, K) or a radius R on an arc, not both",
+        ),
+        (false, false) => fault(
+            column,
+            "an arc needs its centre (I, J, K in its plane) or its radius R",
+        ),
+        _ => Ok(radius_word),
+    }
+}
+
+/// Whether the block gives an end point in the plane of axes `a`, `b` (an axis word of
+/// either, or a polar word), as an `R` arc needs.
+fn ends_in_plane(w: &Words, (a, b): (usize, usize)) -> bool {
+    [b'x', b'y', b'z']
+        .iter()
+        .enumerate()
+        .any(|(k, l)| (k == a || k == b) && w.has(*l))
+        || w.has(b'@')
+        || w.has(b'^')
+}
+
+/// The arc's signed sweep \[rad\] with its `turns`: [`sweep`] plus a full turn for each turn
+/// past the first, in the arc's direction.
+fn turned_sweep(ends: &Ends, centre: &Vector2<f64>, clockwise: bool, turns: u32) -> f64 {
+    let extra = f64::from(turns - 1) * core::f64::consts::TAU;
+    let base = sweep(&ends.start, &ends.end, centre, clockwise);
+    if clockwise {
+        base - extra
+    } else {
+        base + extra
     }
 }
 

@@ -82,23 +82,7 @@ impl Machine {
             Plane::Yz => ((1, 2, 0), b'x'),
         };
         let axis_name = char::from(depth_letter.to_ascii_uppercase());
-        let Some(r_word) = w.take(b'r').or(if same { self.cycle.r } else { None }) else {
-            return fault(
-                column,
-                std::format!("{name}: R, the retract plane (needed on a cycle's first block)"),
-            );
-        };
-        let Some(depth_word) = w
-            .take(depth_letter)
-            .or(if same { self.cycle.depth } else { None })
-        else {
-            return fault(
-                column,
-                std::format!(
-                    "{name}: {axis_name}, the hole's depth (needed on a cycle's first block)"
-                ),
-            );
-        };
+        let (r_word, depth_word) = self.cycle_levels(w, depth_letter, same, &name, column)?;
         let (ia, ib, ic) = axes;
         let here = |m: &Self, k: usize| m.pos.get(k).copied().unwrap_or(0.0) / m.units;
         let initial = match self.cycle.initial {
@@ -140,21 +124,68 @@ impl Machine {
             let (a, b) = holes
                 .next()
                 .map_err(|e| (column, std::format!("{name}: {e}")))?;
-            let c = here(self, ic);
-            if rep == 0 && c > r {
-                let p = self.cycle_point(&g, a, b, c);
-                self.emit(Motion::Rapid, p, 0.0, column)?;
-                self.rapid_to(&g, a, b, r, column)?;
-            } else {
-                self.rapid_to(&g, a, b, g.clear, column)?;
-                if g.clear > r {
-                    self.rapid_to(&g, a, b, r, column)?;
-                }
-            }
+            self.approach(&g, a, b, rep == 0, column)?;
             self.cycle_body(&g, &body, a, b, w, code, column)?;
         }
         self.cycle.r = Some(r_word);
         self.cycle.depth = Some(depth_word);
+        Ok(())
+    }
+
+    /// The block's R and depth words (the drilling axis' letter `depth_letter`), program
+    /// units: its own, or in a series of the same cycle (`same`) the remembered ones.
+    fn cycle_levels(
+        &self,
+        w: &mut Words,
+        depth_letter: u8,
+        same: bool,
+        name: &str,
+        column: usize,
+    ) -> Result<(f64, f64), Fault> {
+        let axis_name = char::from(depth_letter.to_ascii_uppercase());
+        let Some(r_word) = w.take(b'r').or(if same { self.cycle.r } else { None }) else {
+            return fault(
+                column,
+                std::format!("{name}: R, the retract plane (needed on a cycle's first block)"),
+            );
+        };
+        let Some(depth_word) = w
+            .take(depth_letter)
+            .or(if same { self.cycle.depth } else { None })
+        else {
+            return fault(
+                column,
+                std::format!(
+                    "{name}: {axis_name}, the hole's depth (needed on a cycle's first block)"
+                ),
+            );
+        };
+        Ok((r_word, depth_word))
+    }
+
+    /// The rapid moves to R over the hole at (`a`, `b`): for the block's `first` hole when
+    /// the tool is above R, straight across at its height and down, else by way of the clear
+    /// height. Program units.
+    fn approach(
+        &mut self,
+        g: &Geometry,
+        a: f64,
+        b: f64,
+        first: bool,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let r = g.r;
+        let c = self.pos.get(g.axes.2).copied().unwrap_or(0.0) / self.units;
+        if first && c > r {
+            let p = self.cycle_point(g, a, b, c);
+            self.emit(Motion::Rapid, p, 0.0, column)?;
+            self.rapid_to(g, a, b, r, column)?;
+        } else {
+            self.rapid_to(g, a, b, g.clear, column)?;
+            if g.clear > r {
+                self.rapid_to(g, a, b, r, column)?;
+            }
+        }
         Ok(())
     }
 
@@ -264,6 +295,13 @@ impl Machine {
                 }
             }
         }
+        self.check_cycle_spindle(code, name, column)?;
+        Ok(body)
+    }
+
+    /// The spindle a cycle needs turning: `G74` counter-clockwise, `G84` clockwise, `G86`,
+    /// `G87` and `G88` either way.
+    fn check_cycle_spindle(&self, code: u16, name: &str, column: usize) -> Result<(), Fault> {
         if matches!(code, 740 | 840 | 860 | 870 | 880) {
             let want = if code == 740 { -1 } else { 1 };
             if self.spindle_dir == 0 || (matches!(code, 740 | 840) && self.spindle_dir != want) {
@@ -282,9 +320,11 @@ impl Machine {
                 );
             }
         }
-        Ok(body)
+        Ok(())
     }
 
+    /// The moves of one hole at (`a`, `b`) from R: the cycle's body down to the bottom and
+    /// out to the clear height. Program units.
     #[allow(clippy::too_many_arguments)] // reason: the cycle's geometry, its words and where it runs
     fn cycle_body(
         &mut self,
@@ -308,25 +348,7 @@ impl Machine {
                 dwell(self)?;
                 self.rapid_to(g, a, b, clear, column)?;
             }
-            730 | 830 => {
-                let delta = PECK_CLEARANCE / self.units;
-                let mut d = r - body.q;
-                let mut pecks = 0u32;
-                while d > bottom {
-                    pecks += 1;
-                    if pecks > 100_000 {
-                        return fault(column, "at most 100000 pecks in one hole");
-                    }
-                    self.feed_to(g, a, b, d, w, column)?;
-                    if code == 830 {
-                        self.rapid_to(g, a, b, r, column)?;
-                    }
-                    self.rapid_to(g, a, b, d + delta, column)?;
-                    d -= body.q;
-                }
-                self.feed_to(g, a, b, bottom, w, column)?;
-                self.rapid_to(g, a, b, clear, column)?;
-            }
+            730 | 830 => self.peck_drill(g, body, a, b, w, code, column)?,
             740 | 840 => {
                 // Tapping: feed in, reverse, dwell, feed out, restore.
                 self.feed_to(g, a, b, bottom, w, column)?;
@@ -352,33 +374,7 @@ impl Machine {
                 self.rapid_to(g, a, b, clear, column)?;
                 self.spindle_dir = dir;
             }
-            870 => {
-                let dir = self.spindle_dir;
-                let (i, j, k) = (
-                    self.cycle.i.unwrap_or(0.0),
-                    self.cycle.j.unwrap_or(0.0),
-                    self.cycle.k.unwrap_or(0.0),
-                );
-                // The offset words of the plane's axes and the middle (counterbore top).
-                let (oa, ob, mid) = match self.plane {
-                    Plane::Xy => (i, j, k),
-                    Plane::Zx => (k, i, j),
-                    Plane::Yz => (j, k, i),
-                };
-                let mid = if self.absolute { mid } else { bottom + mid };
-                self.rapid_to(g, a + oa, b + ob, r, column)?;
-                self.spindle_dir = 0;
-                self.rapid_to(g, a + oa, b + ob, bottom, column)?;
-                self.rapid_to(g, a, b, bottom, column)?;
-                self.spindle_dir = dir;
-                self.feed_to(g, a, b, mid, w, column)?;
-                self.feed_to(g, a, b, bottom, w, column)?;
-                self.spindle_dir = 0;
-                self.rapid_to(g, a + oa, b + ob, bottom, column)?;
-                self.rapid_to(g, a + oa, b + ob, clear, column)?;
-                self.rapid_to(g, a, b, clear, column)?;
-                self.spindle_dir = dir;
-            }
+            870 => self.back_bore(g, a, b, w, column)?,
             890 => {
                 self.feed_to(g, a, b, bottom, w, column)?;
                 dwell(self)?;
@@ -386,6 +382,82 @@ impl Machine {
             }
             _ => return fault(column, std::format!("{}: not a canned cycle", g_name(code))),
         }
+        Ok(())
+    }
+
+    /// `G73` (chip break: back up [`PECK_CLEARANCE`]) and `G83` (out to R and back to
+    /// [`PECK_CLEARANCE`] above the last depth): feed down `Q` at a time to the bottom, then
+    /// out at rapid. Heights in program units.
+    #[allow(clippy::too_many_arguments)] // reason: the cycle's geometry, its words and where it runs
+    fn peck_drill(
+        &mut self,
+        g: &Geometry,
+        body: &Body,
+        a: f64,
+        b: f64,
+        w: &Words,
+        code: u16,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let (r, bottom, clear) = (g.r, g.bottom, g.clear);
+        let delta = PECK_CLEARANCE / self.units;
+        let mut d = r - body.q;
+        let mut pecks = 0u32;
+        while d > bottom {
+            pecks += 1;
+            if pecks > 100_000 {
+                return fault(column, "at most 100000 pecks in one hole");
+            }
+            self.feed_to(g, a, b, d, w, column)?;
+            if code == 830 {
+                self.rapid_to(g, a, b, r, column)?;
+            }
+            self.rapid_to(g, a, b, d + delta, column)?;
+            d -= body.q;
+        }
+        self.feed_to(g, a, b, bottom, w, column)?;
+        self.rapid_to(g, a, b, clear, column)?;
+        Ok(())
+    }
+
+    /// `G87`, the back bore: down to the bottom at rapid, offset by the plane's centre words
+    /// with the spindle stopped, then on the hole's axis feed to the middle height (the normal's
+    /// word: absolute, or from the bottom in `G91`) and back, and out at rapid offset again.
+    /// Heights in program units.
+    fn back_bore(
+        &mut self,
+        g: &Geometry,
+        a: f64,
+        b: f64,
+        w: &Words,
+        column: usize,
+    ) -> Result<(), Fault> {
+        let (r, bottom, clear) = (g.r, g.bottom, g.clear);
+        let dir = self.spindle_dir;
+        let (i, j, k) = (
+            self.cycle.i.unwrap_or(0.0),
+            self.cycle.j.unwrap_or(0.0),
+            self.cycle.k.unwrap_or(0.0),
+        );
+        // The offset words of the plane's axes and the middle (counterbore top).
+        let (oa, ob, mid) = match self.plane {
+            Plane::Xy => (i, j, k),
+            Plane::Zx => (k, i, j),
+            Plane::Yz => (j, k, i),
+        };
+        let mid = if self.absolute { mid } else { bottom + mid };
+        self.rapid_to(g, a + oa, b + ob, r, column)?;
+        self.spindle_dir = 0;
+        self.rapid_to(g, a + oa, b + ob, bottom, column)?;
+        self.rapid_to(g, a, b, bottom, column)?;
+        self.spindle_dir = dir;
+        self.feed_to(g, a, b, mid, w, column)?;
+        self.feed_to(g, a, b, bottom, w, column)?;
+        self.spindle_dir = 0;
+        self.rapid_to(g, a + oa, b + ob, bottom, column)?;
+        self.rapid_to(g, a + oa, b + ob, clear, column)?;
+        self.rapid_to(g, a, b, clear, column)?;
+        self.spindle_dir = dir;
         Ok(())
     }
 }

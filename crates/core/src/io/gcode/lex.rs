@@ -11,6 +11,7 @@ use std::vec::Vec;
 
 use super::Dialect;
 
+mod oword;
 mod value;
 
 /// Deepest nesting of brackets, functions and unary signs in one value: 128 (LinuxCNC's
@@ -405,57 +406,21 @@ impl Parser<'_> {
         (self.b.nodes.len() - 1) as u32
     }
 
+    /// The normalised line: an optional `/` (block delete) and line number, then one O-word
+    /// statement or the words and parameter settings, in order.
     fn line(&mut self) -> Result<(), LexError> {
         if self.peek() == Some(b'/') {
             self.b.delete = true;
             self.at += 1;
         }
-        if self.peek() == Some(b'n') {
-            self.at += 1;
-            let from = self.at;
-            while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
-                self.at += 1;
-            }
-            if self.at == from {
-                return self.err(std::format!(
-                    "digits after N (a line number), got {}",
-                    self.got()
-                ));
-            }
-            if self.peek() == Some(b'.') {
-                self.at += 1;
-                let frac = self.at;
-                while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
-                    self.at += 1;
-                }
-                if self.at == frac {
-                    return self.err("digits after the '.' of a line number".to_string());
-                }
-            }
-        }
+        self.line_number()?;
         if self.peek() == Some(b'o') {
             return self.o_word();
         }
         while let Some(c) = self.peek() {
             let column = self.column();
             match c {
-                b'#' => {
-                    self.at += 1;
-                    let target = self.param()?;
-                    if self.peek() != Some(b'=') {
-                        return self.err(std::format!(
-                            "'=' after the parameter (a parameter setting #n=value), got {}",
-                            self.got()
-                        ));
-                    }
-                    self.at += 1;
-                    let value = self.value()?;
-                    self.b.items.push(Item::Set {
-                        target,
-                        value,
-                        column,
-                    });
-                }
+                b'#' => self.setting(column)?,
                 b'a'..=b'z' | b'@' | b'^' | b'$' if c != b'n' && c != b'o' => {
                     self.at += 1;
                     if c != b'g'
@@ -495,6 +460,54 @@ impl Parser<'_> {
         Ok(())
     }
 
+    /// An optional `N` line number at the start: digits, then an optional `.` and digits.
+    fn line_number(&mut self) -> Result<(), LexError> {
+        if self.peek() == Some(b'n') {
+            self.at += 1;
+            let from = self.at;
+            while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
+                self.at += 1;
+            }
+            if self.at == from {
+                return self.err(std::format!(
+                    "digits after N (a line number), got {}",
+                    self.got()
+                ));
+            }
+            if self.peek() == Some(b'.') {
+                self.at += 1;
+                let frac = self.at;
+                while matches!(self.peek(), Some(c) if c.is_ascii_digit()) {
+                    self.at += 1;
+                }
+                if self.at == frac {
+                    return self.err("digits after the '.' of a line number".to_string());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A parameter setting `#n=value` (the `#` at the cursor), at `column`.
+    fn setting(&mut self, column: usize) -> Result<(), LexError> {
+        self.at += 1;
+        let target = self.param()?;
+        if self.peek() != Some(b'=') {
+            return self.err(std::format!(
+                "'=' after the parameter (a parameter setting #n=value), got {}",
+                self.got()
+            ));
+        }
+        self.at += 1;
+        let value = self.value()?;
+        self.b.items.push(Item::Set {
+            target,
+            value,
+            column,
+        });
+        Ok(())
+    }
+
     /// The run of letters from here (a keyword, a function's name) and where it starts.
     fn letters(&mut self) -> (usize, String) {
         let from = self.at;
@@ -503,87 +516,6 @@ impl Parser<'_> {
         }
         let run = self.b.text.get(from..self.at).unwrap_or(&[]);
         (from, run.iter().map(|&c| char::from(c)).collect())
-    }
-
-    fn o_word(&mut self) -> Result<(), LexError> {
-        let column = self.column();
-        self.at += 1;
-        let label = if self.peek() == Some(b'<') {
-            self.at += 1;
-            let (s, e) = self.name()?;
-            Label::Name(s, e)
-        } else {
-            Label::Value(self.value()?)
-        };
-        let (from, word) = self.letters();
-        let keyword = match word.as_str() {
-            "sub" => Keyword::Sub,
-            "endsub" => Keyword::Endsub,
-            "call" => Keyword::Call,
-            "do" => Keyword::Do,
-            "while" => Keyword::While,
-            "repeat" => Keyword::Repeat,
-            "if" => Keyword::If,
-            "elseif" => Keyword::Elseif,
-            "else" => Keyword::Else,
-            "endif" => Keyword::Endif,
-            "break" => Keyword::Break,
-            "continue" => Keyword::Continue,
-            "endwhile" => Keyword::Endwhile,
-            "endrepeat" => Keyword::Endrepeat,
-            "return" => Keyword::Return,
-            "" => Keyword::Header,
-            other => {
-                return Err((
-                    self.column_of(from),
-                    std::format!(
-                        "an O-word keyword (sub, endsub, call, return, if, elseif, else, \
-                         endif, while, endwhile, do, repeat, endrepeat, break, continue), got \
-                         {other:?}"
-                    ),
-                ));
-            }
-        };
-        let mut args = Vec::new();
-        match keyword {
-            Keyword::If | Keyword::Elseif | Keyword::While | Keyword::Repeat => {
-                if self.peek() != Some(b'[') {
-                    return self.err(std::format!(
-                        "a [condition] after '{}', got {}",
-                        keyword.name(),
-                        self.got()
-                    ));
-                }
-                args.push(self.value()?);
-            }
-            Keyword::Call => {
-                while self.peek() == Some(b'[') {
-                    if args.len() >= 30 {
-                        return self
-                            .err("at most 30 arguments to a subroutine (#1-#30)".to_string());
-                    }
-                    args.push(self.value()?);
-                }
-            }
-            Keyword::Endsub | Keyword::Return if self.peek() == Some(b'[') => {
-                args.push(self.value()?);
-            }
-            _ => {}
-        }
-        if self.peek().is_some() {
-            return self.err(std::format!(
-                "nothing after the O-word '{}' but a comment, got {}",
-                keyword.name(),
-                self.got()
-            ));
-        }
-        self.b.o_word = Some(OWord {
-            label,
-            keyword,
-            args,
-            column,
-        });
-        Ok(())
     }
 
     /// A name up to `>` (the `<` consumed); lower case, no spaces (normalised).

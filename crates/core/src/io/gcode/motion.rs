@@ -39,8 +39,39 @@ impl Machine {
             w.g.iter()
                 .find(|g| super::words_group(g.0) == Some(1))
                 .copied();
+        let Some(code) = self.motion_code(w, explicit, consumed)? else {
+            return Ok(());
+        };
+        let column = explicit.map_or_else(|| w.first_of(AXES).unwrap_or(1), |e| e.1);
+        self.check_g53(w, code)?;
+        if !is_cycle(code) {
+            self.cycle.initial = None;
+        }
+        if code != 50 {
+            self.spline_pq = None;
+        }
+        self.run_motion(w, code, column)?;
+        if code != 50 && code != 51 {
+            self.motion = Some(code);
+        }
+        if code <= 30 {
+            self.plain_motion = Some(code);
+        }
+        let _ = params;
+        Ok(())
+    }
+
+    /// The motion code the line runs: its own group-1 code (`explicit`, with its column), or
+    /// the modal one when axis words (or an arc's centre words) are given; `None` when it runs
+    /// none (`G80` cancels the motion mode here).
+    fn motion_code(
+        &mut self,
+        w: &Words,
+        explicit: Option<(u16, usize)>,
+        consumed: bool,
+    ) -> Result<Option<u16>, Fault> {
         let has_axes = !consumed && w.any_unused(AXES);
-        let code = match explicit {
+        match explicit {
             Some((800, column)) => {
                 if has_axes {
                     return fault(
@@ -50,7 +81,7 @@ impl Machine {
                 }
                 self.motion = None;
                 self.cycle.initial = None;
-                return Ok(());
+                Ok(None)
             }
             Some((code, column)) => {
                 if is_cycle(code) && !has_axes {
@@ -59,7 +90,7 @@ impl Machine {
                         std::format!("{}: a cycle needs axis words", g_name(code)),
                     );
                 }
-                code
+                Ok(Some(code))
             }
             None => {
                 let arc_words =
@@ -68,26 +99,28 @@ impl Machine {
                     if let Some(column) = w.g(530) {
                         return fault(column, "G53 needs axis words and G0 or G1");
                     }
-                    return Ok(());
+                    return Ok(None);
                 }
                 match self.motion.or(if self.dialect.motion_after_g80() {
                     self.plain_motion
                 } else {
                     None
                 }) {
-                    Some(code) => code,
-                    None => {
-                        return fault(
-                            w.first_of(AXES).unwrap_or(1),
-                            "axis words with no motion mode to use them (the line needs G0, G1, \
-                             G2, G3 or a cycle: G80 and the program start leave none; the fanuc \
-                             dialect moves in the last G0-G3 mode instead)",
-                        );
-                    }
+                    Some(code) => Ok(Some(code)),
+                    None => fault(
+                        w.first_of(AXES).unwrap_or(1),
+                        "axis words with no motion mode to use them (the line needs G0, G1, \
+                         G2, G3 or a cycle: G80 and the program start leave none; the fanuc \
+                         dialect moves in the last G0-G3 mode instead)",
+                    ),
                 }
             }
-        };
-        let column = explicit.map_or_else(|| w.first_of(AXES).unwrap_or(1), |e| e.1);
+        }
+    }
+
+    /// `G53` (machine coordinates) with the line's motion `code`: only with `G0` or `G1`, and
+    /// not in incremental distance mode.
+    fn check_g53(&self, w: &Words, code: u16) -> Result<(), Fault> {
         if let Some(g53) = w.g(530) {
             if !matches!(code, 0 | 10) {
                 return fault(g53, "G53 moves with G0 or G1 only");
@@ -99,12 +132,12 @@ impl Machine {
                 );
             }
         }
-        if !is_cycle(code) {
-            self.cycle.initial = None;
-        }
-        if code != 50 {
-            self.spline_pq = None;
-        }
+        Ok(())
+    }
+
+    /// Runs motion `code` (ten times its G number): a straight move (to machine coordinates
+    /// with `G53`), an arc, a spline or a canned cycle.
+    fn run_motion(&mut self, w: &mut Words, code: u16, column: usize) -> Result<(), Fault> {
         match code {
             0 | 10 => {
                 let end = if w.g(530).is_some() {
@@ -117,26 +150,16 @@ impl Machine {
                 } else {
                     Motion::Linear
                 };
-                self.straight(motion, end, w, column)?;
+                self.straight(motion, end, w, column)
             }
-            20 | 30 => self.arc(w, code == 20, column)?,
-            50 | 51 => self.spline(w, code == 50, column)?,
-            _ if is_cycle(code) => self.cycle(w, code, column)?,
-            _ => {
-                return fault(
-                    column,
-                    std::format!("{}: not a motion this reader runs", g_name(code)),
-                );
-            }
+            20 | 30 => self.arc(w, code == 20, column),
+            50 | 51 => self.spline(w, code == 50, column),
+            _ if is_cycle(code) => self.cycle(w, code, column),
+            _ => fault(
+                column,
+                std::format!("{}: not a motion this reader runs", g_name(code)),
+            ),
         }
-        if code != 50 && code != 51 {
-            self.motion = Some(code);
-        }
-        if code <= 30 {
-            self.plain_motion = Some(code);
-        }
-        let _ = params;
-        Ok(())
     }
 
     /// The end point of the axis words (and `@` `^` polar words, G17 only), program frame.
@@ -297,7 +320,41 @@ impl Machine {
         {
             return Ok(());
         }
-        let motion = match motion {
+        let motion = self.machine_motion(motion, column)?;
+        if self.moves.len() >= MAX_MOVES {
+            // The column says "the moves budget" to the reading loop (a LoadError::TooLarge).
+            return Err((
+                usize::MAX,
+                LoadError::TooLarge {
+                    what: std::format!("G-code program moves (at line {})", self.line),
+                    limit: MAX_MOVES,
+                    got: self.moves.len() + 1,
+                }
+                .to_string(),
+            ));
+        }
+        self.start_operation();
+        self.moves.push(Move {
+            spindle: self.spindle(),
+            // Before the first tool change, the tool the program selected (posts for manual
+            // tool changes write T without M6: the operator puts that tool in).
+            tool: if self.tool == 0 {
+                self.selected
+            } else {
+                self.tool
+            },
+            path_control: self.path_control,
+            start_axis,
+            end_axis,
+            ..Move::new(self.line, motion, start, stop, feed)
+        });
+        Ok(())
+    }
+
+    /// `motion` in the machine frame: an arc's centre moved there (refused when rotary axes
+    /// stand turned without tool centre point control); other motions as they are.
+    fn machine_motion(&self, motion: Motion, column: usize) -> Result<Motion, Fault> {
+        Ok(match motion {
             Motion::Arc {
                 plane,
                 center,
@@ -318,19 +375,12 @@ impl Machine {
                 }
             }
             m => m,
-        };
-        if self.moves.len() >= MAX_MOVES {
-            // The column says "the moves budget" to the reading loop (a LoadError::TooLarge).
-            return Err((
-                usize::MAX,
-                LoadError::TooLarge {
-                    what: std::format!("G-code program moves (at line {})", self.line),
-                    limit: MAX_MOVES,
-                    got: self.moves.len() + 1,
-                }
-                .to_string(),
-            ));
-        }
+        })
+    }
+
+    /// Starts an operation at the next move when there is none yet or one is due (a tool
+    /// change, a comment after moves), named by the last comment or else by the tool.
+    fn start_operation(&mut self) {
         if self.operations.is_empty() || self.operation_next {
             let tool = if self.tool == 0 {
                 self.selected
@@ -347,21 +397,6 @@ impl Machine {
             });
             self.operation_next = false;
         }
-        self.moves.push(Move {
-            spindle: self.spindle(),
-            // Before the first tool change, the tool the program selected (posts for manual
-            // tool changes write T without M6: the operator puts that tool in).
-            tool: if self.tool == 0 {
-                self.selected
-            } else {
-                self.tool
-            },
-            path_control: self.path_control,
-            start_axis,
-            end_axis,
-            ..Move::new(self.line, motion, start, stop, feed)
-        });
-        Ok(())
     }
 
     /// The move's start and end tips and axes in the workpiece frame: the machine points as
