@@ -1,11 +1,11 @@
-//! `displacement` and the tick-shape `compliance_map::query` allocate nothing: a counting
+//! `displacement` and the tick-shape `compliance_map::step` and `step_grid` allocate nothing: a counting
 //! global allocator over 1e4 queries of each. Its own test binary with a single test, so
 //! nothing else allocates while it counts.
 #![allow(unsafe_code)] // reason: a GlobalAlloc impl is unsafe by definition; it only forwards to System
 #![allow(clippy::unwrap_used, clippy::indexing_slicing)]
 
 use deflect_core::compliance_map::{
-    self, ComplianceMap, ComplianceMapView, Interpolation, OutOfGrid, QueryOptions,
+    self, ComplianceMap, ComplianceMapView, GridMap, Interpolation, OutOfGrid, QueryOptions,
 };
 use deflect_core::io::map_csv;
 use deflect_core::units::{ForceUnit, LengthUnit};
@@ -57,6 +57,10 @@ fn displacement_allocates_nothing() {
     let mut datas: Vec<compliance_map::Data> =
         views.iter().map(compliance_map::Data::new).collect();
     assert!(views.iter().zip(&datas).all(|(v, d)| d.check(v)));
+    // The N-D grid map in the same tick shape.
+    let grid = GridMap::from_map(&oc);
+    let mut grid_data = compliance_map::Data::new(&grid);
+    let (mut grid_ok, mut grid_checksum) = (0usize, 0.0);
     let mut out = [0.0; 2];
     let mut direct = [0.0; 2];
     let (mut ok, mut refused, mut checksum) = (0usize, 0usize, 0.0);
@@ -77,6 +81,10 @@ fn displacement_allocates_nothing() {
                 checksum += out[0] + out[1];
             }
             Err(_) => refused += 1,
+        }
+        if compliance_map::step_grid(&grid, &mut grid_data, &p, &f).is_ok() {
+            grid_ok += 1;
+            grid_checksum += grid_data.displacement()[0];
         }
         // `query` on a view with the same options gives what `view.displacement` gives,
         // bit for bit, placement and errors included.
@@ -113,4 +121,5 @@ fn displacement_allocates_nothing() {
     assert_eq!((query_ok, query_refused), (ok, refused));
     assert!(ok > 7_000 && refused > 100, "ok {ok}, refused {refused}");
     assert!(checksum.is_finite() && checksum != 0.0);
+    assert!(grid_ok > 1_000 && grid_checksum.is_finite() && grid_checksum != 0.0);
 }

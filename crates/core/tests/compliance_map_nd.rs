@@ -381,3 +381,70 @@ fn a_csv_of_static_tests_names_its_grid_axes_and_converts_units() {
         }
     ));
 }
+
+#[test]
+fn the_tick_shape_serves_the_grid_map() {
+    use deflect_core::compliance_map::{self, Data};
+    // 2 x 2 x 2 nodes, one force and one displacement axis; compliance affine in the
+    // coordinates, 1e-6 (1 + x + y + z) m/N, which trilinear interpolation reproduces: at
+    // (0.5, 1, 2) it is 4.5e-6 m/N, so 100 N give 4.5e-4 m.
+    let axes = vec![vec![0.0, 1.0], vec![0.0, 2.0], vec![0.0, 4.0]];
+    let mut slopes = Vec::new();
+    for x in [0.0, 1.0] {
+        for y in [0.0, 2.0] {
+            for z in [0.0, 4.0] {
+                slopes.push(1e-6 * (1.0 + x + y + z));
+            }
+        }
+    }
+    let grid = GridMap::new(axes, names(3), 1, 1, slopes, vec![0.0; 8]).unwrap();
+    let mut data = Data::new(&grid);
+    assert!(data.check(&grid));
+    let placement = compliance_map::step_grid(&grid, &mut data, &[0.5, 1.0, 2.0], &[100.0]);
+    assert_eq!(placement, Ok(Placement::Inside));
+    assert_eq!(data.placement, Placement::Inside);
+    assert_eq!(data.displacement().len(), 1);
+    assert!(
+        (data.displacement()[0] - 4.5e-4).abs() < 1e-18,
+        "{:?}",
+        data.displacement()
+    );
+    // The tick shape is the grid's own query, bit for bit.
+    let mut direct = [0.0];
+    grid.displacement(&[0.5, 1.0, 2.0], &[100.0], &mut direct)
+        .unwrap();
+    assert_eq!(data.displacement()[0].to_bits(), direct[0].to_bits());
+    // Wrong input is typed, and the workspace keeps its last answer.
+    assert!(matches!(
+        compliance_map::step_grid(&grid, &mut data, &[0.5, 1.0], &[100.0]),
+        Err(TickError::WrongLength {
+            what: "point",
+            expected: 3,
+            got: 2
+        })
+    ));
+    assert!(matches!(
+        compliance_map::step_grid(&grid, &mut data, &[0.5, 1.0, 4.5], &[100.0]),
+        Err(TickError::OutOfGrid { axis: 2, .. })
+    ));
+    assert_eq!(data.displacement()[0].to_bits(), direct[0].to_bits());
+    // A workspace made for a map of other axis counts is refused.
+    let map2 = ComplianceMap::new(
+        vec![0.0, 1.0],
+        vec![0.0, 1.0],
+        2,
+        2,
+        vec![0.0; 16],
+        vec![0.0; 16],
+    )
+    .unwrap();
+    let mut other = Data::new(&map2);
+    assert!(!other.check(&grid));
+    assert!(matches!(
+        compliance_map::step_grid(&grid, &mut other, &[0.5, 1.0, 2.0], &[100.0]),
+        Err(TickError::ModelMismatch {
+            what: "map axes",
+            ..
+        })
+    ));
+}

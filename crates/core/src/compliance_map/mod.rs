@@ -140,8 +140,8 @@ pub struct QueryOptions {
     pub out_of_grid: OutOfGrid,
 }
 
-/// Per-query workspace of the tick shape: the displacement of the last [`step`] and the
-/// dimensions of the map it was made for. Queries need no other buffer.
+/// Per-query workspace of the tick shape: the displacement of the last [`step`] (or
+/// [`step_grid`]) and the axis counts of the map it was made for. Queries need no other buffer.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Data {
     n_force: usize,
@@ -152,25 +152,85 @@ pub struct Data {
     pub placement: Placement,
 }
 
+/// What a [`Data`] workspace is sized by: a map's force and displacement axis counts. The
+/// 2-D map and the N-D [`GridMap`] both have them, so one workspace and one tick shape serve
+/// both ([`step`] and [`step_grid`]).
+pub trait MapAxes {
+    /// Force axes the map is loaded along (`F` of `[F, D]` coefficients).
+    fn force_axes(&self) -> usize;
+    /// Displacement axes the map returns.
+    fn displacement_axes(&self) -> usize;
+}
+
+impl MapAxes for ComplianceMapView<'_> {
+    fn force_axes(&self) -> usize {
+        self.n_force()
+    }
+    fn displacement_axes(&self) -> usize {
+        self.n_displacement()
+    }
+}
+
+#[cfg(feature = "alloc")]
+impl MapAxes for ComplianceMap {
+    fn force_axes(&self) -> usize {
+        self.n_force()
+    }
+    fn displacement_axes(&self) -> usize {
+        self.n_displacement()
+    }
+}
+
+#[cfg(feature = "alloc")]
+impl MapAxes for GridMap {
+    fn force_axes(&self) -> usize {
+        self.n_force()
+    }
+    fn displacement_axes(&self) -> usize {
+        self.n_displacement()
+    }
+}
+
 impl Data {
-    /// A workspace for `map`.
-    pub fn new(map: &ComplianceMapView<'_>) -> Self {
+    /// A workspace for `map` (a 2-D view or map, or an N-D grid map).
+    pub fn new<M: MapAxes + ?Sized>(map: &M) -> Self {
         Self {
-            n_force: map.n_force(),
-            n_disp: map.n_displacement(),
+            n_force: map.force_axes(),
+            n_disp: map.displacement_axes(),
             displacement: [0.0; MAX_AXES],
             placement: Placement::Inside,
         }
     }
 
     /// Whether this workspace was made for a map of `map`'s dimensions.
-    pub fn check(&self, map: &ComplianceMapView<'_>) -> bool {
-        self.n_force == map.n_force() && self.n_disp == map.n_displacement()
+    pub fn check<M: MapAxes + ?Sized>(&self, map: &M) -> bool {
+        self.n_force == map.force_axes() && self.n_disp == map.displacement_axes()
     }
 
     /// The displacement of the last query, `n_displacement` entries.
     pub fn displacement(&self) -> &[f64] {
         self.displacement.get(..self.n_disp).unwrap_or(&[])
+    }
+
+    /// Runs `query` into this workspace's displacement after checking it was made for `map`:
+    /// the part [`step`] and [`step_grid`] share.
+    #[inline(always)]
+    fn query<M: MapAxes + ?Sized>(
+        &mut self,
+        map: &M,
+        query: impl FnOnce(&mut [f64]) -> Result<Placement, TickError>,
+    ) -> Result<Placement, TickError> {
+        if !self.check(map) {
+            return Err(TickError::ModelMismatch {
+                what: "map axes",
+                expected: map.force_axes() * MAX_AXES + map.displacement_axes(),
+                got: self.n_force * MAX_AXES + self.n_disp,
+            });
+        }
+        let out = self.displacement.get_mut(..self.n_disp).unwrap_or(&mut []);
+        let placement = query(out)?;
+        self.placement = placement;
+        Ok(placement)
     }
 }
 
@@ -216,17 +276,23 @@ pub fn step(
     position: [f64; 2],
     force: &[f64],
 ) -> Result<Placement, TickError> {
-    if !data.check(map) {
-        return Err(TickError::ModelMismatch {
-            what: "map axes",
-            expected: map.n_force() * MAX_AXES + map.n_displacement(),
-            got: data.n_force * MAX_AXES + data.n_disp,
-        });
-    }
-    let out = data.displacement.get_mut(..data.n_disp).unwrap_or(&mut []);
-    let placement = map.displacement(position, force, out)?;
-    data.placement = placement;
-    Ok(placement)
+    data.query(map, |out| map.displacement(position, force, out))
+}
+
+/// One query of the tick shape on an N-D grid map: the displacement at `point` (one
+/// coordinate per grid axis, in the axes' units) under `force` (`n_force` entries
+/// \[N | N m\]) with the map's default options, into `data.displacement`. Allocation-free,
+/// never panics; see [`GridMap::displacement_with`]. A 2-D `GridMap::from_map(&map)` gives
+/// what [`step`] gives on `map` to rounding (its kernel sums in another order).
+#[cfg(feature = "alloc")]
+#[inline]
+pub fn step_grid(
+    map: &GridMap,
+    data: &mut Data,
+    point: &[f64],
+    force: &[f64],
+) -> Result<Placement, TickError> {
+    data.query(map, |out| map.displacement(point, force, out))
 }
 
 /// Square root usable without `std`.
