@@ -392,22 +392,31 @@ fn check_measurements(
                 return Err(BuildError::NonFiniteMeasurement { row, column });
             }
         }
-        for (column, v) in DISPLACEMENT_COLUMNS
-            .iter()
-            .zip(m.displacement.iter())
-            .take(nd)
-        {
-            if !v.is_finite() {
-                return Err(BuildError::NonFiniteMeasurement { row, column });
-            }
+        check_load(row, &m.displacement, m.force_axis, nf, nd)?;
+    }
+    Ok(())
+}
+
+/// The part of a reading's check the 2-D and N-D fits share: its first `nd` displacements
+/// finite and its force axis below `nf`, errors naming row `row`.
+pub(super) fn check_load(
+    row: usize,
+    displacement: &[f64; MAX_AXES],
+    force_axis: usize,
+    nf: usize,
+    nd: usize,
+) -> Result<(), BuildError> {
+    for (column, v) in DISPLACEMENT_COLUMNS.iter().zip(displacement).take(nd) {
+        if !v.is_finite() {
+            return Err(BuildError::NonFiniteMeasurement { row, column });
         }
-        if m.force_axis >= nf {
-            return Err(BuildError::ForceAxisOutOfRange {
-                row,
-                force_axis: m.force_axis,
-                n_force: nf,
-            });
-        }
+    }
+    if force_axis >= nf {
+        return Err(BuildError::ForceAxisOutOfRange {
+            row,
+            force_axis,
+            n_force: nf,
+        });
     }
     Ok(())
 }

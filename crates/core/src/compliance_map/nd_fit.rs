@@ -7,7 +7,7 @@ use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::fit::{DISPLACEMENT_COLUMNS, FitOptions, cluster, fit_lines, grouped_order};
+use super::fit::{FitOptions, check_load, cluster, fit_lines, grouped_order};
 use super::grid::AxisId;
 use super::nd::{GridMap, MAX_GRID_DIMS, MAX_GRID_NODES};
 use super::view::check_counts;
@@ -158,18 +158,7 @@ fn check_readings(
                 column: "force",
             });
         }
-        for (column, v) in DISPLACEMENT_COLUMNS.iter().zip(&m.displacement).take(nd) {
-            if !v.is_finite() {
-                return Err(BuildError::NonFiniteMeasurement { row, column });
-            }
-        }
-        if m.force_axis >= nf {
-            return Err(BuildError::ForceAxisOutOfRange {
-                row,
-                force_axis: m.force_axis,
-                n_force: nf,
-            });
-        }
+        check_load(row, &m.displacement, m.force_axis, nf, nd)?;
     }
     Ok(())
 }
