@@ -378,14 +378,7 @@ fn check_measurements(
     nf: usize,
     nd: usize,
 ) -> Result<(), BuildError> {
-    if measurements.len() > MAX_MEASUREMENTS {
-        return Err(BuildError::Budget {
-            what: "measurements",
-            budget: "MAX_MEASUREMENTS",
-            limit: MAX_MEASUREMENTS,
-            requested: measurements.len(),
-        });
-    }
+    check_budget(measurements.len())?;
     for (row, m) in measurements.iter().enumerate() {
         for (column, v) in [("x", m.x), ("y", m.y), ("force", m.force)] {
             if !v.is_finite() {
@@ -393,6 +386,19 @@ fn check_measurements(
             }
         }
         check_load(row, &m.displacement, m.force_axis, nf, nd)?;
+    }
+    Ok(())
+}
+
+/// At most [`MAX_MEASUREMENTS`] readings, for the 2-D and the N-D fit.
+pub(super) fn check_budget(readings: usize) -> Result<(), BuildError> {
+    if readings > MAX_MEASUREMENTS {
+        return Err(BuildError::Budget {
+            what: "measurements",
+            budget: "MAX_MEASUREMENTS",
+            limit: MAX_MEASUREMENTS,
+            requested: readings,
+        });
     }
     Ok(())
 }

@@ -30,6 +30,19 @@ pub const MAX_GRID_DIMS: usize = 4;
 /// displacement axis pair; a typed [`BuildError::Budget`] past it.
 pub const MAX_GRID_NODES: usize = 1 << 20;
 
+/// At most [`MAX_GRID_NODES`] nodes, for a grid built or fitted.
+pub(super) fn check_node_budget(nodes: usize) -> Result<(), BuildError> {
+    if nodes > MAX_GRID_NODES {
+        return Err(BuildError::Budget {
+            what: "grid nodes",
+            budget: "MAX_GRID_NODES",
+            limit: MAX_GRID_NODES,
+            requested: nodes,
+        });
+    }
+    Ok(())
+}
+
 /// A compliance map over a 1-4 dimensional rectilinear grid (see the module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GridMap {
@@ -91,14 +104,7 @@ impl GridMap {
             *inv = check_axis(AxisId::Grid(k), nodes_k)?;
             nodes = nodes.saturating_mul(nodes_k.len());
         }
-        if nodes > MAX_GRID_NODES {
-            return Err(BuildError::Budget {
-                what: "grid nodes",
-                budget: "MAX_GRID_NODES",
-                limit: MAX_GRID_NODES,
-                requested: nodes,
-            });
-        }
+        check_node_budget(nodes)?;
         let mut strides = [0usize; MAX_GRID_DIMS];
         let mut stride = 1usize;
         for k in (0..dims).rev() {

@@ -7,11 +7,11 @@ use alloc::string::String;
 use alloc::vec;
 use alloc::vec::Vec;
 
-use super::fit::{FitOptions, check_load, cluster, fit_lines, grouped_order};
+use super::MAX_AXES;
+use super::fit::{FitOptions, check_budget, check_load, cluster, fit_lines, grouped_order};
 use super::grid::AxisId;
-use super::nd::{GridMap, MAX_GRID_DIMS, MAX_GRID_NODES};
+use super::nd::{GridMap, MAX_GRID_DIMS, check_node_budget};
 use super::view::check_counts;
-use super::{MAX_AXES, MAX_MEASUREMENTS};
 use crate::error::BuildError;
 
 /// One static-test reading on an N-D grid: at node `point` (its first `dims` entries) a force
@@ -54,8 +54,8 @@ impl GridMeasurement {
 ///
 /// Errors name the reading (row and column) or the node: non-finite values, a force axis
 /// `>= n_force`, ambiguous coordinates, a missing node ([`BuildError::MissingGridNode`]), a
-/// repeated (node, axis, force), fewer than 2 force levels, past [`MAX_MEASUREMENTS`] or
-/// [`MAX_GRID_NODES`].
+/// repeated (node, axis, force), fewer than 2 force levels, past [`super::MAX_MEASUREMENTS`] or
+/// [`super::MAX_GRID_NODES`].
 pub fn fit_grid(
     names: Vec<String>,
     measurements: &[GridMeasurement],
@@ -137,14 +137,7 @@ fn check_readings(
             expected: "1 to 4 axes",
         });
     }
-    if measurements.len() > MAX_MEASUREMENTS {
-        return Err(BuildError::Budget {
-            what: "measurements",
-            budget: "MAX_MEASUREMENTS",
-            limit: MAX_MEASUREMENTS,
-            requested: measurements.len(),
-        });
-    }
+    check_budget(measurements.len())?;
     for (row, m) in measurements.iter().enumerate() {
         for (k, v) in m.point.iter().enumerate().take(dims) {
             if !v.is_finite() {
@@ -174,7 +167,7 @@ struct Lines {
 
 impl Lines {
     /// Clusters each axis's coordinates within `tolerance` into grid lines; at least 2 per
-    /// axis and at most [`MAX_GRID_NODES`] nodes.
+    /// axis and at most [`super::MAX_GRID_NODES`] nodes.
     fn cluster(
         dims: usize,
         measurements: &[GridMeasurement],
@@ -203,14 +196,7 @@ impl Lines {
                 });
             }
         }
-        if nodes > MAX_GRID_NODES {
-            return Err(BuildError::Budget {
-                what: "grid nodes",
-                budget: "MAX_GRID_NODES",
-                limit: MAX_GRID_NODES,
-                requested: nodes,
-            });
-        }
+        check_node_budget(nodes)?;
         Ok(Self {
             dims,
             axes,
