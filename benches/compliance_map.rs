@@ -5,7 +5,9 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use deflect_core::compliance_map::{ComplianceMap, Interpolation, OutOfGrid, QueryOptions};
+use deflect_core::compliance_map::{
+    ComplianceMap, GridMap, Interpolation, OutOfGrid, QueryOptions,
+};
 use deflect_core::io::map_csv;
 use deflect_core::units::{ForceUnit, LengthUnit};
 
@@ -255,6 +257,66 @@ fn bench(c: &mut Criterion) {
     group.bench_function("batch_1e5/reference_hand/even", |b| {
         b.iter(|| hand_batch(&pos, &mut out))
     });
+    group.finish();
+    grid_map(c, &even, &points);
+}
+
+/// The N-D `GridMap` on the same queries: over two axes it is the 2-D map's fast path (the
+/// 2-D map's kernels); over three (the 2-D grid with a third axis of 3 nodes, the query at
+/// its middle) the general tensor-product path.
+fn grid_map(c: &mut Criterion, even: &ComplianceMap, points: &[([f64; 2], [f64; 2])]) {
+    let planar = GridMap::from_map(even);
+    let (x, y) = (even.x().to_vec(), even.y().to_vec());
+    let nodes = x.len() * y.len();
+    let block = even.n_force() * even.n_displacement();
+    let (mut slopes, mut offsets) = (Vec::new(), Vec::new());
+    for node in 0..nodes {
+        let range = node * block..(node + 1) * block;
+        let s = even.slopes().get(range.clone()).unwrap_or(&[]);
+        let o = even.offsets().get(range).unwrap_or(&[]);
+        for _ in 0..3 {
+            slopes.extend_from_slice(s);
+            offsets.extend_from_slice(o);
+        }
+    }
+    let names = ["x", "y", "z"].map(String::from).to_vec();
+    let spatial = match GridMap::new(
+        vec![x, y, vec![0.0, 0.5, 1.0]],
+        names,
+        even.n_force(),
+        even.n_displacement(),
+        slopes,
+        offsets,
+    ) {
+        Ok(m) => m,
+        Err(e) => panic!("{e}"),
+    };
+    let mut group = c.benchmark_group("grid_map");
+    for method in [Interpolation::Bilinear, Interpolation::Bicubic] {
+        let options = QueryOptions {
+            interpolation: method,
+            out_of_grid: OutOfGrid::Error,
+        };
+        let mut k = 0usize;
+        let mut out = [0.0; 2];
+        group.bench_function(format!("{method:?}/2d_even"), |b| {
+            b.iter(|| {
+                k = (k + 1) & 1023;
+                let (p, f) = points.get(k).copied().unwrap_or_default();
+                let s = planar.displacement_with(black_box(&p), black_box(&f), &mut out, options);
+                black_box((s, out))
+            })
+        });
+        group.bench_function(format!("{method:?}/3d_even"), |b| {
+            b.iter(|| {
+                k = (k + 1) & 1023;
+                let (p, f) = points.get(k).copied().unwrap_or_default();
+                let q = [p[0], p[1], 0.25];
+                let s = spatial.displacement_with(black_box(&q), black_box(&f), &mut out, options);
+                black_box((s, out))
+            })
+        });
+    }
     group.finish();
 }
 

@@ -92,7 +92,21 @@ fn every_node_is_reproduced_exactly_in_1_to_4_dimensions() {
                     let want: f64 = (0..2)
                         .map(|f| map.slopes()[c + f] * force[f] + map.offsets()[c + f])
                         .sum();
-                    assert_eq!(*g, want, "{dims}-D {method:?} node {node} axis {d}");
+                    if dims == 2 {
+                        // The 2-D map's kernels (the 2-D grid map's fast path) add the
+                        // offsets as one sum: the node's lines to the rounding of that order.
+                        let size: f64 = (0..2)
+                            .map(|f| {
+                                (map.slopes()[c + f] * force[f]).abs() + map.offsets()[c + f].abs()
+                            })
+                            .sum();
+                        assert!(
+                            (*g - want).abs() <= 4.0 * f64::EPSILON * size,
+                            "{dims}-D {method:?} node {node} axis {d}: {g} against {want}"
+                        );
+                    } else {
+                        assert_eq!(*g, want, "{dims}-D {method:?} node {node} axis {d}");
+                    }
                 }
             }
         }
@@ -101,8 +115,7 @@ fn every_node_is_reproduced_exactly_in_1_to_4_dimensions() {
 
 #[test]
 fn in_two_dimensions_it_is_the_paper_map() {
-    // The same tensor-product weights; the 2-D kernel sums in another order (to rounding of
-    // the largest component).
+    // A 2-D grid map queries through the 2-D map's kernels: the same bits.
     let (x, y) = (axis(0.2, 6), axis(-0.1, 5));
     let n = x.len() * y.len() * 4;
     let slopes: Vec<f64> = (0..n).map(|k| 1e-6 * noise(k)).collect();
@@ -127,12 +140,8 @@ fn in_two_dimensions_it_is_the_paper_map() {
                 let pa = map2.displacement_with(p, &f, &mut a, o).unwrap();
                 let pb = nd.displacement_with(&p, &f, &mut b, o).unwrap();
                 assert_eq!(pa, pb);
-                let scale = a.iter().fold(1e-12f64, |m, v| m.max(v.abs()));
                 for (u, v) in a.iter().zip(&b) {
-                    assert!(
-                        (u - v).abs() <= 1e-14 * scale,
-                        "{method:?} {policy:?} {p:?}: {a:?} {b:?}"
-                    );
+                    assert_eq!(u.to_bits(), v.to_bits(), "{method:?} {policy:?} {p:?}");
                 }
             }
         }

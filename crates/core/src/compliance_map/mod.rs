@@ -283,7 +283,7 @@ pub fn step(
 /// coordinate per grid axis, in the axes' units) under `force` (`n_force` entries
 /// \[N | N m\]) with the map's default options, into `data.displacement`. Allocation-free,
 /// never panics; see [`GridMap::displacement_with`]. A 2-D `GridMap::from_map(&map)` gives
-/// what [`step`] gives on `map` to rounding (its kernel sums in another order).
+/// what [`step`] gives on `map`, bit for bit (the 2-D map is the grid map's fast path).
 #[cfg(feature = "alloc")]
 #[inline]
 pub fn step_grid(

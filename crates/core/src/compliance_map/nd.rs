@@ -10,8 +10,10 @@
 //! `sum_k i_k * stride_k` with the last axis fastest (the 2-D map's `i * ny + j`), and its
 //! coefficient `(d, f)` at `node * n_displacement * n_force + d * n_force + f`.
 //!
-//! The 2-D [`super::ComplianceMap`] keeps its own specialised kernels (its batch lookup is not
-//! slowed by the generality here); [`GridMap::from_map`] turns one into a 2-D `GridMap`.
+//! One concept, two kernels: the 2-D [`super::ComplianceMap`] is the fast path. A `GridMap`
+//! of two axes holds one and answers its queries with the 2-D map's specialised kernels (the
+//! same bits as the 2-D map, at its speed); grids of 1, 3 or 4 axes take the general
+//! tensor-product path here. [`GridMap::from_map`] turns a 2-D map into a 2-D `GridMap`.
 //! Queries allocate nothing and never panic.
 
 use alloc::string::{String, ToString};
@@ -55,6 +57,31 @@ pub struct GridMap {
     slopes: Vec<f64>,
     offsets: Vec<f64>,
     options: QueryOptions,
+    /// The same map as a 2-D [`ComplianceMap`] when it has two axes (derived at build): its
+    /// queries take the 2-D map's kernels, so a 2-D grid map answers what the 2-D map
+    /// answers, bit for bit, at its speed. Twice the coefficients' memory for 2-D maps.
+    planar: Option<ComplianceMap>,
+}
+
+/// The 2-D map of a grid map with two axes, or `None` for another dimension count (the axes
+/// and coefficients are already checked, so building it cannot fail on them).
+fn planar_of(
+    axes: &[Vec<f64>],
+    n_force: usize,
+    n_displacement: usize,
+    slopes: &[f64],
+    offsets: &[f64],
+) -> Option<ComplianceMap> {
+    let [x, y] = axes else { return None };
+    ComplianceMap::new(
+        x.clone(),
+        y.clone(),
+        n_force,
+        n_displacement,
+        slopes.to_vec(),
+        offsets.to_vec(),
+    )
+    .ok()
 }
 
 impl GridMap {
@@ -126,6 +153,7 @@ impl GridMap {
                 return Err(BuildError::NonFinite { what, index });
             }
         }
+        let planar = planar_of(&axes, n_force, n_displacement, &slopes, &offsets);
         Ok(Self {
             axes,
             inv_steps,
@@ -136,6 +164,7 @@ impl GridMap {
             slopes,
             offsets,
             options: QueryOptions::default(),
+            planar,
         })
     }
 
@@ -151,16 +180,21 @@ impl GridMap {
             // The map's axes were checked when it was built.
             *inv = check_axis(id, nodes).unwrap_or(0.0);
         }
+        let (n_force, n_displacement) = (map.n_force(), map.n_displacement());
+        let (slopes, offsets) = (map.slopes().to_vec(), map.offsets().to_vec());
+        let axes = vec![x, y];
+        let planar = planar_of(&axes, n_force, n_displacement, &slopes, &offsets);
         Self {
-            strides: [y.len(), 1, 0, 0],
-            axes: vec![x, y],
+            strides: [axes.get(1).map_or(1, Vec::len), 1, 0, 0],
+            axes,
             inv_steps,
             names: vec!["x".to_string(), "y".to_string()],
-            n_force: map.n_force(),
-            n_displacement: map.n_displacement(),
-            slopes: map.slopes().to_vec(),
-            offsets: map.offsets().to_vec(),
+            n_force,
+            n_displacement,
+            slopes,
+            offsets,
             options: map.options(),
+            planar,
         }
     }
 
@@ -246,6 +280,9 @@ impl GridMap {
         }
         crate::error::check_finite("point", point)?;
         crate::error::check_finite("force", force)?;
+        if let (Some(planar), &[x, y]) = (&self.planar, point) {
+            return planar.displacement_with([x, y], force, out, options);
+        }
         let mut stencils = [Stencil {
             base: 0,
             len: 1,
