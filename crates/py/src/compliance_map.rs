@@ -3,8 +3,7 @@
 
 use deflect_core::TickError;
 use deflect_core::compliance_map::{
-    self as cm, ComplianceMap as CoreMap, FitOptions, HoldOutAxis, Interpolation, MAX_AXES,
-    Measurement, OutOfGrid, QueryOptions,
+    self as cm, ComplianceMap as CoreMap, FitOptions, HoldOutAxis, Measurement, QueryOptions,
 };
 use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
@@ -19,51 +18,8 @@ use crate::arrays::{batch_pair, check_count, indices, matrix, vector_upto};
 use crate::batch;
 use crate::errors::{build_err, load_err, shape_error, tick_err};
 use crate::field::DisplacementField;
-use crate::out::{emit, fill_into};
-
-pub(crate) fn parse_interpolation(s: &str) -> PyResult<Interpolation> {
-    match s.to_ascii_lowercase().as_str() {
-        "bilinear" | "linear" | "multilinear" => Ok(Interpolation::Bilinear),
-        "bicubic" | "cubic" => Ok(Interpolation::Bicubic),
-        _ => Err(InputError::new_err(format!(
-            "interpolation must be \"bilinear\" (\"multilinear\") or \"bicubic\" (\"cubic\"), got {s:?}"
-        ))),
-    }
-}
-
-/// The query options of the Python names (`interpolation`, `out_of_grid`), each checked.
-pub(crate) fn query_options(interpolation: &str, out_of_grid: &str) -> PyResult<QueryOptions> {
-    Ok(QueryOptions {
-        interpolation: parse_interpolation(interpolation)?,
-        out_of_grid: parse_out_of_grid(out_of_grid)?,
-    })
-}
-
-pub(crate) fn parse_out_of_grid(s: &str) -> PyResult<OutOfGrid> {
-    match s.to_ascii_lowercase().as_str() {
-        "error" => Ok(OutOfGrid::Error),
-        "clamp" => Ok(OutOfGrid::Clamp),
-        "extrapolate" => Ok(OutOfGrid::Extrapolate),
-        _ => Err(InputError::new_err(format!(
-            "out_of_grid must be \"error\", \"clamp\" or \"extrapolate\", got {s:?}"
-        ))),
-    }
-}
-
-pub(crate) fn interpolation_name(i: Interpolation) -> &'static str {
-    match i {
-        Interpolation::Bicubic => "bicubic",
-        _ => "bilinear",
-    }
-}
-
-pub(crate) fn out_of_grid_name(o: OutOfGrid) -> &'static str {
-    match o {
-        OutOfGrid::Clamp => "clamp",
-        OutOfGrid::Extrapolate => "extrapolate",
-        _ => "error",
-    }
-}
+use crate::map_common::{self, interpolation_name, out_of_grid_name, query_options};
+use crate::out::fill_into;
 
 pub(crate) fn units(force_unit: &str, length_unit: &str) -> PyResult<(ForceUnit, LengthUnit)> {
     let f = ForceUnit::parse(force_unit).ok_or_else(|| {
@@ -100,14 +56,7 @@ impl ComplianceMap {
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
     ) -> PyResult<QueryOptions> {
-        let mut o = self.inner.options();
-        if let Some(s) = interpolation {
-            o.interpolation = parse_interpolation(s)?;
-        }
-        if let Some(s) = out_of_grid {
-            o.out_of_grid = parse_out_of_grid(s)?;
-        }
-        Ok(o)
+        map_common::options_over(self.inner.options(), interpolation, out_of_grid)
     }
 }
 
@@ -300,18 +249,8 @@ impl ComplianceMap {
     /// whose first non-blank character is `{`) or a path (`str` or `os.PathLike`) to the file.
     #[staticmethod]
     fn from_json(source: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let inner = match source.extract::<String>() {
-            Ok(text) if text.trim_start().starts_with('{') => map_json::from_str(&text),
-            Ok(path) => map_json::from_path(&path),
-            Err(_) => {
-                map_json::from_path(source.extract::<std::path::PathBuf>().map_err(|_| {
-                    InputError::new_err(
-                        "source: expected the JSON text or a path (str or os.PathLike)",
-                    )
-                })?)
-            }
-        }
-        .map_err(load_err)?;
+        let inner =
+            map_common::json_source(source, map_json::from_str, |p| map_json::from_path(p))?;
         Ok(Self { inner })
     }
 
@@ -362,15 +301,9 @@ impl ComplianceMap {
         let p = cm::planar_position(&vector_upto(position, "position", 3, "3 coordinates")?)
             .map_err(tick_err)?;
         let f = vector_upto(force, "force", cm::MAX_AXES, "MAX_AXES")?;
-        let nd = self.inner.n_displacement();
-        let mut buf = [0.0; MAX_AXES];
-        let d = buf.get_mut(..nd).unwrap_or(&mut []);
-        self.inner
-            .displacement_with(p, &f, d, o)
-            .map_err(tick_err)?;
-        // A new numpy-owned array with the values copied: cheaper than handing over a Rust
-        // buffer for a few entries.
-        emit(py, d, &[nd], out)
+        map_common::one_query(py, self.inner.n_displacement(), out, |d| {
+            self.inner.displacement_with(p, &f, d, o).map_err(tick_err)
+        })
     }
 
     /// Displacements (N, n_displacement) [m] for positions `P` (N, 2) or (N, 3) [m] (z

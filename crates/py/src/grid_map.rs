@@ -14,12 +14,10 @@ use pyo3::prelude::*;
 use crate::InputError;
 use crate::args;
 use crate::arrays::{array_dyn, check_count, indices, matrix, try_copy, vector_upto};
-use crate::compliance_map::{
-    ComplianceMap, interpolation_name, out_of_grid_name, parse_interpolation, parse_out_of_grid,
-    query_options, units,
-};
+use crate::compliance_map::{ComplianceMap, units};
 use crate::errors::{build_err, load_err, shape_error, tick_err, tick_err_at};
-use crate::out::{emit, fill_into};
+use crate::map_common::{self, interpolation_name, out_of_grid_name, query_options};
+use crate::out::fill_into;
 
 /// A compliance map over a grid of 1 to 4 dimensions: `axes` a list of 1-4 increasing node
 /// coordinate arrays (task space x, y, z [m], or joint angles [rad]), named by `names`
@@ -48,11 +46,7 @@ impl GridMap {
         interpolation: Option<&str>,
         out_of_grid: Option<&str>,
     ) -> PyResult<QueryOptions> {
-        let d = self.inner.options();
-        Ok(QueryOptions {
-            interpolation: interpolation.map_or(Ok(d.interpolation), parse_interpolation)?,
-            out_of_grid: out_of_grid.map_or(Ok(d.out_of_grid), parse_out_of_grid)?,
-        })
+        map_common::options_over(self.inner.options(), interpolation, out_of_grid)
     }
 
     /// A tick error, an out-of-grid one naming the map's axis (the core's message knows axes
@@ -285,18 +279,9 @@ impl GridMap {
     /// map of version 1.
     #[staticmethod]
     fn from_json(source: &Bound<'_, PyAny>) -> PyResult<Self> {
-        let inner = match source.extract::<String>() {
-            Ok(text) if text.trim_start().starts_with('{') => map_json::grid_from_str(&text),
-            Ok(path) => map_json::grid_from_path(&path),
-            Err(_) => {
-                map_json::grid_from_path(source.extract::<std::path::PathBuf>().map_err(|_| {
-                    InputError::new_err(
-                        "source: expected the JSON text or a path (str or os.PathLike)",
-                    )
-                })?)
-            }
-        }
-        .map_err(load_err)?;
+        let inner = map_common::json_source(source, map_json::grid_from_str, |p| {
+            map_json::grid_from_path(p)
+        })?;
         Ok(Self { inner })
     }
 
@@ -335,13 +320,11 @@ impl GridMap {
         let o = self.options(interpolation, out_of_grid)?;
         let p = vector_upto(point, "point", MAX_GRID_DIMS, "MAX_GRID_DIMS")?;
         let f = vector_upto(force, "force", MAX_AXES, "MAX_AXES")?;
-        let nd = self.inner.n_displacement();
-        let mut buf = [0.0; MAX_AXES];
-        let d = buf.get_mut(..nd).unwrap_or(&mut []);
-        self.inner
-            .displacement_with(&p, &f, d, o)
-            .map_err(|e| self.query_err(None, e))?;
-        emit(py, d, &[nd], out)
+        map_common::one_query(py, self.inner.n_displacement(), out, |d| {
+            self.inner
+                .displacement_with(&p, &f, d, o)
+                .map_err(|e| self.query_err(None, e))
+        })
     }
 
     /// Displacements (N, n_displacement) [m] at points `P` (N, dims) under forces `F`

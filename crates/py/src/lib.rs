@@ -35,6 +35,7 @@ mod kinematics;
 mod machining;
 mod machining_job;
 mod machining_result;
+mod map_common;
 mod mechanism;
 mod motion;
 mod out;
