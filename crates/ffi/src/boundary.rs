@@ -201,6 +201,30 @@ pub(crate) unsafe fn load<T>(
     status
 }
 
+/// [`load`] of a handle built by `make` from the C string `arg` (JSON or CSV text, or a file's
+/// path), named `what` in the error for a NULL or non-UTF-8 string: what the loaders from
+/// text and from a path share.
+///
+/// # Safety
+/// `arg` is NULL or NUL-terminated; `out` is NULL or writable; `err` is NULL or writable for
+/// `err_len` bytes.
+pub(crate) unsafe fn load_str<T>(
+    arg: *const c_char,
+    what: &'static str,
+    out: *mut *mut T,
+    err: *mut c_char,
+    err_len: usize,
+    make: impl FnOnce(&str) -> Result<T, (DeflectStatus, String)>,
+) -> DeflectStatus {
+    let make = || {
+        // SAFETY: NULL or NUL-terminated by the caller's contract.
+        let s = unsafe { c_str(arg, what) }?;
+        make(s)
+    };
+    // SAFETY: forwarded caller contract.
+    unsafe { load(out, err, err_len, make) }
+}
+
 /// Always unwinds (panics) inside Rust and returns `DEFLECT_ERR_PANIC`: lets a C caller check
 /// that panics are contained at the boundary. Prints nothing.
 #[unsafe(no_mangle)]

@@ -8,7 +8,7 @@ use std::ffi::c_char;
 use deflect_core::compliance_map::GridMap;
 use deflect_core::io::map_json;
 
-use crate::boundary::{c_str, destroy, guard, handle, handle_mut, load, slice, slice_mut, write};
+use crate::boundary::{destroy, guard, handle, handle_mut, load_str, slice, slice_mut, write};
 use crate::map::query_options;
 use crate::status::{DeflectStatus, load_failure, placement_code, tick_status};
 
@@ -44,14 +44,13 @@ pub unsafe extern "C" fn deflect_grid_map_from_json(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let text = unsafe { c_str(text, "text") }?;
-        let map = map_json::grid_from_str(text).map_err(load_failure)?;
-        Ok(DeflectGridMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(text, "text", out, err, err_len, |text| {
+            let map = map_json::grid_from_str(text).map_err(load_failure)?;
+            Ok(DeflectGridMap { map })
+        })
+    }
 }
 
 /// `deflect_grid_map_from_json` on the contents of the file at `path`.
@@ -65,14 +64,13 @@ pub unsafe extern "C" fn deflect_grid_map_load_json(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let path = unsafe { c_str(path, "path") }?;
-        let map = map_json::grid_from_path(path).map_err(load_failure)?;
-        Ok(DeflectGridMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(path, "path", out, err, err_len, |path| {
+            let map = map_json::grid_from_path(path).map_err(load_failure)?;
+            Ok(DeflectGridMap { map })
+        })
+    }
 }
 
 /// Frees a grid map handle. NULL is a no-op.

@@ -9,7 +9,7 @@ use deflect_core::io::{map_csv, map_json};
 use deflect_core::units::{ForceUnit, LengthUnit};
 
 use crate::boundary::{
-    array, c_str, destroy, guard, handle, handle_mut, load, slice, slice_mut, write,
+    array, destroy, guard, handle, handle_mut, load_str, slice, slice_mut, write,
 };
 use crate::status::{
     DEFLECT_ERR_INVALID_ARGUMENT, DeflectStatus, load_failure, placement_code, tick_status,
@@ -107,15 +107,14 @@ pub unsafe extern "C" fn deflect_compliance_map_from_paper_csv(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let text = unsafe { c_str(text, "text") }?;
-        let (f, l) = units(force_unit, length_unit)?;
-        let map = map_csv::from_str(text, f, l).map_err(load_failure)?;
-        Ok(DeflectComplianceMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(text, "text", out, err, err_len, |text| {
+            let (f, l) = units(force_unit, length_unit)?;
+            let map = map_csv::from_str(text, f, l).map_err(load_failure)?;
+            Ok(DeflectComplianceMap { map })
+        })
+    }
 }
 
 /// `deflect_compliance_map_from_paper_csv` on the contents of the file at `path`.
@@ -131,15 +130,14 @@ pub unsafe extern "C" fn deflect_compliance_map_load_paper_csv(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let path = unsafe { c_str(path, "path") }?;
-        let (f, l) = units(force_unit, length_unit)?;
-        let map = map_csv::from_path(path, f, l).map_err(load_failure)?;
-        Ok(DeflectComplianceMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(path, "path", out, err, err_len, |path| {
+            let (f, l) = units(force_unit, length_unit)?;
+            let map = map_csv::from_path(path, f, l).map_err(load_failure)?;
+            Ok(DeflectComplianceMap { map })
+        })
+    }
 }
 
 /// Loads a compliance map from deflect's versioned JSON text (`format_version` 1, SI units,
@@ -158,14 +156,13 @@ pub unsafe extern "C" fn deflect_compliance_map_from_json(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let text = unsafe { c_str(text, "text") }?;
-        let map = map_json::from_str(text).map_err(load_failure)?;
-        Ok(DeflectComplianceMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(text, "text", out, err, err_len, |text| {
+            let map = map_json::from_str(text).map_err(load_failure)?;
+            Ok(DeflectComplianceMap { map })
+        })
+    }
 }
 
 /// `deflect_compliance_map_from_json` on the contents of the file at `path`.
@@ -179,14 +176,13 @@ pub unsafe extern "C" fn deflect_compliance_map_load_json(
     err: *mut c_char,
     err_len: usize,
 ) -> DeflectStatus {
-    let make = || {
-        // SAFETY: NULL or NUL-terminated by contract.
-        let path = unsafe { c_str(path, "path") }?;
-        let map = map_json::from_path(path).map_err(load_failure)?;
-        Ok(DeflectComplianceMap { map })
-    };
     // SAFETY: forwarded caller contract.
-    unsafe { load(out, err, err_len, make) }
+    unsafe {
+        load_str(path, "path", out, err, err_len, |path| {
+            let map = map_json::from_path(path).map_err(load_failure)?;
+            Ok(DeflectComplianceMap { map })
+        })
+    }
 }
 
 /// Frees a map handle. NULL is a no-op.
