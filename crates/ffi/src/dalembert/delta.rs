@@ -4,13 +4,14 @@
 //! servo tick.
 
 use deflect_core::compliance_map::GridMap;
-use deflect_core::dalembert::parallel::{self, Data, Model};
+use deflect_core::dalembert::parallel::{Data, Model};
 use deflect_core::mechanism::Delta;
 use nalgebra::Vector3;
 
+use super::corrector;
 use crate::boundary::{array, destroy, guard, handle, handle_mut, load, write};
 use crate::grid_map::DeflectGridMap;
-use crate::status::{DEFLECT_ERR_NULL, DeflectStatus, build_failure, placement_code, tick_status};
+use crate::status::{DEFLECT_ERR_NULL, DeflectStatus, build_failure, tick_status};
 
 /// Geometry of a Delta robot \[m\] and its singularity threshold \[m/rad\].
 #[repr(C)]
@@ -158,10 +159,13 @@ pub unsafe extern "C" fn deflect_delta_corrector_create(
         };
         // SAFETY: NULL or a live handle by contract.
         let map = unsafe { handle(map) }.map_err(|s| (s, "map is NULL".to_owned()))?;
-        let model = Model::new(d, map.map().clone(), mass)
-            .and_then(|m| m.with_fixed_point(fixed_point_iterations as usize, tolerance))
-            .map_err(build_failure)?;
-        let data = Data::new(&model);
+        let corrector::Corrector { model, data } = corrector::build(
+            d,
+            map.map().clone(),
+            mass,
+            fixed_point_iterations,
+            tolerance,
+        )?;
         Ok(DeflectDeltaCorrector { model, data })
     };
     // SAFETY: forwarded caller contract for `out`.
@@ -199,28 +203,25 @@ pub unsafe extern "C" fn deflect_delta_corrector_step(
 ) -> DeflectStatus {
     guard(|| {
         // SAFETY: pointers valid for the stated lengths (or NULL) by contract.
-        let (c, x, a) = unsafe {
+        let (c, (x, a)) = unsafe {
             (
                 handle_mut(corrector)?,
-                array::<3>(desired)?,
-                array::<3>(acceleration)?,
+                corrector::inputs::<3>(desired, acceleration)?,
             )
         };
         if out.is_null() {
             return Err(DEFLECT_ERR_NULL);
         }
-        let t = parallel::step(&c.model, &mut c.data, &Vector3::from(x), &Vector3::from(a))
-            .map_err(|e| tick_status(&e))?;
-        let v = |v: Vector3<f64>| [v.x, v.y, v.z];
+        let t = corrector::tick(&c.model, &mut c.data, &x, &a)?;
         let tick = DeflectCorrectedTick3 {
-            desired: v(t.desired),
-            commanded: v(t.commanded),
-            joints: v(t.joints),
-            force: v(t.load),
-            displacement: v(t.displacement),
-            iterations: u32::try_from(t.iterations).unwrap_or(u32::MAX),
-            fixed_point_residual: t.diagnostics.fixed_point_residual,
-            placement: placement_code(t.diagnostics.placement),
+            desired: t.desired,
+            commanded: t.commanded,
+            joints: t.joints,
+            force: t.force,
+            displacement: t.displacement,
+            iterations: t.iterations,
+            fixed_point_residual: t.fixed_point_residual,
+            placement: t.placement,
         };
         // SAFETY: non-null (checked), writable by contract.
         unsafe { write(out, tick) }

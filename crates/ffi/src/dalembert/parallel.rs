@@ -5,11 +5,11 @@
 use deflect_core::ComplianceMap;
 use deflect_core::dalembert::parallel::{self, Data, Model};
 use deflect_core::mechanism::ParallelRobot2;
-use nalgebra::Vector2;
 
-use crate::boundary::{array, destroy, guard, handle, handle_mut, load, write};
+use super::corrector;
+use crate::boundary::{destroy, guard, handle, handle_mut, load, write};
 use crate::map::DeflectComplianceMap;
-use crate::status::{DEFLECT_ERR_NULL, DeflectStatus, build_failure, placement_code, tick_status};
+use crate::status::{DEFLECT_ERR_NULL, DeflectStatus, build_failure};
 
 /// The paper's tuned D'Alembert mass parameter m* \[kg\].
 pub const DEFLECT_PAPER_MASS: f64 = 5.0;
@@ -115,10 +115,13 @@ pub unsafe extern "C" fn deflect_dalembert_create(
         };
         // SAFETY: NULL or a live handle by contract.
         let map = unsafe { handle(map) }.map_err(|s| (s, "map is NULL".to_owned()))?;
-        let model = Model::new(robot, map.map.clone(), mass)
-            .and_then(|m| m.with_fixed_point(fixed_point_iterations as usize, tolerance))
-            .map_err(build_failure)?;
-        let data = Data::new(&model);
+        let corrector::Corrector { model, data } = corrector::build(
+            robot,
+            map.map.clone(),
+            mass,
+            fixed_point_iterations,
+            tolerance,
+        )?;
         Ok(DeflectDalembert { model, data })
     };
     // SAFETY: forwarded caller contract for `out`.
@@ -159,28 +162,25 @@ pub unsafe extern "C" fn deflect_dalembert_step(
 ) -> DeflectStatus {
     guard(|| {
         // SAFETY: pointers valid for the stated lengths (or NULL) by contract.
-        let (c, x, a) = unsafe {
+        let (c, (x, a)) = unsafe {
             (
                 handle_mut(corrector)?,
-                array::<2>(desired)?,
-                array::<2>(acceleration)?,
+                corrector::inputs::<2>(desired, acceleration)?,
             )
         };
         if out.is_null() {
             return Err(DEFLECT_ERR_NULL);
         }
-        let t = parallel::step(&c.model, &mut c.data, &Vector2::from(x), &Vector2::from(a))
-            .map_err(|e| tick_status(&e))?;
-        let v = |v: Vector2<f64>| [v.x, v.y];
+        let t = corrector::tick(&c.model, &mut c.data, &x, &a)?;
         let tick = DeflectCorrectedTick2 {
-            desired: v(t.desired),
-            commanded: v(t.commanded),
-            joints: v(t.joints),
-            force: v(t.load),
-            displacement: v(t.displacement),
-            iterations: u32::try_from(t.iterations).unwrap_or(u32::MAX),
-            fixed_point_residual: t.diagnostics.fixed_point_residual,
-            placement: placement_code(t.diagnostics.placement),
+            desired: t.desired,
+            commanded: t.commanded,
+            joints: t.joints,
+            force: t.force,
+            displacement: t.displacement,
+            iterations: t.iterations,
+            fixed_point_residual: t.fixed_point_residual,
+            placement: t.placement,
         };
         // SAFETY: non-null (checked), writable by contract.
         unsafe { write(out, tick) }
