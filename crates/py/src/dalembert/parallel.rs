@@ -1,34 +1,24 @@
 //! `deflect.DalembertCorrector`: the 2 kHz D'Alembert trajectory corrector of the paper's
 //! parallel robot driven by a compliance map.
 
-use std::sync::{Mutex, MutexGuard, PoisonError};
-
 use deflect_core::compliance_map::ComplianceMap as CoreMap;
 use deflect_core::dalembert::parallel::{self, Tick};
 use deflect_core::mechanism::ParallelRobot2 as CoreRobot2;
 use deflect_core::{Placement, TickError};
 use nalgebra::Vector2;
 use numpy::ndarray::{Array1, Array2, Ix2};
-use numpy::{IntoPyArray, PyArray1, PyArray2, ToPyArray};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
+use super::corrector::{self, Corrector};
 use crate::InputError;
 use crate::args;
-use crate::arrays::{try_array, try_copy, vector};
+use crate::arrays::{try_array, try_copy};
 use crate::compliance_map::ComplianceMap;
-use crate::errors::{build_err, tick_err, tick_err_at};
+use crate::errors::{tick_err, tick_err_at};
 use crate::mechanism::ParallelRobot2;
 use crate::motion::Trajectory;
-
-/// The corrector of the paper's robot driven by a compliance map (copied in at construction).
-type Model = parallel::Model<CoreRobot2, CoreMap>;
-/// Its workspace and last joints (closed-form IK and a map: no buffers).
-type Data = parallel::Data<(), (), 2>;
-
-fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
-    Ok(Vector2::from_column_slice(&vector(a, what, 2)?))
-}
 
 /// D'Alembert trajectory correction of the paper's five-bar (Paksoy et al., Fig. 2) from a
 /// compliance map: per tick `F_D = -mass * a` (Eq. 5), displacement from the compliance map
@@ -37,19 +27,11 @@ fn vec2(a: &Bound<'_, PyAny>, what: &str) -> PyResult<Vector2<f64>> {
 #[pyclass(module = "deflect", frozen)]
 #[derive(Debug)]
 pub struct DalembertCorrector {
-    model: Model,
-    /// The tick state (the last joints, the next IK seed); locked per call so that the class
-    /// stays frozen and `correct` can run without the GIL.
-    data: Mutex<Data>,
+    /// The corrector of the paper's robot driven by a compliance map (copied in at
+    /// construction), with its tick state.
+    corrector: Corrector<CoreRobot2, CoreMap, 2>,
     /// The constructor's arguments, for pickling.
     config: Py<pyo3::types::PyTuple>,
-}
-
-impl DalembertCorrector {
-    fn data(&self) -> MutexGuard<'_, Data> {
-        // A poisoned lock only means another call failed mid-tick; the data stays valid.
-        self.data.lock().unwrap_or_else(PoisonError::into_inner)
-    }
 }
 
 /// Result of `DalembertCorrector.correct`: one row per tick.
@@ -110,22 +92,17 @@ impl DalembertCorrector {
                 mechanism.get_type().name()?
             )));
         };
-        let model = Model::new(
+        let corrector = Corrector::new(
             mechanism.get().inner,
             compliance_map.get().inner.clone(),
             mass,
-        )
-        .and_then(|m| m.with_fixed_point(iterations, tolerance))
-        .map_err(build_err)?;
-        let data = Mutex::new(Data::new(&model));
+            iterations,
+            tolerance,
+        )?;
         let config = (compliance_map, mechanism, mass, iterations, tolerance)
             .into_pyobject(compliance_map.py())?
             .unbind();
-        Ok(Self {
-            model,
-            data,
-            config,
-        })
+        Ok(Self { corrector, config })
     }
 
     /// Pickling and `copy.deepcopy`: the configuration (the constructor's arguments, the map
@@ -143,7 +120,7 @@ impl DalembertCorrector {
     /// Mass parameter m* [kg].
     #[getter]
     fn mass(&self) -> f64 {
-        self.model.mass()
+        self.corrector.model.mass()
     }
 
     /// One tick: `position` (2,) [m], planned `acceleration` (2,) [m/s^2] -> dict with
@@ -158,24 +135,18 @@ impl DalembertCorrector {
         acceleration: &Bound<'py, PyAny>,
         seed: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let x = vec2(position, "position")?;
-        let a = vec2(acceleration, "acceleration")?;
-        let seed = seed.map(|s| vec2(s, "seed")).transpose()?;
+        let x = corrector::input::<2>(position, "position")?;
+        let a = corrector::input::<2>(acceleration, "acceleration")?;
+        let seed = seed.map(|s| corrector::input::<2>(s, "seed")).transpose()?;
+        let c = &self.corrector;
         let t: Tick<2, 2> = {
-            let mut data = self.data();
+            let mut data = c.data();
             if let Some(q) = seed {
                 data.set_seed(q);
             }
-            parallel::step(&self.model, &mut data, &x, &a).map_err(tick_err)?
+            parallel::step(&c.model, &mut data, &x, &a).map_err(tick_err)?
         };
-        let d = PyDict::new(py);
-        d.set_item("commanded", t.commanded.as_slice().to_pyarray(py))?;
-        d.set_item("joints", t.joints.as_slice().to_pyarray(py))?;
-        d.set_item("force", t.load.as_slice().to_pyarray(py))?;
-        d.set_item("displacement", t.displacement.as_slice().to_pyarray(py))?;
-        d.set_item("iterations", t.iterations)?;
-        d.set_item("model_status", t.diagnostics.placement.name())?;
-        Ok(d)
+        corrector::tick_dict(py, &t)
     }
 
     /// Corrects every tick of a planned 2-D `trajectory` (from `plan_line`/`plan_polyline`),
@@ -203,13 +174,14 @@ impl DalembertCorrector {
         ];
         let t = Array1::from_vec(try_copy(&samples.t.view(), what)?);
         let result = py.detach(|| -> Result<_, (usize, TickError)> {
-            let mut data = self.data();
+            let c = &self.corrector;
+            let mut data = c.data();
             let mut flagged = Vec::new();
             let inputs = pos.rows().into_iter().zip(acc.rows());
             for (i, (prow, arow)) in inputs.enumerate() {
                 let x = Vector2::from_iterator(prow.iter().copied());
                 let a = Vector2::from_iterator(arow.iter().copied());
-                let t = parallel::step(&self.model, &mut data, &x, &a).map_err(|e| (i, e))?;
+                let t = parallel::step(&c.model, &mut data, &x, &a).map_err(|e| (i, e))?;
                 for (arr, v) in
                     out.iter_mut()
                         .zip([t.desired, t.commanded, t.joints, t.load, t.displacement])
